@@ -1,0 +1,442 @@
+"""Click-and-drag measuring: the modal operator ``vg.measure_drag`` and its viewport tool.
+
+Press on the active mesh, drag out the radius while the patch is previewed, release to measure.
+The interaction itself is :class:`~vg_addon.drag_state.DragMachine` (pure, tested without a
+screen); this module ray-casts, turns events into machine events, draws and records. A release
+records through the same ``execute`` as ``vg.measure_xyz``, with the snapped centre vertex, so
+``vg.measure_xyz`` with the recorded numbers reproduces the measurement bit for bit.
+"""
+
+from __future__ import annotations
+
+import contextlib
+
+import bpy
+import numpy as np
+from bpy.props import EnumProperty, FloatProperty, FloatVectorProperty, StringProperty
+from bpy_extras import view3d_utils
+from mathutils import Vector
+
+from ..properties import PATCH_ITEMS
+from ..ui.drag_overlay import DragOverlay, patch_vertex_data
+from ..vg_addon import GoniometerError
+from ..vg_addon.drag_state import DragMachine, Phase, surface_callbacks
+from .measure import VG_OT_measure_xyz, typed_value
+from .mesh_data import check_measurable, evaluated_geometry, surface_for
+
+TOOL_ID = "vg.measure_drag_tool"
+
+# Running / pass-through / finished statuses of DragSession.handle.
+RUNNING, PASS, DONE = "running", "pass", "done"
+
+_DIGITS = {
+    **{
+        name: str(i)
+        for i, name in enumerate(
+            ("ZERO", "ONE", "TWO", "THREE", "FOUR", "FIVE", "SIX", "SEVEN", "EIGHT", "NINE")
+        )
+    },
+    **{f"NUMPAD_{i}": str(i) for i in range(10)},
+    "PERIOD": ".",
+    "NUMPAD_PERIOD": ".",
+}
+_NAVIGATION = {
+    "MIDDLEMOUSE",
+    "WHEELUPMOUSE",
+    "WHEELDOWNMOUSE",
+    "WHEELINMOUSE",
+    "WHEELOUTMOUSE",
+    "TRACKPADPAN",
+    "TRACKPADZOOM",
+    "NDOF_MOTION",
+    "MOUSEROTATE",
+    "MOUSESMARTZOOM",
+}
+
+# Status bar hints: (icons, text). Only icons that exist in Blender 4.2 and 5.0.
+HINTS = (
+    (("MOUSE_LMB",), "Release: measure"),
+    (("EVENT_ESC", "MOUSE_RMB"), "Cancel"),
+    ((), "0-9 .  type the radius"),
+    (("EVENT_BACKSPACE",), "Erase"),
+    (("EVENT_RETURN",), "Measure typed"),
+    (("EVENT_L",), "λ +"),
+    (("EVENT_SHIFT", "EVENT_L"), "λ −"),
+    (("EVENT_CTRL", "MOUSE_MMB"), "Wheel: λ"),
+    (("MOUSE_MMB",), "Navigate"),
+)
+
+
+def translate_event(event_type: str, value: str, *, ctrl=False, shift=False, alt=False):
+    """What a Blender event means to the drag: ``(action, argument)``.
+
+    Actions: ``"move"``, ``"release"``, ``"enter"``, ``"cancel"``, ``"type"`` (argument: the
+    character), ``"backspace"``, ``"lam"`` (argument: steps of λ), ``"pass"`` (navigation, let
+    Blender have it), ``"ignore"`` (swallow it, so no shortcut fires mid-drag).
+    """
+    if event_type == "MOUSEMOVE":
+        return "move", None
+    if event_type == "LEFTMOUSE":
+        return ("release", None) if value == "RELEASE" else ("ignore", None)
+    if event_type in ("WHEELUPMOUSE", "WHEELDOWNMOUSE") and ctrl:
+        return "lam", (1 if event_type == "WHEELUPMOUSE" else -1)
+    if event_type in _NAVIGATION:
+        return "pass", None
+    if event_type == "WINDOW_DEACTIVATE":
+        return "cancel", "The window lost focus: nothing was recorded."
+    if value != "PRESS":
+        return "ignore", None
+    if event_type in ("ESC", "RIGHTMOUSE"):
+        return "cancel", None
+    if event_type in ("RET", "NUMPAD_ENTER"):
+        return "enter", None
+    if event_type == "BACK_SPACE":
+        return "backspace", None
+    if event_type == "L" and not (ctrl or alt):
+        return "lam", (-1 if shift else 1)
+    if event_type in _DIGITS and not (ctrl or alt or shift):
+        return "type", _DIGITS[event_type]
+    return "ignore", None
+
+
+def format_length(scene, value: float) -> str:
+    """``value`` (Blender units) in the scene's length units, e.g. ``"2.5 mm"``."""
+    units = scene.unit_settings
+    if units.system == "NONE":
+        return f"{value:.5g}"
+    return bpy.utils.units.to_string(
+        units.system,
+        "LENGTH",
+        value * units.scale_length,
+        precision=5,
+        split_unit=units.use_separate,
+        compatible_unit=False,
+    )
+
+
+def ray_cast_object(obj, depsgraph, region, region_data, coord):
+    """World-space point where the view ray through region pixel ``coord`` first hits ``obj``.
+
+    Only ``obj`` is tested (its evaluated mesh, in object space); ``None`` when the ray misses.
+    """
+    coord = Vector(coord)
+    origin = view3d_utils.region_2d_to_origin_3d(region, region_data, coord)
+    direction = view3d_utils.region_2d_to_vector_3d(region, region_data, coord)
+    obj_eval = obj.evaluated_get(depsgraph)
+    to_world = obj_eval.matrix_world
+    to_local = to_world.inverted_safe()
+    local_origin = to_local @ origin
+    local_direction = to_local.to_3x3() @ direction
+    hit, location, _normal, _face = obj_eval.ray_cast(local_origin, local_direction)
+    return np.array(to_world @ location, dtype=np.float64) if hit else None
+
+
+def view_plane_radius(region, region_data, coord, center) -> float:
+    """Distance from ``center`` to the point under ``coord`` on the view plane through it."""
+    point = view3d_utils.region_2d_to_location_3d(
+        region, region_data, Vector(coord), Vector(center)
+    )
+    return float(np.linalg.norm(np.array(point, dtype=np.float64) - center))
+
+
+def object_alive(context, obj) -> bool:
+    """Whether ``obj`` still exists and is in the scene (it may be deleted mid-drag)."""
+    try:
+        name = obj.name
+    except ReferenceError:
+        return False
+    return context.scene.objects.get(name) == obj
+
+
+def in_region(region, coord) -> bool:
+    return 0 <= coord[0] < region.width and 0 <= coord[1] < region.height
+
+
+class DragSession:
+    """One drag on one object: the machine, the prepared surface, the overlay and the hints.
+
+    Created by :meth:`start` at the press; fed events by :meth:`handle`; :meth:`finish` (safe to
+    call repeatedly) removes the drawing and the header and status texts on every way out.
+    """
+
+    def __init__(self, obj, surface, patch: str, lam: float):
+        self.obj = obj
+        self.surface = surface
+        self.patch = patch
+        self.machine = DragMachine(
+            **surface_callbacks(surface, patch), lam=lam, quantize=typed_value
+        )
+        self.overlay = DragOverlay()
+        self._area = None
+        self._workspace = None
+
+    @classmethod
+    def start(cls, context, coord) -> DragSession:
+        """Ray-cast at region pixel ``coord`` on the active object and start dragging there.
+
+        Raises
+        ------
+        GoniometerError
+            Not a 3D viewport, no measurable active mesh, or the press missed it.
+        """
+        region, region_data = context.region, context.region_data
+        if (
+            context.area is None
+            or context.area.type != "VIEW_3D"
+            or region is None
+            or (region.type != "WINDOW" or region_data is None)
+        ):
+            raise GoniometerError(
+                "Drag measuring works in the 3D viewport: choose the Goniometer tool in its "
+                "toolbar and press on the mesh."
+            )
+        obj = context.active_object
+        check_measurable(obj)
+        settings = context.scene.vg_settings
+        depsgraph = context.evaluated_depsgraph_get()
+        surface = surface_for(obj, evaluated_geometry(obj, depsgraph))
+        session = cls(obj, surface, settings.patch, typed_value(settings.seg_param))
+        hit = ray_cast_object(obj, depsgraph, region, region_data, coord)
+        if not session.machine.press(hit):
+            raise GoniometerError(session.machine.message)
+        session._area, session._workspace = context.area, context.workspace
+        session.overlay.start()
+        try:
+            session.refresh(context)
+        except BaseException:
+            session.finish(context)
+            raise
+        return session
+
+    def handle(self, context, action: str, argument=None, coord=None) -> str:
+        """Apply one translated event; returns ``"running"``, ``"pass"`` or ``"done"``.
+
+        ``coord`` is the mouse position relative to the region (needed for ``"move"``).
+        """
+        machine = self.machine
+        if not object_alive(context, self.obj):
+            machine.cancel("The object was deleted: nothing was recorded.")
+            return DONE
+        region, region_data = context.region, context.region_data
+        if region is None or region_data is None or context.area != self._area:
+            machine.cancel("Left the 3D view: nothing was recorded.")
+            return DONE
+        if action == "pass":
+            return PASS
+        if action == "move":
+            if not in_region(region, coord):
+                machine.cancel("Left the 3D view: nothing was recorded.")
+                return DONE
+            machine.move(view_plane_radius(region, region_data, coord, machine.center))
+        elif action == "type":
+            machine.type_character(argument)
+        elif action == "backspace":
+            machine.backspace()
+        elif action == "lam":
+            machine.change_lam(argument)
+        elif action == "release":
+            machine.release()
+        elif action == "enter":
+            machine.enter()
+        elif action == "cancel":
+            machine.cancel(*((argument,) if argument else ()))
+        else:
+            return RUNNING
+        if machine.phase is Phase.DRAGGING:
+            self.refresh(context)
+            return RUNNING
+        return DONE
+
+    def refresh(self, context) -> None:
+        """Hand the preview to the overlay and update the header; redraw the viewport."""
+        machine = self.machine
+        measurement = machine.measurement
+        if measurement is not None:
+            coords = patch_vertex_data(self.surface.points, measurement.indices)
+            labels = measurement.labels
+        else:
+            coords, labels = patch_vertex_data(self.surface.points, machine.indices), None
+        self.overlay.update(machine.center, machine.radius, coords, labels)
+        if self._area is not None:
+            self._area.header_text_set(self.header_text(context.scene))
+            self._area.tag_redraw()
+        if self._workspace is not None:
+            self._workspace.status_text_set(draw_status_hints)
+
+    def header_text(self, scene) -> str:
+        """The header line: radius, vertex count, λ, the angle after a λ change, and any hint."""
+        machine = self.machine
+        parts = [f"Goniometer radius {format_length(scene, machine.radius)}"]
+        if machine.typed:
+            parts[0] += f" (typed {machine.typed})"
+        parts.append(f"{machine.n_vertices} vertices")
+        parts.append(f"λ {machine.lam:g}")
+        if machine.measurement is not None:
+            parts.append(f"angle {machine.measurement.angle:.2f}°")
+        if machine.message:
+            parts.append(machine.message)
+        return "  ·  ".join(parts)
+
+    def finish(self, context=None) -> None:
+        """Remove the drawing and the texts; safe to call more than once."""
+        self.overlay.stop()
+        area, self._area = self._area, None
+        workspace, self._workspace = self._workspace, None
+        for clear in (
+            lambda: area.header_text_set(None),
+            lambda: area.tag_redraw(),
+            lambda: workspace.status_text_set(None),
+        ):
+            with contextlib.suppress(AttributeError, ReferenceError):  # already gone
+                clear()
+
+
+def record_properties(session: DragSession) -> dict | None:
+    """The operator properties that record a finished drag (None when it recorded nothing).
+
+    ``location`` is the snapped centre vertex, so ``vg.measure_xyz`` with these values snaps to
+    the same vertex and measures the same patch.
+    """
+    record = session.machine.record
+    if session.machine.phase is not Phase.MEASURED or record is None:
+        return None
+    return {
+        "location": tuple(record.center),
+        "radius": record.radius,
+        "seg_param": record.lam,
+        "patch": session.patch,
+    }
+
+
+def draw_status_hints(header, context):
+    """The status bar while dragging (called by Blender with the status bar's layout)."""
+    row = header.layout.row(align=True)
+    for icons, text in HINTS:
+        for icon in icons:
+            row.label(text="", icon=icon)
+        row.label(text=text)
+        row.separator(factor=2.0)
+
+
+class VG_OT_measure_drag(bpy.types.Operator):
+    """Press on a break edge of the active mesh, drag out the patch radius, release to measure"""
+
+    bl_idname = "vg.measure_drag"
+    bl_label = "Measure by Dragging"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender reads a set)
+
+    # The same properties as vg.measure_xyz: execute() is that operator's, so the two record
+    # the same measurement for the same values.
+    location: FloatVectorProperty(
+        name="Location",
+        description="Centre (the snapped vertex of the press), world space; default: the 3D cursor",
+        size=3,
+        subtype="TRANSLATION",
+        unit="LENGTH",
+    )
+    radius: FloatProperty(
+        name="Radius",
+        description="Patch radius, world space; default: the panel's radius",
+        min=0.0,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    seg_param: FloatProperty(
+        name="λ (SegParam)", description="Segmentation parameter; default: the panel's", min=0.0
+    )
+    patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
+    note: StringProperty(name="Note", description="Free text stored with the measurement")
+
+    def invoke(self, context, event):
+        try:
+            self._session = DragSession.start(context, (event.mouse_region_x, event.mouse_region_y))
+        except GoniometerError as error:
+            self.report({"WARNING"}, str(error))
+            return {"CANCELLED"}
+        context.window_manager.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        session = self._session
+        try:
+            action, argument = translate_event(
+                event.type, event.value, ctrl=event.ctrl, shift=event.shift, alt=event.alt
+            )
+            coord = None
+            if context.region is not None:
+                coord = (event.mouse_x - context.region.x, event.mouse_y - context.region.y)
+            status = session.handle(context, action, argument, coord)
+        except BaseException:
+            session.finish(context)
+            raise
+        if status == PASS:
+            return {"PASS_THROUGH"}
+        if status == RUNNING:
+            return {"RUNNING_MODAL"}
+        session.finish(context)
+        return self.commit(context, session)
+
+    def cancel(self, context):
+        """Blender ends the modal operator (file load, window closed, ...): clean up."""
+        session = getattr(self, "_session", None)
+        if session is not None:
+            session.finish(context)
+
+    def commit(self, context, session: DragSession):
+        """Record the finished drag through :meth:`execute`, or report why nothing was."""
+        values = record_properties(session)
+        if values is None:
+            self.report({"INFO"}, session.machine.message or "Nothing was recorded.")
+            return {"CANCELLED"}
+        for name, value in values.items():
+            setattr(self, name, value)  # stored for redo (Adjust Last Operation) as well
+        return self.execute(context)
+
+    def execute(self, context):
+        return VG_OT_measure_xyz.execute(self, context)
+
+
+class VG_WT_measure_drag(bpy.types.WorkSpaceTool):
+    bl_space_type = "VIEW_3D"
+    bl_context_mode = "OBJECT"
+    bl_idname = TOOL_ID
+    bl_label = "Goniometer"
+    bl_description = (
+        "Measure a break angle: press on the edge, drag out the radius, release.\n"
+        "Type digits for an exact radius, L / Shift L or Ctrl wheel to change λ, Esc to cancel"
+    )
+    bl_icon = "ops.generic.select_circle"
+    bl_widget = None
+    bl_keymap = (("vg.measure_drag", {"type": "LEFTMOUSE", "value": "PRESS"}, None),)
+
+    def draw_settings(context, layout, tool):  # noqa: N805 (Blender's signature: no self)
+        settings = context.scene.vg_settings
+        layout.prop(settings, "seg_param")
+        layout.prop(settings, "patch")
+
+
+classes = (VG_OT_measure_drag,)
+
+
+_tool = {"registered": False}
+
+
+def tool_registered() -> bool:
+    """Whether :func:`register_tool` has added the tool (and :func:`unregister_tool` not yet
+    removed it)."""
+    return _tool["registered"]
+
+
+def register_tool() -> None:
+    """Add the Goniometer tool to the 3D viewport toolbar (Object Mode), after Measure."""
+    if not _tool["registered"]:
+        bpy.utils.register_tool(VG_WT_measure_drag, after={"builtin.measure"}, separator=True)
+        _tool["registered"] = True
+
+
+def unregister_tool() -> None:
+    """Remove the Goniometer tool from the toolbar (a no-op when it is not there)."""
+    if _tool["registered"]:
+        bpy.utils.unregister_tool(VG_WT_measure_drag)
+        _tool["registered"] = False

@@ -1,0 +1,216 @@
+"""Operators that measure and manage the measurement list (thin: the work is in ``measuring``)."""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+from bpy.props import EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, StringProperty
+
+from ..properties import PATCH_ITEMS
+from ..vg_addon import GoniometerError
+from . import measuring
+from .mesh_data import check_measurable, evaluated_geometry
+
+
+def typed_value(value: float) -> float:
+    """The float64 of the shortest decimal that a 32-bit operator property rounds to ``value``.
+
+    Operator properties are 32-bit, so a typed 0.1 arrives as 0.10000000149...; measuring with
+    0.1 instead keeps the recorded radius (and CSV) equal to what the user typed.
+    """
+    return float(str(np.float32(value)))
+
+
+def _stale_warning(obj) -> str:
+    stale = [str(item.number) for item in obj.vg.measurements if item.stale]
+    if not stale:
+        return ""
+    return (
+        f"Measurement(s) {', '.join(stale)} of '{obj.name}' are stale: the mesh or its transform "
+        "changed since they were taken. Their numbers are kept; they are no longer painted."
+    )
+
+
+class VG_OT_measure_xyz(bpy.types.Operator):
+    """Measure the break angle on the active mesh at a point (default: the 3D cursor)"""
+
+    bl_idname = "vg.measure_xyz"
+    bl_label = "Measure at 3D Cursor"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+
+    location: FloatVectorProperty(
+        name="Location",
+        description="Centre to measure at, world space (snaps to the nearest vertex); "
+        "default: the 3D cursor",
+        size=3,
+        subtype="TRANSLATION",
+        unit="LENGTH",
+    )
+    radius: FloatProperty(
+        name="Radius",
+        description="Patch radius, world space; default: the panel's radius",
+        min=0.0,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    seg_param: FloatProperty(
+        name="λ (SegParam)", description="Segmentation parameter; default: the panel's", min=0.0
+    )
+    patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
+    note: StringProperty(name="Note", description="Free text stored with the measurement")
+
+    def execute(self, context):
+        settings = context.scene.vg_settings
+        given = self.properties.is_property_set
+        if not given("location"):
+            self.location = context.scene.cursor.location
+        if not given("radius"):
+            self.radius = settings.radius
+        if not given("seg_param"):
+            self.seg_param = settings.seg_param
+        if not given("patch"):
+            self.patch = settings.patch
+        obj = context.active_object
+        try:
+            item = measuring.measure_on_object(
+                obj,
+                [typed_value(v) for v in self.location],
+                typed_value(self.radius),
+                typed_value(self.seg_param),
+                self.patch,
+                depsgraph=context.evaluated_depsgraph_get(),
+                note=self.note,
+            )
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report(
+            {"INFO"},
+            f"Measurement {item.number} (break {item.break_number}) on '{obj.name}': "
+            f"{item.angle:.2f}° (fit error {item.fit_error:.3g}, {item.n_vertices} vertices)",
+        )
+        if warning := _stale_warning(obj):
+            self.report({"WARNING"}, warning)
+        return {"FINISHED"}
+
+
+def _active_measurable(operator, context):
+    """The active object if it can be measured, else report why and return None."""
+    obj = context.active_object
+    try:
+        check_measurable(obj)
+    except GoniometerError as error:
+        operator.report({"ERROR"}, str(error))
+        return None
+    return obj
+
+
+class VG_OT_next_break(bpy.types.Operator):
+    """Start a new break: the next measurements get the next break number and colour pair"""
+
+    bl_idname = "vg.next_break"
+    bl_label = "Next Break"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+
+    def execute(self, context):
+        obj = _active_measurable(self, context)
+        if obj is None:
+            return {"CANCELLED"}
+        obj.vg.break_number += 1
+        self.report({"INFO"}, f"Break {obj.vg.break_number} on '{obj.name}'")
+        return {"FINISHED"}
+
+
+class VG_OT_delete_measurement(bpy.types.Operator):
+    """Delete a measurement from the list and repaint the others"""
+
+    bl_idname = "vg.delete_measurement"
+    bl_label = "Delete Measurement"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+
+    index: IntProperty(
+        name="Index", description="Position in the list; -1: the selected one", default=-1, min=-1
+    )
+
+    def execute(self, context):
+        obj = _active_measurable(self, context)
+        if obj is None:
+            return {"CANCELLED"}
+        data = obj.vg
+        index = data.active_index if self.index < 0 else self.index
+        if not 0 <= index < len(data.measurements):
+            self.report({"ERROR"}, f"'{obj.name}' has no measurement at list position {index}.")
+            return {"CANCELLED"}
+        try:
+            geometry = evaluated_geometry(obj, context.evaluated_depsgraph_get())
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        number = data.measurements[index].number
+        data.measurements.remove(index)
+        data.active_index = min(index, max(len(data.measurements) - 1, 0))
+        measuring.repaint(obj, geometry=geometry)
+        self.report({"INFO"}, f"Deleted measurement {number} of '{obj.name}'")
+        return {"FINISHED"}
+
+
+class VG_OT_clear_measurements(bpy.types.Operator):
+    """Delete every measurement of the active object and paint it grey"""
+
+    bl_idname = "vg.clear_measurements"
+    bl_label = "Clear Measurements"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+
+    def invoke(self, context, event):
+        return context.window_manager.invoke_confirm(self, event)
+
+    def execute(self, context):
+        obj = _active_measurable(self, context)
+        if obj is None:
+            return {"CANCELLED"}
+        try:
+            geometry = evaluated_geometry(obj, context.evaluated_depsgraph_get())
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        count = len(obj.vg.measurements)
+        obj.vg.measurements.clear()
+        obj.vg.active_index = 0
+        obj.vg.next_number = 1
+        obj.vg.break_number = 1
+        measuring.repaint(obj, geometry=geometry)
+        self.report({"INFO"}, f"Cleared {count} measurement(s) of '{obj.name}'")
+        return {"FINISHED"}
+
+
+class VG_OT_repaint(bpy.types.Operator):
+    """Check which measurements are stale and repaint the sides of the others"""
+
+    bl_idname = "vg.repaint"
+    bl_label = "Update Colours"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+
+    def execute(self, context):
+        obj = _active_measurable(self, context)
+        if obj is None:
+            return {"CANCELLED"}
+        try:
+            measuring.repaint(obj, depsgraph=context.evaluated_depsgraph_get())
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report(
+            {"WARNING"} if _stale_warning(obj) else {"INFO"},
+            _stale_warning(obj) or f"Colours of '{obj.name}' are up to date",
+        )
+        return {"FINISHED"}
+
+
+classes = (
+    VG_OT_measure_xyz,
+    VG_OT_next_break,
+    VG_OT_delete_measurement,
+    VG_OT_clear_measurements,
+    VG_OT_repaint,
+)

@@ -1,0 +1,254 @@
+"""The measuring pipeline shared by every way of measuring (operators, batch runs, the drag tool).
+
+``measure_on_object`` validates, measures, records and repaints; ``repaint`` redoes the colours
+from the recorded measurements; ``replicate_rows`` re-measures a CSV's rows, all or nothing. Each
+raises :class:`GoniometerError` for bad input before changing anything.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from pathlib import Path
+
+import numpy as np
+
+from ..vg_addon import GoniometerError, Measurement, csvio
+from . import colors, records
+from .mesh_data import Geometry, check_measurable, evaluated_geometry, surface_for
+
+# Measurements are deterministic, so a repaint can reuse the sides of a measurement it has
+# already computed for the same geometry and inputs.
+_SIDES_CACHE_SIZE = 256
+_MAX_LISTED = 20  # rows named in an error message
+_sides: OrderedDict[tuple, Measurement] = OrderedDict()
+
+
+def _key(fingerprint: str, center, radius: float, lam: float, patch: str) -> tuple:
+    return (fingerprint, np.asarray(center, dtype=np.float64).tobytes(), radius, lam, patch)
+
+
+def _remember(fingerprint: str, m: Measurement) -> None:
+    _sides[_key(fingerprint, m.center, m.radius, m.lam, m.patch)] = m
+    while len(_sides) > _SIDES_CACHE_SIZE:
+        _sides.popitem(last=False)
+
+
+def _replay(obj, geometry: Geometry, item) -> Measurement:
+    args = records.replay_args(item)
+    key = _key(geometry.fingerprint, args["center"], args["radius"], args["lam"], args["patch"])
+    m = _sides.get(key)
+    if m is None:
+        m = surface_for(obj, geometry).measure(**args)
+        _remember(geometry.fingerprint, m)
+    return m
+
+
+def measure(obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None):
+    """Measure ``obj`` without recording anything: ``(Measurement, Geometry)``.
+
+    The building block for previews (e.g. a drag tool) and for :func:`measure_on_object`.
+    """
+    check_measurable(obj)
+    geometry = evaluated_geometry(obj, depsgraph)
+    m = surface_for(obj, geometry).measure(location, radius, lam, patch)
+    _remember(geometry.fingerprint, m)
+    return m, geometry
+
+
+def measure_on_object(
+    obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None, note=""
+):
+    """Measure the active mesh at ``location``, record the measurement and repaint the sides.
+
+    Parameters
+    ----------
+    obj : bpy.types.Object
+        The mesh object; its evaluated mesh (modifiers applied) is measured in world space.
+    location : array_like, shape (3,)
+        Requested centre, world space, scene units (float64 is kept exactly); it snaps to the
+        nearest vertex within ``radius``.
+    radius : float
+        Patch radius, world space, scene units.
+    lam : float
+        Segmentation parameter λ (MeshLab's SegParam).
+    patch : {"euclidean", "geodesic"}
+    depsgraph : bpy.types.Depsgraph, optional
+        Default: the context's evaluated depsgraph.
+    note : str
+        Free text stored with the measurement (the CSV's User Data).
+
+    Returns
+    -------
+    The new ``VG_Measurement`` item on ``obj.vg.measurements`` (now the active one).
+
+    Raises
+    ------
+    GoniometerError
+        No object, not a mesh, linked data, Edit Mode, an empty mesh, a location farther than
+        ``radius`` from the surface, too few vertices, ...; nothing is changed then.
+    """
+    m, geometry = measure(obj, location, radius, lam, patch, depsgraph=depsgraph)
+    records.add_measurement(obj, m, geometry.fingerprint, note=note)
+    repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    return obj.vg.measurements[obj.vg.active_index]
+
+
+def repaint(obj, *, depsgraph=None, geometry: Geometry | None = None) -> list[int]:
+    """Update the stale flags and repaint the "VG Sides" colours of ``obj`` from its records.
+
+    Every measurement whose geometry fingerprint still matches the evaluated mesh is re-measured
+    at its exact stored centre, radius, λ and patch mode (deterministic, so its sides are the
+    ones it had) and painted, later measurements over earlier ones. The others are flagged
+    stale and left unpainted.
+
+    Returns
+    -------
+    list of int
+        The numbers of the stale measurements.
+    """
+    check_measurable(obj)
+    if geometry is None:
+        geometry = evaluated_geometry(obj, depsgraph)
+    measured, stale = [], []
+    for item in obj.vg.measurements:
+        is_stale = item.fingerprint != geometry.fingerprint
+        if not is_stale:
+            try:
+                measured.append((_replay(obj, geometry, item), item.break_number))
+            except GoniometerError:
+                is_stale = True
+        if item.stale != is_stale:
+            item.stale = is_stale
+        if is_stale:
+            stale.append(item.number)
+    colors.write_attribute(obj.data, colors.original_vertex_colours(obj, geometry, measured))
+    colors.show_in_viewports()
+    return stale
+
+
+def stale_numbers(obj, *, depsgraph=None) -> set[int]:
+    """Numbers of ``obj``'s measurements taken on other geometry than its current evaluated mesh
+    (computed, not read from the flags; nothing is changed)."""
+    if not len(obj.vg.measurements):
+        return set()
+    try:
+        current = evaluated_geometry(obj, depsgraph).fingerprint
+    except GoniometerError:  # e.g. every vertex deleted since
+        current = None
+    return {item.number for item in obj.vg.measurements if item.fingerprint != current}
+
+
+def replicate_rows(
+    obj,
+    rows,
+    *,
+    ignore_mesh_names=False,
+    radius=None,
+    lam=2.0,
+    patch="euclidean",
+    depsgraph=None,
+    source="the CSV",
+):
+    """Re-measure every replication row on ``obj`` and record them all, or nothing.
+
+    Parameters
+    ----------
+    rows : list of csvio.ReplicationRow
+    ignore_mesh_names : bool
+        Accept rows whose mesh name is neither this object's nor its mesh's.
+    radius, lam, patch
+        Used for rows that do not give their own (a plain points CSV); a row without a radius
+        is an error when ``radius`` is None.
+    source : str
+        How to name the rows' origin in messages (e.g. the file name).
+
+    Each new measurement keeps the row's break number when it has one (else the object's
+    current break) and takes the row's label or User Data as its note.
+
+    Returns
+    -------
+    list of int
+        Numbers of the new measurements.
+
+    Raises
+    ------
+    GoniometerError
+        Listing every row that names another mesh or cannot be measured; nothing is recorded.
+    """
+    check_measurable(obj)
+    if not rows:
+        raise GoniometerError(f"{source} has no measurement rows: nothing to import.")
+    if not ignore_mesh_names:
+        others = csvio.rows_for_other_meshes(rows, (obj.name, obj.data.name))
+        if others:
+            shown = others[:_MAX_LISTED]
+            listed = ", ".join(f"{r.row_number} ('{r.mesh_name}')" for r in shown)
+            more = f" and {len(others) - len(shown)} more" if len(others) > len(shown) else ""
+            raise GoniometerError(
+                f"{len(others)} row(s) of {source} name another mesh than '{obj.name}': rows "
+                f"{listed}{more}. Nothing was imported. Select the right object, or tick "
+                "'Ignore mesh names' to measure them on this one."
+            )
+    geometry = evaluated_geometry(obj, depsgraph)
+    surface = surface_for(obj, geometry)
+    results, failures = [], []
+    for row in rows:
+        try:
+            row_radius = radius if row.radius is None else row.radius
+            if row_radius is None:
+                raise GoniometerError("no radius (the CSV has no Radius for this row)")
+            m = surface.measure(
+                (row.x, row.y, row.z),
+                row_radius,
+                lam if row.lam is None else row.lam,
+                row.patch or patch,
+            )
+        except GoniometerError as error:
+            failures.append(f"row {row.row_number}: {error}")
+            continue
+        results.append((row, m))
+    if failures:
+        raise GoniometerError(
+            f"{len(failures)} of {len(rows)} rows of {source} could not be measured on "
+            f"'{obj.name}'; nothing was imported.\n"
+            + "\n".join(failures[:_MAX_LISTED])
+            + (
+                f"\n... and {len(failures) - _MAX_LISTED} more"
+                if len(failures) > _MAX_LISTED
+                else ""
+            )
+        )
+    numbers = []
+    for row, m in results:
+        _remember(geometry.fingerprint, m)
+        item = records.add_measurement(
+            obj, m, geometry.fingerprint, note=row.label or "", break_number=row.break_number
+        )
+        numbers.append(item.number)
+    repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    return numbers
+
+
+def import_csv(obj, path, *, depsgraph=None, **options) -> list[int]:
+    """Read a measurement CSV (ours, MeshLab's, the earlier add-on's or plain x, y, z points) and
+    replicate it on ``obj``; ``options`` as for :func:`replicate_rows`."""
+    rows = csvio.read_replication_csv(Path(path))
+    return replicate_rows(obj, rows, depsgraph=depsgraph, source=f"'{Path(path).name}'", **options)
+
+
+def export_rows(objects, scene, *, depsgraph=None) -> list:
+    """CSV rows of every measurement of ``objects`` (stale ones flagged), in list order."""
+    units = records.units_label(scene)
+    rows = []
+    for obj in objects:
+        stale = stale_numbers(obj, depsgraph=depsgraph)
+        rows.extend(
+            records.to_row(obj, item, stale=item.number in stale, units=units)
+            for item in obj.vg.measurements
+        )
+    return rows
+
+
+def clear_cache() -> None:
+    """Forget the remembered sides (called on unregister)."""
+    _sides.clear()

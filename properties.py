@@ -1,0 +1,195 @@
+"""Data saved in the .blend: the panel settings (``Scene.vg_settings``) and each object's
+measurements (``Object.vg``).
+
+Blender's FloatProperty holds a 32-bit float, too coarse to replay a measurement exactly, so every
+recorded number lives, exactly as float64, in the JSON text of ``VG_Measurement.exact``
+(``json`` writes floats with ``repr``, which round-trips). The float properties of a measurement
+(angle, radius, centre, ...) are read-only views of that text for the panel; they are computed,
+not stored. Plain Python code should read the exact numbers with :func:`exact_numbers`.
+"""
+
+from __future__ import annotations
+
+import json
+
+import bpy
+from bpy.props import (
+    BoolProperty,
+    CollectionProperty,
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    IntProperty,
+    PointerProperty,
+    StringProperty,
+)
+from bpy.types import PropertyGroup
+
+from .vg_addon import palette
+
+PATCH_ITEMS = (
+    ("euclidean", "Euclidean", "All vertices within the radius (a ball around the centre)"),
+    ("geodesic", "Geodesic", "Vertices reachable along mesh edges within the radius"),
+)
+
+
+def exact_numbers(item) -> dict:
+    """The float64 numbers of a measurement, decoded from its ``exact`` JSON text.
+
+    Keys: ``angle``, ``fit``, ``fit_plus``, ``fit_minus``, ``radius``, ``lam``, ``snap_distance``
+    (floats) and ``center``, ``requested``, ``normal_plus``, ``normal_minus`` (lists of 3 floats).
+    """
+    try:
+        return json.loads(item.exact) if item.exact else {}
+    except ValueError:
+        return {}
+
+
+def _number(key):
+    def get(self):
+        return float(exact_numbers(self).get(key, 0.0))
+
+    return get
+
+
+def _vector(key):
+    def get(self):
+        value = exact_numbers(self).get(key)
+        return tuple(value) if value else (0.0, 0.0, 0.0)
+
+    return get
+
+
+def _side_colour(side):
+    def get(self):
+        names = self.colors.split("/")
+        rgb = palette.OKABE_ITO.get(names[side].strip()) if len(names) == 2 else None
+        return tuple(c / 255.0 for c in (rgb or palette.NEUTRAL_GREY))
+
+    return get
+
+
+class VG_Measurement(PropertyGroup):
+    """One measurement on an object, with everything needed to redo it."""
+
+    number: IntProperty(name="Measurement #", description="Measurement number on this object")
+    break_number: IntProperty(name="Break #", description="Break this measurement belongs to")
+    exact: StringProperty(
+        name="Exact numbers",
+        description="The measurement's float64 numbers (JSON); the source of every number shown",
+        options={"HIDDEN"},
+    )
+    patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="How the patch was chosen")
+    n_vertices: IntProperty(name="Vertices", description="Vertices in the patch")
+    n_plus: IntProperty(name="Vertices +", description="Vertices on the + side")
+    n_minus: IntProperty(name="Vertices −", description="Vertices on the − side")
+    date: StringProperty(name="Date", description="When the measurement was taken (ISO 8601)")
+    note: StringProperty(name="Note", description="Free text, exported as the CSV's User Data")
+    colors: StringProperty(
+        name="Colours", description="Palette colours of the + and − sides, '+ colour/− colour'"
+    )
+    fingerprint: StringProperty(
+        name="Geometry fingerprint",
+        description="Hash of the evaluated mesh and transform the measurement was taken on",
+        options={"HIDDEN"},
+    )
+    stale: BoolProperty(
+        name="Stale",
+        description="The mesh or its transform changed since this measurement was taken: its "
+        "numbers are kept as recorded, but it is no longer painted",
+    )
+
+    # Read-only views of the exact numbers, for drawing.
+    angle: FloatProperty(name="Angle (°)", get=_number("angle"), precision=2)
+    fit_error: FloatProperty(name="Fit error", get=_number("fit"), precision=6)
+    fit_error_plus: FloatProperty(name="Fit error +", get=_number("fit_plus"), precision=6)
+    fit_error_minus: FloatProperty(name="Fit error −", get=_number("fit_minus"), precision=6)
+    radius: FloatProperty(name="Radius", subtype="DISTANCE", unit="LENGTH", get=_number("radius"))
+    seg_param: FloatProperty(name="λ (SegParam)", get=_number("lam"))
+    snap_distance: FloatProperty(
+        name="Snap distance", subtype="DISTANCE", unit="LENGTH", get=_number("snap_distance")
+    )
+    center: FloatVectorProperty(
+        name="Centre", size=3, subtype="XYZ", unit="LENGTH", get=_vector("center")
+    )
+    requested_center: FloatVectorProperty(
+        name="Requested centre", size=3, subtype="XYZ", unit="LENGTH", get=_vector("requested")
+    )
+    normal_plus: FloatVectorProperty(
+        name="Plane normal +", size=3, subtype="DIRECTION", get=_vector("normal_plus")
+    )
+    normal_minus: FloatVectorProperty(
+        name="Plane normal −", size=3, subtype="DIRECTION", get=_vector("normal_minus")
+    )
+    color_plus: FloatVectorProperty(
+        name="Colour +", size=3, subtype="COLOR_GAMMA", get=_side_colour(0)
+    )
+    color_minus: FloatVectorProperty(
+        name="Colour −", size=3, subtype="COLOR_GAMMA", get=_side_colour(1)
+    )
+
+
+class VG_ObjectData(PropertyGroup):
+    """An object's measurements (``Object.vg``)."""
+
+    measurements: CollectionProperty(type=VG_Measurement)
+    active_index: IntProperty(name="Active measurement", default=0, min=0)
+    break_number: IntProperty(
+        name="Break #", description="Break the next measurement belongs to", default=1, min=1
+    )
+    next_number: IntProperty(
+        name="Next measurement #", description="Number the next measurement gets", default=1, min=1
+    )
+
+
+class VG_SceneSettings(PropertyGroup):
+    """The panel's measuring settings (``Scene.vg_settings``)."""
+
+    radius: FloatProperty(
+        name="Radius",
+        description="Patch radius around the centre, in scene units (world space)",
+        default=1.0,
+        min=0.0,
+        soft_min=1e-4,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    seg_param: FloatProperty(
+        name="λ (SegParam)",
+        description="Segmentation parameter λ of the Virtual Goniometer (MeshLab's SegParam); "
+        "larger values favour splitting along the break",
+        default=2.0,
+        min=0.0,
+        soft_max=10.0,
+        precision=3,
+    )
+    patch: EnumProperty(
+        name="Patch", items=PATCH_ITEMS, default="euclidean", description="How the patch is chosen"
+    )
+    export_all_objects: BoolProperty(
+        name="All objects",
+        description="Export the measurements of every object in the scene, not only the active one",
+        default=False,
+    )
+    ignore_mesh_names: BoolProperty(
+        name="Ignore mesh names",
+        description="Import rows whose Mesh Name is not this object's (e.g. a renamed scan)",
+        default=False,
+    )
+
+
+classes = (VG_Measurement, VG_ObjectData, VG_SceneSettings)
+
+
+def register_properties() -> None:
+    """Attach the settings and measurement groups to Scene and Object (classes already registered)."""
+    bpy.types.Scene.vg_settings = PointerProperty(type=VG_SceneSettings)
+    bpy.types.Object.vg = PointerProperty(type=VG_ObjectData)
+
+
+def unregister_properties() -> None:
+    """Remove what :func:`register_properties` attached (the data stays in the .blend)."""
+    for owner, name in ((bpy.types.Object, "vg"), (bpy.types.Scene, "vg_settings")):
+        if hasattr(owner, name):
+            delattr(owner, name)

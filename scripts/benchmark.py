@@ -1,0 +1,95 @@
+"""Benchmark the measuring core and print the numbers (no pass/fail: read them).
+
+Run: ``.venv/bin/python scripts/benchmark.py`` (after ``bash scripts/setup.sh``), or with any
+Python that has NumPy. Prints: spatial-index build for a 1M-vertex mesh, patch query time,
+measurement time for 1k/10k/100k-vertex patches, measurements per second on the 1M-vertex mesh,
+and WithinSS on 100k values.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from vg_addon.synth import wedge
+
+from vg_addon import GridIndex, Surface, withinss_split
+
+
+def best_of(function, repeats: int) -> float:
+    """Smallest wall time of ``repeats`` calls, in seconds."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def radius_for(surface: Surface, center, target: int) -> float:
+    """A radius whose Euclidean patch around ``center`` holds about ``target`` vertices."""
+    distances = np.sort(np.linalg.norm(surface.points - center, axis=1))
+    return float(distances[min(target, distances.size) - 1]) * (1 + 1e-9)
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--vertices", type=int, default=1_000_000, help="size of the big mesh")
+    args = parser.parse_args(argv)
+
+    print(
+        f"machine: {platform.machine()}, {platform.processor() or 'cpu'}, "
+        f"Python {platform.python_version()}, NumPy {np.__version__}"
+    )
+    side = int(np.sqrt(args.vertices / 2))
+    mesh = wedge(90, n=side, irregular=True, seed=0)
+    print(f"mesh: 90° wedge, {len(mesh.points):,} vertices, {len(mesh.triangles):,} triangles")
+
+    build = best_of(lambda: GridIndex(mesh.points), 3)
+    print(f"index build ({len(mesh.points):,} vertices):        {build * 1e3:8.1f} ms")
+    start = time.perf_counter()
+    surface = Surface(mesh.points, mesh.triangles)
+    print(
+        f"surface build (normals + index):          {(time.perf_counter() - start) * 1e3:8.1f} ms"
+    )
+
+    center = np.zeros(3)
+    for target in (1_000, 2_000, 10_000, 100_000):
+        radius = radius_for(surface, center, target)
+        repeats = 50 if target <= 10_000 else 5
+        query = best_of(lambda r=radius: surface.index.ball(center, r), repeats)
+        measure = best_of(lambda r=radius: surface.measure(center, r), repeats)
+        m = surface.measure(center, radius)
+        print(
+            f"patch {m.n_vertices:>7,} vertices: query {query * 1e3:7.2f} ms, "
+            f"query + measurement {measure * 1e3:7.2f} ms, angle {m.angle:.4f}°"
+        )
+
+    radius = radius_for(surface, center, 2_000)
+    rng = np.random.default_rng(0)
+    on_crease = mesh.points[np.abs(mesh.points[:, 1]) + np.abs(mesh.points[:, 2]) < 1e-12]
+    centers = on_crease[rng.integers(0, len(on_crease), 500)]
+    start = time.perf_counter()
+    for c in centers:
+        surface.measure(c, radius)
+    elapsed = time.perf_counter() - start
+    print(f"measurements per second (2k-vertex patches, 1M mesh): {len(centers) / elapsed:8.0f}")
+
+    geodesic = best_of(lambda: surface.measure(center, radius, patch="geodesic"), 10)
+    print(f"geodesic patch + measurement (2k vertices):  {geodesic * 1e3:7.2f} ms")
+
+    values = rng.normal(size=100_000)
+    print(
+        f"WithinSS, 100k values:                   {best_of(lambda: withinss_split(values), 10) * 1e3:8.2f} ms"
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,118 @@
+"""Small helpers for the Blender tests: meshes from NumPy, world coordinates, state snapshots."""
+
+from __future__ import annotations
+
+import json
+
+import bpy
+import numpy as np
+
+COLOUR_ATTRIBUTE = "VG Sides"
+
+
+def mesh_object(
+    name, points, triangles, *, location=(0, 0, 0), rotation=(0, 0, 0), scale=(1, 1, 1)
+):
+    """A new mesh object in the scene, made active and selected, with the given transform."""
+    points = np.asarray(points, dtype=np.float32)
+    triangles = np.asarray(triangles, dtype=np.int32)
+    mesh = bpy.data.meshes.new(name)
+    mesh.vertices.add(points.shape[0])
+    mesh.vertices.foreach_set("co", points.ravel())
+    mesh.loops.add(triangles.size)
+    mesh.loops.foreach_set("vertex_index", triangles.ravel())
+    mesh.polygons.add(triangles.shape[0])
+    mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
+    mesh.update(calc_edges=True)
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    obj.location, obj.rotation_euler, obj.scale = location, rotation, scale
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.context.view_layer.update()
+    return obj
+
+
+def local_points(obj) -> np.ndarray:
+    """The object's own (unevaluated) vertex coordinates, float32 as Blender stores them."""
+    co = np.empty(len(obj.data.vertices) * 3, dtype=np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def world(points, obj) -> np.ndarray:
+    """``points`` (object space) in world space, float64, by the object's matrix_world."""
+    matrix = np.array(obj.matrix_world, dtype=np.float64)
+    return np.asarray(points, dtype=np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def exact(item) -> dict:
+    """The exact float64 numbers recorded for a measurement item."""
+    return json.loads(item.exact)
+
+
+def colours(obj) -> np.ndarray | None:
+    """The "VG Sides" colours per vertex (float32 RGBA), or None."""
+    attribute = obj.data.color_attributes.get(COLOUR_ATTRIBUTE)
+    if attribute is None:
+        return None
+    rgba = np.empty(len(attribute.data) * 4, dtype=np.float32)
+    attribute.data.foreach_get("color", rgba)
+    return rgba.reshape(-1, 4)
+
+
+def snapshot(obj) -> dict:
+    """Everything the extension may change on an object: to check that nothing changed."""
+    data = obj.vg
+    items = [
+        {
+            key: getattr(item, key)
+            for key in (
+                "number",
+                "break_number",
+                "exact",
+                "patch",
+                "n_vertices",
+                "n_plus",
+                "n_minus",
+                "date",
+                "note",
+                "colors",
+                "fingerprint",
+                "stale",
+            )
+        }
+        for item in data.measurements
+    ]
+    rgba = colours(obj)
+    return {
+        "items": items,
+        "active_index": data.active_index,
+        "break_number": data.break_number,
+        "next_number": data.next_number,
+        "attributes": sorted(a.name for a in obj.data.attributes),
+        "active_colour": obj.data.color_attributes.active_color_name,
+        "colours": None if rgba is None else rgba.tobytes(),
+    }
+
+
+def expected_colours(vg_module, n, sides) -> np.ndarray:
+    """Colours the extension should paint: grey, then each (indices, labels, break) in order."""
+    palette = vg_module.vg_addon.palette
+    rgba = np.tile(palette.neutral_linear(), (n, 1))
+    for indices, labels, break_number in sides:
+        plus, minus = palette.pair_linear(break_number)
+        rgba[indices[labels]] = plus
+        rgba[indices[~labels]] = minus
+    return rgba.astype(np.float32)
+
+
+def wedge_object(angle, name="Wedge", *, n=40, irregular=True, **transform):
+    """A synthetic wedge (two planes meeting at ``angle`` degrees along an edge through the
+    origin) as a mesh object; the true angle is in ``obj["true_angle"]``."""
+    from vg_addon.synth import wedge
+
+    shape = wedge(angle, n=n, irregular=irregular)
+    obj = mesh_object(name, shape.points, shape.triangles, **transform)
+    obj["true_angle"] = float(shape.angle)
+    return obj

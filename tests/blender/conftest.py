@@ -1,0 +1,83 @@
+"""Blender-side test setup: a throwaway Blender user directory, the extension built and installed
+into it as a user would (Install from Disk), and a fresh empty file for every test.
+
+``BLENDER_USER_RESOURCES`` is read once, when ``bpy`` is imported, so it is set here, before any
+test module of this folder imports bpy. The whole folder skips where bpy is not installed.
+"""
+
+import atexit
+import importlib
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+if "bpy" in sys.modules:
+    _USER_DIR = None  # imported earlier by someone else: too late to redirect it
+else:
+    _USER_DIR = tempfile.mkdtemp(prefix="vg-blender-user-")
+    os.environ["BLENDER_USER_RESOURCES"] = _USER_DIR
+    atexit.register(shutil.rmtree, _USER_DIR, ignore_errors=True)
+
+bpy = pytest.importorskip("bpy", reason="the bpy module (Blender as a Python module) is needed")
+
+import addon_utils  # noqa: E402  (Blender's, importable once bpy is)
+
+REPO = "user_default"
+MODULE = f"bl_ext.{REPO}.virtual_goniometer"
+
+
+@pytest.fixture(scope="session")
+def extension_zip(tmp_path_factory) -> Path:
+    """The extension zip, built and validated by scripts/build_extension.py."""
+    out = tmp_path_factory.mktemp("dist")
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "scripts" / "build_extension.py"), "--output-dir", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    return Path(result.stdout.strip().splitlines()[-1])
+
+
+@pytest.fixture(scope="session")
+def installed_extension(extension_zip):
+    """The extension installed from its zip into the throwaway user directory and enabled."""
+    extensions = Path(bpy.utils.user_resource("EXTENSIONS"))
+    if _USER_DIR is None or not extensions.is_relative_to(_USER_DIR):
+        pytest.skip(
+            "bpy was imported before tests/blender/conftest.py could point "
+            "BLENDER_USER_RESOURCES at a throwaway directory; refusing to install into "
+            f"{extensions}"
+        )
+    bpy.ops.extensions.package_install_files(
+        filepath=str(extension_zip), repo=REPO, enable_on_install=True
+    )
+    assert (extensions / REPO / "virtual_goniometer" / "blender_manifest.toml").is_file()
+    return importlib.import_module(MODULE)
+
+
+def enable_extension() -> None:
+    """Enable the installed extension if a test left it disabled."""
+    if MODULE not in bpy.context.preferences.addons:
+        addon_utils.enable(MODULE, default_set=True, handle_error=_raise)
+
+
+def _raise(error):
+    raise error
+
+
+@pytest.fixture
+def vg(installed_extension):
+    """The enabled extension's root module, in a fresh empty Blender file."""
+    enable_extension()
+    bpy.ops.wm.read_homefile(use_empty=True)
+    yield installed_extension
+    enable_extension()

@@ -1,0 +1,419 @@
+"""vg_batch.py, run as a user runs it (a subprocess of this Python, which has bpy): inputs, point
+lists, outputs, errors and exit codes, sharding, parallel jobs, .blend and PNG outputs, the demo;
+and the batch numbers against the extension's own bpy.ops.vg.measure_xyz, bit for bit."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import os
+import struct
+import subprocess
+import sys
+from pathlib import Path
+
+import bpy
+import numpy as np
+import pytest
+from bpy_helpers import colours, exact, mesh_object
+
+from vg_addon import csvio, meshio
+from vg_addon.synth import bone_fragment, wedge
+
+ROOT = Path(__file__).resolve().parents[2]
+SCRIPT = ROOT / "vg_batch.py"
+RADIUS = 0.3
+# Points on the crease (the x axis) of the synthetic wedges, as the decimals a user would type.
+CREASE = [("-0.4", "0", "0"), ("0.05", "0", "0"), ("0.35", "0", "0")]
+
+
+def batch(*args, env=None, timeout=600) -> subprocess.CompletedProcess:
+    """Run ``python vg_batch.py ARGS`` with this test's Python (the one with bpy)."""
+    return subprocess.run(
+        [sys.executable, str(SCRIPT), *(str(a) for a in args)],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=None if env is None else {**os.environ, **env},
+        check=False,
+    )
+
+
+def ok(result: subprocess.CompletedProcess, code: int = 0) -> subprocess.CompletedProcess:
+    assert result.returncode == code, result.stdout + result.stderr
+    return result
+
+
+def rows_of(path) -> list[csvio.MeasurementRow]:
+    """The rows of an export, read back with the schema's own reader (bit-exact numbers)."""
+    return csvio.read_measurements_csv(Path(path))
+
+
+def without_dates(rows) -> list[dict]:
+    return [{k: v for k, v in dataclasses.asdict(r).items() if k != "date"} for r in rows]
+
+
+def write_obj(path, points, triangles) -> Path:
+    with open(path, "w", encoding="ascii") as handle:
+        handle.writelines(f"v {x!r} {y!r} {z!r}\n" for x, y, z in points.tolist())
+        handle.writelines(f"f {a} {b} {c}\n" for a, b, c in (triangles + 1).tolist())
+    return Path(path)
+
+
+def write_stl(path, points, triangles) -> Path:
+    record = np.dtype([("normal", "<f4", (3,)), ("corners", "<f4", (3, 3)), ("attr", "<u2")])
+    records = np.zeros(len(triangles), record)
+    records["corners"] = points[triangles]
+    with open(path, "wb") as handle:
+        handle.write(b"binary STL written by test_batch".ljust(80, b" "))
+        handle.write(struct.pack("<I", len(records)))
+        handle.write(records.tobytes())
+    return Path(path)
+
+
+def write_csv(path, header, rows) -> Path:
+    with open(path, "w", encoding="utf-8", newline="") as handle:
+        writer = csv.writer(handle, lineterminator="\n")
+        writer.writerow(header)
+        writer.writerows(rows)
+    return Path(path)
+
+
+def png_size(path) -> tuple[int, int]:
+    data = Path(path).read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG"
+    return struct.unpack(">II", data[16:24])
+
+
+@pytest.fixture(scope="module")
+def meshes(tmp_path_factory) -> dict:
+    """Wedges of 90° (as PLY, OBJ and STL) and 60° (PLY), with their true angles."""
+    folder = tmp_path_factory.mktemp("meshes")
+    w90 = wedge(90.0, n=24, irregular=True, seed=3)
+    w60 = wedge(60.0, n=24, irregular=True, seed=4)
+    return {
+        "ply": meshio.write_ply(folder / "w90.ply", w90.points, w90.triangles),
+        "obj": write_obj(folder / "w90_obj.obj", w90.points, w90.triangles),
+        "stl": write_stl(folder / "w90_stl.stl", w90.points, w90.triangles),
+        "ply60": meshio.write_ply(folder / "w60.ply", w60.points, w60.triangles),
+        "angles": {"w90": w90.angle, "w60": w60.angle},
+    }
+
+
+@pytest.fixture(scope="module")
+def two_meshes(meshes, tmp_path_factory) -> dict:
+    """A points CSV over both wedges, rows interleaved, and the unsharded single-job run."""
+    folder = tmp_path_factory.mktemp("two")
+    rows = []
+    for i, x in enumerate(["-0.45", "-0.3", "-0.1", "0.0", "0.2", "0.4", "0.45"]):
+        rows.append(["w60" if i % 3 == 1 else "w90", x, "0", "0", f"p{i}"])
+    points = write_csv(folder / "points.csv", ["mesh", "x", "y", "z", "label"], rows)
+    out = folder / "whole.csv"
+    result = ok(batch(meshes["ply"], meshes["ply60"], "--points", points, "--radius", RADIUS,
+                      "--out", out))  # fmt: skip
+    return {"points": points, "out": out, "rows": rows_of(out), "stderr": result.stderr}
+
+
+# --------------------------------------------------------------------------- command line
+
+
+def test_help_documents_every_option():
+    text = ok(batch("--help")).stdout
+    for needed in (
+        "blender -b", "--python vg_batch.py --", "--object", "--at X Y Z", "--points CSV",
+        "--radius", "--lambda", "--patch", "--out CSV", "--save-blend", "--render DIR",
+        "--jobs", "--shard K/N", "--demo", "--out-dir", "--units", "exit status", "MeshLab",
+    ):  # fmt: skip
+        assert needed in text, needed
+
+
+def test_points_given_with_at_on_ply_obj_and_stl(meshes, tmp_path):
+    at = [arg for point in CREASE for arg in ("--at", *point)]
+    results = {}
+    for kind in ("ply", "obj", "stl"):
+        out = tmp_path / f"{kind}.csv"
+        ok(batch(meshes[kind], *at, "--radius", RADIUS, "--out", out))
+        results[kind] = rows_of(out)
+    rows = results["ply"]
+    assert [r.mesh_name for r in rows] == ["w90"] * 3
+    assert [r.number for r in rows] == [1, 2, 3]
+    assert [r.requested for r in rows] == [tuple(float(v) for v in p) for p in CREASE]
+    for r in rows:
+        assert not r.error
+        assert abs(r.angle - 90.0) < 0.01
+        assert (r.radius, r.seg_param, r.patch) == (RADIUS, 2.0, "euclidean")
+        assert r.units == "BU" and r.extension_version and r.blender_version
+    # The same surface in three file formats: the same float32 vertices and faces in Blender,
+    # hence the same numbers, bit for bit.
+    for kind in ("obj", "stl"):
+        assert [r.angle for r in results[kind]] == [r.angle for r in rows]
+        assert [r.normal_plus for r in results[kind]] == [r.normal_plus for r in rows]
+
+
+def test_points_csv_plain_our_export_and_meshlab_replicate_the_same_angles(meshes, tmp_path):
+    plain = write_csv(
+        tmp_path / "plain.csv",
+        ["x", "y", "z", "radius", "lambda", "label"],
+        [[*p, RADIUS, "2", f"site {i}"] for i, p in enumerate(CREASE, start=1)],
+    )
+    first = tmp_path / "first.csv"
+    ok(batch(meshes["ply"], "--points", plain, "--out", first))
+    original = rows_of(first)
+    assert [r.user_data for r in original] == ["site 1", "site 2", "site 3"]
+
+    # Our own export, fed back: every row re-measured at its snapped centre, same numbers.
+    again = tmp_path / "again.csv"
+    ok(batch(meshes["ply"], "--points", first, "--out", again))
+    for a, b in zip(original, rows_of(again), strict=True):
+        assert (b.angle, b.fit, b.x, b.y, b.z, b.n_vertices) == (a.angle, a.fit, a.x, a.y, a.z,
+                                                                 a.n_vertices)  # fmt: skip
+
+    # The MeshLab plugin's CSV: its 14 columns, the file name as Mesh Name, its own radius and
+    # SegParam per row (here a different radius on the second row).
+    meshlab_rows = [
+        ["w90.ply", "2021-03-04", str(i), "1", "", f"m{i}", "90.1", "500",
+         repr(r.radius if i != 2 else 0.25), repr(r.x), repr(r.y), repr(r.z), "0.001", "2"]
+        for i, r in enumerate(original, start=1)
+    ]  # fmt: skip
+    meshlab = write_csv(tmp_path / "meshlab.csv", csvio.MESHLAB_COLUMNS, meshlab_rows)
+    replicated = tmp_path / "replicated.csv"
+    ok(batch(meshes["ply"], "--points", meshlab, "--out", replicated))
+    rows = rows_of(replicated)
+    assert [r.radius for r in rows] == [RADIUS, 0.25, RADIUS]
+    assert [r.user_data for r in rows] == ["m1", "m2", "m3"]
+    assert rows[0].angle == original[0].angle and rows[2].angle == original[2].angle
+    assert abs(rows[1].angle - 90.0) < 0.01
+
+
+def test_several_meshes_rows_matched_by_mesh_column_in_input_order(two_meshes, meshes):
+    rows = two_meshes["rows"]
+    assert [r.user_data for r in rows] == [f"p{i}" for i in range(7)]
+    assert [r.mesh_name for r in rows] == ["w90", "w60", "w90", "w90", "w60", "w90", "w90"]
+    for r in rows:
+        assert not r.error
+        assert abs(r.angle - meshes["angles"][r.mesh_name]) < 0.01
+    # Measurement numbers count per mesh, in input order.
+    assert [r.number for r in rows] == [1, 1, 2, 3, 2, 4, 5]
+    assert "measurements/s" in two_meshes["stderr"]
+    assert "7 measured, 0 failed" in two_meshes["stderr"]
+
+
+def test_shards_concatenate_to_the_unsharded_run(two_meshes, meshes, tmp_path):
+    shards = []
+    for k in (1, 2):
+        out = tmp_path / f"shard{k}.csv"
+        ok(batch(meshes["ply"], meshes["ply60"], "--points", two_meshes["points"],
+                 "--radius", RADIUS, "--shard", f"{k}/2", "--out", out))  # fmt: skip
+        shards.append(rows_of(out))
+    assert [len(s) for s in shards] == [3, 4]
+    assert without_dates(shards[0] + shards[1]) == without_dates(two_meshes["rows"])
+
+
+def test_jobs_2_equals_jobs_1_and_saves_every_mesh(vg, two_meshes, meshes, tmp_path):
+    out, blend = tmp_path / "jobs2.csv", tmp_path / "jobs2.blend"
+    ok(batch(meshes["ply"], meshes["ply60"], "--points", two_meshes["points"],
+             "--radius", RADIUS, "--jobs", "2", "--out", out, "--save-blend", blend))  # fmt: skip
+    rows = rows_of(out)
+    assert without_dates(rows) == without_dates(two_meshes["rows"])
+
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    for name, count in (("w90", 5), ("w60", 2)):
+        obj = bpy.data.objects[name]
+        items = list(obj.vg.measurements)
+        assert len(items) == count
+        mine = [r for r in rows if r.mesh_name == name]
+        assert [exact(i)["angle"] for i in items] == [r.angle for r in mine]
+        assert colours(obj) is not None
+
+
+def test_a_row_that_fails_gets_its_error_and_the_run_goes_on(meshes, tmp_path):
+    points = write_csv(
+        tmp_path / "points.csv",
+        ["mesh", "x", "y", "z"],
+        [["w90", "0", "0", "0"], ["w90", "0", "0", "5"], ["w91", "0", "0", "0"],
+         ["w90", "0.2", "0", "0"]],
+    )  # fmt: skip
+    out = tmp_path / "out.csv"
+    result = ok(batch(meshes["ply"], "--points", points, "--radius", RADIUS, "--out", out), 1)
+    rows = rows_of(out)
+    assert [bool(r.error) for r in rows] == [False, True, True, False]
+    assert "farther than the radius" in rows[1].error
+    assert rows[1].requested == (0.0, 0.0, 5.0) and rows[1].angle is None
+    assert rows[1].number == 2 and rows[3].number == 3  # a failed row keeps its number
+    assert "'w91', which is not among the meshes given" in rows[2].error
+    assert abs(rows[3].angle - 90.0) < 0.01
+    assert "2 measured, 2 failed" in result.stderr
+    assert "row 3 on 'w90'" in result.stderr
+
+
+def test_missing_file_malformed_csv_and_bad_arguments_exit_2(meshes, tmp_path):
+    out = tmp_path / "out.csv"
+    result = ok(batch(tmp_path / "nope.ply", "--at", 0, 0, 0, "--radius", 1, "--out", out), 2)
+    assert "nope.ply: no such file or folder" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert not out.exists()
+
+    bad = tmp_path / "bad.csv"
+    bad.write_text("x,y,z\n0,0,0\n1,abc,0\n", encoding="utf-8")
+    result = ok(batch(meshes["ply"], "--points", bad, "--radius", 1, "--out", out), 2)
+    assert "row 3: y is not a number ('abc')" in result.stderr
+
+    result = ok(batch(meshes["ply"], "--at", 0, 0, 0, "--out", out), 2)
+    assert "--at needs --radius" in result.stderr
+    result = ok(batch(meshes["ply"], "--radius", 1, "--out", out), 2)
+    assert "--at X Y Z" in result.stderr and "--points CSV" in result.stderr
+
+
+def test_an_unreadable_mesh_fails_alone_with_exit_2(meshes, tmp_path):
+    broken = tmp_path / "broken.ply"
+    broken.write_bytes(b"ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n")
+    out = tmp_path / "out.csv"
+    result = ok(batch(broken, meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS,
+                      "--out", out), 2)  # fmt: skip
+    rows = rows_of(out)
+    assert [r.mesh_name for r in rows] == ["broken", "w90"]
+    assert "could not read the mesh" in rows[0].error and "broken.ply" in rows[0].error
+    assert not rows[1].error and abs(rows[1].angle - 90.0) < 0.01
+    assert "unreadable mesh" in result.stderr
+
+
+def test_a_crashing_worker_loses_only_its_mesh(two_meshes, meshes, tmp_path):
+    out = tmp_path / "out.csv"
+    ok(batch(meshes["ply"], meshes["ply60"], "--points", two_meshes["points"], "--radius", RADIUS,
+             "--jobs", "2", "--out", out, env={"VG_BATCH_ABORT_ON_MESH": "w60"}), 1)  # fmt: skip
+    rows = rows_of(out)
+    whole = two_meshes["rows"]
+    for row, expected in zip(rows, whole, strict=True):
+        if row.mesh_name == "w60":
+            assert "worker process measuring this mesh stopped" in row.error
+        else:
+            assert row.angle == expected.angle and not row.error
+
+
+def test_render_writes_a_png_per_mesh(meshes, tmp_path):
+    renders = tmp_path / "renders"
+    result = ok(batch(meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS, "--out",
+                      tmp_path / "out.csv", "--render", renders, "--render-size", 48, 32,
+                      "--render-samples", 1))  # fmt: skip
+    assert png_size(renders / "w90.png") == (48, 32)
+    assert "wrote 1 render(s)" in result.stderr
+
+
+# --------------------------------------------------------------------------- against the extension
+
+
+def test_batch_angle_equals_measure_xyz_on_blenders_own_ply_import(vg, meshes, tmp_path):
+    out = tmp_path / "out.csv"
+    ok(batch(meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS, "--lambda", "1.5",
+             "--out", out))  # fmt: skip
+    row = rows_of(out)[0]
+
+    bpy.ops.wm.ply_import(filepath=str(meshes["ply"]))
+    obj = bpy.data.objects["w90"]
+    bpy.context.view_layer.objects.active = obj
+    location = tuple(float(v) for v in CREASE[1])
+    bpy.ops.vg.measure_xyz(location=location, radius=RADIUS, seg_param=1.5)
+    numbers = exact(obj.vg.measurements[0])
+    assert numbers["angle"] == row.angle
+    assert numbers["fit"] == row.fit
+    assert tuple(numbers["normal_plus"]) == row.normal_plus
+    assert tuple(numbers["normal_minus"]) == row.normal_minus
+    assert tuple(numbers["center"]) == (row.x, row.y, row.z)
+    assert tuple(numbers["requested"]) == row.requested
+    assert obj.vg.measurements[0].n_vertices == row.n_vertices
+
+
+def test_blend_input_world_space_and_saved_measurements(vg, tmp_path):
+    """An object of a .blend, moved, turned and scaled: the batch measures it in world space
+    exactly as measure_xyz does, and the saved .blend lists the measurements, painted."""
+    shape = wedge(75.0, n=30, irregular=True, seed=5)
+    obj = mesh_object("Bone", shape.points, shape.triangles, location=(10.0, -2.0, 3.0),
+                      rotation=(0.3, -0.2, 1.1), scale=(2.0, 2.0, 2.0))  # fmt: skip
+    source = tmp_path / "study.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(source))
+    centre = np.array(obj.matrix_world) @ np.array([0.1, 0.0, 0.0, 1.0])
+    point = [str(np.float32(v)) for v in centre[:3]]  # as a user would type them
+
+    out, saved = tmp_path / "out.csv", tmp_path / "saved.blend"
+    ok(batch(source, "--object", "Bone", "--at", *point, "--radius", "0.6", "--out", out,
+             "--save-blend", saved))  # fmt: skip
+    row = rows_of(out)[0]
+    assert abs(row.angle - 75.0) < 0.01
+
+    bpy.ops.vg.measure_xyz(location=[float(v) for v in point], radius=0.6)
+    mine = exact(obj.vg.measurements[0])
+    assert (mine["angle"], mine["fit"]) == (row.angle, row.fit)
+    assert tuple(mine["center"]) == (row.x, row.y, row.z)
+
+    bpy.ops.wm.open_mainfile(filepath=str(saved))
+    stored = bpy.data.objects["Bone"]
+    assert bpy.context.view_layer.objects.active == stored
+    assert [exact(i)["angle"] for i in stored.vg.measurements] == [row.angle]
+    painted = colours(stored)
+    assert painted is not None
+    # The extension's own repaint, from the stored records, gives the same colours: the stored
+    # measurement is not stale and the batch painted it as the extension does.
+    bpy.ops.vg.repaint()
+    assert not stored.vg.measurements[0].stale
+    np.testing.assert_array_equal(colours(stored), painted)
+
+
+def test_blend_input_errors_exit_2(tmp_path):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    shape = wedge(75.0, n=8)
+    mesh_object("A", shape.points, shape.triangles)
+    mesh_object("B", shape.points, shape.triangles)
+    source = tmp_path / "two.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(source))
+    out = tmp_path / "out.csv"
+    result = ok(batch(source, "--at", 0, 0, 0, "--radius", 1, "--out", out), 2)
+    assert "2 mesh objects (A, B): name the ones to measure with --object" in result.stderr
+    result = ok(batch(source, "--object", "C", "--at", 0, 0, 0, "--radius", 1, "--out", out), 2)
+    assert "has no object named 'C'" in result.stderr
+
+
+def test_sample_scan_in_millimetres_matches_measure_xyz(vg, shared_data, tmp_path):
+    path = shared_data / "sample_mesh.ply"
+    if not path.is_file():
+        pytest.skip(f"{path} is not there")
+    data = meshio.read_mesh(path)
+    size = float(np.linalg.norm(data.points.max(axis=0) - data.points.min(axis=0)))
+    radius = repr(round(size * 0.03, 3))
+    picks = [str(np.float32(v)) for i in (100, 5000, 12000) for v in data.points[i]]
+    at = [arg for i in range(3) for arg in ("--at", *picks[3 * i : 3 * i + 3])]
+    out = tmp_path / "out.csv"
+    ok(batch(path, *at, "--radius", radius, "--units", "mm", "--out", out))
+    rows = rows_of(out)
+    assert all(not r.error for r in rows)
+    assert all(r.units.startswith("BU (1 BU = 0.001 m") for r in rows)
+
+    bpy.ops.wm.ply_import(filepath=str(path))
+    obj = bpy.data.objects["sample_mesh"]
+    bpy.context.view_layer.objects.active = obj
+    for i, row in enumerate(rows):
+        location = [float(v) for v in picks[3 * i : 3 * i + 3]]
+        bpy.ops.vg.measure_xyz(location=location, radius=float(radius))
+        numbers = exact(obj.vg.measurements[i])
+        assert (numbers["angle"], numbers["fit"]) == (row.angle, row.fit)
+
+
+# --------------------------------------------------------------------------- the demo
+
+
+def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
+    out = tmp_path / "demo"
+    result = ok(batch("--demo", "--out-dir", out))
+    sites = bone_fragment().sites
+    rows = rows_of(out / "measurements.csv")
+    assert len(rows) == len(sites)
+    for site, row in zip(sites, rows, strict=True):
+        assert not row.error
+        assert row.user_data == site.label
+        assert abs(row.angle - site.angle) < 2.0, (site.label, row.angle, site.angle)
+        assert site.label in result.stdout
+    assert rows[0].units.startswith("BU (1 BU = 0.001 m")
+    assert len({r.break_number for r in rows}) == len(sites)  # one colour pair per site
+    assert "true angle" in result.stdout and f"Output folder: {out}" in result.stdout
+    assert png_size(out / "bone_fragment.png") == (800, 600)
+    assert (out / "bone_fragment.blend").stat().st_size > 0
+    assert meshio.read_mesh(out / "bone_fragment.ply").n_vertices > 200_000

@@ -1,0 +1,405 @@
+"""The drag tool in real bpy: ray cast through a real 3D-view region, the drag session driven by
+translated events, EXEC_DEFAULT equal to vg.measure_xyz, and clean exits.
+
+Headless limits (see docs/README_drag.md): ``INVOKE_DEFAULT`` cannot run without an event loop,
+so ``invoke``/``modal`` themselves are not called; they only forward to ``DragSession`` and
+``translate_event``, which are tested here. The view matrices cannot be recomputed in background
+mode, so the test mesh is placed in front of the startup file's saved perspective view.
+"""
+
+import importlib
+from types import SimpleNamespace
+
+import bpy
+import numpy as np
+import pytest
+from bpy_extras import view3d_utils
+from bpy_helpers import exact, mesh_object, snapshot
+from mathutils import Matrix, Vector
+
+N = 31  # grid vertices per side
+SCALE = 2.0
+
+
+def folded_grid(n: int = N):
+    """A square grid folded at 90° along the x axis, ridge at z = 0, faces going down to -z,
+    wound so the normals point out (+z side): the method needs outward normals."""
+    s = np.linspace(-1.0, 1.0, n)
+    x, t = np.meshgrid(s, s, indexing="ij")
+    x, t = x.ravel(), t.ravel()
+    points = np.column_stack([x, t * np.sqrt(0.5), -np.abs(t) * np.sqrt(0.5)])
+    grid = np.arange(n * n).reshape(n, n)
+    a, b = grid[:-1, :-1].ravel(), grid[1:, :-1].ravel()
+    c, d = grid[1:, 1:].ravel(), grid[:-1, 1:].ravel()
+    triangles = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    return points, triangles
+
+
+@pytest.fixture
+def drag(vg):
+    """The drag module, its operator registered (by the extension, or here until it is)."""
+    module = importlib.import_module(f"{vg.__name__}.operators.drag")
+    registered_here = not hasattr(bpy.types, "VG_OT_measure_drag")
+    if registered_here:
+        bpy.utils.register_class(module.VG_OT_measure_drag)
+    yield module
+    if registered_here:
+        bpy.utils.unregister_class(module.VG_OT_measure_drag)
+
+
+@pytest.fixture
+def view(drag):
+    """The startup screen's 3D viewport, as the context, with a ridge mesh facing its camera."""
+    windows = bpy.context.window_manager.windows
+    if not len(windows):
+        pytest.skip("this bpy build has no window in background mode: no 3D view to test with")
+    window = windows[0]
+    area = next((a for a in window.screen.areas if a.type == "VIEW_3D"), None)
+    if area is None:
+        pytest.skip("the startup screen has no 3D viewport")
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    rv3d = area.spaces.active.region_3d
+    with bpy.context.temp_override(window=window, area=area, region=region):
+        # Put the mesh at the middle of the view, its +z towards the camera.
+        middle = (region.width / 2, region.height / 2)
+        target = view3d_utils.region_2d_to_location_3d(region, rv3d, middle, rv3d.view_location)
+        camera = rv3d.view_matrix.inverted().to_3x3()
+        points, triangles = folded_grid()
+        obj = mesh_object("Ridge", points * SCALE, triangles)
+        obj.matrix_world = Matrix.Translation(target) @ camera.to_4x4()
+        bpy.context.view_layer.update()
+        world = np.array(obj.matrix_world)
+        world_points = (points * SCALE) @ world[:3, :3].T + world[:3, 3]
+        yield SimpleNamespace(
+            window=window,
+            area=area,
+            region=region,
+            rv3d=rv3d,
+            obj=obj,
+            points=world_points,
+            right=np.array(camera.col[0]),
+        )
+
+
+def pixel(view, point):
+    """Region pixel coordinates of a world point."""
+    coord = view3d_utils.location_3d_to_region_2d(view.region, view.rv3d, Vector(point))
+    assert coord is not None
+    return (float(coord[0]), float(coord[1]))
+
+
+def ridge_vertex(view, k: int = N // 2) -> int:
+    """Index of vertex ``k`` along the ridge (t = 0)."""
+    return k * N + N // 2
+
+
+def start(drag, view, vertex: int, offset=(0.3, -0.2)):
+    x, y = pixel(view, view.points[vertex])
+    return drag.DragSession.start(bpy.context, (x + offset[0], y + offset[1]))
+
+
+def send(drag, session, event_type, value="PRESS", coord=None, **modifiers):
+    action, argument = drag.translate_event(event_type, value, **modifiers)
+    return session.handle(bpy.context, action, argument, coord)
+
+
+def handler_removed(handle) -> bool:
+    """True if Blender no longer has the draw handler (removing it again is an error)."""
+    try:
+        bpy.types.SpaceView3D.draw_handler_remove(handle, "WINDOW")
+    except ValueError:
+        return True
+    return False
+
+
+def record_fields(item) -> dict:
+    """Everything a measurement records, except its number and date."""
+    keys = ("exact", "patch", "n_vertices", "n_plus", "n_minus", "fingerprint", "note")
+    return {key: getattr(item, key) for key in keys}
+
+
+# -- the ray cast and the radius through a real region ---------------------------------------
+
+
+def pixel_size(drag, view, point) -> float:
+    """World size of one pixel on the view plane through ``point``."""
+    x, y = pixel(view, point)
+    return drag.view_plane_radius(view.region, view.rv3d, (x + 1.0, y), point)
+
+
+def test_ray_cast_from_region_pixels_hits_the_projected_vertices(drag, view):
+    # view3d_utils un-projects with float32 matrices, so a hit is exact to a fraction of a
+    # pixel, not to float64: well within the vertex spacing that snapping resolves.
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    spacing = 2.0 * SCALE / (N - 1)
+    for vertex in (ridge_vertex(view), ridge_vertex(view, 5), 7 * N + 3, 20 * N + 25):
+        point = view.points[vertex]
+        coord = pixel(view, point)
+        hit = drag.ray_cast_object(view.obj, depsgraph, view.region, view.rv3d, coord)
+        assert hit is not None
+        assert np.linalg.norm(hit - point) < min(pixel_size(drag, view, point), spacing / 10)
+        nearest = np.argmin(np.linalg.norm(view.points - hit, axis=1))
+        assert nearest == vertex
+    assert drag.ray_cast_object(view.obj, depsgraph, view.region, view.rv3d, (3, 3)) is None
+
+
+def test_radius_is_measured_on_the_view_plane(drag, view):
+    center = view.points[ridge_vertex(view)]
+    tolerance = pixel_size(drag, view, center)
+    assert 0 < tolerance < 0.05
+    for radius in (0.05, 0.4, 1.3):
+        coord = pixel(view, center + radius * view.right)
+        measured = drag.view_plane_radius(view.region, view.rv3d, coord, center)
+        assert measured == pytest.approx(radius, abs=tolerance)
+
+
+# -- the drag session, driven by translated events --------------------------------------------
+
+
+def test_drag_and_release_records_exactly_what_measure_xyz_records(drag, view):
+    center_vertex = ridge_vertex(view)
+    session = start(drag, view, center_vertex)
+    assert np.array_equal(session.machine.center, view.points[center_vertex])  # snapped
+    handle = session.overlay.handle
+    assert session.overlay.active
+    far = pixel(view, view.points[center_vertex] + 0.7 * view.right)
+    assert send(drag, session, "MOUSEMOVE", "NOTHING", far) == drag.RUNNING
+    assert session.machine.n_vertices > 50 and session.machine.message == ""
+    assert "vertices" in session.header_text(bpy.context.scene)
+    assert send(drag, session, "LEFTMOUSE", "RELEASE", far) == drag.DONE
+    session.finish(bpy.context)
+    assert handler_removed(handle) and not session.overlay.active
+
+    values = drag.record_properties(session)
+    record = session.machine.record
+    tolerance = pixel_size(drag, view, view.points[center_vertex])
+    assert values["radius"] == record.radius == pytest.approx(0.7, abs=tolerance)
+    assert bpy.ops.vg.measure_drag("EXEC_DEFAULT", **values) == {"FINISHED"}
+    assert bpy.ops.vg.measure_xyz("EXEC_DEFAULT", **values) == {"FINISHED"}
+    dragged, typed = view.obj.vg.measurements
+    assert record_fields(dragged) == record_fields(typed)
+    numbers = exact(dragged)
+    assert numbers["angle"] == record.measurement.angle  # the preview measured the same thing
+    assert numbers["center"] == list(view.points[center_vertex])
+    assert dragged.n_vertices == session.machine.n_vertices
+    assert abs(numbers["angle"] - 90.0) < 1e-3
+
+
+def test_typed_radius_is_recorded_exactly(drag, view):
+    session = start(drag, view, ridge_vertex(view))
+    far = pixel(view, view.points[ridge_vertex(view)] + 0.2 * view.right)
+    send(drag, session, "MOUSEMOVE", "NOTHING", far)
+    for key in ("ZERO", "PERIOD", "FOUR", "THREE", "NUMPAD_7"):
+        assert send(drag, session, key) == drag.RUNNING
+    assert session.machine.radius == 0.437
+    assert "typed 0.437" in session.header_text(bpy.context.scene)
+    send(drag, session, "MOUSEMOVE", "NOTHING", far)  # typing wins over the mouse
+    assert session.machine.radius == 0.437
+    assert send(drag, session, "RET") == drag.DONE
+    session.finish(bpy.context)
+    bpy.ops.vg.measure_drag("EXEC_DEFAULT", **drag.record_properties(session))
+    assert exact(view.obj.vg.measurements[0])["radius"] == 0.437
+
+
+def test_lam_keys_and_ctrl_wheel_remeasure_and_are_recorded(drag, view):
+    session = start(drag, view, ridge_vertex(view))
+    far = pixel(view, view.points[ridge_vertex(view)] + 0.6 * view.right)
+    send(drag, session, "MOUSEMOVE", "NOTHING", far)
+    assert send(drag, session, "L") == drag.RUNNING
+    assert send(drag, session, "WHEELUPMOUSE", ctrl=True) == drag.RUNNING
+    assert send(drag, session, "L", shift=True) == drag.RUNNING
+    assert session.machine.lam == 2.25
+    assert session.machine.measurement is not None and session.machine.measurement.lam == 2.25
+    assert "angle" in session.header_text(bpy.context.scene)
+    # navigation passes through, without changing anything
+    for event_type in ("WHEELUPMOUSE", "MIDDLEMOUSE"):
+        assert send(drag, session, event_type) == drag.PASS
+    assert session.machine.lam == 2.25
+    send(drag, session, "LEFTMOUSE", "RELEASE", far)
+    session.finish(bpy.context)
+    values = drag.record_properties(session)
+    assert values["seg_param"] == 2.25
+    bpy.ops.vg.measure_drag("EXEC_DEFAULT", **values)
+    assert exact(view.obj.vg.measurements[0])["lam"] == 2.25
+
+
+@pytest.mark.parametrize("cancel", [("ESC", "PRESS"), ("RIGHTMOUSE", "PRESS")])
+def test_cancel_changes_nothing_and_removes_the_draw_handler(drag, view, cancel):
+    before = snapshot(view.obj)
+    session = start(drag, view, ridge_vertex(view))
+    handle = session.overlay.handle
+    far = pixel(view, view.points[ridge_vertex(view)] + 0.5 * view.right)
+    send(drag, session, "MOUSEMOVE", "NOTHING", far)
+    assert send(drag, session, *cancel) == drag.DONE
+    session.finish(bpy.context)
+    assert session.machine.phase == "cancelled" and drag.record_properties(session) is None
+    assert handler_removed(handle)
+    assert snapshot(view.obj) == before
+    session.finish(bpy.context)  # a second finish is harmless
+
+
+def test_small_drag_previews_too_few_and_records_nothing(drag, view):
+    before = snapshot(view.obj)
+    session = start(drag, view, ridge_vertex(view))
+    near = pixel(view, view.points[ridge_vertex(view)] + 0.01 * view.right)
+    send(drag, session, "MOUSEMOVE", "NOTHING", near)
+    assert session.machine.n_vertices < 6
+    assert "Too few vertices" in session.header_text(bpy.context.scene)
+    assert send(drag, session, "LEFTMOUSE", "RELEASE", near) == drag.DONE
+    session.finish(bpy.context)
+    assert drag.record_properties(session) is None
+    assert "Nothing was recorded" in session.machine.message
+    assert snapshot(view.obj) == before
+
+
+def test_press_that_misses_the_mesh_says_why(drag, view):
+    with pytest.raises(ValueError, match="Missed the mesh"):
+        drag.DragSession.start(bpy.context, (3, 3))
+
+
+def test_non_mesh_active_object_is_refused(drag, view):
+    empty = bpy.data.objects.new("Empty", None)
+    bpy.context.scene.collection.objects.link(empty)
+    bpy.context.view_layer.objects.active = empty
+    with pytest.raises(ValueError, match="not a mesh"):
+        start(drag, view, ridge_vertex(view))
+
+
+def test_object_deleted_mid_drag_ends_cleanly(drag, view):
+    session = start(drag, view, ridge_vertex(view))
+    handle = session.overlay.handle
+    bpy.data.objects.remove(view.obj)
+    far = (view.region.width / 2 + 40, view.region.height / 2)
+    assert send(drag, session, "MOUSEMOVE", "NOTHING", far) == drag.DONE
+    session.finish(bpy.context)
+    assert session.machine.phase == "cancelled" and "deleted" in session.machine.message
+    assert handler_removed(handle)
+
+
+def test_leaving_the_region_ends_cleanly(drag, view):
+    before = snapshot(view.obj)
+    session = start(drag, view, ridge_vertex(view))
+    handle = session.overlay.handle
+    assert send(drag, session, "MOUSEMOVE", "NOTHING", (-5.0, 10.0)) == drag.DONE
+    session.finish(bpy.context)
+    assert session.machine.phase == "cancelled" and "Left the 3D view" in session.machine.message
+    assert handler_removed(handle) and snapshot(view.obj) == before
+
+
+def test_other_keys_are_swallowed_mid_drag(drag, view):
+    session = start(drag, view, ridge_vertex(view))
+    for event_type in ("X", "DEL", "TAB", "G"):
+        assert send(drag, session, event_type) == drag.RUNNING
+    assert session.machine.phase == "dragging"
+    session.finish(bpy.context)
+
+
+# -- execute() with explicit values -----------------------------------------------------------
+
+
+@pytest.mark.parametrize("patch", ["euclidean", "geodesic"])
+def test_exec_default_equals_measure_xyz(drag, view, patch):
+    values = {
+        "location": tuple(view.points[ridge_vertex(view, 9)] + [0.01, -0.02, 0.015]),
+        "radius": 0.55,
+        "seg_param": 1.5,
+        "patch": patch,
+    }
+    assert bpy.ops.vg.measure_drag("EXEC_DEFAULT", **values) == {"FINISHED"}
+    assert bpy.ops.vg.measure_xyz("EXEC_DEFAULT", **values) == {"FINISHED"}
+    dragged, typed = view.obj.vg.measurements
+    assert record_fields(dragged) == record_fields(typed)
+    assert dragged.number == 1 and typed.number == 2
+    assert exact(dragged)["radius"] == 0.55 and exact(dragged)["lam"] == 1.5
+
+
+def test_exec_default_bad_input_reports_and_records_nothing(drag, view):
+    before = snapshot(view.obj)
+    far_away = tuple(view.points[0] + 100.0)
+    with pytest.raises(RuntimeError, match="farther than the radius"):
+        bpy.ops.vg.measure_drag("EXEC_DEFAULT", location=far_away, radius=0.5, seg_param=2.0)
+    assert snapshot(view.obj) == before
+
+
+# -- pieces: events, hints, units, overlay, tool ----------------------------------------------
+
+
+def test_translate_event(drag):
+    t = drag.translate_event
+    assert t("MOUSEMOVE", "NOTHING") == ("move", None)
+    assert t("INBETWEEN_MOUSEMOVE", "NOTHING") == ("ignore", None)
+    assert t("LEFTMOUSE", "RELEASE") == ("release", None)
+    assert t("LEFTMOUSE", "PRESS") == ("ignore", None)
+    assert t("ESC", "PRESS")[0] == t("RIGHTMOUSE", "PRESS")[0] == "cancel"
+    assert t("ESC", "RELEASE") == ("ignore", None)
+    assert t("RET", "PRESS") == t("NUMPAD_ENTER", "PRESS") == ("enter", None)
+    assert t("FIVE", "PRESS") == t("NUMPAD_5", "PRESS") == ("type", "5")
+    assert t("PERIOD", "PRESS") == ("type", ".")
+    assert t("FIVE", "PRESS", ctrl=True) == ("ignore", None)
+    assert t("BACK_SPACE", "PRESS") == ("backspace", None)
+    assert t("L", "PRESS") == ("lam", 1)
+    assert t("L", "PRESS", shift=True) == ("lam", -1)
+    assert t("WHEELUPMOUSE", "PRESS", ctrl=True) == ("lam", 1)
+    assert t("WHEELDOWNMOUSE", "PRESS", ctrl=True) == ("lam", -1)
+    assert t("WHEELUPMOUSE", "PRESS") == t("MIDDLEMOUSE", "PRESS") == ("pass", None)
+    assert t("TRACKPADPAN", "NOTHING") == t("NDOF_MOTION", "NOTHING") == ("pass", None)
+    assert t("WINDOW_DEACTIVATE", "NOTHING")[0] == "cancel"
+
+
+def test_status_hint_icons_exist(drag):
+    icons = bpy.types.UILayout.bl_rna.functions["label"].parameters["icon"].enum_items.keys()
+    used = {icon for hint_icons, _ in drag.HINTS for icon in hint_icons}
+    assert used <= set(icons)
+
+
+def test_radius_is_shown_in_scene_units(drag, vg):
+    units = bpy.context.scene.unit_settings
+    units.system = "METRIC"
+    units.scale_length = 0.001
+    assert drag.format_length(bpy.context.scene, 2.5).replace(" ", "") == "2.5mm"
+    units.system = "NONE"
+    assert drag.format_length(bpy.context.scene, 0.4) == "0.4"
+
+
+def test_overlay_data_and_handler_lifecycle(vg, drag):
+    overlay_module = importlib.import_module(f"{vg.__name__}.ui.drag_overlay")
+    points = np.random.default_rng(0).normal(size=(50, 3))
+    data = overlay_module.patch_vertex_data(points, np.array([3, 1, 4]))
+    assert data.dtype == np.float32 and data.flags.c_contiguous and data.shape == (3, 3)
+    assert np.array_equal(data, points[[3, 1, 4]].astype(np.float32))
+    ring = overlay_module.circle_points([1, 2, 3], 0.5, [1, 0, 0], [0, 0, 1], segments=16)
+    assert ring.shape == (17, 3) and np.allclose(ring[0], ring[-1])
+    assert np.allclose(np.linalg.norm(ring - [1, 2, 3], axis=1), 0.5, atol=1e-6)
+    assert np.allclose(ring[:, 1], 2.0)
+    overlay = overlay_module.DragOverlay()
+    overlay.start()
+    handle = overlay.handle
+    overlay.start()  # once only
+    assert overlay.handle is handle
+    overlay.update([0, 0, 0], 0.5, data, labels=np.array([True, False, True]))
+    overlay.stop()
+    overlay.stop()
+    assert handler_removed(handle) and not overlay.active
+
+
+def test_tool_registers_in_the_toolbar(drag, view):
+    registered_here = not drag.tool_registered()  # the extension may have done it already
+    drag.register_tool()
+    drag.register_tool()  # a second call is a no-op
+    try:
+        bindings = {
+            (item.idname, item.type, item.value)
+            for config in bpy.context.window_manager.keyconfigs
+            for keymap in config.keymaps
+            if keymap.name.endswith(drag.VG_WT_measure_drag.bl_label)
+            for item in keymap.keymap_items
+        }
+        assert ("vg.measure_drag", "LEFTMOUSE", "PRESS") in bindings
+        assert bpy.ops.wm.tool_set_by_id(name=drag.TOOL_ID) == {"FINISHED"}
+        active = bpy.context.workspace.tools.from_space_view3d_mode("OBJECT")
+        assert active.idname == drag.TOOL_ID
+        bpy.ops.wm.tool_set_by_id(name="builtin.select_box")
+    finally:
+        if registered_here:
+            drag.unregister_tool()
+            assert not drag.tool_registered()

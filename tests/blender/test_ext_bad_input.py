@@ -1,0 +1,200 @@
+"""Bad input: a clear message (the operator's error report), never a traceback, and nothing changed."""
+
+import bpy
+import numpy as np
+import pytest
+from bpy_helpers import (
+    colours,
+    exact,
+    expected_colours,
+    local_points,
+    snapshot,
+    wedge_object,
+    world,
+)
+
+from vg_addon import Surface
+
+
+def measured_wedge():
+    """A wedge with one measurement already, so that 'nothing changed' has something to keep."""
+    obj = wedge_object(100.0)
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    return obj
+
+
+def assert_refused(match, **kwargs):
+    with pytest.raises(RuntimeError, match=match) as error:
+        bpy.ops.vg.measure_xyz(**kwargs)
+    assert "Traceback" not in str(error.value)
+
+
+def test_no_active_object(vg):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    bpy.context.view_layer.objects.active = None
+    assert_refused("No active object", location=(0, 0, 0), radius=0.5)
+    assert snapshot(obj) == before
+
+
+def test_not_a_mesh(vg):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    empty = bpy.data.objects.new("Empty", None)
+    bpy.context.scene.collection.objects.link(empty)
+    bpy.context.view_layer.objects.active = empty
+    assert_refused(
+        "'Empty' is not a mesh but an object of type EMPTY", location=(0, 0, 0), radius=0.5
+    )
+    curve = bpy.data.objects.new("Curve", bpy.data.curves.new("Curve", "CURVE"))
+    bpy.context.scene.collection.objects.link(curve)
+    bpy.context.view_layer.objects.active = curve
+    assert_refused("not a mesh", location=(0, 0, 0), radius=0.5)
+    assert snapshot(obj) == before
+
+
+def test_empty_mesh(vg):
+    obj = bpy.data.objects.new("Nothing", bpy.data.meshes.new("Nothing"))
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    before = snapshot(obj)
+    assert_refused("'Nothing' has no vertices", location=(0, 0, 0), radius=0.5)
+    assert snapshot(obj) == before
+
+
+def test_location_farther_than_the_radius(vg):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    assert_refused("farther than the radius", location=(0, 0, 5.0), radius=0.5)
+    assert snapshot(obj) == before
+
+
+def test_radius_too_small(vg):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    on_a_vertex = exact(obj.vg.measurements[0])["center"]
+    assert_refused("use a larger radius", location=on_a_vertex, radius=0.01)
+    assert snapshot(obj) == before
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"radius": 0.0}, "adius"),
+        ({"radius": float("nan")}, "adius"),
+        ({"lam": -1.0}, "λ|lam|SegParam"),
+        ({"patch": "spherical"}, "Unknown patch mode"),
+        ({"location": (np.inf, 0, 0)}, "entre|finite"),
+    ],
+)
+def test_bad_numbers_through_the_pipeline_function(vg, kwargs, match):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    args = {"location": (0, 0, 0), "radius": 0.5, "lam": 2.0, "patch": "euclidean"} | kwargs
+    with pytest.raises(vg.vg_addon.GoniometerError, match=match):
+        vg.operators.measuring.measure_on_object(obj, **args)
+    assert snapshot(obj) == before
+
+
+def test_edit_mode(vg):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    bpy.ops.object.mode_set(mode="EDIT")
+    try:
+        assert_refused("Edit Mode", location=(0, 0, 0), radius=0.5)
+    finally:
+        bpy.ops.object.mode_set(mode="OBJECT")
+    assert snapshot(obj) == before
+
+
+def test_linked_data_is_read_only(vg, tmp_path):
+    wedge_object(100.0, "Linked wedge")
+    library = tmp_path / "library.blend"
+    bpy.data.libraries.write(str(library), {bpy.data.objects["Linked wedge"]})
+    bpy.ops.wm.read_homefile(use_empty=True)
+    with bpy.data.libraries.load(str(library), link=True) as (_source, target):
+        target.objects = ["Linked wedge"]
+    obj = target.objects[0]
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    assert obj.library is not None
+    assert_refused("is linked from .*library.blend.*Make Local", location=(0, 0, 0), radius=0.5)
+    assert len(obj.vg.measurements) == 0
+    assert colours(obj) is None
+
+
+def edit_a_vertex(obj):
+    co = local_points(obj).copy()
+    co[0] += 0.01
+    obj.data.vertices.foreach_set("co", co.ravel())
+    obj.data.update()
+    bpy.context.view_layer.update()
+
+
+def test_stale_measurement_is_kept_but_not_painted(vg, capfd):
+    obj = measured_wedge()
+    first = exact(obj.vg.measurements[0])
+    edit_a_vertex(obj)
+    bpy.ops.vg.repaint()
+    assert "Measurement(s) 1 of 'Wedge' are stale" in capfd.readouterr().out
+    item = obj.vg.measurements[0]
+    assert item.stale and exact(item) == first  # numbers kept as recorded
+    grey = np.asarray(vg.vg_addon.palette.neutral_linear(), dtype=np.float32)
+    assert (colours(obj) == grey).all()  # not mis-coloured on the changed mesh
+
+    # A new measurement on the edited mesh is painted; the stale one still is not.
+    bpy.ops.vg.measure_xyz(location=(0.2, 0, 0), radius=0.4)
+    assert "are stale" in capfd.readouterr().out
+    surface = Surface(world(local_points(obj), obj), _triangles(obj))
+    m = surface.measure([0.2, 0, 0], 0.4)
+    np.testing.assert_array_equal(
+        colours(obj), expected_colours(vg, len(obj.data.vertices), [(m.indices, m.labels, 1)])
+    )
+    assert [i.stale for i in obj.vg.measurements] == [True, False]
+
+    # Putting the vertex back makes the first measurement valid again, and the second stale.
+    co = local_points(obj).copy()
+    co[0] -= 0.01
+    obj.data.vertices.foreach_set("co", co.ravel())
+    obj.data.update()
+    bpy.ops.vg.repaint()
+    assert [i.stale for i in obj.vg.measurements] == [False, True]
+
+
+def test_edits_are_noticed_without_running_an_operator(vg):
+    """A handler notes edited objects; a timer (which needs Blender's event loop, so it is
+    called by hand here) then flags their stale measurements and repaints."""
+    watch = vg.operators.watch
+    obj = measured_wedge()
+    assert not watch.refresh(obj)  # nothing to do yet
+    edit_a_vertex(obj)
+    assert "Wedge" in watch._pending
+    watch._check_pending()
+    assert obj.vg.measurements[0].stale
+    grey = np.asarray(vg.vg_addon.palette.neutral_linear(), dtype=np.float32)
+    assert (colours(obj) == grey).all()
+    assert not watch.refresh(obj)
+
+
+def test_moving_the_object_makes_measurements_stale(vg):
+    obj = measured_wedge()
+    obj.location.x += 1.0
+    bpy.context.view_layer.update()
+    bpy.ops.vg.repaint()
+    assert obj.vg.measurements[0].stale
+
+
+def _triangles(obj):
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", tris)
+    return tris.reshape(-1, 3)
+
+
+def test_delete_with_nothing_selected(vg):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    with pytest.raises(RuntimeError, match="no measurement at list position 5"):
+        bpy.ops.vg.delete_measurement(index=5)
+    assert snapshot(obj) == before

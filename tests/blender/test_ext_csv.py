@@ -1,0 +1,229 @@
+"""CSV export and import (replication): the MeshLab header, bit-identical angles, all or nothing."""
+
+import csv
+import tomllib
+
+import bpy
+import pytest
+from bpy_helpers import exact, snapshot, wedge_object
+from conftest import ROOT
+
+from vg_addon import csvio
+
+with open(ROOT / "blender_manifest.toml", "rb") as _handle:
+    MANIFEST = tomllib.load(_handle)
+
+MESHLAB_HEADER = (
+    "Mesh Name,Date,Measurement #,Break #,Colors,User Data,Angle,Number of Vertices,Radius,"
+    "x,y,z,fit,SegParam"
+)
+
+
+def measured_wedge(name="Wedge", angle=100.0):
+    obj = wedge_object(angle, name)
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5, note="=SUM(A1)")
+    bpy.ops.vg.measure_xyz(location=(0.3, 0.01, 0), radius=0.35, seg_param=1.5)
+    bpy.ops.vg.next_break()
+    bpy.ops.vg.measure_xyz(location=(-0.3, 0.05, 0), radius=0.4, patch="geodesic")
+    return obj
+
+
+def read_rows(path):
+    with open(path, newline="", encoding="utf-8") as handle:
+        return list(csv.reader(handle))
+
+
+def test_export_starts_with_the_meshlab_columns(vg, tmp_path):
+    obj = measured_wedge()
+    path = tmp_path / "out.csv"
+    assert bpy.ops.vg.export_csv(filepath=str(path)) == {"FINISHED"}
+    header, *rows = read_rows(path)
+    assert ",".join(header[:14]) == MESHLAB_HEADER
+    assert tuple(header) == csvio.EXPORT_COLUMNS
+    assert len(rows) == 3
+    exported = csvio.read_measurements_csv(path)
+    for row, item in zip(exported, obj.vg.measurements, strict=True):
+        numbers = exact(item)
+        assert row.mesh_name == "Wedge"
+        assert (row.number, row.break_number) == (item.number, item.break_number)
+        assert row.angle == numbers["angle"] and row.radius == numbers["radius"]
+        assert [row.x, row.y, row.z] == numbers["center"]
+        assert row.seg_param == numbers["lam"] and row.patch == item.patch
+        assert (row.n_vertices, row.n_plus, row.n_minus) == (
+            item.n_vertices,
+            item.n_plus,
+            item.n_minus,
+        )
+        assert list(row.normal_plus) == numbers["normal_plus"]
+        assert row.stale is False
+        assert row.blender_version == bpy.app.version_string
+        assert row.extension_version == MANIFEST["version"]
+        assert row.units
+    assert exported[0].user_data == "=SUM(A1)"
+    assert rows[0][5] == "'=SUM(A1)"  # the spreadsheet sees text, not a formula
+    assert exported[2].colors == csvio.format_colors("vermillion/sky blue")
+
+
+def test_export_then_import_replicates_exactly(vg, tmp_path):
+    obj = measured_wedge()
+    path = tmp_path / "out.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    bpy.ops.vg.import_csv(filepath=str(path))
+    assert len(obj.vg.measurements) == 6
+    originals, replicas = obj.vg.measurements[:3], obj.vg.measurements[3:]
+    spread = 0.0
+    for original, replica in zip(originals, replicas, strict=True):
+        a, b = exact(original), exact(replica)
+        spread = max(spread, abs(a["angle"] - b["angle"]))
+        for key in ("angle", "fit", "radius", "lam", "center", "normal_plus", "normal_minus"):
+            assert a[key] == b[key], key
+        assert replica.patch == original.patch
+        assert replica.break_number == original.break_number
+        assert replica.n_vertices == original.n_vertices
+    assert spread == 0.0
+    assert [m.number for m in replicas] == [4, 5, 6]
+    assert replicas[0].note == "=SUM(A1)"
+
+
+def test_export_all_objects(vg, tmp_path):
+    measured_wedge("A")
+    measured_wedge("B", angle=70.0)
+    wedge_object(50.0, "Unmeasured")
+    path = tmp_path / "all.csv"
+    bpy.ops.vg.export_csv(filepath=str(path), all_objects=True)
+    names = [row.mesh_name for row in csvio.read_measurements_csv(path)]
+    assert names == ["A"] * 3 + ["B"] * 3
+    only = tmp_path / "active.csv"
+    with pytest.raises(RuntimeError, match="'Unmeasured' has no measurements"):
+        bpy.ops.vg.export_csv(filepath=str(only))  # the active object: the last one made
+    assert not only.exists()
+
+
+def test_export_marks_stale_measurements(vg, tmp_path):
+    obj = measured_wedge()
+    obj.location.z += 1.0
+    bpy.context.view_layer.update()
+    path = tmp_path / "stale.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    assert [row.stale for row in csvio.read_measurements_csv(path)] == [True] * 3
+
+
+def write(path, text):
+    path.write_text(text, encoding="utf-8")
+    return str(path)
+
+
+def meshlab_row(obj_name, x, y, z, radius, lam, number=1, break_number=1, fit="0.001"):
+    return (
+        f"{obj_name},2019-05-03 10:12,{number},{break_number},red/blue,,95.1,400,{radius},"
+        f"{x},{y},{z},{fit},{lam}"
+    )
+
+
+@pytest.mark.parametrize("fit", ["0.0012", "fill"], ids=["meshlab", "earlier-blender-add-on"])
+def test_import_meshlab_and_earlier_add_on_files(vg, tmp_path, fit):
+    obj = wedge_object(100.0)
+    text = "\n".join(
+        [
+            MESHLAB_HEADER,
+            meshlab_row("Wedge.ply", 0.0, 0.0, 0.0, 0.5, 2, fit=fit),
+            meshlab_row("Wedge.ply", 0.3, 0.0, 0.0, 0.3, 1.5, number=2, break_number=2, fit=fit),
+        ]
+    )
+    bpy.ops.vg.import_csv(filepath=write(tmp_path / "meshlab.csv", text))
+    first, second = obj.vg.measurements
+    assert exact(first)["radius"] == 0.5 and exact(first)["lam"] == 2.0
+    assert exact(second)["requested"] == [0.3, 0.0, 0.0] and second.break_number == 2
+    bpy.ops.vg.measure_xyz(location=(0.3, 0.0, 0.0), radius=0.3, seg_param=1.5)
+    assert exact(obj.vg.measurements[2])["angle"] == exact(second)["angle"]
+
+
+def test_import_plain_points_takes_the_panel_settings(vg, tmp_path):
+    obj = wedge_object(100.0)
+    bpy.context.scene.vg_settings.radius = 0.45
+    bpy.ops.vg.import_csv(filepath=write(tmp_path / "p.csv", "x,y,z\n0,0,0\n0.2,0,0\n"))
+    assert [exact(m)["radius"] for m in obj.vg.measurements] == [0.45, 0.45]
+
+
+BAD_CSVS = {
+    "missing column": (
+        "Mesh Name,Radius,x,y\nWedge,0.5,0,0\n",
+        r"missing the required column\(s\) z",
+    ),
+    "garbage row": (
+        "Mesh Name,Radius,x,y,z\nWedge,0.5,0,0,0\nWedge,0.5,abc,0,0\nWedge,zero,0,0,0\n",
+        r"row 3: x is not a number(.|\n)*row 4: Radius is not a number",
+    ),
+    "another mesh": (
+        "Mesh Name,Radius,x,y,z\nWedge,0.5,0,0,0\nFemur_12.ply,0.5,0,0,0\n",
+        r"row\(s\) of 'bad.csv' name another mesh than 'Wedge': rows 3 \('Femur_12.ply'\)",
+    ),
+    "semicolon delimiter": (
+        "Mesh Name;Radius;x;y;z\nWedge;0,5;0;0;0\n",
+        r"(;|delimiter|semicolon)",
+    ),
+    "row off the surface": (
+        "Mesh Name,Radius,x,y,z\nWedge,0.5,0,0,0\nWedge,0.5,0,0,7\nWedge,0.001,{x!r},{y!r},{z!r}\n",
+        r"2 of 3 rows(.|\n)*row 3: .*farther than(.|\n)*row 4: .*larger radius",
+    ),
+    "empty file": ("", r"empty"),
+    "header only": ("x,y,z\n", r"no data rows"),
+}
+
+
+@pytest.mark.parametrize("case", BAD_CSVS)
+def test_bad_csv_is_refused_with_row_numbers_and_nothing_changes(vg, tmp_path, case):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    text, message = BAD_CSVS[case]
+    x, y, z = exact(obj.vg.measurements[0])["center"]  # on a vertex: only the radius is wrong
+    text = text.format(x=x, y=y, z=z)
+    with pytest.raises(RuntimeError, match=message):
+        bpy.ops.vg.import_csv(filepath=write(tmp_path / "bad.csv", text))
+    assert snapshot(obj) == before
+
+
+def test_missing_file(vg, tmp_path):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    with pytest.raises(RuntimeError, match="Could not read"):
+        bpy.ops.vg.import_csv(filepath=str(tmp_path / "nowhere.csv"))
+    assert snapshot(obj) == before
+
+
+def test_ignore_mesh_names(vg, tmp_path):
+    source = measured_wedge("Original")
+    path = tmp_path / "original.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    copy = wedge_object(100.0, "Copy")
+    with pytest.raises(RuntimeError, match="name another mesh"):
+        bpy.ops.vg.import_csv(filepath=str(path))
+    bpy.ops.vg.import_csv(filepath=str(path), ignore_mesh_names=True)
+    assert [exact(m)["angle"] for m in copy.vg.measurements] == [
+        exact(m)["angle"] for m in source.vg.measurements
+    ]
+
+
+def test_export_with_nothing_to_export(vg, tmp_path):
+    wedge_object(100.0)
+    with pytest.raises(RuntimeError, match="'Wedge' has no measurements to export"):
+        bpy.ops.vg.export_csv(filepath=str(tmp_path / "x.csv"))
+    with pytest.raises(RuntimeError, match="No object in this scene has measurements"):
+        bpy.ops.vg.export_csv(filepath=str(tmp_path / "x.csv"), all_objects=True)
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_export_to_a_missing_folder(vg, tmp_path):
+    measured_wedge()
+    with pytest.raises(RuntimeError, match=r"folder .* does not exist.*was not written"):
+        bpy.ops.vg.export_csv(filepath=str(tmp_path / "no such folder" / "x.csv"))
+
+
+def test_a_damaged_record_is_reported_not_crashed_on(vg, tmp_path):
+    obj = measured_wedge()
+    obj.vg.measurements[1].exact = '{"angle": 1.0}'  # e.g. edited by a script
+    bpy.ops.vg.repaint()
+    assert [m.stale for m in obj.vg.measurements] == [False, True, False]
+    with pytest.raises(RuntimeError, match="Measurement 2 has lost its stored numbers"):
+        bpy.ops.vg.export_csv(filepath=str(tmp_path / "x.csv"))
+    assert not (tmp_path / "x.csv").exists()

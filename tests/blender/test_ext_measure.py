@@ -1,0 +1,290 @@
+"""bpy.ops.vg.measure_xyz against the core: same world-space inputs, bit-identical numbers."""
+
+import bpy
+import numpy as np
+import pytest
+from bpy_helpers import (
+    COLOUR_ATTRIBUTE,
+    colours,
+    exact,
+    expected_colours,
+    local_points,
+    mesh_object,
+    wedge_object,
+    world,
+)
+
+from vg_addon import Surface
+
+
+def triangles_of(obj) -> np.ndarray:
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", tris)
+    return tris.reshape(-1, 3).astype(np.int64)
+
+
+def core_surface(obj) -> Surface:
+    """The core's Surface of the object's own mesh, in world space, built here independently."""
+    tris = triangles_of(obj)
+    if np.linalg.det(np.array(obj.matrix_world)[:3, :3]) < 0:
+        tris = tris[:, ::-1]
+    return Surface(world(local_points(obj), obj), tris)
+
+
+def assert_same(item, m):
+    """The recorded item holds exactly the core measurement ``m``."""
+    numbers = exact(item)
+    assert numbers["angle"] == m.angle
+    assert numbers["fit"] == m.fit_error
+    assert numbers["fit_plus"] == m.fit_error_plus
+    assert numbers["fit_minus"] == m.fit_error_minus
+    assert numbers["radius"] == m.radius
+    assert numbers["lam"] == m.lam
+    assert numbers["center"] == m.center.tolist()
+    assert numbers["requested"] == m.requested_center.tolist()
+    assert numbers["normal_plus"] == m.normal_plus.tolist()
+    assert numbers["normal_minus"] == m.normal_minus.tolist()
+    assert numbers["snap_distance"] == m.snap_distance
+    assert (item.n_vertices, item.n_plus, item.n_minus) == (m.n_vertices, m.n_plus, m.n_minus)
+    assert item.patch == m.patch
+    assert not item.stale
+
+
+@pytest.mark.parametrize("angle", [30.0, 90.0, 121.5, 160.0])
+def test_wedge_angle_matches_core_bit_for_bit(vg, angle):
+    obj = wedge_object(angle)
+    bpy.ops.vg.measure_xyz(location=(0.01, -0.02, 0.0), radius=0.5, seg_param=2.0)
+    item = obj.vg.measurements[0]
+    m = core_surface(obj).measure([0.01, -0.02, 0.0], 0.5, 2.0)
+    assert_same(item, m)
+    assert abs(item.angle - obj["true_angle"]) < 0.01
+    assert (item.number, item.break_number) == (1, 1)
+    assert item.date and item.colors == "orange/blue"
+
+
+def test_typed_values_are_kept_as_typed(vg):
+    """Operator properties are float32; 0.3 must be measured and recorded as the float64 0.3."""
+    obj = wedge_object(75.0)
+    bpy.ops.vg.measure_xyz(location=(0.1, 0.2, 0.0), radius=0.3, seg_param=1.7)
+    numbers = exact(obj.vg.measurements[0])
+    assert numbers["radius"] == 0.3
+    assert numbers["lam"] == 1.7
+    assert numbers["requested"] == [0.1, 0.2, 0.0]
+
+
+def test_defaults_come_from_the_cursor_and_the_panel(vg):
+    obj = wedge_object(100.0)
+    scene = bpy.context.scene
+    scene.cursor.location = (0.05, 0.1, 0.0)
+    scene.vg_settings.radius = 0.45
+    scene.vg_settings.seg_param = 3.0
+    scene.vg_settings.patch = "geodesic"
+    bpy.ops.vg.measure_xyz()
+    item = obj.vg.measurements[0]
+    numbers = exact(item)
+    assert numbers["requested"] == [0.05, 0.1, 0.0]
+    assert (numbers["radius"], numbers["lam"], item.patch) == (0.45, 3.0, "geodesic")
+    assert_same(item, core_surface(obj).measure([0.05, 0.1, 0.0], 0.45, 3.0, "geodesic"))
+
+
+def test_reports_the_angle(vg, capfd):
+    obj = wedge_object(60.0)
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    out = capfd.readouterr()
+    angle = obj.vg.measurements[0].angle
+    assert f"{angle:.2f}°" in out.out + out.err
+
+
+def test_colour_attribute_paints_the_sides_and_spares_the_users_colours(vg):
+    obj = wedge_object(80.0)
+    mine = obj.data.color_attributes.new("Scan colour", "BYTE_COLOR", "CORNER")
+    rng = np.random.default_rng(1)
+    before = rng.random(len(mine.data) * 4).astype(np.float32)
+    mine.data.foreach_set("color", before)
+    before = np.empty_like(before)
+    obj.data.color_attributes["Scan colour"].data.foreach_get("color", before)
+
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.4)
+    bpy.ops.vg.next_break()
+    bpy.ops.vg.measure_xyz(location=(0.3, 0.0, 0.0), radius=0.3)
+    surface = core_surface(obj)
+    first = surface.measure([0, 0, 0], 0.4)
+    second = surface.measure([0.3, 0, 0], 0.3)
+
+    attribute = obj.data.color_attributes[COLOUR_ATTRIBUTE]
+    assert (attribute.domain, attribute.data_type) == ("POINT", "FLOAT_COLOR")
+    assert obj.data.color_attributes.active_color_name == COLOUR_ATTRIBUTE
+    n = len(obj.data.vertices)
+    expected = expected_colours(
+        vg, n, [(first.indices, first.labels, 1), (second.indices, second.labels, 2)]
+    )
+    np.testing.assert_array_equal(colours(obj), expected)
+    assert obj.vg.measurements[1].colors == "vermillion/sky blue"
+
+    after = np.empty_like(before)
+    obj.data.color_attributes["Scan colour"].data.foreach_get("color", after)
+    np.testing.assert_array_equal(after, before)
+
+
+def test_viewports_show_attribute_colours(vg):
+    wedge_object(90.0)
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    spaces = [
+        space
+        for window in bpy.context.window_manager.windows
+        for area in window.screen.areas
+        if area.type == "VIEW_3D"
+        for space in area.spaces
+        if space.type == "VIEW_3D" and space.shading.type == "SOLID"
+    ]
+    if not spaces:
+        pytest.skip("this bpy session has no solid-shaded 3D viewport")
+    assert all(space.shading.color_type == "VERTEX" for space in spaces)
+
+
+def test_non_uniform_scale_rotation_and_translation_are_honoured(vg):
+    obj = wedge_object(
+        60.0, location=(3.0, -1.0, 2.0), rotation=(0.3, 0.2, 1.1), scale=(2.0, 0.5, 1.3)
+    )
+    centre = world(np.zeros((1, 3)), obj)[0]
+    bpy.ops.vg.measure_xyz(location=centre.tolist(), radius=0.6)
+    item = obj.vg.measurements[0]
+    typed = [float(str(np.float32(v))) for v in centre]
+    m = core_surface(obj).measure(typed, 0.6)
+    assert_same(item, m)
+    # The non-uniform scale changes the angle: measuring the object-space mesh would be wrong.
+    unscaled = Surface(local_points(obj), triangles_of(obj)).measure([0, 0, 0], 0.6)
+    assert abs(unscaled.angle - m.angle) > 1.0
+
+
+def test_mirrored_object_keeps_outward_normals(vg):
+    plain = wedge_object(110.0, "Plain")
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    mirrored = wedge_object(110.0, "Mirrored", scale=(-1.0, 1.0, 1.0))
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    a, b = plain.vg.measurements[0], mirrored.vg.measurements[0]
+    assert abs(a.angle - b.angle) < 1e-9
+    assert_same(b, core_surface(mirrored).measure([0, 0, 0], 0.5))
+
+
+def evaluated_surface(obj) -> Surface:
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    mesh.calc_loop_triangles()
+    tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", tris)
+    obj_eval.to_mesh_clear()
+    return Surface(world(co.reshape(-1, 3), obj), tris.reshape(-1, 3))
+
+
+def test_deforming_modifier_is_applied(vg):
+    obj = wedge_object(95.0)
+    modifier = obj.modifiers.new("Displace", "DISPLACE")
+    modifier.strength = 0.05
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    item = obj.vg.measurements[0]
+    surface = evaluated_surface(obj)
+    assert not np.array_equal(surface.points, world(local_points(obj), obj))
+    m = surface.measure([0, 0, 0], 0.5)
+    assert_same(item, m)
+    np.testing.assert_array_equal(
+        colours(obj), expected_colours(vg, len(obj.data.vertices), [(m.indices, m.labels, 1)])
+    )
+
+
+def test_subdivision_modifier_is_applied(vg):
+    obj = wedge_object(70.0, n=20)
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    modifier = obj.modifiers.new("Subdivision", "SUBSURF")
+    modifier.subdivision_type = "SIMPLE"
+    modifier.levels = 1
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    plain, subdivided = obj.vg.measurements
+    m = evaluated_surface(obj).measure([0, 0, 0], 0.5)
+    assert_same(subdivided, m)
+    assert subdivided.n_vertices > plain.n_vertices
+    assert plain.stale  # the evaluated mesh changed under it
+    # Every original vertex inside the patch is painted with one of the pair's colours.
+    rgba = colours(obj)
+    offsets = world(local_points(obj), obj) - m.center
+    inside = np.einsum("ij,ij->i", offsets, offsets) <= 0.5 * 0.5
+    grey = np.asarray(vg.vg_addon.palette.neutral_linear(), dtype=np.float32)
+    assert not (rgba[inside] == grey).all(axis=1).any()
+    assert (rgba[~inside] == grey).all()
+
+
+def test_geodesic_patch(vg):
+    obj = wedge_object(85.0)
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5, patch="geodesic")
+    assert_same(obj.vg.measurements[0], core_surface(obj).measure([0, 0, 0], 0.5, patch="geodesic"))
+
+
+def test_measure_on_object_keeps_float64_inputs_exactly(vg):
+    """The pipeline function other tools call takes float64 as it is."""
+    from vg_addon.synth import wedge
+
+    shape = wedge(88.0, n=30, irregular=True)
+    obj = mesh_object("Exact", shape.points, shape.triangles, location=(0.1, 0.2, 0.3))
+    location = world(np.zeros((1, 3)), obj)[0] + 1e-9  # on the edge, between vertices
+    item = vg.operators.measuring.measure_on_object(obj, location, 0.123456789, 1.5, note="hi")
+    m = core_surface(obj).measure(location, 0.123456789, 1.5)
+    assert_same(item, m)
+    assert item.note == "hi"
+
+
+# Reference meshes ---------------------------------------------------------------------------
+
+TOP, OUTER = 4, 2
+
+
+def reference_object(path):
+    from vg_addon.meshio import read_mesh
+
+    mesh = read_mesh(path)
+    return mesh, mesh_object(path.stem, mesh.points, mesh.triangles)
+
+
+def test_half_annulus_right_angle(vg, shared_data):
+    mesh, obj = reference_object(shared_data / "HalfAnnulus.ply")
+    labels = np.load(shared_data / "HalfAnnulus_Labels.npz")["labels"]
+    corner = labels[mesh.triangles]
+    straddling = (corner == TOP).any(axis=1) & (corner == OUTER).any(axis=1)
+    vertices = np.unique(mesh.triangles[straddling])
+    middle = np.median(mesh.points[vertices], axis=0)
+    centre = mesh.points[
+        vertices[np.argmin(np.linalg.norm(mesh.points[vertices] - middle, axis=1))]
+    ]
+    item = vg.operators.measuring.measure_on_object(obj, centre, 0.4)
+    assert_same(item, core_surface(obj).measure(centre, 0.4))
+    assert abs(item.angle - 90.0) < 10.0
+
+
+def test_intersecting_spheres_rim(vg, shared_data):
+    _, obj = reference_object(shared_data / "IntersectingSpheres.ply")
+    points = world(local_points(obj), obj)
+    centred = points - points.mean(axis=0)
+    axis = np.linalg.svd(centred, full_matrices=False)[2][2]
+    radial = np.linalg.norm(centred - np.outer(centred @ axis, axis), axis=1)
+    centre = points[np.argmax(radial)]
+    radius = 0.06 * float(np.ptp(points, axis=0).max())
+    item = vg.operators.measuring.measure_on_object(obj, centre, radius)
+    assert_same(item, core_surface(obj).measure(centre, radius))
+    assert abs(item.angle - 70.53) < 5.0
+
+
+def test_sample_bone_scan(vg, shared_data):
+    _, obj = reference_object(shared_data / "sample_mesh.ply")
+    points = world(local_points(obj), obj)
+    # The vertex farthest along the scan's long axis is on its broken end.
+    centred = points - points.mean(axis=0)
+    axis = np.linalg.svd(centred, full_matrices=False)[2][0]
+    centre = points[np.argmax(centred @ axis)]
+    radius = 0.05 * float(np.ptp(points, axis=0).max())
+    item = vg.operators.measuring.measure_on_object(obj, centre, radius)
+    assert_same(item, core_surface(obj).measure(centre, radius))
+    assert 0.0 < item.angle < 180.0

@@ -1,0 +1,200 @@
+"""Algorithm 1 on synthetic wedges of known angle, invariances, reproducibility and errors."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from vg_addon.synth import wedge
+
+from vg_addon import GoniometerError, Surface, goniometer
+
+ANGLES = [5, 10, 20, 30, 45, 60, 75, 90, 105, 120, 135, 150, 165, 170, 175]
+
+
+def random_rotation(seed):
+    q, r = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q
+
+
+@pytest.mark.parametrize("irregular", [False, True])
+@pytest.mark.parametrize("angle", ANGLES)
+def test_wedges_measure_their_angle(angle, irregular):
+    mesh = wedge(angle, n=60, irregular=irregular, seed=angle)
+    m = Surface(mesh.points, mesh.triangles).measure([0.0, 0.0, 0.0], radius=0.5)
+    assert m.angle == pytest.approx(angle, abs=0.5)
+    assert m.n_plus + m.n_minus == m.n_vertices == m.indices.size
+    assert min(m.n_plus, m.n_minus) >= 3
+
+
+@pytest.mark.parametrize("angle", [15, 20, 30, 45, 60, 90])
+def test_unbalanced_sides_do_not_flip_a_plane(angle):
+    """The per-side orientation rule: a sharp wedge with unequal sides must not read 180 - angle.
+
+    The paper's literal rule orients both plane normals by the global mean normal, which leans to
+    the larger side; on these patches it flips one plane for the sharp angles.
+    """
+    mesh = wedge(angle, n=60, imbalance=0.3, seed=3)
+    m = Surface(mesh.points, mesh.triangles).measure([0.0, 0.0, 0.0], radius=0.6)
+    assert m.angle == pytest.approx(angle, abs=0.5)
+    assert m.n_plus < 0.75 * m.n_minus or m.n_minus < 0.75 * m.n_plus
+    literal_sign = np.sign(m.mean_normal @ m.normal_plus) * np.sign(m.mean_normal @ m.normal_minus)
+    literal = 180 - np.degrees(np.arccos(literal_sign * (m.normal_plus @ m.normal_minus)))
+    if angle <= 45:
+        assert literal == pytest.approx(180 - angle, abs=0.5)
+
+
+def test_segmentation_matches_the_true_sides():
+    mesh = wedge(60, n=60, irregular=True, seed=7)
+    m = Surface(mesh.points, mesh.triangles).measure([0.1, 0.0, 0.0], radius=0.5)
+    side = mesh.side[m.indices]
+    off_crease = side != 0
+    plus_side = side[m.labels & off_crease]
+    minus_side = side[~m.labels & off_crease]
+    assert np.unique(plus_side).size == 1
+    assert np.unique(minus_side).size == 1
+    assert plus_side[0] != minus_side[0]
+
+
+def test_goniometer_on_a_given_patch_matches_surface_measure():
+    mesh = wedge(70, n=50)
+    surface = Surface(mesh.points, mesh.triangles)
+    m = surface.measure([0.0, 0.0, 0.0], radius=0.5)
+    direct = goniometer(
+        surface.points[m.indices], surface.normals[m.indices], lam=2.0, center=m.center, radius=0.5
+    )
+    assert direct.angle == m.angle
+    assert np.array_equal(direct.labels, m.labels)
+    assert direct.patch == "given"
+
+
+def test_same_call_twice_is_bit_identical():
+    mesh = wedge(83, n=60, irregular=True, seed=11)
+    surface = Surface(mesh.points, mesh.triangles)
+    a = surface.measure([0.05, 0.01, 0.0], 0.45)
+    b = surface.measure([0.05, 0.01, 0.0], 0.45)
+    c = Surface(mesh.points, mesh.triangles).measure([0.05, 0.01, 0.0], 0.45)
+    for other in (b, c):
+        assert other.angle == a.angle
+        assert other.fit_error == a.fit_error
+        assert np.array_equal(other.indices, a.indices)
+        assert np.array_equal(other.normal_plus, a.normal_plus)
+
+
+def test_vertex_order_changes_nothing():
+    mesh = wedge(48, n=50, irregular=True, seed=5)
+    permutation = np.random.default_rng(0).permutation(len(mesh.points))
+    inverse = np.argsort(permutation)
+    a = Surface(mesh.points, mesh.triangles).measure([0.0, 0.0, 0.0], 0.5)
+    b = Surface(mesh.points[permutation], inverse[mesh.triangles]).measure([0.0, 0.0, 0.0], 0.5)
+    assert b.angle == a.angle
+    assert b.fit_error == a.fit_error
+    assert np.array_equal(permutation[b.indices], a.indices)
+    assert np.array_equal(b.labels, a.labels)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_rigid_motion_and_scale_change_the_angle_by_less_than_1e7(seed):
+    mesh = wedge(37 + 25 * seed, n=50, irregular=True, seed=seed)
+    center = np.array([0.03, 0.0, 0.0])
+    base = Surface(mesh.points, mesh.triangles).measure(center, 0.5)
+    rotation = random_rotation(seed)
+    shift = np.random.default_rng(seed).normal(size=3) * 100
+    scale = 10.0 ** np.random.default_rng(seed + 9).uniform(-2, 2)
+    moved = Surface(scale * mesh.points @ rotation.T + shift, mesh.triangles)
+    m = moved.measure(scale * rotation @ center + shift, 0.5 * scale)
+    assert abs(m.angle - base.angle) < 1e-7
+    assert m.n_vertices == base.n_vertices
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    angle=st.floats(8, 172),
+    n=st.integers(30, 70),
+    noise=st.floats(0, 0.004),
+    seed=st.integers(0, 10_000),
+)
+def test_random_noisy_wedges(angle, n, noise, seed):
+    mesh = wedge(angle, n=n, irregular=True, seed=seed)
+    rng = np.random.default_rng(seed)
+    points = mesh.points + rng.normal(scale=noise, size=mesh.points.shape)
+    m = Surface(points, mesh.triangles).measure([0.0, 0.0, 0.0], radius=0.5)
+    assert np.isfinite(m.angle) and 0 < m.angle < 180
+    tolerance = 0.5 + 600 * noise  # noise tilts the fitted planes; clean wedges stay within 0.5°
+    assert m.angle == pytest.approx(angle, abs=tolerance)
+    assert m.fit_error >= 0
+
+
+def test_obtuse_angles_are_not_folded():
+    for angle in (95, 120, 150, 170):
+        mesh = wedge(angle, n=60)
+        m = Surface(mesh.points, mesh.triangles).measure([0, 0, 0], 0.5)
+        assert m.angle > 90
+
+
+class TestErrors:
+    def setup_method(self):
+        mesh = wedge(90, n=40)
+        self.surface = Surface(mesh.points, mesh.triangles)
+
+    @pytest.mark.parametrize("radius", [0, -1, float("nan"), float("inf"), "abc"])
+    def test_bad_radius(self, radius):
+        with pytest.raises(GoniometerError, match="radius"):
+            self.surface.measure([0, 0, 0], radius)
+
+    @pytest.mark.parametrize("lam", [-1, float("nan")])
+    def test_bad_lambda(self, lam):
+        with pytest.raises(GoniometerError, match="λ"):
+            self.surface.measure([0, 0, 0], 0.5, lam=lam)
+
+    def test_centre_off_the_surface(self):
+        with pytest.raises(GoniometerError, match="farther than the radius"):
+            self.surface.measure([0, 0, 5], 0.5)
+
+    def test_too_small_radius(self):
+        with pytest.raises(GoniometerError, match="larger radius"):
+            self.surface.measure([0, 0, 0], 0.03)
+
+    def test_unknown_patch_mode(self):
+        with pytest.raises(GoniometerError, match="euclidean"):
+            self.surface.measure([0, 0, 0], 0.5, patch="manhattan")
+
+    def test_flat_patch_is_refused_not_180(self):
+        mesh = wedge(90, n=40)
+        surface = Surface(mesh.points, mesh.triangles)
+        with pytest.raises(GoniometerError, match="break edge"):
+            surface.measure(mesh.points[np.argmax(mesh.points[:, 1])] * 0.8, 0.1)
+
+    def test_non_finite_points(self):
+        mesh = wedge(90, n=20)
+        points = mesh.points.copy()
+        points[3] = np.nan
+        with pytest.raises(GoniometerError, match="not finite"):
+            Surface(points, mesh.triangles)
+
+    def test_non_finite_normals(self):
+        mesh = wedge(90, n=20)
+        normals = np.ones_like(mesh.points)
+        normals[0, 1] = np.inf
+        with pytest.raises(GoniometerError, match="not finite"):
+            goniometer(mesh.points, normals)
+
+    def test_mismatched_normals(self):
+        with pytest.raises(GoniometerError, match="one normal per point"):
+            goniometer(np.zeros((10, 3)), np.ones((9, 3)))
+
+    def test_empty_mesh(self):
+        with pytest.raises(GoniometerError, match="empty"):
+            Surface(np.zeros((0, 3)))
+
+    def test_triangle_index_out_of_range(self):
+        with pytest.raises(GoniometerError, match="does not match"):
+            Surface(np.zeros((3, 3)), [[0, 1, 7]])
+
+    def test_collinear_side(self):
+        points = np.array([[x, 0.0, 0.0] for x in range(5)] + [[0, y, 1.0] for y in range(5)])
+        normals = np.array([[0, 0, 1.0]] * 5 + [[1.0, 0, 0]] * 5)
+        with pytest.raises(GoniometerError, match="line"):
+            goniometer(points, normals)

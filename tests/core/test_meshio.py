@@ -1,0 +1,549 @@
+"""Mesh file readers: reference meshes, every PLY flavour, OBJ and STL variants, and errors.
+
+The PLY files here are written by a small independent writer (struct / text), not by
+``write_ply``, so the reader is checked against the format and not against itself.
+"""
+
+import struct
+
+import numpy as np
+import pytest
+
+from vg_addon import GoniometerError
+from vg_addon.meshio import MeshData, read_mesh, write_ply
+
+STRUCT_CODES = {
+    "char": "b", "int8": "b", "uchar": "B", "uint8": "B", "short": "h", "int16": "h",
+    "ushort": "H", "uint16": "H", "int": "i", "int32": "i", "uint": "I", "uint32": "I",
+    "float": "f", "float32": "f", "double": "d", "float64": "d",
+}  # fmt: skip
+NUMPY_TYPES = {name: np.dtype(code) for name, code in STRUCT_CODES.items()}
+FORMATS = ["ascii", "binary_little_endian", "binary_big_endian"]
+
+
+# ------------------------------------------------------------------------------ a tiny PLY writer
+
+
+def ply_bytes(fmt, elements, comments=("comment made by the test",)):
+    """A PLY file. ``elements``: list of (name, properties, rows); a property is
+    ``(name, type)`` or ``(name, "list", count_type, item_type)``; a row is a tuple with a
+    sequence in place of each list."""
+    header = ["ply", f"format {fmt} 1.0", *comments]
+    for name, props, rows in elements:
+        header.append(f"element {name} {len(rows)}")
+        for prop in props:
+            if prop[1] == "list":
+                header.append(f"property list {prop[2]} {prop[3]} {prop[0]}")
+            else:
+                header.append(f"property {prop[1]} {prop[0]}")
+    header.append("end_header")
+    out = bytearray(("\n".join(header) + "\n").encode())
+    order = {"binary_little_endian": "<", "binary_big_endian": ">"}.get(fmt)
+    for _, props, rows in elements:
+        for row in rows:
+            if order is None:
+                words = []
+                for prop, value in zip(props, row, strict=True):
+                    if prop[1] == "list":
+                        words.append(str(len(value)))
+                        words += [as_text(v, prop[3]) for v in value]
+                    else:
+                        words.append(as_text(value, prop[1]))
+                out += (" ".join(words) + "\n").encode()
+            else:
+                for prop, value in zip(props, row, strict=True):
+                    if prop[1] == "list":
+                        out += struct.pack(order + STRUCT_CODES[prop[2]], len(value))
+                        out += struct.pack(f"{order}{len(value)}{STRUCT_CODES[prop[3]]}", *value)
+                    else:
+                        out += struct.pack(order + STRUCT_CODES[prop[1]], value)
+    return bytes(out)
+
+
+def as_text(value, type_name):
+    if NUMPY_TYPES[type_name].kind == "f":
+        return repr(float(NUMPY_TYPES[type_name].type(value)))
+    return str(int(value))
+
+
+def fan(polygons):
+    return [(p[0], p[i], p[i + 1]) for p in polygons for i in range(1, len(p) - 1)]
+
+
+def grid_polygons(kind):
+    """Vertices of a 4 x 3 grid and its faces: triangles, quads or mixed polygons."""
+    points = [(0.1 * i - 0.05, 0.3 * j + 1 / 3, 0.01 * i * j) for j in range(3) for i in range(4)]
+    quads = [(j * 4 + i, j * 4 + i + 1, j * 4 + i + 5, j * 4 + i + 4)
+             for j in range(2) for i in range(3)]  # fmt: skip
+    if kind == "triangles":
+        faces = fan(quads)
+    elif kind == "quads":
+        faces = quads
+    else:  # a pentagon (two quads merged), quads and triangles
+        faces = [(0, 1, 2, 6, 5), *quads[2:4], *fan(quads[4:])]
+    return points, faces
+
+
+# --------------------------------------------------------------------------- reference meshes
+
+
+def ply_header_counts(path):
+    """Element counts, property types and header size, parsed independently."""
+    with open(path, "rb") as file:
+        data = file.read()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    counts, types = {}, {}
+    for line in data[:end].decode("ascii").splitlines():
+        words = line.split()
+        if words and words[0] == "element":
+            counts[words[1]] = int(words[2])
+            current = words[1]
+            types[current] = []
+        elif words and words[0] == "property":
+            types[current].append(words[1:])
+    return data, end, counts, types
+
+
+REFERENCE = ["HalfAnnulus.ply", "IntersectingSpheres.ply", "sample_mesh.ply"]
+
+
+@pytest.mark.parametrize("name", REFERENCE)
+def test_reference_meshes_load_with_the_header_counts(shared_data, name):
+    path = shared_data / name
+    data, body, counts, types = ply_header_counts(path)
+    mesh = read_mesh(path)
+    assert isinstance(mesh, MeshData)
+    assert mesh.name == path.stem
+    assert mesh.points.shape == (counts["vertex"], 3)
+    assert mesh.triangles.shape == (counts["face"], 3)
+    assert mesh.points.dtype == np.float64 and mesh.triangles.dtype == np.int64
+    assert mesh.normals is None
+
+    # First and last vertex and face, unpacked with struct at offsets computed from the header.
+    coord = STRUCT_CODES[types["vertex"][0][0]]
+    assert mesh.source_dtype == NUMPY_TYPES[types["vertex"][0][0]].name
+    vertex_size = 3 * struct.calcsize(coord)
+    count_code, index_code = (STRUCT_CODES[t] for t in types["face"][0][1:3])
+    face_size = struct.calcsize(count_code) + 3 * struct.calcsize(index_code)
+    faces_at = body + counts["vertex"] * vertex_size
+    assert len(data) == faces_at + counts["face"] * face_size  # all faces are triangles
+    for k in (0, counts["vertex"] - 1):
+        expected = struct.unpack_from("<3" + coord, data, body + k * vertex_size)
+        assert tuple(mesh.points[k]) == expected
+    for k in (0, counts["face"] - 1):
+        n, *corners = struct.unpack_from(f"<{count_code}3{index_code}", data,
+                                         faces_at + k * face_size)  # fmt: skip
+        assert n == 3 and tuple(mesh.triangles[k]) == tuple(corners)
+    assert mesh.triangles.max() < counts["vertex"]
+
+
+# ------------------------------------------------------------------------------- PLY flavours
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("coord", ["float", "double", "float32", "float64"])
+@pytest.mark.parametrize(("count_type", "index_type"),
+                         [("uchar", "int"), ("int", "int"), ("uint8", "uint"), ("ushort", "int32")])
+@pytest.mark.parametrize("kind", ["triangles", "quads", "mixed"])
+def test_ply_flavours(tmp_path, fmt, coord, count_type, index_type, kind):
+    points, faces = grid_polygons(kind)
+    elements = [
+        ("vertex", [(c, coord) for c in "xyz"], points),
+        ("face", [("vertex_indices", "list", count_type, index_type)], [(f,) for f in faces]),
+    ]
+    path = tmp_path / "mesh.ply"
+    path.write_bytes(ply_bytes(fmt, elements))
+    mesh = read_mesh(path)
+    stored = np.array(points, dtype=NUMPY_TYPES[coord]).astype(np.float64)
+    assert np.array_equal(mesh.points, stored)
+    assert mesh.triangles.tolist() == [list(t) for t in fan(faces)]
+    assert mesh.source_dtype == NUMPY_TYPES[coord].name
+    assert mesh.normals is None
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("kind", ["triangles", "quads", "mixed"])
+def test_ply_extra_properties_elements_and_comments(tmp_path, fmt, kind):
+    """Colours, quality and normals in odd places, extra face properties and lists, other
+    elements before and after, comments and obj_info: only x y z, normals and faces count."""
+    points, faces = grid_polygons(kind)
+    rng = np.random.default_rng(1)
+    normals = rng.normal(size=(len(points), 3)).astype(np.float32)
+    vertex_props = [("red", "uchar"), ("x", "double"), ("quality", "float"), ("y", "double"),
+                    ("tags", "list", "uchar", "short"), ("z", "double"),
+                    ("nx", "float"), ("ny", "float"), ("nz", "float"), ("alpha", "uchar")]  # fmt: skip
+    vertex_rows = [
+        (i % 256, p[0], 0.5 * i, p[1], list(range(i % 3)), p[2], *normals[i], 255)
+        for i, p in enumerate(points)
+    ]
+    face_props = [("flags", "uchar"), ("vertex_indices", "list", "uchar", "int"),
+                  ("texcoord", "list", "uchar", "float"), ("tag", "int")]  # fmt: skip
+    face_rows = [(7, f, [0.25] * (2 * len(f)), -k) for k, f in enumerate(faces)]
+    elements = [
+        ("material", [("ambient", "float"), ("power", "uchar")], [(0.5, 2), (0.25, 3)]),
+        ("range", [("values", "list", "int", "double")], [([1.0, 2.0],), ([],), ([3.0],)]),
+        ("vertex", vertex_props, vertex_rows),
+        ("face", face_props, face_rows),
+        ("edge", [("vertex1", "int"), ("vertex2", "int")], [(0, 1), (1, 2)]),
+    ]
+    comments = ("comment first", "obj_info scanned by a test", "comment   end_header is a word")
+    path = tmp_path / "extras.ply"
+    path.write_bytes(ply_bytes(fmt, elements, comments))
+    mesh = read_mesh(path)
+    assert np.array_equal(mesh.points, np.array(points))
+    assert mesh.triangles.tolist() == [list(t) for t in fan(faces)]
+    assert np.array_equal(mesh.normals, normals.astype(np.float64))
+    assert mesh.source_dtype == "float64"
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_ply_point_cloud_and_empty_face_element(tmp_path, fmt):
+    points, _ = grid_polygons("triangles")
+    path = tmp_path / "cloud.ply"
+    path.write_bytes(ply_bytes(fmt, [("vertex", [(c, "float") for c in "xyz"], points)]))
+    assert read_mesh(path).triangles is None
+    path.write_bytes(ply_bytes(fmt, [
+        ("vertex", [(c, "float") for c in "xyz"], points),
+        ("face", [("vertex_indices", "list", "uchar", "int")], []),
+    ]))  # fmt: skip
+    mesh = read_mesh(path)
+    assert mesh.triangles is None and mesh.n_triangles == 0 and mesh.n_vertices == len(points)
+
+
+def test_ply_crlf_header_and_case_insensitive_extension(tmp_path):
+    points, faces = grid_polygons("quads")
+    data = ply_bytes("binary_little_endian", [
+        ("vertex", [(c, "float") for c in "xyz"], points),
+        ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
+    ])  # fmt: skip
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    path = tmp_path / "Windows.PLY"
+    path.write_bytes(data[:end].replace(b"\n", b"\r\n") + data[end:])
+    mesh = read_mesh(str(path))
+    assert mesh.name == "Windows"
+    assert mesh.triangles.tolist() == [list(t) for t in fan(faces)]
+
+
+def test_ply_non_finite_normals_are_dropped(tmp_path):
+    points, faces = grid_polygons("triangles")
+    rows = [(*p, 0.0, 0.0, 1.0 if i else float("nan")) for i, p in enumerate(points)]
+    props = [(c, "float") for c in ("x", "y", "z", "nx", "ny", "nz")]
+    path = tmp_path / "n.ply"
+    path.write_bytes(ply_bytes("binary_little_endian", [("vertex", props, rows)]))
+    assert read_mesh(path).normals is None
+
+
+def test_ply_many_mixed_polygons(tmp_path):
+    """The general (mixed polygon size) path on a few thousand random polygons."""
+    rng = np.random.default_rng(5)
+    n = 500
+    points = rng.normal(size=(n, 3))
+    faces = [tuple(rng.choice(n, size=k, replace=False)) for k in rng.integers(3, 9, 3000)]
+    for fmt in FORMATS:
+        for count_type in ("uchar", "int"):
+            path = tmp_path / f"{fmt}_{count_type}.ply"
+            path.write_bytes(ply_bytes(fmt, [
+                ("vertex", [(c, "double") for c in "xyz"], points.tolist()),
+                ("face", [("flags", "short"), ("vertex_indices", "list", count_type, "uint")],
+                 [(1, f) for f in faces]),
+            ]))  # fmt: skip
+            mesh = read_mesh(path)
+            assert np.array_equal(mesh.points, points)
+            assert mesh.triangles.tolist() == [list(t) for t in fan(faces)]
+
+
+# ---------------------------------------------------------------------------------- write_ply
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_write_ply_round_trips_exactly(tmp_path, binary):
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(300, 3)) * 10.0 ** rng.integers(-8, 8, size=(300, 1))
+    points[0] = [-0.0, 1e-300, 1.0 / 3.0]
+    triangles = rng.integers(0, 300, size=(500, 3))
+    normals = rng.normal(size=(300, 3))
+    path = write_ply(tmp_path / "out.ply", points, triangles, normals, binary=binary)
+    mesh = read_mesh(path)
+    assert np.array_equal(mesh.points, points)
+    assert np.array_equal(mesh.triangles, triangles)
+    assert np.array_equal(mesh.normals, normals)
+    assert mesh.source_dtype == "float64"
+    assert path.read_bytes().startswith(b"ply\nformat " + (b"binary" if binary else b"ascii"))
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_write_ply_point_cloud(tmp_path, binary):
+    points = np.arange(30, dtype=float).reshape(10, 3) / 7
+    mesh = read_mesh(write_ply(tmp_path / "cloud.ply", points, binary=binary))
+    assert np.array_equal(mesh.points, points) and mesh.triangles is None and mesh.normals is None
+
+
+@pytest.mark.parametrize(
+    ("points", "triangles", "normals", "message"),
+    [
+        (np.zeros((0, 3)), None, None, "points"),
+        (np.zeros((4, 2)), None, None, "points"),
+        ([[0, 0, np.nan]], None, None, "not finite"),
+        (np.zeros((3, 3)), [[0, 1, 3]], None, "outside"),
+        (np.zeros((3, 3)), [[0.0, 1.0, 2.0]], None, "integer"),
+        (np.zeros((3, 3)), None, np.zeros((2, 3)), "normals"),
+    ],
+)
+def test_write_ply_rejects_bad_input(tmp_path, points, triangles, normals, message):
+    with pytest.raises(GoniometerError, match=message):
+        write_ply(tmp_path / "bad.ply", points, triangles, normals)
+
+
+# -------------------------------------------------------------------------------------------- OBJ
+
+
+def write_text(path, text):
+    path.write_bytes(text.encode())
+    return path
+
+
+def test_obj_face_forms_relative_indices_and_ignored_statements(tmp_path):
+    text = """# a comment
+mtllib thing.mtl
+o thing
+v 0 0 0
+v 1 0 0 0.5 0.25 0.125
+v 1 1 0
+v 0 1 0
+vt 0 0
+vt 1 0
+vn 0 0 1
+g group one
+usemtl stone
+s off
+f 1 2 3
+f 1/1 3/2 4/1
+f 1//1 2//1 3//1
+f 1/1/1 2/2/1 3/1/1 4/2/1
+f -4 -3 -1
+v 0.5 0.5 2e-1
+f -5/1/1 -4/2/1 -1/1/1
+l 1 2
+p 3
+"""
+    mesh = read_mesh(write_text(tmp_path / "forms.obj", text))
+    assert np.array_equal(mesh.points, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 0.2]])
+    expected = [[0, 1, 2], [0, 2, 3], [0, 1, 2], [0, 1, 2], [0, 2, 3], [0, 1, 3], [0, 1, 4]]
+    assert mesh.triangles.tolist() == expected
+    assert mesh.normals is None  # one vn for five vertices
+    assert mesh.source_dtype == "float64" and mesh.name == "forms"
+
+
+def test_obj_polygons_crlf_tabs_and_leading_blanks(tmp_path):
+    text = "v 0 0 0\r\n  v\t1 0 0\r\nv 2 1 0\r\n\tv 1 2 0\r\nv 0 1 0\r\n\r\n  f 1 2 3 4 5\r\n"
+    mesh = read_mesh(write_text(tmp_path / "crlf.OBJ", text))
+    assert mesh.n_vertices == 5
+    assert mesh.triangles.tolist() == [[0, 1, 2], [0, 2, 3], [0, 3, 4]]
+
+
+def test_obj_one_to_one_normals_are_kept(tmp_path):
+    text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0.6 0.8\nvn 1 0 0\nf 1//1 2//2 3//3\n"
+    mesh = read_mesh(write_text(tmp_path / "n.obj", text))
+    assert np.array_equal(mesh.normals, [[0, 0, 1], [0, 0.6, 0.8], [1, 0, 0]])
+    for faces in ("f 1//2 2//1 3//3\n", "f 1 2 3\n", "f 1/1 2/2 3/3\n", "f 1//1 2 3//3\n"):
+        mixed = text.rsplit("f", 1)[0] + faces
+        assert read_mesh(write_text(tmp_path / "m.obj", mixed)).normals is None, faces
+    cloud = "v 0 0 0\nvn 1 0 0\nv 1 0 0\nvn 0 1 0\n"
+    assert np.array_equal(read_mesh(write_text(tmp_path / "c.obj", cloud)).normals,
+                          [[1, 0, 0], [0, 1, 0]])  # fmt: skip
+
+
+def test_obj_point_cloud(tmp_path):
+    mesh = read_mesh(write_text(tmp_path / "cloud.obj", "v 1 2 3\nv 4 5 6\n"))
+    assert mesh.triangles is None and mesh.points.tolist() == [[1, 2, 3], [4, 5, 6]]
+
+
+def test_obj_matches_ply_of_the_same_mesh(tmp_path):
+    points, faces = grid_polygons("mixed")
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in points]
+    lines += ["f " + " ".join(f"{i + 1}/{i + 1}" for i in f) for f in faces]
+    mesh = read_mesh(write_text(tmp_path / "grid.obj", "\n".join(lines)))  # no final newline
+    assert np.array_equal(mesh.points, points)
+    assert mesh.triangles.tolist() == [list(t) for t in fan(faces)]
+
+
+# -------------------------------------------------------------------------------------------- STL
+
+CUBE_CORNERS = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], float)
+CUBE_TRIANGLES = [[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]]  # fmt: skip
+
+
+def stl_binary(corners, header=b"binary stl from a test"):
+    data = bytearray(header.ljust(80, b"\0"))
+    data += struct.pack("<I", len(corners))
+    for triangle in corners:
+        data += struct.pack("<3f", 0, 0, 0) + struct.pack("<9f", *np.ravel(triangle)) + b"\0\0"
+    return bytes(data)
+
+
+def stl_ascii(corners):
+    lines = ["solid cube"]
+    for triangle in corners:
+        lines += ["  facet normal 0 0 0", "    outer loop"]
+        lines += [f"      vertex {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in triangle]
+        lines += ["    endloop", "  endfacet"]
+    return ("\n".join([*lines, "endsolid cube"]) + "\n").encode()
+
+
+@pytest.mark.parametrize("flavour", ["binary", "binary solid header", "ascii"])
+def test_stl_vertices_are_merged_into_an_indexed_mesh(tmp_path, flavour):
+    corners = CUBE_CORNERS[CUBE_TRIANGLES] * 0.1  # 0.1 is not exact in float32
+    if flavour == "ascii":
+        data = stl_ascii(corners.astype(np.float32).astype(float))
+    else:
+        data = stl_binary(corners, b"solid cube" if "solid" in flavour else b"cube")
+    path = tmp_path / "cube.stl"
+    path.write_bytes(data)
+    mesh = read_mesh(path)
+    assert mesh.n_vertices == 8 and mesh.n_triangles == 12
+    assert np.array_equal(mesh.points[mesh.triangles], corners.astype(np.float32).astype(float))
+    first_seen = list(dict.fromkeys(np.ravel(CUBE_TRIANGLES)))
+    assert np.array_equal(mesh.points, (CUBE_CORNERS[first_seen] * 0.1).astype(np.float32))
+    assert mesh.normals is None
+    assert mesh.source_dtype == ("float64" if flavour == "ascii" else "float32")
+
+
+def test_stl_signed_zeros_are_one_vertex(tmp_path):
+    corners = np.array([[[0.0, 0, 0], [1, 0, 0], [0, 1, 0]], [[-0.0, -0.0, 0], [0, 1, 0], [1, 0, 0]]])
+    path = tmp_path / "zeros.stl"
+    path.write_bytes(stl_binary(corners))
+    mesh = read_mesh(path)
+    assert mesh.n_vertices == 3 and mesh.triangles.tolist() == [[0, 1, 2], [0, 2, 1]]
+
+
+def test_stl_trailing_bytes_after_binary_data_are_ignored(tmp_path):
+    path = tmp_path / "padded.stl"
+    path.write_bytes(stl_binary(CUBE_CORNERS[CUBE_TRIANGLES]) + b"\0" * 7)
+    assert read_mesh(path).n_triangles == 12
+
+
+# ----------------------------------------------------------------------------------------- errors
+
+
+def expect_error(path, *fragments):
+    with pytest.raises(GoniometerError) as caught:
+        read_mesh(path)
+    message = str(caught.value)
+    assert path.name in message, message
+    for fragment in fragments:
+        assert fragment.lower() in message.lower(), message
+    return message
+
+
+def test_missing_file_and_folder(tmp_path):
+    expect_error(tmp_path / "nowhere.ply", "not found")
+    folder = tmp_path / "folder.ply"
+    folder.mkdir()
+    expect_error(folder, "folder")
+
+
+def test_empty_file_and_unknown_format(tmp_path):
+    for name in ("empty.ply", "empty.obj", "empty.stl"):
+        expect_error(write_text(tmp_path / name, ""), "empty")
+    expect_error(write_text(tmp_path / "mesh.xyz", "1 2 3\n"), "unknown mesh format", ".ply")
+    expect_error(write_text(tmp_path / "noextension", "ply\n"), "unknown mesh format")
+
+
+@pytest.mark.parametrize(
+    ("text", "fragments"),
+    [
+        ("solid nothing\n", ("not a PLY file",)),
+        ("ply\nformat ascii 1.0\nelement vertex 1\n", ("end_header",)),
+        ("ply\nformat text 1.0\nend_header\n", ("unknown PLY format",)),
+        ("ply\nelement vertex 0\nend_header\n", ("no 'format'",)),
+        ("ply\nformat ascii 1.0\nproperty float x\nend_header\n", ("before any element",)),
+        ("ply\nformat ascii 1.0\nelement vertex 1\nproperty half x\nend_header\n", ("half",)),
+        ("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n",
+         ("no y, z coordinate",)),
+        ("ply\nformat ascii 1.0\nelement face 0\nend_header\n", ("no 'vertex' element",)),
+        ("ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+         "property float z\nend_header\n", ("no vertices",)),
+        ("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+         "property float z\nend_header\n0 0 0\n1 nan 0\n", ("not finite", "vertex 1")),
+        ("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+         "property float z\nend_header\n0 zero 0\n", ("not a number",)),
+        ("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+         "property float z\nend_header\n0 0 0\n", ("truncated", "vertex")),
+        ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+         "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", ("out of range", "vertex 3", "3 vertices")),
+        ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+         "0 0 0\n1 0 0\n0 1 0\n3 0 1.5 2\n", ("not a valid int32",)),
+        ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 1\nproperty list uchar float vertex_indices\n"
+         "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", ("must be integers",)),
+    ],
+)
+def test_malformed_ply(tmp_path, text, fragments):
+    expect_error(write_text(tmp_path / "bad.ply", text), *fragments)
+
+
+@pytest.mark.parametrize("kind", ["triangles", "mixed"])
+@pytest.mark.parametrize("cut", ["vertices", "faces"])
+def test_truncated_binary_ply(tmp_path, kind, cut):
+    points, faces = grid_polygons(kind)
+    data = ply_bytes("binary_little_endian", [
+        ("vertex", [(c, "float") for c in "xyz"], points),
+        ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
+    ])  # fmt: skip
+    body = data.index(b"end_header\n") + len(b"end_header\n")
+    keep = body + 12 * len(points) - 5 if cut == "vertices" else len(data) - 3
+    element = "vertex" if cut == "vertices" else "face"
+    (tmp_path / "short.ply").write_bytes(data[:keep])
+    expect_error(tmp_path / "short.ply", "truncated", f"'{element}' element")
+
+
+def test_binary_ply_face_index_out_of_range(tmp_path):
+    points, faces = grid_polygons("quads")
+    faces[-1] = (0, 1, 2, 99)
+    path = tmp_path / "range.ply"
+    path.write_bytes(ply_bytes("binary_big_endian", [
+        ("vertex", [(c, "double") for c in "xyz"], points),
+        ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
+    ]))  # fmt: skip
+    expect_error(path, "out of range", "vertex 99", "12 vertices")
+
+
+@pytest.mark.parametrize(
+    ("text", "fragments"),
+    [
+        ("v 0 0 0\nv 1 0\n", ("line 2", "three coordinates")),
+        ("v 0 0 0\nv 1 O 0\nv 0 1 0\n", ("line 2", "cannot read")),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 x\n", ("line 5", "cannot read")),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2.5 3\nf 1 2 3\n", ("line 5", "indices")),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 /2 3\n", ("line 4", "no vertex index")),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", ("line 4", "index 0")),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", ("out of range",)),
+        ("v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n", ("out of range",)),
+        ("v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n", ("not finite", "vertex 1")),
+        ("# nothing here\nvt 0 0\n", ("no vertices",)),
+    ],
+)
+def test_malformed_obj(tmp_path, text, fragments):
+    expect_error(write_text(tmp_path / "bad.obj", text), *fragments)
+
+
+def test_malformed_stl(tmp_path):
+    whole = stl_binary(CUBE_CORNERS[CUBE_TRIANGLES])
+    path = tmp_path / "bad.stl"
+    path.write_bytes(whole[:-20])
+    expect_error(path, "truncated", "12 triangles")
+    path.write_bytes(stl_binary(CUBE_CORNERS[CUBE_TRIANGLES], b"solid looks like text")[:-20])
+    expect_error(path, "truncated")
+    path.write_bytes(b"not an stl")
+    expect_error(path, "not an STL")
+    path.write_bytes(b"solid x\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n")
+    expect_error(path, "multiple of three")
+    path.write_bytes(b"solid x\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0 0\n")
+    expect_error(path, "line 4", "exactly three")
+    path.write_bytes(stl_binary([[[0, 0, 0], [1, np.nan, 0], [0, 1, 0]]]))
+    expect_error(path, "not finite")
+    path.write_bytes(stl_binary([]))
+    expect_error(path, "no vertices")

@@ -1,0 +1,159 @@
+"""Spatial index, patch selection (Euclidean and geodesic), snapping and normals."""
+
+import heapq
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from vg_addon.synth import wedge
+
+from vg_addon import GoniometerError, GridIndex, Surface
+from vg_addon.normals import vertex_normals
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(1, 400),
+    seed=st.integers(0, 1000),
+    radius=st.floats(0.001, 3.0),
+    flat=st.booleans(),
+)
+def test_ball_equals_brute_force(n, seed, radius, flat):
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(-1, 1, size=(n, 3))
+    if flat:
+        points[:, 2] = 0.0
+    index = GridIndex(points)
+    center = rng.uniform(-1.5, 1.5, size=3)
+    ids, distances = index.ball(center, radius)
+    expected = np.flatnonzero(np.linalg.norm(points - center, axis=1) <= radius)
+    assert np.array_equal(np.sort(ids), expected)
+    assert np.allclose(distances, np.linalg.norm(points[ids] - center, axis=1))
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(1, 300), seed=st.integers(0, 1000), limit=st.floats(0.01, 5.0))
+def test_nearest_equals_brute_force(n, seed, limit):
+    rng = np.random.default_rng(seed)
+    points = rng.normal(size=(n, 3))
+    center = rng.normal(size=3)
+    vertex, distance = GridIndex(points).nearest(center, limit)
+    all_distances = np.linalg.norm(points - center, axis=1)
+    if all_distances.min() > limit:
+        assert vertex == -1
+    else:
+        assert distance == pytest.approx(all_distances.min())
+        assert all_distances[vertex] == pytest.approx(all_distances.min())
+
+
+def dijkstra(points, triangles, source, radius):
+    """Textbook Dijkstra along mesh edges, for checking the vectorised version."""
+    neighbours = {}
+    for a, b, c in triangles:
+        for u, v in ((a, b), (b, c), (c, a)):
+            neighbours.setdefault(u, set()).add(v)
+            neighbours.setdefault(v, set()).add(u)
+    distance = {source: 0.0}
+    queue = [(0.0, source)]
+    while queue:
+        d, u = heapq.heappop(queue)
+        if d > distance.get(u, np.inf):
+            continue
+        for v in neighbours.get(u, ()):
+            candidate = d + float(np.linalg.norm(points[u] - points[v]))
+            if candidate <= radius and candidate < distance.get(v, np.inf):
+                distance[v] = candidate
+                heapq.heappush(queue, (candidate, v))
+    return distance
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_geodesic_patch_equals_dijkstra(seed):
+    mesh = wedge(60 + 20 * seed, n=24, irregular=True, seed=seed)
+    surface = Surface(mesh.points, mesh.triangles)
+    center_index, _ = surface.snap([0.02, 0.0, 0.0], 1.0)
+    radius = 0.45
+    patch = surface.patch(center_index, radius, "geodesic")
+    expected = dijkstra(mesh.points, mesh.triangles, center_index, radius)
+    assert set(patch.tolist()) == set(expected)
+
+
+def test_geodesic_patch_is_inside_the_euclidean_patch():
+    mesh = wedge(30, n=40, irregular=True, seed=2)
+    surface = Surface(mesh.points, mesh.triangles)
+    center_index, _ = surface.snap([0.0, 0.0, 0.0], 1.0)
+    geodesic = set(surface.patch(center_index, 0.5, "geodesic").tolist())
+    euclidean = set(surface.patch(center_index, 0.5, "euclidean").tolist())
+    assert geodesic < euclidean
+
+
+def test_geodesic_measure_reads_the_angle():
+    mesh = wedge(75, n=60, irregular=True, seed=4)
+    m = Surface(mesh.points, mesh.triangles).measure([0, 0, 0], 0.5, patch="geodesic")
+    assert m.patch == "geodesic"
+    assert m.angle == pytest.approx(75, abs=0.5)
+
+
+def test_geodesic_needs_faces():
+    mesh = wedge(75, n=30)
+    surface = Surface(mesh.points, normals=np.tile([0.0, 0.0, 1.0], (len(mesh.points), 1)))
+    with pytest.raises(GoniometerError, match="point cloud"):
+        surface.patch(0, 0.5, "geodesic")
+
+
+def test_centre_snaps_to_the_nearest_vertex():
+    mesh = wedge(90, n=40)
+    surface = Surface(mesh.points, mesh.triangles)
+    target = mesh.points[123]
+    m = surface.measure(target + np.array([0.001, 0.0, 0.0]), 0.5)
+    nearest = np.argmin(np.linalg.norm(mesh.points - m.requested_center, axis=1))
+    assert np.array_equal(m.center, mesh.points[nearest])
+    assert m.snap_distance == pytest.approx(np.linalg.norm(m.requested_center - m.center))
+    replay = surface.measure(m.center, 0.5)
+    assert replay.snap_distance == 0.0
+    assert replay.angle == m.angle
+
+
+def test_area_weighted_normals_point_outward_on_a_wedge():
+    mesh = wedge(90, n=20)
+    normals, valid = vertex_normals(mesh.points, mesh.triangles)
+    assert valid.all()
+    assert np.allclose(np.linalg.norm(normals, axis=1), 1.0)
+    plus = mesh.side > 0
+    assert np.allclose(normals[plus], normals[plus][0])
+    assert (normals[:, 2] > 0).all()
+
+
+def test_unreferenced_vertices_and_zero_area_faces_never_give_nan():
+    mesh = wedge(90, n=20)
+    points = np.vstack([mesh.points, [[5.0, 5.0, 5.0]]])  # unreferenced
+    degenerate = [[0, 0, 1], [2, 2, 2]]  # zero area
+    triangles = np.vstack([mesh.triangles, degenerate])
+    normals, valid = vertex_normals(points, triangles)
+    assert np.isfinite(normals).all()
+    assert not valid[-1]
+    surface = Surface(points, triangles)
+    with pytest.raises(GoniometerError, match="farther"):
+        surface.measure([5.0, 5.0, 5.0], 0.1)  # the stray vertex is never snapped to
+    assert np.isfinite(surface.measure([0, 0, 0], 0.5).angle)
+
+
+def test_point_cloud_normals_are_consistent_and_measure():
+    mesh = wedge(100, n=50, irregular=True, seed=1)
+    cloud = Surface(mesh.points)  # no faces: PCA normals
+    with_faces = Surface(mesh.points, mesh.triangles)
+    agree = np.einsum("ij,ij->i", cloud.normals, with_faces.normals)
+    inner = np.abs(mesh.points[:, 1]) < 0.8 * np.abs(mesh.points[:, 1]).max()
+    assert (agree[cloud.valid & inner] > 0.9).mean() > 0.95
+    m = cloud.measure([0, 0, 0], 0.5)
+    assert m.angle == pytest.approx(100, abs=2.0)
+
+
+def test_point_cloud_normals_point_outward_on_a_sphere():
+    rng = np.random.default_rng(0)
+    points = rng.normal(size=(4000, 3))
+    points /= np.linalg.norm(points, axis=1, keepdims=True)
+    surface = Surface(points + np.array([3.0, -1.0, 2.0]))
+    outward = np.einsum("ij,ij->i", surface.normals, points)
+    assert (outward[surface.valid] > 0.9).all()

@@ -1,0 +1,128 @@
+"""The drag preview in the 3D viewport: the patch's outline circle and its vertices.
+
+The operator owns one :class:`DragOverlay`; it starts drawing when the drag starts and must be
+stopped on every way out (release, cancel, error, the window manager cancelling the operator).
+Mouse moves only hand over new data (NumPy arrays); the GPU batch is built lazily in the draw
+callback, the one place a GPU context is guaranteed.
+"""
+
+from __future__ import annotations
+
+import bpy
+import gpu
+import numpy as np
+from gpu_extras.batch import batch_for_shader
+
+from ..vg_addon import palette
+
+PATCH_COLOR = (1.0, 1.0, 0.6, 0.9)
+SIDE_COLORS = tuple((*(c / 255.0 for c in rgb), 0.95) for rgb in palette.pair_srgb8(1))
+CIRCLE_COLOR = (1.0, 1.0, 1.0, 0.9)
+POINT_SIZE = 4.0
+CIRCLE_SEGMENTS = 96
+
+
+def patch_vertex_data(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """The patch vertices as the contiguous float32 (k, 3) array a GPU vertex buffer takes."""
+    return np.ascontiguousarray(points[indices], dtype=np.float32)
+
+
+def circle_points(center, radius: float, right, up, segments: int = CIRCLE_SEGMENTS) -> np.ndarray:
+    """A closed polyline (``segments + 1`` float32 points): the circle in the plane ``right, up``.
+
+    Drawn in the view plane, it is the outline of the ball the Euclidean patch is cut from.
+    """
+    angles = np.linspace(0.0, 2.0 * np.pi, segments + 1)
+    right = np.asarray(right, dtype=np.float64)
+    up = np.asarray(up, dtype=np.float64)
+    ring = np.cos(angles)[:, None] * right + np.sin(angles)[:, None] * up
+    return (np.asarray(center, dtype=np.float64) + radius * ring).astype(np.float32)
+
+
+class DragOverlay:
+    """The viewport drawing of one drag: a draw handler plus the data it draws.
+
+    ``start`` adds the handler (once), ``stop`` removes it (safe to call any number of times).
+    """
+
+    def __init__(self):
+        self._handle = None
+        self._coords: np.ndarray | None = None
+        self._labels: np.ndarray | None = None
+        self._batches = None
+        self.center: np.ndarray | None = None
+        self.radius = 0.0
+
+    @property
+    def active(self) -> bool:
+        """Whether the draw handler is installed."""
+        return self._handle is not None
+
+    @property
+    def handle(self):
+        """Blender's handle of the installed draw handler, or None."""
+        return self._handle
+
+    def start(self) -> None:
+        """Install the draw handler in every 3D viewport (a no-op when already installed)."""
+        if self._handle is None:
+            self._handle = bpy.types.SpaceView3D.draw_handler_add(
+                self._draw, (), "WINDOW", "POST_VIEW"
+            )
+
+    def stop(self) -> None:
+        """Remove the draw handler and drop the data; safe to call more than once."""
+        handle, self._handle = self._handle, None
+        self._coords = self._labels = self._batches = self.center = None
+        if handle is not None:
+            bpy.types.SpaceView3D.draw_handler_remove(handle, "WINDOW")
+
+    def update(self, center, radius: float, coords: np.ndarray | None, labels=None) -> None:
+        """New preview: the circle ``center``/``radius`` and the patch vertices.
+
+        ``coords`` is a float32 (k, 3) array (see :func:`patch_vertex_data`); ``labels``, when a
+        measurement of the patch exists, is its bool "+" side per vertex, drawn in two colours.
+        """
+        self.center = None if center is None else np.asarray(center, dtype=np.float64)
+        self.radius = float(radius)
+        self._coords = coords
+        self._labels = None if labels is None else np.asarray(labels, dtype=bool)
+        self._batches = None
+
+    def _build_batches(self, shader) -> list:
+        coords, labels = self._coords, self._labels
+        if coords is None or not len(coords):
+            return []
+        if labels is None:
+            groups = [(coords, PATCH_COLOR)]
+        else:
+            groups = [(coords[labels], SIDE_COLORS[0]), (coords[~labels], SIDE_COLORS[1])]
+        return [
+            (batch_for_shader(shader, "POINTS", {"pos": group}), color)
+            for group, color in groups
+            if len(group)
+        ]
+
+    def _draw(self) -> None:
+        region_data = bpy.context.region_data
+        if region_data is None or self.center is None:
+            return
+        shader = gpu.shader.from_builtin("UNIFORM_COLOR")
+        gpu.state.blend_set("ALPHA")
+        gpu.state.depth_test_set("NONE")  # the whole patch is measured, hidden side included
+        shader.bind()
+        if self._batches is None:
+            self._batches = self._build_batches(shader)
+        gpu.state.point_size_set(POINT_SIZE)
+        for batch, color in self._batches:
+            shader.uniform_float("color", color)
+            batch.draw(shader)
+        if self.radius > 0.0:
+            rotation = np.array(region_data.view_rotation.to_matrix())
+            ring = circle_points(self.center, self.radius, rotation[:, 0], rotation[:, 1])
+            gpu.state.line_width_set(2.0)
+            shader.uniform_float("color", CIRCLE_COLOR)
+            batch_for_shader(shader, "LINE_STRIP", {"pos": ring}).draw(shader)
+            gpu.state.line_width_set(1.0)
+        gpu.state.point_size_set(1.0)
+        gpu.state.blend_set("NONE")

@@ -1,0 +1,247 @@
+"""Algorithm 1 of the Virtual Goniometer paper on a patch of vertices and normals."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import GoniometerError
+from .result import Measurement
+from .withinss import withinss_split
+
+MIN_SIDE_VERTICES = 3
+"""A side needs three vertices to define a plane."""
+
+FLAT_TOLERANCE_DEG = 0.5
+"""Angles closer than this to 180° mean the patch holds no break edge."""
+
+_RANK_TOLERANCE = 1e-10
+
+
+def canonical_order(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Order that sorts a patch by coordinates (then normals), independent of vertex numbering.
+
+    Every sum in the algorithm runs in this order, so the result is bit-identical whatever order
+    the vertices of the mesh come in.
+    """
+    keys = (normals[:, 2], normals[:, 1], normals[:, 0], points[:, 2], points[:, 1], points[:, 0])
+    return np.lexsort(keys)
+
+
+def _smallest_eigenvector(matrix: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """Smallest eigenvalue, its unit eigenvector (sign fixed) and all eigenvalues of a 3x3 SPD matrix."""
+    values, vectors = np.linalg.eigh(matrix)
+    vector = vectors[:, 0]
+    if vector[np.argmax(np.abs(vector))] < 0:  # a deterministic sign, independent of LAPACK's
+        vector = -vector
+    return float(values[0]), vector, values
+
+
+def _fit_plane(points: np.ndarray, side: str) -> tuple[np.ndarray, float]:
+    """PCA plane fit: the unit normal and the mean squared distance of the points to the plane."""
+    centred = points - points.mean(axis=0)
+    covariance = centred.T @ centred / points.shape[0]
+    error, normal, values = _smallest_eigenvector(covariance)
+    if values[1] <= _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny):
+        raise GoniometerError(
+            f"The vertices on the {side} side lie on a line, so no plane can be fitted: "
+            "use a larger radius or move the centre onto the break edge."
+        )
+    return normal, max(error, 0.0)
+
+
+def _check_finite(name: str, array: np.ndarray) -> None:
+    bad = ~np.isfinite(array).all(axis=1)
+    if bad.any():
+        first = int(np.flatnonzero(bad)[0])
+        raise GoniometerError(
+            f"{int(bad.sum())} {name} are not finite (NaN or infinite), the first at row {first}: "
+            f"repair or remove them before measuring."
+        )
+
+
+def measure_patch(
+    points: np.ndarray,
+    normals: np.ndarray,
+    center: np.ndarray,
+    radius: float,
+    lam: float,
+) -> dict:
+    """Run Algorithm 1 on a validated, canonically ordered float64 patch.
+
+    Returns a dict of the measured fields of :class:`~vg_addon.result.Measurement`; ``labels`` follow
+    the order of ``points``. Callers normally use :func:`goniometer` or ``Surface.measure``.
+    """
+    n_points = points.shape[0]
+    if n_points < 2 * MIN_SIDE_VERTICES:
+        raise GoniometerError(
+            f"The patch holds {n_points} vertices; at least {2 * MIN_SIDE_VERTICES} are needed "
+            f"({MIN_SIDE_VERTICES} per side): use a larger radius."
+        )
+    _, tangent, normal_eigenvalues = _smallest_eigenvector(normals.T @ normals)
+    mean_normal = normals.mean(axis=0)
+    cross = np.cross(tangent, mean_normal)
+    cross_norm = float(np.linalg.norm(cross))
+    if normal_eigenvalues[1] <= 1e-12 * normal_eigenvalues[2] or cross_norm <= 1e-12:
+        raise GoniometerError(
+            "The normals in the patch do not define a break edge (they are all parallel, or they "
+            "cancel out): move the centre onto a break edge or use a larger radius."
+        )
+    binormal = cross / cross_norm
+    projection = (normals + (lam / radius) * (points - center)) @ binormal
+    threshold, _ = withinss_split(projection, min_size=MIN_SIDE_VERTICES)
+    labels = projection >= threshold
+
+    sides = {}
+    for name, mask in (("+", labels), ("-", ~labels)):
+        normal, error = _fit_plane(points[mask], name)
+        if np.dot(normal, normals[mask].mean(axis=0)) < 0:
+            normal = -normal
+        sides[name] = (normal, error, int(mask.sum()))
+
+    (normal_plus, error_plus, n_plus), (normal_minus, error_minus, n_minus) = sides["+"], sides["-"]
+    cosine = float(np.clip(np.dot(normal_plus, normal_minus), -1.0, 1.0))
+    angle = 180.0 - float(np.degrees(np.arccos(cosine)))
+    if angle > 180.0 - FLAT_TOLERANCE_DEG:
+        raise GoniometerError(
+            f"No break edge found: the two sides fit planes within {180.0 - angle:.2f}° of each other, "
+            "so the patch is flat. Move the centre onto the break edge, or use a larger radius."
+        )
+    return {
+        "angle": angle,
+        "fit_error": error_plus + error_minus,
+        "fit_error_plus": error_plus,
+        "fit_error_minus": error_minus,
+        "normal_plus": normal_plus,
+        "normal_minus": normal_minus,
+        "tangent": tangent,
+        "mean_normal": mean_normal / np.linalg.norm(mean_normal),
+        "binormal": binormal,
+        "threshold": threshold,
+        "labels": labels,
+        "n_vertices": n_points,
+        "n_plus": n_plus,
+        "n_minus": n_minus,
+    }
+
+
+def as_points(name: str, values, *, allow_empty: bool = False) -> np.ndarray:
+    """Validate an (n, 3) array of finite numbers and return it as C-contiguous float64."""
+    try:
+        array = np.ascontiguousarray(np.asarray(values, dtype=np.float64))
+    except (TypeError, ValueError) as error:
+        raise GoniometerError(f"The {name} must be numbers in an (n, 3) array: {error}") from None
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise GoniometerError(
+            f"The {name} must be an (n, 3) array of x, y, z values; got shape {array.shape}."
+        )
+    if not allow_empty and array.shape[0] == 0:
+        raise GoniometerError(f"There are no {name}: the mesh or patch is empty.")
+    _check_finite(name, array)
+    return array
+
+
+def as_radius(radius) -> float:
+    """Validate a patch radius: a finite number greater than zero."""
+    try:
+        value = float(radius)
+    except (TypeError, ValueError):
+        raise GoniometerError(f"The radius must be a number; got {radius!r}.") from None
+    if not np.isfinite(value) or value <= 0:
+        raise GoniometerError(f"The radius must be a finite number greater than 0; got {value!r}.")
+    return value
+
+
+def as_lambda(lam) -> float:
+    """Validate the segmentation parameter λ: a finite number, zero or more."""
+    try:
+        value = float(lam)
+    except (TypeError, ValueError):
+        raise GoniometerError(f"λ (SegParam) must be a number; got {lam!r}.") from None
+    if not np.isfinite(value) or value < 0:
+        raise GoniometerError(f"λ (SegParam) must be a finite number ≥ 0; got {value!r}.")
+    return value
+
+
+def as_center(center) -> np.ndarray:
+    """Validate a centre: three finite numbers."""
+    try:
+        value = np.asarray(center, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise GoniometerError(
+            f"The centre must be three numbers x, y, z; got {center!r}."
+        ) from None
+    if value.shape != (3,) or not np.isfinite(value).all():
+        raise GoniometerError(f"The centre must be three finite numbers x, y, z; got {center!r}.")
+    return value
+
+
+def unit_normals(name: str, normals: np.ndarray) -> np.ndarray:
+    """Normalise given normals; zero-length ones are an error (they carry no direction)."""
+    lengths = np.linalg.norm(normals, axis=1)
+    zero = lengths <= 1e-300
+    if zero.any():
+        raise GoniometerError(
+            f"{int(zero.sum())} {name} have zero length (the first at row "
+            f"{int(np.flatnonzero(zero)[0])}): recompute the normals or drop those vertices."
+        )
+    return normals / lengths[:, None]
+
+
+def goniometer(points, normals, lam: float = 2.0, center=None, radius=None) -> Measurement:
+    """Measure the break angle of a patch you already have (Algorithm 1 of the paper).
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 3)
+        The patch vertices ``X``.
+    normals : array_like, shape (n, 3)
+        Their outward normals ``N`` (normalised here).
+    lam : float, optional
+        The segmentation parameter λ ≥ 0 (default 2).
+    center : array_like, shape (3,), optional
+        The centre ``x̄`` of the projection; default the mean of ``points``.
+    radius : float, optional
+        The ``r`` of the projection; default the largest distance from ``center`` to a point.
+
+    Returns
+    -------
+    Measurement
+        ``labels`` follow the order of ``points``; ``indices`` is ``None``; ``patch`` is ``"given"``.
+
+    Raises
+    ------
+    GoniometerError
+        On non-finite or mis-shaped input, too few vertices (in the patch or on a side), a flat patch
+        or a side whose vertices are collinear.
+    """
+    points = as_points("points", points)
+    normals = as_points("normals", normals)
+    if normals.shape != points.shape:
+        raise GoniometerError(
+            f"There must be one normal per point: {points.shape[0]} points, {normals.shape[0]} normals."
+        )
+    normals = unit_normals("normals", normals)
+    lam = as_lambda(lam)
+    order = canonical_order(points, normals)
+    ordered_points, ordered_normals = points[order], normals[order]
+    center = ordered_points.mean(axis=0) if center is None else as_center(center)
+    if radius is None:
+        radius = float(np.sqrt(((ordered_points - center) ** 2).sum(axis=1).max()))
+        if radius <= 0:
+            raise GoniometerError("All points coincide, so the patch has no extent to measure.")
+    radius = as_radius(radius)
+    fields = measure_patch(ordered_points, ordered_normals, center, radius, lam)
+    labels = np.empty_like(fields["labels"])
+    labels[order] = fields["labels"]
+    fields["labels"] = labels
+    return Measurement(
+        **fields,
+        indices=None,
+        center=center,
+        requested_center=None,
+        snap_distance=0.0,
+        center_index=-1,
+        radius=radius,
+        lam=lam,
+        patch="given",
+    )

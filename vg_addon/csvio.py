@@ -1,0 +1,955 @@
+"""Measurement CSV files: the export schema, its writer, and the readers used to replicate.
+
+Every export starts with the 14 columns of the MeshLab Virtual Goniometer plugin, in its order
+(:data:`MESHLAB_COLUMNS`), so analysis scripts written for MeshLab files keep working; this
+extension's own columns follow (:data:`EXPORT_COLUMNS`). The earlier AMAAZE Blender add-on wrote
+the same 14 columns.
+
+Writing (:func:`write_measurements_csv`) is UTF-8, comma-delimited, ``\\n`` line ends, floats
+as ``repr`` (the shortest text that reads back to the same float64, bit for bit), text cells
+protected against spreadsheet formula injection, and atomic: the old file stays intact if
+anything fails.
+
+Reading for replication (:func:`read_replication_csv`, the paper's "xyz method") accepts this
+extension's exports, the MeshLab plugin's file, the earlier Blender add-on's file and a plain
+points CSV (``x,y,z`` with optional radius, lambda, patch mode, label and mesh columns). It
+checks every row first and raises one :class:`GoniometerError` listing every problem, or
+returns every row: never part of a file.
+
+Row numbers in messages and in :attr:`ReplicationRow.row_number` are the rows a spreadsheet
+shows for the file: the header is row 1, so the first data row is row 2. Blank lines count as
+rows (a spreadsheet shows them as empty rows); a quoted cell that spans lines stays one row.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import io
+import math
+import operator
+import os
+import re
+import secrets
+import stat
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+
+from .errors import GoniometerError
+from .palette import OKABE_ITO
+from .surface import PATCH_MODES
+
+#: The MeshLab Virtual Goniometer plugin's header, exactly (``SegParam`` is λ).
+MESHLAB_COLUMNS = (
+    "Mesh Name",
+    "Date",
+    "Measurement #",
+    "Break #",
+    "Colors",
+    "User Data",
+    "Angle",
+    "Number of Vertices",
+    "Radius",
+    "x",
+    "y",
+    "z",
+    "fit",
+    "SegParam",
+)
+
+# (MeasurementRow field, kind, CSV columns), in column order. Kinds: text, int, float, bool and
+# vec3 (three float columns).
+_SCHEMA = (
+    ("mesh_name", "text", ("Mesh Name",)),
+    ("date", "text", ("Date",)),
+    ("number", "int", ("Measurement #",)),
+    ("break_number", "int", ("Break #",)),
+    ("colors", "text", ("Colors",)),
+    ("user_data", "text", ("User Data",)),
+    ("angle", "float", ("Angle",)),
+    ("n_vertices", "int", ("Number of Vertices",)),
+    ("radius", "float", ("Radius",)),
+    ("x", "float", ("x",)),
+    ("y", "float", ("y",)),
+    ("z", "float", ("z",)),
+    ("fit", "float", ("fit",)),
+    ("seg_param", "float", ("SegParam",)),
+    ("patch", "text", ("Patch Mode",)),
+    ("n_plus", "int", ("Vertices +",)),
+    ("n_minus", "int", ("Vertices -",)),
+    ("fit_plus", "float", ("Fit +",)),
+    ("fit_minus", "float", ("Fit -",)),
+    ("normal_plus", "vec3", ("Normal + x", "Normal + y", "Normal + z")),
+    ("normal_minus", "vec3", ("Normal - x", "Normal - y", "Normal - z")),
+    ("requested", "vec3", ("Requested x", "Requested y", "Requested z")),
+    ("snap_distance", "float", ("Snap Distance",)),
+    ("units", "text", ("Units",)),
+    ("stale", "bool", ("Stale",)),
+    ("extension_version", "text", ("Extension Version",)),
+    ("blender_version", "text", ("Blender Version",)),
+    ("error", "text", ("error",)),
+)
+
+#: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
+EXPORT_COLUMNS = tuple(column for _, _, columns in _SCHEMA for column in columns)
+
+#: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
+SOURCE_FORMATS = ("extension", "meshlab", "points")
+
+_TRUE = "TRUE"
+_FALSE = "FALSE"
+_MAX_LISTED = 20
+
+# Leading characters that make a spreadsheet treat a cell as a formula (OWASP's list). The
+# apostrophe is included so that escaping is reversible: a text that starts with one is
+# escaped too, and the reader removes exactly one.
+_FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "'")
+
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_INTEGER = re.compile(r"[+-]?\d+")
+
+# File extensions a CSV's mesh name may carry (MeshLab writes the scan's file name).
+_MESH_FILE_SUFFIXES = frozenset(
+    [
+        ".ply",
+        ".obj",
+        ".stl",
+        ".off",
+        ".glb",
+        ".gltf",
+        ".fbx",
+        ".dae",
+        ".x3d",
+        ".wrl",
+        ".3ds",
+        ".abc",
+        ".usd",
+        ".usda",
+        ".usdc",
+        ".usdz",
+        ".vtk",
+    ]
+)
+
+
+@dataclass
+class MeasurementRow:
+    """One row of an export; one field per column (vectors take three columns).
+
+    A failed row (the batch script's) has ``error`` set and ``None`` in the numbers it could not
+    compute; those cells are written empty.
+
+    Attributes
+    ----------
+    mesh_name : str
+        Object name (``Mesh Name``).
+    date : str
+        When it was measured, ISO 8601 with UTC offset (see :func:`now_iso`).
+    number, break_number : int or None
+        ``Measurement #`` and ``Break #``.
+    colors : str
+        ``"+ colour/- colour"`` as hex sRGB, e.g. ``"#E69F00/#0072B2"`` (see :func:`format_colors`).
+    user_data : str
+        Free-text note.
+    angle : float or None
+        Degrees.
+    n_vertices, n_plus, n_minus : int or None
+        Vertices in the patch and on its two sides.
+    radius : float or None
+        Patch radius, scene units.
+    x, y, z : float or None
+        The centre the measurement snapped to (a mesh vertex).
+    fit, fit_plus, fit_minus : float or None
+        Fit errors of both planes, and of each.
+    seg_param : float or None
+        λ, the segmentation parameter.
+    patch : str
+        ``"euclidean"`` or ``"geodesic"``.
+    normal_plus, normal_minus : tuple of 3 float, or None
+        Unit normals of the two sides.
+    requested : tuple of 3 float, or None
+        The centre that was asked for, before snapping.
+    snap_distance : float or None
+        Distance from ``requested`` to ``(x, y, z)``.
+    units : str
+        What one coordinate unit is.
+    stale : bool
+        The mesh changed since the measurement was taken.
+    extension_version, blender_version : str
+    error : str
+        Empty for a good row; why it failed otherwise.
+    """
+
+    mesh_name: str = ""
+    date: str = ""
+    number: int | None = None
+    break_number: int | None = None
+    colors: str = ""
+    user_data: str = ""
+    angle: float | None = None
+    n_vertices: int | None = None
+    radius: float | None = None
+    x: float | None = None
+    y: float | None = None
+    z: float | None = None
+    fit: float | None = None
+    seg_param: float | None = None
+    patch: str = ""
+    n_plus: int | None = None
+    n_minus: int | None = None
+    fit_plus: float | None = None
+    fit_minus: float | None = None
+    normal_plus: tuple[float, float, float] | None = None
+    normal_minus: tuple[float, float, float] | None = None
+    requested: tuple[float, float, float] | None = None
+    snap_distance: float | None = None
+    units: str = ""
+    stale: bool = False
+    extension_version: str = ""
+    blender_version: str = ""
+    error: str = ""
+
+
+@dataclass(frozen=True)
+class ReplicationRow:
+    """One row to re-measure, as read by :func:`read_replication_csv`.
+
+    Attributes
+    ----------
+    row_number : int
+        The row a spreadsheet shows for it (the header is row 1, the first data row 2).
+    mesh_name : str or None
+        The mesh the row was measured on; ``None`` when the file has no mesh column or the cell
+        is blank.
+    x, y, z : float
+        The centre to measure at.
+    radius : float or None
+        Patch radius (> 0); ``None`` when the file has no radius column or the cell is blank.
+    lam : float or None
+        λ (≥ 0), from ``SegParam`` / ``lambda`` / ...; ``None`` when absent or blank.
+    patch : str or None
+        ``"euclidean"`` or ``"geodesic"``; ``None`` when absent or blank.
+    label : str or None
+        From ``label`` (preferred) or ``User Data``; ``None`` when absent or blank.
+    number : int or float or None
+        The original ``Measurement #`` (MeshLab's burst measurements are fractional, e.g. 3.05);
+        ``None`` when absent, blank or not a number.
+    break_number : int or None
+        The original ``Break #``; ``None`` when absent, blank or not a whole number.
+    source_format : str
+        ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
+        columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
+        else with x, y, z columns).
+    """
+
+    row_number: int
+    mesh_name: str | None
+    x: float
+    y: float
+    z: float
+    radius: float | None = None
+    lam: float | None = None
+    patch: str | None = None
+    label: str | None = None
+    number: int | float | None = None
+    break_number: int | None = None
+    source_format: str = "points"
+
+
+# --------------------------------------------------------------------------- small helpers
+
+
+def now_iso() -> str:
+    """The local time with its UTC offset, to the second: ``"2024-05-01T14:03:11+02:00"``."""
+    return datetime.now().astimezone().isoformat(timespec="seconds")
+
+
+def _hex_colour(colour) -> str:
+    if isinstance(colour, str):
+        text = colour.strip()
+        if re.fullmatch(r"#[0-9A-Fa-f]{6}", text):
+            return text.upper()
+        rgb = OKABE_ITO.get(" ".join(text.casefold().split()))
+        if rgb is None:
+            raise GoniometerError(
+                f"Unknown colour {colour!r}: use a palette name ({', '.join(OKABE_ITO)}), "
+                "'#RRGGBB', or three 0-255 values."
+            )
+    else:
+        rgb = colour
+    try:
+        values = [operator.index(c) for c in rgb]
+    except TypeError:
+        values = []
+    if len(values) != 3 or not all(0 <= c <= 255 for c in values):
+        raise GoniometerError(
+            f"Colour {colour!r} is not three whole numbers from 0 to 255 (8-bit sRGB)."
+        )
+    return "#{:02X}{:02X}{:02X}".format(*values)
+
+
+def format_colors(pair_rgb) -> str:
+    """The ``Colors`` cell for a ("+" side, "-" side) colour pair: ``"#E69F00/#56B4E9"``.
+
+    Parameters
+    ----------
+    pair_rgb : sequence of two colours, or str
+        Each colour is three 8-bit sRGB integers (0-255), a ``"#RRGGBB"`` string, or a name of
+        :data:`vg_addon.palette.OKABE_ITO` (case-insensitive). A string ``"orange/blue"`` is
+        split at the ``/``.
+
+    Raises
+    ------
+    GoniometerError
+        Not exactly two colours, or a colour that is none of the above.
+    """
+    pair = pair_rgb.split("/") if isinstance(pair_rgb, str) else list(pair_rgb)
+    if len(pair) != 2:
+        raise GoniometerError(
+            f"A colour pair needs exactly two colours ('+' side, '-' side), got {pair_rgb!r}."
+        )
+    return "/".join(_hex_colour(colour) for colour in pair)
+
+
+def _escape_text(text: str) -> str:
+    """Prefix an apostrophe to text a spreadsheet would run as a formula."""
+    return "'" + text if text.startswith(_FORMULA_START) else text
+
+
+def _unescape_text(text: str) -> str:
+    """Undo :func:`_escape_text`; other leading apostrophes (e.g. in foreign files) stay."""
+    if len(text) > 1 and text[0] == "'" and text[1] in _FORMULA_START:
+        return text[1:]
+    return text
+
+
+def _split_names(names) -> tuple[str, ...]:
+    if isinstance(names, str):
+        return (names,)
+    return tuple(str(name) for name in names)
+
+
+def _mesh_stem(name: str) -> str:
+    # MeshLab writes the scan's file name (maybe with a folder); strip the folder and a mesh
+    # file extension only, so Blender's "bone.001" stays distinct from "bone".
+    base = re.split(r"[\\/]", name)[-1]
+    stem, dot, suffix = base.rpartition(".")
+    if dot and stem and "." + suffix.casefold() in _MESH_FILE_SUFFIXES:
+        return stem
+    return base
+
+
+def mesh_name_matches(csv_name: str | None, names) -> bool:
+    """Whether a CSV's mesh name refers to a mesh known by ``names``.
+
+    Parameters
+    ----------
+    csv_name : str or None
+        The row's mesh name. Blank or ``None`` matches any mesh.
+    names : str or iterable of str
+        The mesh's names, e.g. its object name and its mesh data name.
+
+    A name matches exactly (case-sensitive, as Blender names are), or after dropping a folder
+    and a mesh file extension (``"scans/bone_12.ply"`` matches ``"bone_12"``).
+    """
+    name = (csv_name or "").strip()
+    if not name:
+        return True
+    candidates = set(_split_names(names))
+    return name in candidates or _mesh_stem(name) in candidates
+
+
+def rows_for_mesh(rows: Iterable[ReplicationRow], mesh_name) -> list[ReplicationRow]:
+    """The rows that refer to ``mesh_name`` (str or several names), or name no mesh at all."""
+    return [row for row in rows if mesh_name_matches(row.mesh_name, mesh_name)]
+
+
+def rows_for_other_meshes(rows: Iterable[ReplicationRow], mesh_name) -> list[ReplicationRow]:
+    """The rows that name another mesh than ``mesh_name`` (str or several names)."""
+    return [row for row in rows if not mesh_name_matches(row.mesh_name, mesh_name)]
+
+
+def check_mesh_names(rows: Sequence[ReplicationRow], mesh_name, *, source="the CSV") -> None:
+    """Raise if any row names another mesh than ``mesh_name`` (str or several names).
+
+    Raises
+    ------
+    GoniometerError
+        Listing those rows' numbers and names (the first 20) and what to do.
+    """
+    others = rows_for_other_meshes(rows, mesh_name)
+    if not others:
+        return
+    shown = next(iter(_split_names(mesh_name)), "")
+    listed = ", ".join(f"{row.row_number} ({row.mesh_name!r})" for row in others[:_MAX_LISTED])
+    more = f" and {len(others) - _MAX_LISTED} more" if len(others) > _MAX_LISTED else ""
+    raise GoniometerError(
+        f"{len(others)} row(s) of {source} name another mesh than '{shown}': rows {listed}{more}. "
+        "Select the mesh they were measured on, or choose to ignore mesh names to measure them "
+        "on this one."
+    )
+
+
+# --------------------------------------------------------------------------- writing
+
+
+def _cell_error(index: int, row, column: str, value, need: str) -> GoniometerError:
+    name = getattr(row, "mesh_name", "")
+    return GoniometerError(
+        f"Cannot write measurement {index + 1} (mesh {name!r}): {column} is {value!r}, "
+        f"not {need}. Nothing was written."
+    )
+
+
+def _float_cell(value, index, row, column) -> str:
+    if value is None:
+        return ""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise _cell_error(index, row, column, value, "a number") from None
+    if not math.isfinite(number):
+        raise _cell_error(index, row, column, value, "a finite number")
+    return repr(number)
+
+
+def _row_cells(index: int, row: MeasurementRow) -> list[str]:
+    cells = []
+    for field, kind, columns in _SCHEMA:
+        value = getattr(row, field)
+        if kind == "text":
+            cells.append(_escape_text("" if value is None else str(value)))
+        elif kind == "float":
+            cells.append(_float_cell(value, index, row, columns[0]))
+        elif kind == "int":
+            if value is None:
+                cells.append("")
+            else:
+                try:
+                    cells.append(str(operator.index(value)))
+                except TypeError:
+                    raise _cell_error(index, row, columns[0], value, "a whole number") from None
+        elif kind == "bool":
+            cells.append("" if value is None else (_TRUE if value else _FALSE))
+        else:  # vec3
+            if value is None:
+                cells.extend(("", "", ""))
+                continue
+            try:
+                parts = list(value)
+            except TypeError:
+                parts = []
+            if len(parts) != 3:
+                raise _cell_error(index, row, field, value, "three numbers")
+            cells.extend(
+                _float_cell(part, index, row, column)
+                for part, column in zip(parts, columns, strict=True)
+            )
+    return cells
+
+
+def _csv_line(cells: Iterable[str]) -> str:
+    # csv.writer on Python 3.11 leaves a lone "\r" unquoted when lines end in "\n", which
+    # splits the row for every reader; quote by hand (RFC 4180).
+    quoted = (
+        '"' + cell.replace('"', '""') + '"' if any(c in cell for c in ',"\r\n') else cell
+        for cell in cells
+    )
+    return ",".join(quoted) + "\n"
+
+
+def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
+    """The text of an export: the :data:`EXPORT_COLUMNS` header and one line per row.
+
+    Floats are written with ``repr`` (so they read back bit-identical), integers as integers,
+    ``None`` as an empty cell, ``stale`` as ``TRUE``/``FALSE``. A text cell that starts with
+    ``= + - @``, a tab, a carriage return or an apostrophe gets a leading apostrophe, so no
+    spreadsheet runs it as a formula (the readers remove it again).
+
+    Raises
+    ------
+    GoniometerError
+        A value that cannot be written: a non-finite or non-numeric float, a fractional count,
+        a vector without three numbers.
+    """
+    lines = [_csv_line(EXPORT_COLUMNS)]
+    lines.extend(_csv_line(_row_cells(index, row)) for index, row in enumerate(rows))
+    return "".join(lines)
+
+
+def _replace_atomically(path: str, data: bytes) -> None:
+    folder = os.path.dirname(os.path.abspath(path)) or "."
+    if not os.path.isdir(folder):
+        raise GoniometerError(
+            f"The folder {folder!r} does not exist: choose an existing folder to write to."
+        )
+    try:
+        mode = stat.S_IMODE(os.stat(path).st_mode)
+    except OSError:
+        mode = None
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
+    base = os.path.basename(path)
+    while True:
+        temp = os.path.join(folder, f".{base}.{secrets.token_hex(4)}.tmp")
+        try:
+            handle = os.open(temp, flags, 0o666)
+            break
+        except FileExistsError:
+            continue
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+            stream.flush()
+            os.fsync(stream.fileno())
+        if mode is not None:
+            with contextlib.suppress(OSError):
+                os.chmod(temp, mode)
+        try:
+            os.replace(temp, path)
+        except OSError as error:
+            raise GoniometerError(
+                f"Could not replace {path!r}: {error.strerror or error}. Is it open in another "
+                "program (e.g. a spreadsheet)? Close it and try again; the old file is unchanged."
+            ) from error
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temp)
+        raise
+
+
+def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
+    """Write an export to ``path`` (UTF-8, comma-delimited, ``\\n`` line ends), atomically.
+
+    The whole text is formatted first (see :func:`format_measurements_csv`), then written to a
+    temporary file in the same folder and moved over ``path`` in one step, so ``path`` holds
+    either its old content or the complete new one; on any failure the temporary file is
+    removed. An existing file's permissions are kept.
+
+    Raises
+    ------
+    GoniometerError
+        A row that cannot be written, a missing folder, or a target that cannot be replaced.
+    OSError
+        Other file-system errors (disk full, no permission to create the file, ...).
+    """
+    data = format_measurements_csv(rows).encode("utf-8")
+    _replace_atomically(os.fspath(path), data)
+
+
+# --------------------------------------------------------------------------- reading
+
+
+def _load(path_or_text) -> tuple[str, str]:
+    """``(text, name for messages)``; a str with a line break is content, other str a path."""
+    if isinstance(path_or_text, bytes):
+        return _decode(path_or_text, "The CSV data"), "The CSV data"
+    if isinstance(path_or_text, str) and ("\n" in path_or_text or "\r" in path_or_text):
+        return path_or_text, "The CSV text"
+    path = Path(os.fspath(path_or_text))
+    source = f"'{path.name}'"
+    return _decode(path.read_bytes(), source), source
+
+
+def _decode(data: bytes, source: str) -> str:
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise GoniometerError(
+            f"{source} is not UTF-8 text (byte {error.start + 1} is 0x{data[error.start]:02X}). "
+            "Save it as 'CSV UTF-8 (comma delimited)' and import again."
+        ) from None
+
+
+_DELIMITER_NAMES = {",": "a comma", ";": "a semicolon (;)", "\t": "a tab"}
+
+
+def _check_delimiter(header_line: str, source: str) -> None:
+    unquoted = re.sub(r'"[^"]*"', "", header_line)
+    counts = {d: unquoted.count(d) for d in _DELIMITER_NAMES}
+    delimiter = max(counts, key=lambda d: (counts[d], d == ","))
+    if delimiter != "," and counts[delimiter] > counts[","]:
+        raise GoniometerError(
+            f"{source} uses {_DELIMITER_NAMES[delimiter]} as its delimiter, not a comma. "
+            "Save it comma-separated (in a spreadsheet: 'CSV UTF-8 (comma delimited)') and "
+            "import again."
+        )
+
+
+def _records(text: str, source: str) -> list[tuple[int, list[str]]]:
+    """Every record with its spreadsheet row number, after the BOM and delimiter checks."""
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    if not text.strip():
+        raise GoniometerError(
+            f"{source} is empty: it needs a header line (e.g. 'x,y,z,radius') and one row per "
+            "measurement."
+        )
+    header_line = next(line for line in text.splitlines() if line.strip())
+    _check_delimiter(header_line, source)
+    reader = csv.reader(io.StringIO(text, newline=""))
+    records = []
+    try:
+        for number, cells in enumerate(reader, start=1):
+            records.append((number, cells))
+    except csv.Error as error:
+        raise GoniometerError(
+            f"{source} is not a readable CSV near line {reader.line_num}: {error}. "
+            "Check the quotes on that line."
+        ) from None
+    return records
+
+
+def _blank(cells: Sequence[str]) -> bool:
+    return all(not cell.strip() for cell in cells)
+
+
+def _normalise(header: str) -> str:
+    return " ".join(header.replace("_", " ").casefold().split())
+
+
+def _problems_error(source: str, problems: list[str]) -> GoniometerError:
+    shown = problems[:_MAX_LISTED]
+    lines = "\n".join(f"  {problem}" for problem in shown)
+    more = f"\n  ... and {len(problems) - _MAX_LISTED} more" if len(problems) > _MAX_LISTED else ""
+    return GoniometerError(
+        f"{source} has {len(problems)} problem(s); nothing was read. Fix them and try again:\n"
+        f"{lines}{more}"
+    )
+
+
+def _parse_float(raw: str) -> tuple[float | None, str | None]:
+    """``(value, None)`` or ``(None, why not)`` for a non-blank cell."""
+    text = raw.strip()
+    if _NUMBER.fullmatch(text):
+        value = float(text)
+        if math.isfinite(value):
+            return value, None
+        return None, f"is not a finite number ({text!r})"
+    try:
+        value = float(text)
+    except ValueError:
+        value = None
+    if value is not None and not math.isfinite(value):
+        return None, f"is not a finite number ({text!r})"
+    hint = ""
+    if "," in text and _NUMBER.fullmatch(text.replace(",", ".", 1)):
+        hint = "; use a point as the decimal separator"
+    return None, f"is not a number ({text!r}{hint})"
+
+
+def _parse_optional_text(raw: str) -> str | None:
+    text = raw.strip()
+    return _unescape_text(text) if text else None
+
+
+# Header aliases of the replication reader, normalised (case-folded, "_" as space, whitespace
+# collapsed). The first alias found in a header wins.
+_REPLICATION_ALIASES = {
+    "mesh_name": ("mesh name", "mesh", "object", "object name", "meshname", "mesh file"),
+    "x": ("x", "center x", "centre x"),
+    "y": ("y", "center y", "centre y"),
+    "z": ("z", "center z", "centre z"),
+    "radius": ("radius", "patch radius", "r"),
+    "lam": ("segparam", "seg param", "lambda", "λ", "lam", "segmentation parameter"),
+    "patch": ("patch mode", "patch", "patchmode"),
+    "label": ("label", "user data", "note", "notes"),
+    "number": ("measurement #", "measurement number", "measurement", "number"),
+    "break_number": ("break #", "break number", "break"),
+    "error": ("error",),
+}
+_REQUIRED = ("x", "y", "z")
+
+
+def _resolve_columns(header: list[str], aliases: dict, problems: list[str]) -> dict:
+    """Field -> column index for the fields the header has; ambiguous names are problems."""
+    positions: dict[str, list[int]] = {}
+    for index, name in enumerate(header):
+        positions.setdefault(_normalise(name), []).append(index)
+    columns = {}
+    for field, names in aliases.items():
+        for alias in names:
+            found = positions.get(alias)
+            if not found:
+                continue
+            if len(found) > 1:
+                listed = " and ".join(str(i + 1) for i in found)
+                problems.append(
+                    f"header: columns {listed} are all named {header[found[0]].strip()!r}; "
+                    "keep one of them"
+                )
+            columns[field] = found[0]
+            break
+    return columns
+
+
+def _source_format(header: list[str]) -> str:
+    names = [_normalise(name) for name in header]
+    if names[: len(MESHLAB_COLUMNS)] == [_normalise(c) for c in MESHLAB_COLUMNS]:
+        ours = {_normalise(c) for c in EXPORT_COLUMNS[len(MESHLAB_COLUMNS) :]}
+        return "extension" if ours & set(names) else "meshlab"
+    return "points"
+
+
+def _header(records, source: str) -> tuple[int, list[str]]:
+    for position, (_, cells) in enumerate(records):
+        if not _blank(cells):
+            return position, cells
+    raise GoniometerError(f"{source} is empty.")  # _records already rejects blank text
+
+
+def _lenient_number(raw: str) -> int | float | None:
+    text = raw.strip()
+    if _INTEGER.fullmatch(text):
+        return int(text)
+    if _NUMBER.fullmatch(text):
+        value = float(text)
+        return value if math.isfinite(value) else None
+    return None
+
+
+def parse_replication_csv(text: str, source: str = "The CSV text") -> list[ReplicationRow]:
+    """Parse CSV text into replication rows; see :func:`read_replication_csv`.
+
+    ``source`` names the text in error messages (e.g. ``"'points.csv'"``).
+    """
+    records = _records(text, source)
+    header_at, header = _header(records, source)
+    problems: list[str] = []
+    columns = _resolve_columns(header, _REPLICATION_ALIASES, problems)
+    missing = [field for field in _REQUIRED if field not in columns]
+    if missing:
+        found = ", ".join(repr(name.strip()) for name in header if name.strip()) or "none"
+        problems.insert(
+            0,
+            f"header: missing the required column(s) {', '.join(missing)} (found: {found}). "
+            "A replication CSV needs x, y and z columns (names are case-insensitive; radius, "
+            "lambda/SegParam, patch mode, label/User Data and mesh name are optional)",
+        )
+    if problems:
+        raise _problems_error(source, problems)
+
+    fmt = _source_format(header)
+    width = len(header)
+    data = [(number, cells) for number, cells in records[header_at + 1 :] if not _blank(cells)]
+    if not data:
+        raise GoniometerError(
+            f"{source} has a header but no data rows: add one row per measurement "
+            "(x, y, z and optionally radius, lambda, ...) below the header."
+        )
+
+    def name_of(field: str) -> str:
+        return header[columns[field]].strip()
+
+    rows, skipped = [], 0
+    for number, cells in data:
+
+        def cell(field: str, cells=cells) -> str:
+            index = columns.get(field)
+            return cells[index] if index is not None and index < len(cells) else ""
+
+        extra = cells[width:]
+        if not _blank(extra):
+            problems.append(
+                f"row {number}: {len(cells)} cells but the header has {width} columns (a comma "
+                "inside an unquoted name or note, or a decimal comma?)"
+            )
+            continue
+        if cell("error").strip() and all(not cell(f).strip() for f in _REQUIRED):
+            skipped += 1
+            continue
+        values: dict[str, float | None] = {}
+        for field in ("x", "y", "z", "radius", "lam"):
+            raw = cell(field)
+            if not raw.strip():
+                values[field] = None
+                if field in _REQUIRED:
+                    problems.append(f"row {number}: {name_of(field)} is empty")
+                continue
+            value, why = _parse_float(raw)
+            values[field] = value
+            if why:
+                problems.append(f"row {number}: {name_of(field)} {why}")
+        if values["radius"] is not None and values["radius"] <= 0:
+            problems.append(
+                f"row {number}: {name_of('radius')} must be greater than 0 "
+                f"(got {cell('radius').strip()})"
+            )
+        if values["lam"] is not None and values["lam"] < 0:
+            problems.append(
+                f"row {number}: {name_of('lam')} (λ) must be 0 or more (got {cell('lam').strip()})"
+            )
+        patch = _parse_optional_text(cell("patch"))
+        if patch is not None:
+            patch = patch.casefold()
+            if patch not in PATCH_MODES:
+                problems.append(
+                    f"row {number}: unknown patch mode {cell('patch').strip()!r} "
+                    f"(use {' or '.join(PATCH_MODES)})"
+                )
+        if problems:
+            continue  # nothing is returned anyway; keep collecting
+        break_number = _lenient_number(cell("break_number"))
+        rows.append(
+            ReplicationRow(
+                row_number=number,
+                mesh_name=_parse_optional_text(cell("mesh_name")),
+                x=values["x"],
+                y=values["y"],
+                z=values["z"],
+                radius=values["radius"],
+                lam=values["lam"],
+                patch=patch,
+                label=_parse_optional_text(cell("label")),
+                number=_lenient_number(cell("number")),
+                break_number=break_number if isinstance(break_number, int) else None,
+                source_format=fmt,
+            )
+        )
+    if problems:
+        raise _problems_error(source, problems)
+    if not rows:
+        raise GoniometerError(
+            f"{source} has no rows to replicate: all {skipped} data row(s) are failed rows "
+            "(their error column is filled and they have no coordinates)."
+        )
+    return rows
+
+
+def read_replication_csv(path_or_text) -> list[ReplicationRow]:
+    """Read the rows to re-measure (the paper's xyz method) from a CSV file or text.
+
+    Parameters
+    ----------
+    path_or_text : str, os.PathLike or bytes
+        A path, or the CSV content itself: a ``str`` containing a line break, or ``bytes``
+        (UTF-8). A ``str`` without a line break is taken as a path.
+
+    Returns
+    -------
+    list of ReplicationRow
+        In file order. ``row_number`` is the spreadsheet row: the header is row 1 (or later, if
+        blank lines come first), so the first data row is normally 2.
+
+    Accepted files: this extension's export; the MeshLab plugin's CSV and the earlier AMAAZE
+    Blender add-on's (both have the 14 MeshLab columns; the add-on writes the text ``fill`` in
+    ``fit``, which is not read); and a plain points CSV. Header names are matched
+    case-insensitively, ignoring surrounding whitespace and with ``_`` read as a space, with
+    aliases: ``Mesh Name``/``Mesh``/``Object``; ``x``/``Center x``; ``Radius``/``r``;
+    ``SegParam``/``Seg Param``/``lambda``/``λ``/``Segmentation Parameter``;
+    ``Patch Mode``/``patch``; ``label``/``User Data``/``note`` (``label`` wins over
+    ``User Data``); ``Measurement #``; ``Break #``; ``error``. Only x, y and z are required.
+    A UTF-8 byte-order mark is ignored; cells are read without surrounding whitespace, and the
+    apostrophe the writer puts before formula-like text is removed.
+
+    Skipped: fully blank lines, and rows whose ``error`` cell is filled *and* whose x, y and z
+    are all blank (a batch run's failed rows). A failed row that has coordinates is kept.
+
+    Raises
+    ------
+    GoniometerError
+        One error listing every problem (the first 20, then "and N more") with its row number
+        and column name: missing x/y/z columns (naming those found), duplicate columns, a blank,
+        non-numeric or non-finite x/y/z/radius/lambda, radius ≤ 0, λ < 0, an unknown patch
+        mode, a row with more cells than the header; or: an empty file, a header without data
+        rows, only failed rows, a ``;`` or tab delimiter, text that is not UTF-8. Nothing is
+        returned then.
+    OSError
+        The file cannot be read.
+    """
+    text, source = _load(path_or_text)
+    return parse_replication_csv(text, source)
+
+
+def _parse_bool(raw: str) -> bool | None:
+    text = raw.strip().casefold()
+    if text in ("true", "yes", "1"):
+        return True
+    if text in ("false", "no", "0", ""):
+        return False
+    return None
+
+
+def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[MeasurementRow]:
+    """Parse an export written by :func:`format_measurements_csv` back into rows.
+
+    Every column of :data:`EXPORT_COLUMNS` must be present (in any order; names are matched
+    case-insensitively); text cells are kept as written (only the formula-guard apostrophe is
+    removed), numbers read back bit-identical. Blank lines are skipped.
+
+    Raises
+    ------
+    GoniometerError
+        Listing every missing column and every cell that does not parse, with row numbers.
+    """
+    records = _records(text, source)
+    header_at, header = _header(records, source)
+    problems: list[str] = []
+    aliases = {column: (_normalise(column),) for column in EXPORT_COLUMNS}
+    columns = _resolve_columns(header, aliases, problems)
+    missing = [column for column in EXPORT_COLUMNS if column not in columns]
+    if missing:
+        problems.insert(
+            0,
+            f"header: missing the column(s) {', '.join(missing)}; this reader needs a complete "
+            "export of this extension (use read_replication_csv for other files)",
+        )
+    if problems:
+        raise _problems_error(source, problems)
+
+    rows = []
+    for number, cells in records[header_at + 1 :]:
+        if _blank(cells):
+            continue
+
+        def cell(column: str, cells=cells) -> str:
+            index = columns[column]
+            return cells[index] if index < len(cells) else ""
+
+        def number_of(column: str, number=number) -> float | None:
+            raw = cell(column)
+            if not raw.strip():
+                return None
+            value, why = _parse_float(raw)
+            if why:
+                problems.append(f"row {number}: {column} {why}")
+            return value
+
+        values = {}
+        for field, kind, names in _SCHEMA:
+            if kind == "text":
+                values[field] = _unescape_text(cell(names[0]))
+            elif kind == "float":
+                values[field] = number_of(names[0])
+            elif kind == "int":
+                raw = cell(names[0]).strip()
+                values[field] = int(raw) if _INTEGER.fullmatch(raw) else None
+                if raw and values[field] is None:
+                    problems.append(f"row {number}: {names[0]} is not a whole number ({raw!r})")
+            elif kind == "bool":
+                values[field] = _parse_bool(cell(names[0]))
+                if values[field] is None:
+                    problems.append(f"row {number}: {names[0]} is not TRUE or FALSE")
+            else:
+                parts = [number_of(name) for name in names]
+                blank = [not cell(name).strip() for name in names]
+                values[field] = None if None in parts else tuple(parts)
+                if any(blank) and not all(blank):
+                    problems.append(
+                        f"row {number}: {', '.join(names)} must be all filled or all empty"
+                    )
+        rows.append(MeasurementRow(**values))
+    if problems:
+        raise _problems_error(source, problems)
+    return rows
+
+
+def read_measurements_csv(path_or_text) -> list[MeasurementRow]:
+    """Read a complete export of this extension back into :class:`MeasurementRow` objects.
+
+    ``path_or_text`` is taken as in :func:`read_replication_csv`. See
+    :func:`parse_measurements_csv`.
+    """
+    text, source = _load(path_or_text)
+    return parse_measurements_csv(text, source)

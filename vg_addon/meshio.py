@@ -1,0 +1,1062 @@
+"""Mesh file readers (PLY, OBJ, STL) and a PLY writer, vectorised with NumPy.
+
+``read_mesh(path)`` picks the reader from the file extension and returns a :class:`MeshData`:
+float64 points, int64 triangles (polygons are fan-triangulated) or ``None`` for a point cloud,
+and per-vertex normals when the file carries them. Every problem with a file is reported as a
+:class:`~vg_addon.errors.GoniometerError` whose message names the file and what is wrong.
+
+Parsing never loops in Python over vertices. The one exception is a binary or ASCII PLY whose
+faces have *different* vertex counts: there the start of each face record depends on the count
+of the previous one, so the record starts are found with one light Python step per face; all
+values are then gathered with NumPy.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import struct
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import GoniometerError
+
+__all__ = ["MESH_EXTENSIONS", "MeshData", "read_mesh", "read_obj", "read_ply", "read_stl", "write_ply"]
+
+MESH_EXTENSIONS = (".ply", ".obj", ".stl")
+
+
+@dataclass(frozen=True, eq=False)
+class MeshData:
+    """A mesh or point cloud read from a file.
+
+    Attributes
+    ----------
+    points : numpy.ndarray
+        ``(n, 3)`` float64 vertex coordinates, in file order.
+    triangles : numpy.ndarray or None
+        ``(m, 3)`` int64 vertex indices (polygons fan-triangulated, file order kept), or ``None``
+        when the file holds no faces (a point cloud).
+    normals : numpy.ndarray or None
+        ``(n, 3)`` float64 per-vertex normals as stored in the file (not normalised), or ``None``
+        when the file has none, they do not map one-to-one to the vertices, or any is not finite.
+    name : str
+        The file name without its extension.
+    source_dtype : str
+        Precision of the coordinates in the file: the declared PLY type of ``x`` (``"float32"``,
+        ``"float64"``, ...), ``"float32"`` for binary STL, ``"float64"`` for text formats
+        without a declared type (OBJ, ASCII STL).
+    """
+
+    points: np.ndarray
+    triangles: np.ndarray | None
+    normals: np.ndarray | None
+    name: str
+    source_dtype: str
+
+    @property
+    def n_vertices(self) -> int:
+        """Number of vertices."""
+        return int(self.points.shape[0])
+
+    @property
+    def n_triangles(self) -> int:
+        """Number of triangles (0 for a point cloud)."""
+        return 0 if self.triangles is None else int(self.triangles.shape[0])
+
+
+def read_mesh(path: str | os.PathLike) -> MeshData:
+    """Read a ``.ply``, ``.obj`` or ``.stl`` file (extension case-insensitive).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The mesh file.
+
+    Returns
+    -------
+    MeshData
+
+    Raises
+    ------
+    GoniometerError
+        If the file is missing, unreadable, of an unknown format, truncated or malformed, has no
+        vertices, has non-finite coordinates or a face index out of range.
+    """
+    path = _as_path(path)
+    readers = {".ply": read_ply, ".obj": read_obj, ".stl": read_stl}
+    reader = readers.get(path.suffix.lower())
+    if reader is None:
+        kind = f"'{path.suffix}'" if path.suffix else "no extension"
+        raise GoniometerError(
+            f"Cannot read '{path}': unknown mesh format ({kind}). "
+            "The Virtual Goniometer reads .ply, .obj and .stl files; export the mesh as one of them."
+        )
+    return reader(path)
+
+
+# ----------------------------------------------------------------------------------------- common
+
+
+def _as_path(path) -> Path:
+    try:
+        return Path(os.fspath(path))
+    except TypeError:
+        raise GoniometerError(
+            f"Expected a file path for the mesh, got {type(path).__name__}."
+        ) from None
+
+
+def _read_bytes(path: Path) -> bytes:
+    if not path.exists():
+        raise GoniometerError(
+            f"Mesh file not found: '{path}'. Check the path and that the file was not moved."
+        )
+    if path.is_dir():
+        raise GoniometerError(f"'{path}' is a folder, not a mesh file; choose the file inside it.")
+    try:
+        data = path.read_bytes()
+    except OSError as error:
+        raise GoniometerError(
+            f"Could not read '{path}': {error.strerror or error}. Check the file's permissions."
+        ) from None
+    if not data:
+        raise GoniometerError(f"'{path}' is empty (0 bytes); re-export the mesh.")
+    return data
+
+
+def _finish(path: Path, points, triangles, normals, source_dtype: str) -> MeshData:
+    """Validate what a reader found and pack it into fresh, writable, contiguous arrays."""
+    points = np.array(points, dtype=np.float64, order="C").reshape(-1, 3)
+    n = points.shape[0]
+    if n == 0:
+        raise GoniometerError(f"'{path}' has no vertices; the file holds nothing to measure.")
+    finite = np.isfinite(points).all(axis=1)
+    if not finite.all():
+        bad = np.flatnonzero(~finite)
+        raise GoniometerError(
+            f"'{path}': {bad.size} vertices have coordinates that are not finite (NaN or "
+            f"infinity), the first is vertex {bad[0]}. Repair or re-export the mesh."
+        )
+    if triangles is not None:
+        triangles = np.array(triangles, dtype=np.int64, order="C").reshape(-1, 3)
+        if triangles.size:
+            low, high = int(triangles.min()), int(triangles.max())
+            if low < 0 or high >= n:
+                bad_value = low if low < 0 else high
+                raise GoniometerError(
+                    f"'{path}': face index out of range: a face refers to vertex {bad_value} "
+                    f"(counting from 0), but the file has {n} vertices (valid 0..{n - 1}). "
+                    "The file is corrupt or was written incorrectly; re-export it."
+                )
+        else:
+            triangles = None
+    if normals is not None:
+        normals = np.array(normals, dtype=np.float64, order="C").reshape(-1, 3)
+        if normals.shape[0] != n or not np.isfinite(normals).all():
+            normals = None
+    return MeshData(points, triangles, normals, path.stem, source_dtype)
+
+
+def _fan(flat: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """Fan-triangulate polygons given as a flat index array and per-polygon counts.
+
+    Polygon ``(v0, v1, ..., vk-1)`` becomes ``(v0, v1, v2), (v0, v2, v3), ...``; polygons with
+    fewer than three vertices give no triangle. Triangles keep the polygons' order.
+    """
+    counts = np.asarray(counts, dtype=np.int64)
+    if counts.size == 0:
+        return np.empty((0, 3), np.int64)
+    k = int(counts[0])
+    if (counts == k).all():
+        if k < 3:
+            return np.empty((0, 3), np.int64)
+        polygons = flat.reshape(-1, k)
+        if k == 3:
+            return polygons
+        fans = [polygons[:, [0, j, j + 1]] for j in range(1, k - 1)]
+        return np.stack(fans, axis=1).reshape(-1, 3)
+    starts = np.cumsum(counts) - counts
+    n_tri = np.maximum(counts - 2, 0)
+    owner = np.repeat(np.arange(counts.size), n_tri)
+    first = np.cumsum(n_tri) - n_tri
+    j = np.arange(owner.size) - np.repeat(first, n_tri) + 1
+    base = starts[owner]
+    return np.stack([flat[base], flat[base + j], flat[base + j + 1]], axis=1)
+
+
+_NOT_BLANK = re.compile(rb"\S")
+
+
+def _parse_numbers(text: bytes) -> np.ndarray | None:
+    """All whitespace-separated numbers in ``text`` as float64, or None if a token is not one."""
+    if _NOT_BLANK.search(text) is None:
+        return np.empty(0)  # np.fromstring returns [-1.0] for blank text
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)
+        try:
+            return np.fromstring(text, dtype=np.float64, sep=" ")
+        except (ValueError, DeprecationWarning):
+            return None
+
+
+# -------------------------------------------------------------------------------------------- PLY
+
+_PLY_TYPES = {
+    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
+    "short": "i2", "int16": "i2", "ushort": "u2", "uint16": "u2",
+    "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
+    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
+}  # fmt: skip
+_PLY_FORMATS = {"ascii": None, "binary_little_endian": "<", "binary_big_endian": ">"}
+
+
+@dataclass
+class _PlyProperty:
+    name: str
+    dtype: np.dtype  # value type (list items for a list)
+    count_dtype: np.dtype | None = None  # None for a scalar property
+
+
+@dataclass
+class _PlyElement:
+    name: str
+    count: int
+    properties: list[_PlyProperty]
+
+    @property
+    def has_lists(self) -> bool:
+        return any(p.count_dtype is not None for p in self.properties)
+
+
+def _ply_header(data: bytes, path: Path) -> tuple[str, list[_PlyElement], int]:
+    """Parse the header; return the format, the elements and the offset of the body."""
+    if not data.startswith(b"ply") or data[3:4] not in (b"\n", b"\r"):
+        raise GoniometerError(
+            f"'{path}' is not a PLY file (it does not start with the line 'ply'). "
+            "Check that the file is a mesh and re-export it as PLY."
+        )
+    fmt = None
+    elements: list[_PlyElement] = []
+    pos = 0
+    number = 0
+    while True:
+        end = data.find(b"\n", pos)
+        if end < 0:
+            raise GoniometerError(
+                f"'{path}': the PLY header has no 'end_header' line; the file is truncated or "
+                "not a PLY file."
+            )
+        line = data[pos:end].decode("latin-1").strip()
+        pos = end + 1
+        number += 1
+        words = line.split()
+        if not words or words[0] in ("ply", "comment", "obj_info"):
+            continue
+        keyword = words[0]
+        where = f"'{path}', header line {number} ('{line}')"
+        if keyword == "end_header":
+            break
+        if keyword == "format":
+            if len(words) < 2 or words[1] not in _PLY_FORMATS:
+                raise GoniometerError(
+                    f"{where}: unknown PLY format; expected ascii, binary_little_endian or "
+                    "binary_big_endian."
+                )
+            fmt = words[1]
+        elif keyword == "element":
+            if len(words) != 3 or not words[2].isdigit():
+                raise GoniometerError(f"{where}: expected 'element <name> <count>'.")
+            elements.append(_PlyElement(words[1], int(words[2]), []))
+        elif keyword == "property":
+            if not elements:
+                raise GoniometerError(f"{where}: a property comes before any element.")
+            elements[-1].properties.append(_ply_property(words, where))
+        # Other keywords do not change the data layout and are ignored.
+    if fmt is None:
+        raise GoniometerError(f"'{path}': the PLY header has no 'format' line; the file is corrupt.")
+    return fmt, elements, pos
+
+
+def _ply_property(words: list[str], where: str) -> _PlyProperty:
+    def dtype(name: str) -> np.dtype:
+        if name not in _PLY_TYPES:
+            raise GoniometerError(
+                f"{where}: unknown property type '{name}'; PLY types are "
+                "char, uchar, short, ushort, int, uint, float and double."
+            )
+        return np.dtype(_PLY_TYPES[name])
+
+    if len(words) >= 2 and words[1] == "list":
+        if len(words) != 5:
+            raise GoniometerError(f"{where}: expected 'property list <count type> <type> <name>'.")
+        count_dtype = dtype(words[2])
+        if count_dtype.kind == "f":
+            raise GoniometerError(f"{where}: a list count must have an integer type.")
+        return _PlyProperty(words[4], dtype(words[3]), count_dtype)
+    if len(words) != 3:
+        raise GoniometerError(f"{where}: expected 'property <type> <name>'.")
+    return _PlyProperty(words[2], dtype(words[1]))
+
+
+def read_ply(path: str | os.PathLike) -> MeshData:
+    """Read a PLY file: ascii, binary little- or big-endian, any scalar property types.
+
+    The ``vertex`` element must have ``x``, ``y``, ``z``; ``nx``, ``ny``, ``nz`` become the
+    normals; other vertex properties (colours, quality, ...) are ignored in any order. The
+    ``face`` element's ``vertex_indices`` (or ``vertex_index``) list is fan-triangulated; other
+    face properties and other elements are skipped.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.ply`` file.
+
+    Returns
+    -------
+    MeshData
+
+    Raises
+    ------
+    GoniometerError
+        For a missing, unreadable, truncated or malformed file (see :func:`read_mesh`).
+    """
+    path = _as_path(path)
+    data = _read_bytes(path)
+    fmt, elements, body = _ply_header(data, path)
+    vertex = next((e for e in elements if e.name == "vertex"), None)
+    if vertex is None:
+        raise GoniometerError(f"'{path}': the PLY file has no 'vertex' element, so no points.")
+    names = [p.name for p in vertex.properties]
+    missing = [c for c in "xyz" if c not in names]
+    if missing:
+        raise GoniometerError(
+            f"'{path}': the PLY vertex element has no {', '.join(missing)} coordinate "
+            f"(its properties are: {', '.join(names) or 'none'})."
+        )
+    for c in "xyz":
+        if vertex.properties[names.index(c)].count_dtype is not None:
+            raise GoniometerError(f"'{path}': the vertex coordinate '{c}' is a list, not a number.")
+    face = next((e for e in elements if e.name == "face"), None)
+    face_list = _face_list_name(face, path) if face is not None else None
+
+    wanted = {"vertex": {"x", "y", "z", "nx", "ny", "nz"}}
+    if face is not None:
+        wanted["face"] = {face_list}
+    if fmt == "ascii":
+        found = _ply_ascii_body(data, body, elements, wanted, path)
+    else:
+        found = _ply_binary_body(data, body, elements, wanted, _PLY_FORMATS[fmt], path)
+
+    values = found["vertex"]
+    points = np.column_stack([values["x"], values["y"], values["z"]])
+    normals = None
+    if all(c in values for c in ("nx", "ny", "nz")):
+        normals = np.column_stack([values["nx"], values["ny"], values["nz"]])
+    triangles = None
+    if face is not None and face.count > 0:
+        flat, counts = found["face"][face_list]
+        triangles = _fan(flat.astype(np.int64), counts)
+    source_dtype = vertex.properties[names.index("x")].dtype.name
+    return _finish(path, points, triangles, normals, source_dtype)
+
+
+def _face_list_name(face: _PlyElement, path: Path) -> str:
+    lists = [p for p in face.properties if p.count_dtype is not None]
+    chosen = next((p for p in lists if p.name in ("vertex_indices", "vertex_index")), None)
+    if chosen is None and len(lists) == 1:
+        chosen = lists[0]
+    if chosen is None:
+        raise GoniometerError(
+            f"'{path}': the PLY face element has no 'vertex_indices' list; cannot read the faces."
+        )
+    if chosen.dtype.kind == "f":
+        raise GoniometerError(
+            f"'{path}': the PLY face list '{chosen.name}' has a floating-point type; "
+            "vertex indices must be integers."
+        )
+    return chosen.name
+
+
+def _truncated(path: Path, element: _PlyElement) -> GoniometerError:
+    return GoniometerError(
+        f"'{path}' is truncated: the data ends inside the '{element.name}' element "
+        f"({element.count} declared in the header). The file was not written completely; "
+        "re-export or copy it again."
+    )
+
+
+def _ply_binary_body(data, pos, elements, wanted, order, path) -> dict:
+    """Read the needed properties of each element from binary data starting at ``pos``."""
+    found: dict[str, dict] = {}
+    buffer = np.frombuffer(data, np.uint8)
+    for element in elements:
+        if all(name in found for name in wanted) or (element.name in found):
+            break
+        need = wanted.get(element.name, set())
+        if not element.has_lists:
+            dtype = np.dtype(
+                [(f"p{i}", p.dtype.newbyteorder(order)) for i, p in enumerate(element.properties)]
+            )
+            size = dtype.itemsize * element.count
+            if pos + size > len(data):
+                raise _truncated(path, element)
+            if need:
+                rows = np.frombuffer(data, dtype, element.count, pos)
+                found[element.name] = {
+                    p.name: rows[f"p{i}"] for i, p in enumerate(element.properties) if p.name in need
+                }
+            pos += size
+            continue
+        values, pos = _binary_uniform_lists(data, pos, element, order, need)
+        if values is None:
+            values, pos = _binary_mixed_lists(data, buffer, pos, element, order, need, path)
+        if need:
+            found[element.name] = values
+    return found
+
+
+def _binary_uniform_lists(data, pos, element, order, need):
+    """Fast path: every record has the list counts of the first one, so one structured dtype
+    reads the whole element. Returns ``(None, pos)`` when that assumption does not hold."""
+    fields = []
+    offset = pos
+    counts = {}
+    for i, p in enumerate(element.properties):
+        if p.count_dtype is None:
+            fields.append((f"p{i}", p.dtype.newbyteorder(order)))
+            offset += p.dtype.itemsize
+            continue
+        count_dtype = p.count_dtype.newbyteorder(order)
+        if offset + count_dtype.itemsize > len(data):
+            return None, pos
+        count = int(np.frombuffer(data, count_dtype, 1, offset)[0])
+        if count < 0 or offset + count * p.dtype.itemsize > len(data):
+            return None, pos
+        counts[i] = count
+        fields.append((f"c{i}", count_dtype))
+        fields.append((f"p{i}", p.dtype.newbyteorder(order), (count,)))
+        offset += count_dtype.itemsize + count * p.dtype.itemsize
+    dtype = np.dtype(fields)
+    size = dtype.itemsize * element.count
+    if element.count == 0:
+        return _empty_values(element, need), pos
+    if pos + size > len(data):
+        return None, pos
+    rows = np.frombuffer(data, dtype, element.count, pos)
+    if any((rows[f"c{i}"] != c).any() for i, c in counts.items()):
+        return None, pos
+    values = {}
+    for i, p in enumerate(element.properties):
+        if p.name not in need:
+            continue
+        if p.count_dtype is None:
+            values[p.name] = rows[f"p{i}"]
+        else:
+            values[p.name] = (
+                rows[f"p{i}"].reshape(-1),
+                np.full(element.count, counts[i], np.int64),
+            )
+    return values, pos + size
+
+
+def _empty_values(element, need):
+    values = {}
+    for p in element.properties:
+        if p.name in need:
+            empty = np.empty(0, p.dtype)
+            values[p.name] = empty if p.count_dtype is None else (empty, np.empty(0, np.int64))
+    return values
+
+
+def _binary_mixed_lists(data, buffer, pos, element, order, need, path):
+    """General path: find each record's start (one Python step per record, since a record's
+    length depends on its counts), then gather every value with NumPy."""
+    # The record layout as runs of fixed bytes separated by list counts.
+    runs: list[tuple[int, str, int, int]] = []  # (fixed bytes before, count format, size, item)
+    fixed = 0
+    for p in element.properties:
+        if p.count_dtype is None:
+            fixed += p.dtype.itemsize
+        else:
+            code = order + p.count_dtype.char
+            runs.append((fixed, code, p.count_dtype.itemsize, p.dtype.itemsize))
+            fixed = 0
+    tail = fixed
+    starts = []
+    append = starts.append
+    try:
+        if len(runs) == 1 and runs[0][1][1] == "B":  # the common face layout: uchar count
+            before, _, _, item = runs[0]
+            for _ in range(element.count):
+                append(pos)
+                pos += before + 1 + data[pos + before] * item + tail
+        else:
+            unpack = [(before, struct.Struct(code).unpack_from, size, item)
+                      for before, code, size, item in runs]  # fmt: skip
+            for _ in range(element.count):
+                append(pos)
+                for before, read, size, item in unpack:
+                    pos += before
+                    count = read(data, pos)[0]
+                    if count < 0:
+                        raise GoniometerError(
+                            f"'{path}': a negative list count ({count}) in the "
+                            f"'{element.name}' element; the file is corrupt."
+                        )
+                    pos += size + count * item
+                pos += tail
+    except (IndexError, struct.error):
+        raise _truncated(path, element) from None
+    if pos > len(data):
+        raise _truncated(path, element)
+
+    cursor = np.array(starts, dtype=np.int64)
+    values = {}
+    for p in element.properties:
+        if p.count_dtype is None:
+            if p.name in need:
+                values[p.name] = _gather(buffer, cursor, p.dtype.newbyteorder(order))
+            cursor = cursor + p.dtype.itemsize
+            continue
+        counts = _gather(buffer, cursor, p.count_dtype.newbyteorder(order)).astype(np.int64)
+        first = cursor + p.count_dtype.itemsize
+        if p.name in need:
+            rank = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+            at = np.repeat(first, counts) + rank * p.dtype.itemsize
+            values[p.name] = (_gather(buffer, at, p.dtype.newbyteorder(order)), counts)
+        cursor = first + counts * p.dtype.itemsize
+    return values, pos
+
+
+def _gather(buffer: np.ndarray, offsets: np.ndarray, dtype: np.dtype) -> np.ndarray:
+    """The values of type ``dtype`` stored at byte ``offsets`` of ``buffer``."""
+    at = offsets[:, None] + np.arange(dtype.itemsize)
+    return np.ascontiguousarray(buffer[at]).view(dtype).reshape(-1)
+
+
+def _ply_ascii_body(data, pos, elements, wanted, path) -> dict:
+    """Read the needed properties from an ASCII body: all numbers are parsed at once."""
+    numbers = _parse_numbers(data[pos:])
+    if numbers is None:
+        raise GoniometerError(
+            f"'{path}': the ASCII PLY data contains something that is not a number; "
+            "the file is corrupt."
+        )
+    found: dict[str, dict] = {}
+    at = 0
+    for element in elements:
+        if all(name in found for name in wanted) or (element.name in found):
+            break
+        need = wanted.get(element.name, set())
+        values, at = _ascii_element(numbers, at, element, need, path)
+        if need:
+            found[element.name] = values
+    return found
+
+
+def _ascii_first_record(numbers, at, props):
+    """Token width and list counts of the record starting at token ``at``, or None."""
+    width = 0
+    counts = {}
+    for i, p in enumerate(props):
+        if p.count_dtype is None:
+            width += 1
+            continue
+        if at + width >= numbers.size:
+            return None
+        count = numbers[at + width]
+        if not (0 <= count <= numbers.size and count == np.floor(count)):
+            return None
+        counts[i] = int(count)
+        width += 1 + counts[i]
+    return width, counts
+
+
+def _ascii_element(numbers, at, element, need, path):
+    """Values of one element from the flat number array, starting at token ``at``."""
+    props = element.properties
+    if element.count == 0:
+        return _empty_values(element, need), at
+    first = _ascii_first_record(numbers, at, props)
+    if first is not None and first[0] and at + first[0] * element.count <= numbers.size:
+        width, counts = first
+        table = numbers[at : at + width * element.count].reshape(element.count, width)
+        columns = {}
+        column = 0
+        for i, p in enumerate(props):
+            if p.count_dtype is None:
+                columns[i] = column
+                column += 1
+            else:
+                if (table[:, column] != counts[i]).any():
+                    break
+                columns[i] = column + 1
+                column += 1 + counts[i]
+        else:
+            values = {}
+            for i, p in enumerate(props):
+                if p.name not in need:
+                    continue
+                if p.count_dtype is None:
+                    values[p.name] = _ascii_cast(table[:, columns[i]], p.dtype, element, path)
+                else:
+                    flat = table[:, columns[i] : columns[i] + counts[i]].reshape(-1)
+                    values[p.name] = (
+                        _ascii_cast(flat, p.dtype, element, path),
+                        np.full(element.count, counts[i], np.int64),
+                    )
+            return values, at + width * element.count
+
+    # Mixed list counts: walk the records (one Python step each), then gather with NumPy.
+    starts = np.empty(element.count, np.int64)
+    pos = at
+    try:
+        for r in range(element.count):
+            starts[r] = pos
+            for p in props:
+                if p.count_dtype is None:
+                    pos += 1
+                    continue
+                count = numbers[pos]
+                if not (0 <= count <= numbers.size and count == np.floor(count)):
+                    raise GoniometerError(
+                        f"'{path}': list count {count:g} in the '{element.name}' element is "
+                        "not a non-negative integer; the file is corrupt."
+                    )
+                pos += 1 + int(count)
+    except IndexError:
+        raise _truncated(path, element) from None
+    if pos > numbers.size:
+        raise _truncated(path, element)
+    cursor = starts
+    values = {}
+    for p in props:
+        if p.count_dtype is None:
+            if p.name in need:
+                values[p.name] = _ascii_cast(numbers[cursor], p.dtype, element, path)
+            cursor = cursor + 1
+            continue
+        counts = numbers[cursor].astype(np.int64)
+        if p.name in need:
+            rank = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+            flat = numbers[np.repeat(cursor + 1, counts) + rank]
+            values[p.name] = (_ascii_cast(flat, p.dtype, element, path), counts)
+        cursor = cursor + 1 + counts
+    return values, pos
+
+
+def _ascii_cast(values: np.ndarray, dtype: np.dtype, element, path) -> np.ndarray:
+    """ASCII numbers stored as the declared type (so an ASCII file reads like its binary twin)."""
+    if dtype.kind in "iu" and values.size:
+        info = np.iinfo(dtype)
+        if (values != np.floor(values)).any() or values.min() < info.min or values.max() > info.max:
+            raise GoniometerError(
+                f"'{path}': a value in the '{element.name}' element is not a valid {dtype.name} "
+                "integer; the file is corrupt."
+            )
+    return values.astype(dtype)
+
+
+# -------------------------------------------------------------------------------------------- OBJ
+
+_WHITESPACE = np.zeros(256, dtype=bool)
+_WHITESPACE[[9, 10, 11, 12, 13, 32]] = True
+_SPACE = np.uint8(32)
+_SLASH = np.uint8(ord("/"))
+_MINUS = np.uint8(ord("-"))
+
+
+class _Text:
+    """Line and word structure of a text file, found with NumPy over its bytes."""
+
+    def __init__(self, data: bytes, path: Path):
+        self.path = path
+        self.buffer = np.frombuffer(data + b"\n", np.uint8)
+        self.blank = _WHITESPACE[self.buffer]
+        self.ends = np.flatnonzero(self.buffer == 10)  # each line's newline
+        starts = np.concatenate([[0], self.ends[:-1] + 1])
+        first = starts.copy()
+        todo = np.flatnonzero(self.blank[first] & (first < self.ends))
+        while todo.size:  # step over leading blanks: one pass per blank column, not per line
+            first[todo] += 1
+            todo = todo[self.blank[first[todo]] & (first[todo] < self.ends[todo])]
+        self.first = first  # first non-blank byte of each line (its newline if the line is blank)
+
+    def keyword(self, word: bytes) -> np.ndarray:
+        """Indices of the lines whose first word is ``word``."""
+        after = self.first + len(word)
+        match = after <= self.ends
+        for k, byte in enumerate(word):
+            match &= self.buffer[np.minimum(self.first + k, self.ends)] == byte
+        return np.flatnonzero(match & self.blank[np.minimum(after, self.ends)])
+
+    def body(self, lines: np.ndarray, skip: int) -> tuple[np.ndarray, np.ndarray]:
+        """Mask of the bytes after the first ``skip`` bytes of each line in ``lines``, and the
+        position where each of those parts begins."""
+        begin = self.first[lines] + skip
+        end = self.ends[lines]
+        keep = begin < end
+        inside = np.zeros(self.buffer.size + 1, np.int8)
+        inside[begin[keep]] = 1
+        inside[end[keep]] = -1
+        return np.cumsum(inside, dtype=np.int8)[:-1].view(bool), begin
+
+    @staticmethod
+    def word_starts(mask: np.ndarray, separator: np.ndarray) -> np.ndarray:
+        """Mask of the first byte of each run of non-separator bytes inside ``mask``."""
+        inside = mask & ~separator
+        starts = inside.copy()
+        starts[1:] &= ~inside[:-1]
+        return starts
+
+    @staticmethod
+    def per_segment(positions: np.ndarray, begin: np.ndarray) -> np.ndarray:
+        """How many of the sorted ``positions`` lie between consecutive ``begin`` positions
+        (the last segment runs to the end)."""
+        at = np.searchsorted(positions, begin)
+        return np.diff(at, append=positions.size).astype(np.int64)
+
+    def floats(self, lines: np.ndarray, skip: int, what: str) -> tuple[np.ndarray, np.ndarray]:
+        """All numbers after the first ``skip`` bytes of the given lines, as float64, and how
+        many each line holds."""
+        mask, begin = self.body(lines, skip)
+        counts = self.per_segment(np.flatnonzero(self.word_starts(mask, self.blank)), begin)
+        values = _parse_numbers(np.where(mask, self.buffer, _SPACE).tobytes())
+        if values is None or values.size != counts.sum():
+            raise GoniometerError(
+                f"'{self.path}', line {self._bad_line(lines, begin)}: cannot read the numbers "
+                f"of this {what} line; the file is corrupt."
+            )
+        return values, counts
+
+    def _bad_line(self, lines: np.ndarray, begin: np.ndarray, convert=float) -> int:
+        """Line number (1-based) of the first line holding a word that ``convert`` rejects;
+        only called to word an error message."""
+        for line, at in zip(lines, begin, strict=True):
+            text = self.buffer[at : self.ends[line]].tobytes().replace(b"/", b" ")
+            try:
+                [convert(word) for word in text.split()]
+            except ValueError:
+                return int(line) + 1
+        return int(lines[-1]) + 1 if lines.size else 1
+
+    def faces(self, lines: np.ndarray):
+        """Face corners of ``f`` lines, each ``i``, ``i/t``, ``i//n`` or ``i/t/n``.
+
+        Returns ``(vertex, normal, counts)``: the raw (1-based or negative) vertex reference of
+        each corner, its normal reference (None unless every corner has one) and the number of
+        corners per line.
+        """
+        mask, begin = self.body(lines, 1)
+        slash = mask & (self.buffer == _SLASH)
+        corners = np.flatnonzero(self.word_starts(mask, self.blank))
+        counts = self.per_segment(corners, begin)
+        part_inside = mask & ~self.blank & ~slash
+        edges = np.diff(part_inside.view(np.int8), prepend=np.int8(0))
+        part_starts = np.flatnonzero(edges == 1)
+        part_stops = np.flatnonzero(edges == -1)  # the byte after each part
+        parts = _parse_integers(self.buffer, part_starts, part_stops)
+        if parts is None:
+            raise GoniometerError(
+                f"'{self.path}', line {self._bad_line(lines, begin, int)}: cannot read the indices "
+                "of this 'f' line; the file is corrupt."
+            )
+        if corners.size and (self.buffer[corners] == _SLASH).any():
+            bad = corners[self.buffer[corners] == _SLASH][0]
+            line = int(lines[np.searchsorted(begin, bad, side="right") - 1]) + 1
+            raise GoniometerError(f"'{self.path}', line {line}: a face corner has no vertex index.")
+        n_parts = self.per_segment(part_starts, corners)
+        n_slashes = self.per_segment(np.flatnonzero(slash), corners)
+        first_part = np.cumsum(n_parts) - n_parts
+        vertex = parts[first_part]
+        normal = None
+        if corners.size and (n_slashes == 2).all() and (n_parts >= 2).all():
+            normal = parts[first_part + n_parts - 1]  # i//n and i/t/n: the last part
+        return vertex, normal, counts
+
+
+def _parse_integers(buffer: np.ndarray, starts: np.ndarray, stops: np.ndarray):
+    """Decimal integers (optional leading '-') at ``buffer[starts[k]:stops[k]]``, or None if
+    any is not one. Vectorised digit by digit: much faster than text-to-float parsing."""
+    if starts.size == 0:
+        return np.zeros(0, np.int64)
+    negative = buffer[starts] == _MINUS
+    first = starts + negative
+    length = stops - first
+    if length.min() < 1 or length.max() > 18:
+        return None
+    value = np.zeros(starts.size, np.int64)
+    for k in range(int(length.max())):
+        if k < length.min():
+            digit = buffer[first + k] - np.uint8(48)  # non-digits wrap around to > 9
+            if (digit > 9).any():
+                return None
+            value = value * 10 + digit
+        else:
+            active = np.flatnonzero(length > k)
+            digit = buffer[first[active] + k] - np.uint8(48)
+            if (digit > 9).any():
+                return None
+            value[active] = value[active] * 10 + digit
+    return np.where(negative, -value, value)
+
+
+def read_obj(path: str | os.PathLike) -> MeshData:
+    """Read a Wavefront OBJ file.
+
+    ``v`` lines give the points (columns after the third, e.g. colours, are ignored), ``f`` lines
+    the faces with corners in any of the forms ``i``, ``i/t``, ``i//n``, ``i/t/n``, negative
+    (relative) indices allowed; polygons are fan-triangulated. ``vn`` normals are returned only if
+    they map one-to-one to the vertices (as many as vertices, and every face corner's normal
+    index equals its vertex index). Comments and all other statements are ignored.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.obj`` file.
+
+    Returns
+    -------
+    MeshData
+
+    Raises
+    ------
+    GoniometerError
+        For a missing, unreadable or malformed file (see :func:`read_mesh`).
+    """
+    path = _as_path(path)
+    text = _Text(_read_bytes(path), path)
+    v_lines = text.keyword(b"v")
+    values, counts = text.floats(v_lines, 1, "'v'")
+    if v_lines.size and counts.min() < 3:
+        bad = v_lines[np.argmax(counts < 3)]
+        raise GoniometerError(f"'{path}', line {bad + 1}: a 'v' line needs three coordinates x y z.")
+    points = values[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
+
+    f_lines = text.keyword(b"f")
+    triangles = corners = normal_refs = None
+    if f_lines.size:
+        vertex_refs, normal_refs, counts = text.faces(f_lines)
+        corners = _obj_indices(vertex_refs, counts, np.searchsorted(v_lines, f_lines), f_lines,
+                               path, "vertex")  # fmt: skip
+        triangles = _fan(corners, counts)
+
+    normals = None
+    vn_lines = text.keyword(b"vn")
+    if vn_lines.size and vn_lines.size == v_lines.size:
+        values, ncounts = text.floats(vn_lines, 2, "'vn'")
+        if ncounts.min() >= 3:
+            normals = values[(np.cumsum(ncounts) - ncounts)[:, None] + np.arange(3)]
+        if corners is not None:
+            if normal_refs is None or (normal_refs == 0).any():
+                normals = None
+            else:
+                defined = np.repeat(np.searchsorted(vn_lines, f_lines), counts)
+                refs = np.where(normal_refs < 0, normal_refs + defined, normal_refs - 1)
+                if not np.array_equal(refs, corners):
+                    normals = None
+    return _finish(path, points, triangles, normals, "float64")
+
+
+def _obj_indices(refs, counts, before, lines, path, what) -> np.ndarray:
+    """OBJ references (1-based, or negative = relative to the ones defined so far) to 0-based."""
+    if (refs == 0).any():
+        bad = lines[np.repeat(np.arange(counts.size), counts)[refs == 0][0]]
+        raise GoniometerError(
+            f"'{path}', line {bad + 1}: face {what} index 0 is invalid (OBJ indices start at 1)."
+        )
+    defined = np.repeat(before, counts)
+    return np.where(refs < 0, refs + defined, refs - 1)
+
+
+# -------------------------------------------------------------------------------------------- STL
+
+_STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("corners", "<f4", (3, 3)), ("attribute", "<u2")])
+
+
+def read_stl(path: str | os.PathLike) -> MeshData:
+    """Read a binary or ASCII STL file and merge identical vertices into an indexed mesh.
+
+    Binary and ASCII are told apart by the binary size rule (84 + 50 bytes per triangle), so a
+    binary file whose header starts with ``solid`` is still read as binary. Corners with exactly
+    identical coordinates become one vertex, numbered in order of first appearance.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.stl`` file.
+
+    Returns
+    -------
+    MeshData
+        With ``normals=None`` (STL stores facet normals only).
+
+    Raises
+    ------
+    GoniometerError
+        For a missing, unreadable, truncated or malformed file (see :func:`read_mesh`).
+    """
+    path = _as_path(path)
+    data = _read_bytes(path)
+    declared = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
+    expected = 84 + _STL_RECORD.itemsize * declared
+    looks_ascii = data[:1024].lstrip()[:5].lower() == b"solid" and b"\0" not in data[:4096]
+    if declared >= 0 and (len(data) == expected or (len(data) > expected and not looks_ascii)):
+        records = np.frombuffer(data, _STL_RECORD, declared, 84)
+        corners = records["corners"].reshape(-1, 3)
+        source_dtype = "float32"
+    elif looks_ascii:
+        text = _Text(data, path)
+        vertex_lines = text.keyword(b"vertex")
+        values, counts = text.floats(vertex_lines, 6, "'vertex'")
+        if vertex_lines.size and (counts != 3).any():
+            bad = vertex_lines[np.argmax(counts != 3)]
+            raise GoniometerError(
+                f"'{path}', line {bad + 1}: a 'vertex' line needs exactly three coordinates."
+            )
+        if vertex_lines.size % 3:
+            raise GoniometerError(
+                f"'{path}': the ASCII STL has {vertex_lines.size} vertex lines, not a multiple "
+                "of three; the file is truncated or corrupt."
+            )
+        if vertex_lines.size == 0 and declared >= 0:
+            raise GoniometerError(
+                f"'{path}' is neither a complete binary STL (its header declares {declared} "
+                f"triangles, {expected} bytes, the file has {len(data)}) nor an ASCII STL with "
+                "'vertex' lines. The file is truncated or corrupt; re-export it."
+            )
+        corners = values.reshape(-1, 3)
+        source_dtype = "float64"
+    elif declared >= 0:
+        raise GoniometerError(
+            f"'{path}' is a truncated binary STL: its header declares {declared} triangles "
+            f"({expected} bytes) but the file has {len(data)} bytes. Re-export or copy it again."
+        )
+    else:
+        raise GoniometerError(
+            f"'{path}' is not an STL file: too short for a binary STL and not ASCII "
+            "('solid ...'). Re-export the mesh."
+        )
+    if not np.isfinite(corners).all():
+        # Report before merging, so the message counts corners as the file stores them.
+        return _finish(path, corners, None, None, source_dtype)
+    points, triangles = _merge_exact(corners)
+    return _finish(path, points, triangles, None, source_dtype)
+
+
+def _merge_exact(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Merge corners with identical coordinates; vertices numbered by first appearance."""
+    n = corners.shape[0]
+    if n == 0:
+        return np.empty((0, 3)), np.empty((0, 3), np.int64)
+    corners = corners + 0.0  # -0.0 and 0.0 are the same point
+    order = np.lexsort((corners[:, 2], corners[:, 1], corners[:, 0]))  # stable
+    ranked = corners[order]
+    new = np.ones(n, dtype=bool)
+    new[1:] = (ranked[1:] != ranked[:-1]).any(axis=1)
+    group = np.cumsum(new) - 1  # group id per sorted corner
+    first = order[new]  # the first appearance of each group (lexsort is stable)
+    renumber = np.empty(first.size, np.int64)
+    renumber[np.argsort(first, kind="stable")] = np.arange(first.size)
+    index = np.empty(n, np.int64)
+    index[order] = renumber[group]
+    points = np.empty((first.size, 3), dtype=np.float64)
+    points[renumber] = corners[first]
+    return points, index.reshape(-1, 3)
+
+
+# ------------------------------------------------------------------------------------------ write
+
+
+def write_ply(
+    path: str | os.PathLike,
+    points,
+    triangles=None,
+    normals=None,
+    binary: bool = True,
+) -> Path:
+    """Write a PLY file with float64 ("double") coordinates, exactly readable by :func:`read_ply`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file to write (overwritten).
+    points : array_like
+        ``(n, 3)`` finite coordinates.
+    triangles : array_like, optional
+        ``(m, 3)`` vertex indices; omitted for a point cloud.
+    normals : array_like, optional
+        ``(n, 3)`` per-vertex normals, written as ``nx ny nz``.
+    binary : bool
+        ``True`` for binary little-endian, ``False`` for ASCII (17 significant digits, so the
+        values round-trip exactly).
+
+    Returns
+    -------
+    pathlib.Path
+        The written path.
+
+    Raises
+    ------
+    GoniometerError
+        If the arrays have the wrong shape, are not finite, indices are out of range, or the
+        file cannot be written.
+    """
+    path = _as_path(path)
+    points = np.asarray(points, dtype=np.float64)
+    if points.ndim != 2 or points.shape[1] != 3 or points.shape[0] == 0:
+        raise GoniometerError(f"write_ply needs (n, 3) points with n > 0, got {points.shape}.")
+    if not np.isfinite(points).all():
+        raise GoniometerError("write_ply: some point coordinates are not finite.")
+    n = points.shape[0]
+    columns = [points]
+    names = ["x", "y", "z"]
+    if normals is not None:
+        normals = np.asarray(normals, dtype=np.float64)
+        if normals.shape != points.shape:
+            raise GoniometerError(
+                f"write_ply: normals must have the points' shape {points.shape}, "
+                f"got {normals.shape}."
+            )
+        columns.append(normals)
+        names += ["nx", "ny", "nz"]
+    if triangles is not None:
+        triangles = np.asarray(triangles)
+        if triangles.ndim != 2 or triangles.shape[1] != 3 or triangles.dtype.kind not in "iu":
+            raise GoniometerError(
+                f"write_ply needs (m, 3) integer triangles, got {triangles.shape} "
+                f"{triangles.dtype}."
+            )
+        if triangles.size and (triangles.min() < 0 or triangles.max() >= n):
+            raise GoniometerError(
+                f"write_ply: a triangle index is outside 0..{n - 1} (the points' range)."
+            )
+    header = ["ply", f"format {'binary_little_endian' if binary else 'ascii'} 1.0",
+              "comment written by the Virtual Goniometer", f"element vertex {n}"]  # fmt: skip
+    header += [f"property double {name}" for name in names]
+    if triangles is not None:
+        header += [f"element face {len(triangles)}", "property list uchar int vertex_indices"]
+    header.append("end_header")
+    vertices = np.hstack(columns)
+    try:
+        with open(path, "wb") as file:
+            file.write(("\n".join(header) + "\n").encode("ascii"))
+            if binary:
+                file.write(vertices.astype("<f8").tobytes())
+                if triangles is not None:
+                    faces = np.empty(len(triangles), [("n", "u1"), ("v", "<i4", (3,))])
+                    faces["n"] = 3
+                    faces["v"] = triangles
+                    file.write(faces.tobytes())
+            else:
+                np.savetxt(file, vertices, fmt="%.17g")
+                if triangles is not None:
+                    np.savetxt(file, np.column_stack([np.full(len(triangles), 3), triangles]),
+                               fmt="%d")  # fmt: skip
+    except OSError as error:
+        raise GoniometerError(f"Could not write '{path}': {error.strerror or error}.") from None
+    return path

@@ -1,0 +1,122 @@
+"""A uniform-grid spatial index for ball queries, built once per surface."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import GoniometerError
+
+_MAX_CELLS_PER_AXIS = 1 << 20
+
+
+def estimate_spacing(points: np.ndarray) -> float:
+    """Typical distance between neighbouring points of a sampled surface (or volume).
+
+    Counts the occupied cells of a grid coarse enough to hold several points per cell: a surface
+    of area A sampled by n points at spacing h occupies about A / c^2 cells of size c, so
+    h ~ c * sqrt(occupied / n).
+    """
+    n = points.shape[0]
+    origin = points.min(axis=0)
+    extent = float((points.max(axis=0) - origin).max())
+    if n < 2 or extent == 0.0:
+        return max(extent, 1.0)
+    cell = extent / 128.0
+    while True:
+        ijk = np.floor((points - origin) / cell).astype(np.int64)
+        side = int(ijk.max()) + 1
+        occupied = np.unique((ijk[:, 0] * side + ijk[:, 1]) * side + ijk[:, 2]).size
+        if occupied <= n / 4 or cell >= extent:
+            return cell * float(np.sqrt(occupied / n))
+        cell *= 2.0
+
+
+class GridIndex:
+    """Points sorted by the cell of a uniform grid they fall in, for fast ball queries.
+
+    The index is built once (a sort of the cell keys); a query visits only the grid columns that
+    overlap the ball's bounding box, so its cost depends on the size of the answer, not of the mesh.
+
+    Parameters
+    ----------
+    points : ndarray, shape (n, 3)
+        Finite float64 coordinates.
+    cell_size : float, optional
+        Grid cell edge; default twice the estimated point spacing.
+    ids : ndarray of int64, shape (n,), optional
+        What a query returns for each point (default ``arange(n)``): lets a caller index a subset.
+    """
+
+    def __init__(self, points: np.ndarray, cell_size: float | None = None, ids=None):
+        points = np.asarray(points, dtype=np.float64)
+        if points.ndim != 2 or points.shape[1] != 3 or points.shape[0] == 0:
+            raise GoniometerError("A spatial index needs a non-empty (n, 3) array of points.")
+        self.origin = points.min(axis=0)
+        extent = points.max(axis=0) - self.origin
+        if cell_size is None:
+            cell_size = 2.0 * estimate_spacing(points)
+        cell_size = max(float(cell_size), float(extent.max()) / _MAX_CELLS_PER_AXIS, 1e-300)
+        self.cell_size = cell_size
+        self.dims = (np.floor(extent / cell_size).astype(np.int64) + 1).astype(np.int64)
+        ijk = self._cells(points)
+        keys = (ijk[:, 0] * self.dims[1] + ijk[:, 1]) * self.dims[2] + ijk[:, 2]
+        order = np.argsort(keys, kind="stable")
+        self.keys = keys[order]
+        self.points = np.ascontiguousarray(points[order])
+        ids = np.arange(points.shape[0], dtype=np.int64) if ids is None else np.asarray(ids)
+        self.ids = ids[order]
+
+    def _cells(self, coordinates: np.ndarray) -> np.ndarray:
+        ijk = np.floor((coordinates - self.origin) / self.cell_size).astype(np.int64)
+        return np.clip(ijk, 0, self.dims - 1)
+
+    def _candidates(self, center: np.ndarray, radius: float) -> np.ndarray:
+        """Positions (into the sorted arrays) of the points in the cells the ball's box overlaps."""
+        low = np.floor((center - radius - self.origin) / self.cell_size)
+        high = np.floor((center + radius - self.origin) / self.cell_size)
+        if (high < 0).any() or (low > self.dims - 1).any():
+            return np.empty(0, dtype=np.int64)
+        low = np.clip(low, 0, self.dims - 1).astype(np.int64)
+        high = np.clip(high, 0, self.dims - 1).astype(np.int64)
+        ix = np.arange(low[0], high[0] + 1, dtype=np.int64)
+        iy = np.arange(low[1], high[1] + 1, dtype=np.int64)
+        column = ((ix[:, None] * self.dims[1] + iy[None, :]) * self.dims[2]).ravel()
+        starts = np.searchsorted(self.keys, column + low[2], side="left")
+        ends = np.searchsorted(self.keys, column + high[2], side="right")
+        lengths = ends - starts
+        total = int(lengths.sum())
+        if total == 0:
+            return np.empty(0, dtype=np.int64)
+        offsets = np.cumsum(lengths) - lengths
+        return np.repeat(starts - offsets, lengths) + np.arange(total, dtype=np.int64)
+
+    def ball(self, center, radius: float) -> tuple[np.ndarray, np.ndarray]:
+        """Ids of the points within ``radius`` of ``center`` (boundary included), and their distances."""
+        center = np.asarray(center, dtype=np.float64)
+        positions = self._candidates(center, radius)
+        offsets = self.points[positions] - center
+        squared = np.einsum("ij,ij->i", offsets, offsets)
+        inside = squared <= radius * radius
+        return self.ids[positions[inside]], np.sqrt(squared[inside])
+
+    def nearest(self, center, max_distance: float) -> tuple[int, float]:
+        """Id of the point nearest ``center`` within ``max_distance``, or ``(-1, inf)`` if none.
+
+        Ties are broken by coordinates, so the answer does not depend on the points' order.
+        """
+        center = np.asarray(center, dtype=np.float64)
+        radius = min(self.cell_size, max_distance)
+        while True:
+            positions = self._candidates(center, radius)
+            if positions.size:
+                offsets = self.points[positions] - center
+                squared = np.einsum("ij,ij->i", offsets, offsets)
+                inside = squared <= radius * radius
+                if inside.any():
+                    positions, squared = positions[inside], squared[inside]
+                    coords = self.points[positions]
+                    best = np.lexsort((coords[:, 2], coords[:, 1], coords[:, 0], squared))[0]
+                    return int(self.ids[positions[best]]), float(np.sqrt(squared[best]))
+            if radius >= max_distance:
+                return -1, float("inf")
+            radius = min(radius * 4.0, max_distance)

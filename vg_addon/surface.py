@@ -1,0 +1,193 @@
+"""A scanned surface, prepared once, measured many times."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .algorithm import (
+    MIN_SIDE_VERTICES,
+    as_center,
+    as_lambda,
+    as_points,
+    as_radius,
+    canonical_order,
+    measure_patch,
+    unit_normals,
+)
+from .errors import GoniometerError
+from .geodesic import EdgeGraph
+from .normals import pca_normals, vertex_normals
+from .result import Measurement
+from .spatial import GridIndex
+
+PATCH_MODES = ("euclidean", "geodesic")
+
+
+def _as_triangles(triangles, n_points: int) -> np.ndarray:
+    try:
+        array = np.ascontiguousarray(np.asarray(triangles, dtype=np.int64))
+    except (TypeError, ValueError, OverflowError) as error:
+        raise GoniometerError(f"The triangles must be integer vertex indices: {error}") from None
+    if array.size == 0:
+        return array.reshape(0, 3)
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise GoniometerError(
+            f"The triangles must be an (m, 3) array of vertex indices; got shape {array.shape}."
+        )
+    if array.min() < 0 or array.max() >= n_points:
+        raise GoniometerError(
+            f"A triangle refers to vertex {int(array.max() if array.max() >= n_points else array.min())},"
+            f" but the mesh has vertices 0 to {n_points - 1}: the face list does not match the points."
+        )
+    return array
+
+
+class Surface:
+    """A mesh or point cloud, prepared once (normals, spatial index) and measured many times.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 3)
+        Vertex coordinates (converted to float64).
+    triangles : array_like of int, shape (m, 3), optional
+        Faces, wound counter-clockwise seen from outside. Needed for the geodesic patch mode.
+    normals : array_like, shape (n, 3), optional
+        Outward vertex normals. Default: area-weighted normals from ``triangles``, or for a point
+        cloud, local-PCA normals oriented outward.
+
+    Notes
+    -----
+    Vertices without a normal (used by no face, or whose faces are all degenerate) are left out
+    of every patch; ``valid`` marks the vertices that take part.
+    """
+
+    def __init__(self, points, triangles=None, normals=None):
+        self.points = as_points("points", points)
+        n = self.points.shape[0]
+        self.triangles = None if triangles is None else _as_triangles(triangles, n)
+        if self.triangles is not None and self.triangles.shape[0] == 0:
+            self.triangles = None
+        self._graph = None
+        if normals is not None:
+            given = as_points("normals", normals)
+            if given.shape != self.points.shape:
+                raise GoniometerError(
+                    f"There must be one normal per point: {n} points, {given.shape[0]} normals."
+                )
+            self.normals = unit_normals("normals", given)
+            self.valid = np.ones(n, dtype=bool)
+        elif self.triangles is not None:
+            self.normals, self.valid = vertex_normals(self.points, self.triangles)
+        else:
+            cloud_index = GridIndex(self.points)
+            self.normals, self.valid = pca_normals(self.points, cloud_index)
+        self.valid_ids = np.flatnonzero(self.valid)
+        if self.valid_ids.size == 0:
+            raise GoniometerError(
+                "No vertex of this mesh has a normal (no faces with area, or an empty point cloud): "
+                "nothing can be measured."
+            )
+        self.index = GridIndex(self.points[self.valid_ids], ids=self.valid_ids)
+
+    @property
+    def n_points(self) -> int:
+        """Number of vertices (including any without a normal)."""
+        return self.points.shape[0]
+
+    def snap(self, center, radius: float) -> tuple[int, float]:
+        """Index of the vertex nearest ``center`` and its distance; an error if farther than ``radius``."""
+        center = as_center(center)
+        radius = as_radius(radius)
+        vertex, distance = self.index.nearest(center, radius)
+        if vertex < 0:
+            raise GoniometerError(
+                f"The centre ({center[0]:g}, {center[1]:g}, {center[2]:g}) is farther than the radius "
+                f"{radius:g} from every vertex of the surface: pick a point on the surface, or check "
+                "that the coordinates are in the mesh's units and frame."
+            )
+        return vertex, distance
+
+    def patch(self, center_index: int, radius: float, patch: str = "euclidean") -> np.ndarray:
+        """Indices of the vertices in the patch of ``radius`` around vertex ``center_index``.
+
+        ``"euclidean"``: within straight-line distance ``radius``. ``"geodesic"``: reachable along
+        mesh edges by a path no longer than ``radius`` (needs triangles).
+        """
+        radius = as_radius(radius)
+        mode = check_patch_mode(patch)
+        center = self.points[center_index]
+        indices, _ = self.index.ball(center, radius)
+        if mode == "geodesic":
+            if self.triangles is None:
+                raise GoniometerError(
+                    "The geodesic patch follows mesh edges, and this surface is a point cloud with no "
+                    "faces: use patch='euclidean', or give the triangles."
+                )
+            if self._graph is None:
+                self._graph = EdgeGraph(self.points, self.triangles)
+            distance = self._graph.distances(indices, center_index, radius)
+            indices = indices[distance <= radius]
+        return indices
+
+    def measure(
+        self, center, radius: float, lam: float = 2.0, patch: str = "euclidean"
+    ) -> Measurement:
+        """Measure the break angle at ``center`` (Algorithm 1 on the patch around it).
+
+        Parameters
+        ----------
+        center : array_like, shape (3,)
+            Where to measure; snapped to the nearest vertex, which becomes ``x̄``.
+        radius : float
+            Patch radius, in the surface's units; also the ``r`` of the projection.
+        lam : float, optional
+            Segmentation parameter λ ≥ 0 (default 2).
+        patch : {"euclidean", "geodesic"}, optional
+            How the patch is chosen (default ``"euclidean"``).
+
+        Returns
+        -------
+        Measurement
+
+        Raises
+        ------
+        GoniometerError
+            Centre farther than ``radius`` from the surface, bad radius or λ, unknown patch mode,
+            too few vertices, a flat patch, or a side that is a line.
+        """
+        requested = as_center(center)
+        radius = as_radius(radius)
+        lam = as_lambda(lam)
+        mode = check_patch_mode(patch)
+        center_index, snap_distance = self.snap(requested, radius)
+        indices = self.patch(center_index, radius, mode)
+        if indices.size < 2 * MIN_SIDE_VERTICES:
+            raise GoniometerError(
+                f"The patch of radius {radius:g} holds only {indices.size} vertices; at least "
+                f"{2 * MIN_SIDE_VERTICES} are needed: use a larger radius."
+            )
+        points, normals = self.points[indices], self.normals[indices]
+        order = canonical_order(points, normals)
+        indices = indices[order]
+        fields = measure_patch(
+            points[order], normals[order], self.points[center_index], radius, lam
+        )
+        return Measurement(
+            **fields,
+            indices=indices,
+            center=self.points[center_index].copy(),
+            requested_center=requested,
+            snap_distance=snap_distance,
+            center_index=int(center_index),
+            radius=radius,
+            lam=lam,
+            patch=mode,
+        )
+
+
+def check_patch_mode(patch) -> str:
+    """Return the patch mode in lower case, or raise if it is not one of :data:`PATCH_MODES`."""
+    mode = str(patch).lower()
+    if mode not in PATCH_MODES:
+        raise GoniometerError(f"Unknown patch mode {patch!r}: use one of {', '.join(PATCH_MODES)}.")
+    return mode
