@@ -7,7 +7,7 @@ Runs inside Blender or with the ``bpy`` module from PyPI, with the same argument
 
 The repository root is the extension package: this script imports it from the folder it sits in
 and registers it, so the measurements are taken, stored and coloured exactly as the extension
-does it (see docs/README_batch.md).
+does it (see the README, "Batch runs from the command line").
 """
 
 from __future__ import annotations
@@ -16,10 +16,12 @@ import argparse
 import contextlib
 import csv
 import dataclasses
+import functools
 import importlib
 import importlib.util
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -28,6 +30,8 @@ import time
 import traceback
 from collections import deque
 from pathlib import Path
+
+import numpy as np
 
 ROOT = Path(__file__).resolve().parent
 PACKAGE = "virtual_goniometer"  # the name the repository root is imported under
@@ -69,8 +73,8 @@ points:
 output:
   --out CSV gets one row per requested point, in input order, in the extension's export
   schema (MeshLab's 14 columns first). A row that cannot be measured has its message in the
-  `error` column and the run goes on. The CSV is rewritten after each mesh, so a run that is
-  stopped keeps what it measured.
+  `error` column and the run goes on. While meshes finish, the CSV is rewritten every few
+  seconds, so a run that is stopped keeps what it measured.
 
 exit status:
   0  every point measured
@@ -227,6 +231,11 @@ def script_argv() -> list[str]:
     return sys.argv[1:]
 
 
+# The extension packages this script registered, to unregister before the process ends: the bpy
+# 4.2 module crashes at exit if Python classes are still registered then.
+_registered: list = []
+
+
 class UsageError(Exception):
     """Bad arguments or input files: exit status 2."""
 
@@ -273,7 +282,6 @@ class Context:
         self.csvio = importlib.import_module(f"{name}.vg_addon.csvio")
         self.meshio = importlib.import_module(f"{name}.vg_addon.meshio")
         self.batchplan = importlib.import_module(f"{name}.vg_addon.batchplan")
-        self.palette = importlib.import_module(f"{name}.vg_addon.palette")
         self.mesh_data = importlib.import_module(f"{name}.operators.mesh_data")
         self.measuring = importlib.import_module(f"{name}.operators.measuring")
         self.records = importlib.import_module(f"{name}.operators.records")
@@ -314,6 +322,7 @@ def load_extension() -> Context:
     sys.modules[PACKAGE] = package
     spec.loader.exec_module(package)
     package.register()
+    _registered.append(package)
     return Context(package)
 
 
@@ -347,9 +356,12 @@ def start_file(ctx_bpy, inputs: list[str]) -> tuple[list[str], str]:
         if not path.is_file():
             raise UsageError(f"{blends[0]}: no such .blend file.")
         try:
-            ctx_bpy.ops.wm.open_mainfile(filepath=str(path.resolve()), load_ui=False)
+            with quiet_stdout():
+                ctx_bpy.ops.wm.open_mainfile(filepath=str(path.resolve()), load_ui=False)
         except RuntimeError as error:
-            raise UsageError(f"{blends[0]}: cannot open it as a .blend file ({error}).") from None
+            raise UsageError(
+                f"{blends[0]}: cannot open it as a .blend file ({str(error).strip()})."
+            ) from None
         return others, str(path)
     if IN_BLENDER and ctx_bpy.data.filepath:
         return others, ctx_bpy.data.filepath
@@ -403,8 +415,6 @@ def file_sources(ctx: Context, inputs: list[str]) -> list[MeshSource]:
 def import_mesh(ctx: Context, source: MeshSource):
     """A new mesh object made from ``source``'s file (float32 coordinates, as Blender stores
     them), linked to the scene at the world origin."""
-    import numpy as np
-
     bpy = ctx.bpy
     data = ctx.meshio.read_mesh(source.path)
     points = np.ascontiguousarray(data.points, dtype=np.float32)
@@ -526,7 +536,11 @@ def measure_mesh(ctx: Context, index: int, source: MeshSource, tasks, options, p
     data = obj.vg
     base = data.next_number - 1  # measurements already on a .blend object keep their numbers
     fresh = len(data.measurements) == 0
-    sides, view = [], [0.0, 0.0, 0.0]
+    # Per vertex, the break number and side of the last measurement covering it (0: none), so
+    # the colours are painted once at the end without keeping every measurement in memory.
+    painter = np.zeros(result.n_vertices, dtype=np.int64)
+    plus_side = np.zeros(result.n_vertices, dtype=bool)
+    view = np.zeros(3)
     last_report = start = time.perf_counter()
     for done, task in enumerate(tasks, start=1):
         try:
@@ -542,8 +556,9 @@ def measure_mesh(ctx: Context, index: int, source: MeshSource, tasks, options, p
             result.rows.append(
                 (task.index, ctx.records.to_row(obj, item, stale=False, units=units))
             )
-            sides.append((m.indices, m.labels, item.break_number))
-            view = [a + b for a, b in zip(view, m.mean_normal, strict=True)]
+            painter[m.indices] = item.break_number
+            plus_side[m.indices] = m.labels
+            view += m.mean_normal
             result.measured += 1
         now = time.perf_counter()
         if progress is not None and now - last_report >= 1.0:
@@ -553,10 +568,16 @@ def measure_mesh(ctx: Context, index: int, source: MeshSource, tasks, options, p
     if len(data.measurements):
         data.next_number = max(item.number for item in data.measurements) + 1
 
-    if sides:
+    if result.measured:
         if fresh and len(obj.data.vertices) == result.n_vertices:
-            # Every measurement is this run's, on these vertices: paint them as repaint() would,
-            # without measuring each one again.
+            # Every measurement is this run's, on these vertices: paint them as repaint() would
+            # (later over earlier), without measuring each one again.
+            painted = np.flatnonzero(painter)
+            sides = [
+                (vertices, plus_side[vertices], int(number))
+                for number in np.unique(painter[painted])
+                for vertices in [painted[painter[painted] == number]]
+            ]
             rgba = ctx.colors.side_colours(result.n_vertices, sides)
             ctx.colors.write_attribute(obj.data, rgba)
         else:
@@ -566,7 +587,7 @@ def measure_mesh(ctx: Context, index: int, source: MeshSource, tasks, options, p
     if options.get("render"):
         path = Path(options["render"]) / f"{safe_file_name(obj.name)}.png"
         try:
-            render_object(bpy, obj, path, options, view)
+            render_object(bpy, obj, path, options, view.tolist())
             result.render = str(path)
         except Exception as error:  # a render problem must not lose the measurements
             result.render_error = f"{type(error).__name__}: {error}"
@@ -652,7 +673,6 @@ def render_object(bpy, obj, path: Path, options: dict, view) -> None:
     along ``view`` (e.g. the sum of the measured patches' mean normals), a sun and a grey sky,
     every surface shown with the side colours."""
     import mathutils
-    import numpy as np
 
     width, height = options.get("render_size", (640, 480))
     direction = mathutils.Vector(view)
@@ -749,7 +769,7 @@ def render_object(bpy, obj, path: Path, options: dict, view) -> None:
 def prepare_saved_file(bpy, objects) -> None:
     """Make the saved .blend open on the measurements: the first object active, solid views
     showing attribute colours and framing the meshes."""
-    import numpy as np
+    import mathutils
 
     objects = [o for o in objects if o is not None]
     if not objects:
@@ -759,7 +779,7 @@ def prepare_saved_file(bpy, objects) -> None:
     for obj in objects:
         obj.select_set(obj == objects[0])
     corners = np.array(
-        [list(obj.matrix_world @ type(obj.location)(c)) for obj in objects for c in obj.bound_box]
+        [list(obj.matrix_world @ mathutils.Vector(c)) for obj in objects for c in obj.bound_box]
     )
     centre = (corners.min(axis=0) + corners.max(axis=0)) / 2
     size = float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0))) or 1.0
@@ -805,12 +825,15 @@ class Run:
     def __init__(self, ctx: Context, args, sources, tasks, total_meshes):
         self.ctx, self.args, self.sources, self.tasks = ctx, args, sources, tasks
         self.total_meshes = total_meshes
+        self.jobs = 1  # processes measuring at once
         self.rows: dict[int, object] = {}
         self.results: list[MeshResult] = []
         self.bad_files: list[str] = []
         self.lock = threading.Lock()
         self.started = time.perf_counter()
         self.last_progress = 0.0
+        self.last_write = 0.0  # when the CSV was last written (perf_counter seconds)
+        self.write_seconds = 0.0  # how long that took
         self.in_flight: dict[int, int] = {}  # mesh -> points done so far (running meshes)
         self.units = ctx.records.units_label(ctx.bpy.context.scene)
         for task in tasks:
@@ -845,7 +868,10 @@ class Run:
                 self.rows[index] = row
             if result.bad_file:
                 self.bad_files.append(result.bad_file)
-            self.write_csv()
+            # Rewrite the CSV now and then (each write costs more as rows accumulate), so a run
+            # that is killed keeps what it measured; finish() always writes.
+            if time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds):
+                self.write_csv()
         source = self.sources[result.mesh]
         rate = result.measured / result.measure_seconds if result.measure_seconds > 0 else 0
         note = f", render failed: {result.render_error}" if result.render_error else ""
@@ -859,8 +885,11 @@ class Run:
             self.say(f"{source.name}{note}")
 
     def write_csv(self) -> None:
+        start = time.perf_counter()
         rows = [self.rows[i] for i in sorted(self.rows)]
         self.ctx.csvio.write_measurements_csv(self.args.out, rows)
+        self.last_write = time.perf_counter()
+        self.write_seconds = self.last_write - start
 
     def finish(self) -> int:
         missing = [t for t in self.tasks if t.index not in self.rows]
@@ -882,9 +911,10 @@ class Run:
             f"{measured:,} measured, {len(failed):,} failed, {len(self.rows):,} points on "
             f"{self.total_meshes:,} mesh(es) in {elapsed:.1f} s"
         )
+        per = f" per process, {self.jobs} processes" if self.jobs > 1 else ""
         self.say(
             f"mesh import {load:.1f} s, surface preparation {prepare:.1f} s, measuring "
-            f"{measuring:.2f} s: {rate:,.0f} measurements/s (import excluded)"
+            f"{measuring:.2f} s: {rate:,.0f} measurements/s{per} (import excluded)"
         )
         by_index = {t.index: t for t in self.tasks}
         for index, row in failed[:10]:
@@ -931,9 +961,15 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
     lock = threading.Lock()
     row_type = run.ctx.csvio.MeasurementRow
 
+    # One BLAS/OpenMP thread per worker: the workers are the parallelism.
+    env = dict(os.environ)
+    for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        env.setdefault(name, "1")
+
     def start():
         return subprocess.Popen(
             worker_command(plan_path),
+            env=env,
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
@@ -941,6 +977,14 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
             errors="replace",
             bufsize=1,
         )
+
+    def fail(mesh: int, message: str) -> None:
+        name = run.sources[mesh].name
+        result = MeshResult(mesh=mesh, failed=len(groups[mesh]))
+        result.rows = [
+            (t.index, error_row(run.ctx, t, name, message, run.units)) for t in groups[mesh]
+        ]
+        run.add(result)
 
     def slot():
         process = None
@@ -950,7 +994,11 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
                     break
                 mesh = queue.popleft()
             if process is None:
-                process = start()
+                try:
+                    process = start()
+                except OSError as error:
+                    fail(mesh, f"could not start a worker process: {error}")
+                    continue
             finished = False
             try:
                 process.stdin.write(f"{mesh}\n")
@@ -973,20 +1021,11 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
                 continue
             code = process.wait()
             process = None
-            message = (
-                f"the worker process measuring this mesh stopped (exit status {code}); "
-                "see its messages above. The other meshes are not affected."
+            fail(
+                mesh,
+                f"the worker process measuring this mesh stopped (exit status {code}); see its "
+                "messages above. The other meshes are not affected.",
             )
-            result = MeshResult(mesh=mesh)
-            for task in groups[mesh]:
-                result.rows.append(
-                    (
-                        task.index,
-                        error_row(run.ctx, task, run.sources[mesh].name, message, run.units),
-                    )
-                )
-            result.failed = len(groups[mesh])
-            run.add(result)
         if process is not None:
             with contextlib.suppress(OSError):
                 process.stdin.close()
@@ -997,10 +1036,6 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
         thread.start()
     for thread in threads:
         thread.join()
-
-
-def task_to_json(task) -> dict:
-    return dataclasses.asdict(task)
 
 
 def worker_main(plan_path: str) -> int:
@@ -1129,40 +1164,43 @@ def run_batch(args, ctx: Context | None = None, blend: str = "") -> tuple[int, R
     parallel = args.jobs > 1 and len(groups) > 1 and not blend
     if args.jobs > 1 and blend and not args.quiet:
         run.say("a .blend input is measured in this process (--jobs applies to mesh files only)")
-    if parallel:
-        with tempfile.TemporaryDirectory(prefix="vg-batch-") as folder:
-            plan = {
-                "folder": folder,
-                "sources": [dataclasses.asdict(s) for s in sources],
-                "tasks": {str(m): [task_to_json(t) for t in ts] for m, ts in groups.items()},
-                "options": options,
-            }
-            run_workers(run, groups, plan, args.jobs)
-            code = run.finish()
-            if args.save_blend:
-                objects = append_objects(bpy, run.results)
-                save_blend(bpy, args.save_blend, objects)
-    else:
-        kept = []
+    folder = tempfile.mkdtemp(prefix="vg-batch-") if parallel else ""
+    kept = []  # objects measured in this process, kept for --save-blend
+    try:
         try:
-            for mesh, mesh_tasks in groups.items():
-                result = safe_measure_mesh(
-                    ctx,
-                    mesh,
-                    sources[mesh],
-                    mesh_tasks,
-                    options,
-                    lambda done, mesh=mesh: run.progress(mesh, done),
-                )
-                run.add(result)
-                if args.save_blend or not sources[mesh].path:
-                    kept.append(result.object_name)
-                elif result.object_name:
-                    forget(bpy, ctx, result.object_name)
+            if parallel:
+                plan = {
+                    "folder": folder,
+                    "sources": [dataclasses.asdict(s) for s in sources],
+                    "tasks": {
+                        str(m): [dataclasses.asdict(t) for t in ts] for m, ts in groups.items()
+                    },
+                    "options": options,
+                }
+                run.jobs = min(args.jobs, len(groups))
+                run_workers(run, groups, plan, args.jobs)
+            else:
+                for mesh, mesh_tasks in groups.items():
+                    progress = functools.partial(run.progress, mesh)
+                    result = safe_measure_mesh(
+                        ctx, mesh, sources[mesh], mesh_tasks, options, progress
+                    )
+                    run.add(result)
+                    if args.save_blend or not sources[mesh].path:
+                        kept.append(result.object_name)
+                    elif result.object_name:
+                        forget(bpy, ctx, result.object_name)
         finally:
-            code = run.finish()
+            code = run.finish()  # also after an error or Ctrl-C: write what was measured
         if args.save_blend:
-            save_blend(bpy, args.save_blend, [bpy.data.objects.get(n) for n in kept if n])
+            if parallel:
+                objects = append_objects(bpy, run.results)
+            else:
+                objects = [bpy.data.objects.get(name) for name in kept if name]
+            save_blend(bpy, args.save_blend, objects)
+    finally:
+        if folder:
+            shutil.rmtree(folder, ignore_errors=True)
     if args.save_blend:
         run.say(f"wrote {args.save_blend}")
     if args.render:
@@ -1206,50 +1244,42 @@ def run_demo(args) -> int:
                 ]
             )
 
-    batch = build_parser().parse_args(
-        [
-            str(ply),
-            "--points",
-            str(points),
-            "--out",
-            str(out / "measurements.csv"),
-            "--save-blend",
-            str(out / "bone_fragment.blend"),
-            "--render",
-            str(out),
-            "--units",
-            "mm",
-            "--render-size",
-            "800",
-            "600",
-            "--jobs",
-            str(args.jobs),
-        ]
-    )
+    outputs = {
+        "--out": out / "measurements.csv",
+        "--save-blend": out / "bone_fragment.blend",
+        "--render": out,
+    }
+    argv = [str(ply), "--points", str(points), "--units", "mm", "--render-size", "800", "600"]
+    argv += [str(value) for option in outputs.items() for value in option]
+    batch = build_parser().parse_args([*argv, "--jobs", str(args.jobs)])
     batch.quiet = args.quiet
     code, run = run_batch(batch, ctx)
+
     rows = [run.rows[i] for i in sorted(run.rows)]
-    print()
-    print(f"{'break site':<24} {'true angle':>11} {'measured':>11} {'difference':>11}  fit error")
+    width = max(len("break site"), *(len(site.label) for site in fragment.sites))
+    print(f"\n{'break site':<{width}}  true angle    measured  difference  fit error")
     for site, row in zip(fragment.sites, rows, strict=True):
         if row.error:
-            print(f"{site.label:<24} {site.angle:>10.2f}° {'failed':>11}  {row.error}")
+            print(f"{site.label:<{width}}  {site.angle:9.2f}°      failed  {row.error}")
             continue
         print(
-            f"{site.label:<24} {site.angle:>10.2f}° {row.angle:>10.2f}° "
-            f"{row.angle - site.angle:>+10.2f}°  {row.fit:.3g}"
+            f"{site.label:<{width}}  {site.angle:9.2f}°  {row.angle:9.2f}°  "
+            f"{row.angle - site.angle:+9.2f}°  {row.fit:.2g}"
         )
-    print()
+    print(
+        f"\nPatch radius {DEMO_RADIUS:g} mm. Measured and true angles differ because each side's "
+        "plane is fitted to a patch\nof a curved cylinder wall; a larger radius averages more of "
+        "the curvature.\n"
+    )
     print(f"Output folder: {out}")
-    for name in (
-        "bone_fragment.ply",
-        "break_sites.csv",
-        "measurements.csv",
-        "bone_fragment.blend",
-        "bone_fragment.png",
+    for path in (
+        ply,
+        points,
+        *(p for p in outputs.values() if p != out),
+        out / "bone_fragment.png",
     ):
-        if (out / name).is_file():
-            print(f"  {name}")
+        if path.is_file():
+            print(f"  {path.name}")
     return code
 
 
@@ -1276,6 +1306,11 @@ def main(argv=None) -> int:
 
 
 def _exit(code: int) -> None:
+    while _registered:
+        try:
+            _registered.pop().unregister()
+        except Exception:
+            traceback.print_exc()
     sys.stdout.flush()
     sys.stderr.flush()
     if IN_BLENDER:

@@ -13,15 +13,13 @@ import contextlib
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, FloatProperty, FloatVectorProperty, StringProperty
 from bpy_extras import view3d_utils
 from mathutils import Vector
 
-from ..properties import PATCH_ITEMS
 from ..ui.drag_overlay import DragOverlay, patch_vertex_data
 from ..vg_addon import GoniometerError
 from ..vg_addon.drag_state import DragMachine, Phase, surface_callbacks
-from .measure import VG_OT_measure_xyz, typed_value
+from .measure import MeasureProperties, VG_OT_measure_xyz, typed_value
 from .mesh_data import check_measurable, evaluated_geometry, surface_for
 
 TOOL_ID = "vg.measure_drag_tool"
@@ -318,35 +316,12 @@ def draw_status_hints(header, context):
         row.separator(factor=2.0)
 
 
-class VG_OT_measure_drag(bpy.types.Operator):
+class VG_OT_measure_drag(MeasureProperties, bpy.types.Operator):
     """Press on a break edge of the active mesh, drag out the patch radius, release to measure"""
 
     bl_idname = "vg.measure_drag"
     bl_label = "Measure by Dragging"
     bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender reads a set)
-
-    # The same properties as vg.measure_xyz: execute() is that operator's, so the two record
-    # the same measurement for the same values.
-    location: FloatVectorProperty(
-        name="Location",
-        description="Centre (the snapped vertex of the press), world space; default: the 3D cursor",
-        size=3,
-        subtype="TRANSLATION",
-        unit="LENGTH",
-    )
-    radius: FloatProperty(
-        name="Radius",
-        description="Patch radius, world space; default: the panel's radius",
-        min=0.0,
-        precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
-    )
-    seg_param: FloatProperty(
-        name="λ (SegParam)", description="Segmentation parameter; default: the panel's", min=0.0
-    )
-    patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
-    note: StringProperty(name="Note", description="Free text stored with the measurement")
 
     def invoke(self, context, event):
         try:

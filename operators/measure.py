@@ -31,12 +31,9 @@ def _stale_warning(obj) -> str:
     )
 
 
-class VG_OT_measure_xyz(bpy.types.Operator):
-    """Measure the break angle on the active mesh at a point (default: the 3D cursor)"""
-
-    bl_idname = "vg.measure_xyz"
-    bl_label = "Measure at 3D Cursor"
-    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+class MeasureProperties:
+    """The inputs of a measurement, shared by every operator that records one (a mixin, so
+    the drag tool's recorded values mean exactly what xyz entry's do)."""
 
     location: FloatVectorProperty(
         name="Location",
@@ -59,6 +56,14 @@ class VG_OT_measure_xyz(bpy.types.Operator):
     )
     patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
     note: StringProperty(name="Note", description="Free text stored with the measurement")
+
+
+class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
+    """Measure the break angle on the active mesh at a point (default: the 3D cursor)"""
+
+    bl_idname = "vg.measure_xyz"
+    bl_label = "Measure at 3D Cursor"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
 
     def execute(self, context):
         settings = context.scene.vg_settings

@@ -24,7 +24,15 @@ import numpy as np
 
 from .errors import GoniometerError
 
-__all__ = ["MESH_EXTENSIONS", "MeshData", "read_mesh", "read_obj", "read_ply", "read_stl", "write_ply"]
+__all__ = [
+    "MESH_EXTENSIONS",
+    "MeshData",
+    "read_mesh",
+    "read_obj",
+    "read_ply",
+    "read_stl",
+    "write_ply",
+]
 
 MESH_EXTENSIONS = (".ply", ".obj", ".stl")
 
@@ -277,7 +285,9 @@ def _ply_header(data: bytes, path: Path) -> tuple[str, list[_PlyElement], int]:
             elements[-1].properties.append(_ply_property(words, where))
         # Other keywords do not change the data layout and are ignored.
     if fmt is None:
-        raise GoniometerError(f"'{path}': the PLY header has no 'format' line; the file is corrupt.")
+        raise GoniometerError(
+            f"'{path}': the PLY header has no 'format' line; the file is corrupt."
+        )
     return fmt, elements, pos
 
 
@@ -394,9 +404,9 @@ def _ply_binary_body(data, pos, elements, wanted, order, path) -> dict:
     found: dict[str, dict] = {}
     buffer = np.frombuffer(data, np.uint8)
     for element in elements:
-        if all(name in found for name in wanted) or (element.name in found):
-            break
-        need = wanted.get(element.name, set())
+        if all(name in found for name in wanted):
+            break  # later elements are not needed, so they need not even be complete
+        need = wanted.get(element.name, set()) if element.name not in found else set()
         if not element.has_lists:
             dtype = np.dtype(
                 [(f"p{i}", p.dtype.newbyteorder(order)) for i, p in enumerate(element.properties)]
@@ -407,7 +417,9 @@ def _ply_binary_body(data, pos, elements, wanted, order, path) -> dict:
             if need:
                 rows = np.frombuffer(data, dtype, element.count, pos)
                 found[element.name] = {
-                    p.name: rows[f"p{i}"] for i, p in enumerate(element.properties) if p.name in need
+                    p.name: rows[f"p{i}"]
+                    for i, p in enumerate(element.properties)
+                    if p.name in need
                 }
             pos += size
             continue
@@ -495,8 +507,10 @@ def _binary_mixed_lists(data, buffer, pos, element, order, need, path):
                 append(pos)
                 pos += before + 1 + data[pos + before] * item + tail
         else:
-            unpack = [(before, struct.Struct(code).unpack_from, size, item)
-                      for before, code, size, item in runs]  # fmt: skip
+            unpack = [
+                (before, struct.Struct(code).unpack_from, size, item)
+                for before, code, size, item in runs
+            ]
             for _ in range(element.count):
                 append(pos)
                 for before, read, size, item in unpack:
@@ -549,9 +563,9 @@ def _ply_ascii_body(data, pos, elements, wanted, path) -> dict:
     found: dict[str, dict] = {}
     at = 0
     for element in elements:
-        if all(name in found for name in wanted) or (element.name in found):
-            break
-        need = wanted.get(element.name, set())
+        if all(name in found for name in wanted):
+            break  # later elements are not needed, so they need not even be complete
+        need = wanted.get(element.name, set()) if element.name not in found else set()
         values, at = _ascii_element(numbers, at, element, need, path)
         if need:
             found[element.name] = values
@@ -834,15 +848,18 @@ def read_obj(path: str | os.PathLike) -> MeshData:
     values, counts = text.floats(v_lines, 1, "'v'")
     if v_lines.size and counts.min() < 3:
         bad = v_lines[np.argmax(counts < 3)]
-        raise GoniometerError(f"'{path}', line {bad + 1}: a 'v' line needs three coordinates x y z.")
+        raise GoniometerError(
+            f"'{path}', line {bad + 1}: a 'v' line needs three coordinates x y z."
+        )
     points = values[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
 
     f_lines = text.keyword(b"f")
     triangles = corners = normal_refs = None
     if f_lines.size:
         vertex_refs, normal_refs, counts = text.faces(f_lines)
-        corners = _obj_indices(vertex_refs, counts, np.searchsorted(v_lines, f_lines), f_lines,
-                               path, "vertex")  # fmt: skip
+        corners = _obj_indices(
+            vertex_refs, counts, np.searchsorted(v_lines, f_lines), f_lines, path, "vertex"
+        )
         triangles = _fan(corners, counts)
 
     normals = None
@@ -953,7 +970,7 @@ def _merge_exact(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     n = corners.shape[0]
     if n == 0:
         return np.empty((0, 3)), np.empty((0, 3), np.int64)
-    corners = corners + 0.0  # -0.0 and 0.0 are the same point
+    # Comparisons treat -0.0 and 0.0 as equal, so they merge (the first one seen is kept).
     order = np.lexsort((corners[:, 2], corners[:, 1], corners[:, 0]))  # stable
     ranked = corners[order]
     new = np.ones(n, dtype=bool)
@@ -1035,8 +1052,12 @@ def write_ply(
             raise GoniometerError(
                 f"write_ply: a triangle index is outside 0..{n - 1} (the points' range)."
             )
-    header = ["ply", f"format {'binary_little_endian' if binary else 'ascii'} 1.0",
-              "comment written by the Virtual Goniometer", f"element vertex {n}"]  # fmt: skip
+    header = [
+        "ply",
+        f"format {'binary_little_endian' if binary else 'ascii'} 1.0",
+        "comment written by the Virtual Goniometer",
+        f"element vertex {n}",
+    ]
     header += [f"property double {name}" for name in names]
     if triangles is not None:
         header += [f"element face {len(triangles)}", "property list uchar int vertex_indices"]
@@ -1055,8 +1076,9 @@ def write_ply(
             else:
                 np.savetxt(file, vertices, fmt="%.17g")
                 if triangles is not None:
-                    np.savetxt(file, np.column_stack([np.full(len(triangles), 3), triangles]),
-                               fmt="%d")  # fmt: skip
+                    np.savetxt(
+                        file, np.column_stack([np.full(len(triangles), 3), triangles]), fmt="%d"
+                    )
     except OSError as error:
         raise GoniometerError(f"Could not write '{path}': {error.strerror or error}.") from None
     return path

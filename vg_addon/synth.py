@@ -186,10 +186,12 @@ def wedge(
         cc, d = ids[1:, 1:].ravel(), ids[1:, :-1].ravel()
         # Quad a-b-c-d runs counter-clockwise in (x, t); its two triangles by either diagonal.
         diagonal_ac = rng.random(a.size) < 0.5 if irregular else np.ones(a.size, dtype=bool)
-        first = np.where(diagonal_ac[:, None], np.column_stack([a, b, cc]),
-                         np.column_stack([a, b, d]))  # fmt: skip
-        second = np.where(diagonal_ac[:, None], np.column_stack([a, cc, d]),
-                          np.column_stack([b, cc, d]))  # fmt: skip
+        first = np.where(
+            diagonal_ac[:, None], np.column_stack([a, b, cc]), np.column_stack([a, b, d])
+        )
+        second = np.where(
+            diagonal_ac[:, None], np.column_stack([a, cc, d]), np.column_stack([b, cc, d])
+        )
         tris = np.stack([first, second], axis=1).reshape(-1, 3)
         if face_sign < 0:
             tris = tris[:, [0, 2, 1]]  # e_x x u points into the solid on face -1
@@ -212,7 +214,7 @@ class BreakSite:
     Attributes
     ----------
     label : str
-        Which rim and where, e.g. ``"oblique/outer, most acute"``.
+        Which rim and where, e.g. ``"oblique/outer acute"``.
     point : tuple of float
         xyz of the rim point; it is a vertex of the mesh (index ``vertex``).
     angle : float
@@ -253,8 +255,9 @@ class BoneFragment:
 
 def _interior_angle(normal_a: np.ndarray, normal_b: np.ndarray) -> float:
     """180 degrees minus the angle between two outward normals."""
-    between = math.atan2(float(np.linalg.norm(np.cross(normal_a, normal_b))),
-                         float(np.dot(normal_a, normal_b)))  # fmt: skip
+    between = math.atan2(
+        float(np.linalg.norm(np.cross(normal_a, normal_b))), float(np.dot(normal_a, normal_b))
+    )
     return 180.0 - math.degrees(between)
 
 
@@ -343,17 +346,23 @@ def bone_fragment(
     # the oblique plane's height on the oblique face, and in between on the cylinders.
     steps_across = np.arange(across) / across
     steps_along = np.arange(along) / along
-    radius = np.concatenate([
-        small_r + (big_r - small_r) * steps_across,
-        np.full(along, big_r),
-        big_r - (big_r - small_r) * steps_across,
-        np.full(along, small_r),
-    ])  # fmt: skip
+    radius = np.concatenate(
+        [
+            small_r + (big_r - small_r) * steps_across,
+            np.full(along, big_r),
+            big_r - (big_r - small_r) * steps_across,
+            np.full(along, small_r),
+        ]
+    )
     fraction = np.concatenate([np.zeros(across), steps_along, np.ones(across), 1.0 - steps_along])
-    region_profile = np.concatenate([
-        np.full(across, REGION_TRANSVERSE), np.full(along, REGION_OUTER),
-        np.full(across, REGION_OBLIQUE), np.full(along, REGION_INNER),
-    ]).astype(np.int8)  # fmt: skip
+    region_profile = np.concatenate(
+        [
+            np.full(across, REGION_TRANSVERSE),
+            np.full(along, REGION_OUTER),
+            np.full(across, REGION_OBLIQUE),
+            np.full(along, REGION_INNER),
+        ]
+    ).astype(np.int8)
     corners = [0, across, across + along, 2 * across + along]
     region_profile[corners] = REGION_RIM
 
@@ -381,9 +390,14 @@ def bone_fragment(
 
     if roughness > 0:
         normals = np.zeros_like(points)
-        radial = np.stack([np.broadcast_to(cos_t[:, None], x.shape),
-                           np.broadcast_to(sin_t[:, None], x.shape),
-                           np.zeros(x.shape)], axis=-1).reshape(-1, 3)  # fmt: skip
+        radial = np.stack(
+            [
+                np.broadcast_to(cos_t[:, None], x.shape),
+                np.broadcast_to(sin_t[:, None], x.shape),
+                np.zeros(x.shape),
+            ],
+            axis=-1,
+        ).reshape(-1, 3)
         normals[region == REGION_OUTER] = radial[region == REGION_OUTER]
         normals[region == REGION_INNER] = -radial[region == REGION_INNER]
         normals[region == REGION_TRANSVERSE] = normal_transverse
@@ -394,12 +408,12 @@ def bone_fragment(
     specs = [  # (label, angle around the axis in eighths of a turn, profile corner, normals)
         ("transverse/outer", 2, corners[1], "outer", "transverse"),
         ("transverse/inner", 6, corners[0], "inner", "transverse"),
-        ("oblique/outer, most acute", 0, corners[2], "outer", "oblique"),
-        ("oblique/outer, 45° around", 1, corners[2], "outer", "oblique"),
-        ("oblique/outer, side", 2, corners[2], "outer", "oblique"),
-        ("oblique/outer, most obtuse", 4, corners[2], "outer", "oblique"),
-        ("oblique/inner, most obtuse", 0, corners[3], "inner", "oblique"),
-        ("oblique/inner, most acute", 4, corners[3], "inner", "oblique"),
+        ("oblique/outer acute", 0, corners[2], "outer", "oblique"),
+        ("oblique/outer 45°", 1, corners[2], "outer", "oblique"),
+        ("oblique/outer side", 2, corners[2], "outer", "oblique"),
+        ("oblique/outer obtuse", 4, corners[2], "outer", "oblique"),
+        ("oblique/inner obtuse", 0, corners[3], "inner", "oblique"),
+        ("oblique/inner acute", 4, corners[3], "inner", "oblique"),
     ]
     for label, eighth, corner, cylinder, face in specs:
         column = eighth * around // 8

@@ -73,8 +73,9 @@ def fan(polygons):
 def grid_polygons(kind):
     """Vertices of a 4 x 3 grid and its faces: triangles, quads or mixed polygons."""
     points = [(0.1 * i - 0.05, 0.3 * j + 1 / 3, 0.01 * i * j) for j in range(3) for i in range(4)]
-    quads = [(j * 4 + i, j * 4 + i + 1, j * 4 + i + 5, j * 4 + i + 4)
-             for j in range(2) for i in range(3)]  # fmt: skip
+    quads = [
+        (j * 4 + i, j * 4 + i + 1, j * 4 + i + 5, j * 4 + i + 4) for j in range(2) for i in range(3)
+    ]
     if kind == "triangles":
         faces = fan(quads)
     elif kind == "quads":
@@ -131,8 +132,9 @@ def test_reference_meshes_load_with_the_header_counts(shared_data, name):
         expected = struct.unpack_from("<3" + coord, data, body + k * vertex_size)
         assert tuple(mesh.points[k]) == expected
     for k in (0, counts["face"] - 1):
-        n, *corners = struct.unpack_from(f"<{count_code}3{index_code}", data,
-                                         faces_at + k * face_size)  # fmt: skip
+        n, *corners = struct.unpack_from(
+            f"<{count_code}3{index_code}", data, faces_at + k * face_size
+        )
         assert n == 3 and tuple(mesh.triangles[k]) == tuple(corners)
     assert mesh.triangles.max() < counts["vertex"]
 
@@ -142,8 +144,10 @@ def test_reference_meshes_load_with_the_header_counts(shared_data, name):
 
 @pytest.mark.parametrize("fmt", FORMATS)
 @pytest.mark.parametrize("coord", ["float", "double", "float32", "float64"])
-@pytest.mark.parametrize(("count_type", "index_type"),
-                         [("uchar", "int"), ("int", "int"), ("uint8", "uint"), ("ushort", "int32")])
+@pytest.mark.parametrize(
+    ("count_type", "index_type"),
+    [("uchar", "int"), ("int", "int"), ("uint8", "uint"), ("ushort", "int32")],
+)
 @pytest.mark.parametrize("kind", ["triangles", "quads", "mixed"])
 def test_ply_flavours(tmp_path, fmt, coord, count_type, index_type, kind):
     points, faces = grid_polygons(kind)
@@ -169,15 +173,28 @@ def test_ply_extra_properties_elements_and_comments(tmp_path, fmt, kind):
     points, faces = grid_polygons(kind)
     rng = np.random.default_rng(1)
     normals = rng.normal(size=(len(points), 3)).astype(np.float32)
-    vertex_props = [("red", "uchar"), ("x", "double"), ("quality", "float"), ("y", "double"),
-                    ("tags", "list", "uchar", "short"), ("z", "double"),
-                    ("nx", "float"), ("ny", "float"), ("nz", "float"), ("alpha", "uchar")]  # fmt: skip
+    vertex_props = [
+        ("red", "uchar"),
+        ("x", "double"),
+        ("quality", "float"),
+        ("y", "double"),
+        ("tags", "list", "uchar", "short"),
+        ("z", "double"),
+        ("nx", "float"),
+        ("ny", "float"),
+        ("nz", "float"),
+        ("alpha", "uchar"),
+    ]
     vertex_rows = [
         (i % 256, p[0], 0.5 * i, p[1], list(range(i % 3)), p[2], *normals[i], 255)
         for i, p in enumerate(points)
     ]
-    face_props = [("flags", "uchar"), ("vertex_indices", "list", "uchar", "int"),
-                  ("texcoord", "list", "uchar", "float"), ("tag", "int")]  # fmt: skip
+    face_props = [
+        ("flags", "uchar"),
+        ("vertex_indices", "list", "uchar", "int"),
+        ("texcoord", "list", "uchar", "float"),
+        ("tag", "int"),
+    ]
     face_rows = [(7, f, [0.25] * (2 * len(f)), -k) for k, f in enumerate(faces)]
     elements = [
         ("material", [("ambient", "float"), ("power", "uchar")], [(0.5, 2), (0.25, 3)]),
@@ -202,20 +219,40 @@ def test_ply_point_cloud_and_empty_face_element(tmp_path, fmt):
     path = tmp_path / "cloud.ply"
     path.write_bytes(ply_bytes(fmt, [("vertex", [(c, "float") for c in "xyz"], points)]))
     assert read_mesh(path).triangles is None
-    path.write_bytes(ply_bytes(fmt, [
-        ("vertex", [(c, "float") for c in "xyz"], points),
-        ("face", [("vertex_indices", "list", "uchar", "int")], []),
-    ]))  # fmt: skip
+    path.write_bytes(
+        ply_bytes(
+            fmt,
+            [
+                ("vertex", [(c, "float") for c in "xyz"], points),
+                ("face", [("vertex_indices", "list", "uchar", "int")], []),
+            ],
+        )
+    )
     mesh = read_mesh(path)
     assert mesh.triangles is None and mesh.n_triangles == 0 and mesh.n_vertices == len(points)
 
 
+def test_ascii_ply_values_take_their_declared_type(tmp_path):
+    """ASCII "0.1" declared float reads as float32(0.1), like the binary twin of the file."""
+    text = (
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty double y\n"
+        "property float z\nend_header\n0.1 0.1 -0.0\n1e-3 2.5 3\n"
+    )
+    mesh = read_mesh(write_text(tmp_path / "declared.ply", text))
+    assert mesh.points[0, 0] == float(np.float32(0.1)) != 0.1
+    assert mesh.points[0, 1] == 0.1 and mesh.points[1, 0] == np.float32(1e-3)
+    assert mesh.source_dtype == "float32"
+
+
 def test_ply_crlf_header_and_case_insensitive_extension(tmp_path):
     points, faces = grid_polygons("quads")
-    data = ply_bytes("binary_little_endian", [
-        ("vertex", [(c, "float") for c in "xyz"], points),
-        ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
-    ])  # fmt: skip
+    data = ply_bytes(
+        "binary_little_endian",
+        [
+            ("vertex", [(c, "float") for c in "xyz"], points),
+            ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
+        ],
+    )
     end = data.index(b"end_header\n") + len(b"end_header\n")
     path = tmp_path / "Windows.PLY"
     path.write_bytes(data[:end].replace(b"\n", b"\r\n") + data[end:])
@@ -225,7 +262,7 @@ def test_ply_crlf_header_and_case_insensitive_extension(tmp_path):
 
 
 def test_ply_non_finite_normals_are_dropped(tmp_path):
-    points, faces = grid_polygons("triangles")
+    points, _ = grid_polygons("triangles")
     rows = [(*p, 0.0, 0.0, 1.0 if i else float("nan")) for i, p in enumerate(points)]
     props = [(c, "float") for c in ("x", "y", "z", "nx", "ny", "nz")]
     path = tmp_path / "n.ply"
@@ -242,11 +279,19 @@ def test_ply_many_mixed_polygons(tmp_path):
     for fmt in FORMATS:
         for count_type in ("uchar", "int"):
             path = tmp_path / f"{fmt}_{count_type}.ply"
-            path.write_bytes(ply_bytes(fmt, [
-                ("vertex", [(c, "double") for c in "xyz"], points.tolist()),
-                ("face", [("flags", "short"), ("vertex_indices", "list", count_type, "uint")],
-                 [(1, f) for f in faces]),
-            ]))  # fmt: skip
+            path.write_bytes(
+                ply_bytes(
+                    fmt,
+                    [
+                        ("vertex", [(c, "double") for c in "xyz"], points.tolist()),
+                        (
+                            "face",
+                            [("flags", "short"), ("vertex_indices", "list", count_type, "uint")],
+                            [(1, f) for f in faces],
+                        ),
+                    ],
+                )
+            )
             mesh = read_mesh(path)
             assert np.array_equal(mesh.points, points)
             assert mesh.triangles.tolist() == [list(t) for t in fan(faces)]
@@ -327,7 +372,9 @@ l 1 2
 p 3
 """
     mesh = read_mesh(write_text(tmp_path / "forms.obj", text))
-    assert np.array_equal(mesh.points, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 0.2]])
+    assert np.array_equal(
+        mesh.points, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 0.2]]
+    )
     expected = [[0, 1, 2], [0, 2, 3], [0, 1, 2], [0, 1, 2], [0, 2, 3], [0, 1, 3], [0, 1, 4]]
     assert mesh.triangles.tolist() == expected
     assert mesh.normals is None  # one vn for five vertices
@@ -349,8 +396,9 @@ def test_obj_one_to_one_normals_are_kept(tmp_path):
         mixed = text.rsplit("f", 1)[0] + faces
         assert read_mesh(write_text(tmp_path / "m.obj", mixed)).normals is None, faces
     cloud = "v 0 0 0\nvn 1 0 0\nv 1 0 0\nvn 0 1 0\n"
-    assert np.array_equal(read_mesh(write_text(tmp_path / "c.obj", cloud)).normals,
-                          [[1, 0, 0], [0, 1, 0]])  # fmt: skip
+    assert np.array_equal(
+        read_mesh(write_text(tmp_path / "c.obj", cloud)).normals, [[1, 0, 0], [0, 1, 0]]
+    )
 
 
 def test_obj_point_cloud(tmp_path):
@@ -370,8 +418,20 @@ def test_obj_matches_ply_of_the_same_mesh(tmp_path):
 # -------------------------------------------------------------------------------------------- STL
 
 CUBE_CORNERS = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], float)
-CUBE_TRIANGLES = [[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]]  # fmt: skip
+CUBE_TRIANGLES = [
+    [0, 1, 3],
+    [0, 3, 2],
+    [4, 6, 7],
+    [4, 7, 5],
+    [0, 4, 5],
+    [0, 5, 1],
+    [2, 3, 7],
+    [2, 7, 6],
+    [0, 2, 6],
+    [0, 6, 4],
+    [1, 5, 7],
+    [1, 7, 3],
+]
 
 
 def stl_binary(corners, header=b"binary stl from a test"):
@@ -410,7 +470,9 @@ def test_stl_vertices_are_merged_into_an_indexed_mesh(tmp_path, flavour):
 
 
 def test_stl_signed_zeros_are_one_vertex(tmp_path):
-    corners = np.array([[[0.0, 0, 0], [1, 0, 0], [0, 1, 0]], [[-0.0, -0.0, 0], [0, 1, 0], [1, 0, 0]]])
+    corners = np.array(
+        [[[-0.0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0.0, -0.0, 0], [0, 1, 0], [1, 0, 0]]]
+    )
     path = tmp_path / "zeros.stl"
     path.write_bytes(stl_binary(corners))
     mesh = read_mesh(path)
@@ -459,26 +521,49 @@ def test_empty_file_and_unknown_format(tmp_path):
         ("ply\nelement vertex 0\nend_header\n", ("no 'format'",)),
         ("ply\nformat ascii 1.0\nproperty float x\nend_header\n", ("before any element",)),
         ("ply\nformat ascii 1.0\nelement vertex 1\nproperty half x\nend_header\n", ("half",)),
-        ("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n",
-         ("no y, z coordinate",)),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n",
+            ("no y, z coordinate",),
+        ),
         ("ply\nformat ascii 1.0\nelement face 0\nend_header\n", ("no 'vertex' element",)),
-        ("ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
-         "property float z\nend_header\n", ("no vertices",)),
-        ("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
-         "property float z\nend_header\n0 0 0\n1 nan 0\n", ("not finite", "vertex 1")),
-        ("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-         "property float z\nend_header\n0 zero 0\n", ("not a number",)),
-        ("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
-         "property float z\nend_header\n0 0 0\n", ("truncated", "vertex")),
-        ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-         "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-         "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", ("out of range", "vertex 3", "3 vertices")),
-        ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-         "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-         "0 0 0\n1 0 0\n0 1 0\n3 0 1.5 2\n", ("not a valid int32",)),
-        ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-         "property float z\nelement face 1\nproperty list uchar float vertex_indices\n"
-         "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", ("must be integers",)),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+            "property float z\nend_header\n",
+            ("no vertices",),
+        ),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+            "property float z\nend_header\n0 0 0\n1 nan 0\n",
+            ("not finite", "vertex 1"),
+        ),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+            "property float z\nend_header\n0 zero 0\n",
+            ("not a number",),
+        ),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+            "property float z\nend_header\n0 0 0\n",
+            ("truncated", "vertex"),
+        ),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+            ("out of range", "vertex 3", "3 vertices"),
+        ),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n1 0 0\n0 1 0\n3 0 1.5 2\n",
+            ("not a valid int32",),
+        ),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar float vertex_indices\n"
+            "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+            ("must be integers",),
+        ),
     ],
 )
 def test_malformed_ply(tmp_path, text, fragments):
@@ -489,10 +574,13 @@ def test_malformed_ply(tmp_path, text, fragments):
 @pytest.mark.parametrize("cut", ["vertices", "faces"])
 def test_truncated_binary_ply(tmp_path, kind, cut):
     points, faces = grid_polygons(kind)
-    data = ply_bytes("binary_little_endian", [
-        ("vertex", [(c, "float") for c in "xyz"], points),
-        ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
-    ])  # fmt: skip
+    data = ply_bytes(
+        "binary_little_endian",
+        [
+            ("vertex", [(c, "float") for c in "xyz"], points),
+            ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
+        ],
+    )
     body = data.index(b"end_header\n") + len(b"end_header\n")
     keep = body + 12 * len(points) - 5 if cut == "vertices" else len(data) - 3
     element = "vertex" if cut == "vertices" else "face"
@@ -504,10 +592,15 @@ def test_binary_ply_face_index_out_of_range(tmp_path):
     points, faces = grid_polygons("quads")
     faces[-1] = (0, 1, 2, 99)
     path = tmp_path / "range.ply"
-    path.write_bytes(ply_bytes("binary_big_endian", [
-        ("vertex", [(c, "double") for c in "xyz"], points),
-        ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
-    ]))  # fmt: skip
+    path.write_bytes(
+        ply_bytes(
+            "binary_big_endian",
+            [
+                ("vertex", [(c, "double") for c in "xyz"], points),
+                ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
+            ],
+        )
+    )
     expect_error(path, "out of range", "vertex 99", "12 vertices")
 
 
