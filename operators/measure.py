@@ -111,6 +111,19 @@ def _active_measurable(operator, context):
     return obj
 
 
+def _active_geometry(operator, context):
+    """The measurable active object and its evaluated geometry, or ``(None, None)`` after
+    reporting why not."""
+    obj = _active_measurable(operator, context)
+    if obj is None:
+        return None, None
+    try:
+        return obj, evaluated_geometry(obj, context.evaluated_depsgraph_get())
+    except GoniometerError as error:
+        operator.report({"ERROR"}, str(error))
+        return None, None
+
+
 class VG_OT_next_break(bpy.types.Operator):
     """Start a new break: the next measurements get the next break number and colour pair"""
 
@@ -139,18 +152,13 @@ class VG_OT_delete_measurement(bpy.types.Operator):
     )
 
     def execute(self, context):
-        obj = _active_measurable(self, context)
+        obj, geometry = _active_geometry(self, context)
         if obj is None:
             return {"CANCELLED"}
         data = obj.vg
         index = data.active_index if self.index < 0 else self.index
         if not 0 <= index < len(data.measurements):
             self.report({"ERROR"}, f"'{obj.name}' has no measurement at list position {index}.")
-            return {"CANCELLED"}
-        try:
-            geometry = evaluated_geometry(obj, context.evaluated_depsgraph_get())
-        except GoniometerError as error:
-            self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         number = data.measurements[index].number
         data.measurements.remove(index)
@@ -171,13 +179,8 @@ class VG_OT_clear_measurements(bpy.types.Operator):
         return context.window_manager.invoke_confirm(self, event)
 
     def execute(self, context):
-        obj = _active_measurable(self, context)
+        obj, geometry = _active_geometry(self, context)
         if obj is None:
-            return {"CANCELLED"}
-        try:
-            geometry = evaluated_geometry(obj, context.evaluated_depsgraph_get())
-        except GoniometerError as error:
-            self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         count = len(obj.vg.measurements)
         obj.vg.measurements.clear()

@@ -19,6 +19,7 @@ from .mesh_data import Geometry, check_measurable, evaluated_geometry, surface_f
 # Measurements are deterministic, so a repaint can reuse the sides of a measurement it has
 # already computed for the same geometry and inputs.
 _SIDES_CACHE_SIZE = 256
+_SIDES_CACHE_VERTICES = 5_000_000  # patch vertices kept in all: bounds the memory, not the count
 _MAX_LISTED = 20  # rows named in an error message
 _sides: OrderedDict[tuple, Measurement] = OrderedDict()
 
@@ -29,7 +30,10 @@ def _key(fingerprint: str, center, radius: float, lam: float, patch: str) -> tup
 
 def _remember(fingerprint: str, m: Measurement) -> None:
     _sides[_key(fingerprint, m.center, m.radius, m.lam, m.patch)] = m
-    while len(_sides) > _SIDES_CACHE_SIZE:
+    while len(_sides) > 1 and (
+        len(_sides) > _SIDES_CACHE_SIZE
+        or sum(kept.n_vertices for kept in _sides.values()) > _SIDES_CACHE_VERTICES
+    ):
         _sides.popitem(last=False)
 
 
@@ -179,16 +183,7 @@ def replicate_rows(
     if not rows:
         raise GoniometerError(f"{source} has no measurement rows: nothing to import.")
     if not ignore_mesh_names:
-        others = csvio.rows_for_other_meshes(rows, (obj.name, obj.data.name))
-        if others:
-            shown = others[:_MAX_LISTED]
-            listed = ", ".join(f"{r.row_number} ('{r.mesh_name}')" for r in shown)
-            more = f" and {len(others) - len(shown)} more" if len(others) > len(shown) else ""
-            raise GoniometerError(
-                f"{len(others)} row(s) of {source} name another mesh than '{obj.name}': rows "
-                f"{listed}{more}. Nothing was imported. Select the right object, or tick "
-                "'Ignore mesh names' to measure them on this one."
-            )
+        csvio.check_mesh_names(rows, (obj.name, obj.data.name), source=source)
     geometry = evaluated_geometry(obj, depsgraph)
     surface = surface_for(obj, geometry)
     results, failures = [], []

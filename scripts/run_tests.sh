@@ -5,11 +5,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh all
 
-echo "== ruff" >&2
-.venv/bin/ruff check .
-.venv/bin/ruff format --check .
-
 status=0
+echo "== ruff" >&2
+.venv/bin/ruff check . || status=1
+.venv/bin/ruff format --check . || status=1
+
 run() {  # run LABEL PYTHON PYTEST-ARGS...
     local label=$1 python=$2
     shift 2

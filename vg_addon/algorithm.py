@@ -8,8 +8,12 @@ from .errors import GoniometerError
 from .result import Measurement
 from .withinss import withinss_split
 
-MIN_SIDE_VERTICES = 3
-"""A side needs three vertices to define a plane."""
+MIN_SIDE_VERTICES = 5
+"""A plane needs three vertices, but three or four always fit one (almost) exactly and would
+report a precise-looking nonsense; five is the fewest whose fit error means something."""
+
+MAX_LAMBDA = 1e6
+"""Beyond this, λ only scales positions past floating-point range; the split no longer changes."""
 
 FLAT_TOLERANCE_DEG = 0.5
 """Angles closer than this to 180° mean the patch holds no break edge."""
@@ -101,6 +105,11 @@ def measure_patch(
     (normal_plus, error_plus, n_plus), (normal_minus, error_minus, n_minus) = sides["+"], sides["-"]
     cosine = float(np.clip(np.dot(normal_plus, normal_minus), -1.0, 1.0))
     angle = 180.0 - float(np.degrees(np.arccos(cosine)))
+    if angle < FLAT_TOLERANCE_DEG:
+        raise GoniometerError(
+            f"The two sides fit planes folded onto each other ({angle:.2f}°): the patch is too "
+            "small or straddles a thin sliver. Use a larger radius or move the centre."
+        )
     if angle > 180.0 - FLAT_TOLERANCE_DEG:
         raise GoniometerError(
             f"No break edge found: the two sides fit planes within {180.0 - angle:.2f}° of each other, "
@@ -157,8 +166,10 @@ def as_lambda(lam) -> float:
         value = float(lam)
     except (TypeError, ValueError):
         raise GoniometerError(f"λ (SegParam) must be a number; got {lam!r}.") from None
-    if not np.isfinite(value) or value < 0:
-        raise GoniometerError(f"λ (SegParam) must be a finite number ≥ 0; got {value!r}.")
+    if not np.isfinite(value) or not 0 <= value <= MAX_LAMBDA:
+        raise GoniometerError(
+            f"λ (SegParam) must be a number from 0 to {MAX_LAMBDA:g} (2 is the usual); got {value!r}."
+        )
     return value
 
 

@@ -387,8 +387,8 @@ def check_mesh_names(rows: Sequence[ReplicationRow], mesh_name, *, source="the C
     more = f" and {len(others) - _MAX_LISTED} more" if len(others) > _MAX_LISTED else ""
     raise GoniometerError(
         f"{len(others)} row(s) of {source} name another mesh than '{shown}': rows {listed}{more}. "
-        "Select the mesh they were measured on, or choose to ignore mesh names to measure them "
-        "on this one."
+        "Nothing was imported. Select the mesh they were measured on, or tick 'Ignore mesh "
+        "names' to measure them on this one."
     )
 
 

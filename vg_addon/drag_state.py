@@ -94,9 +94,9 @@ class DragMachine:
         :class:`GoniometerError`.
     lam : float, optional
         The starting λ (default 2).
-    quantize : callable ``(radius) -> radius``, optional
-        Applied to every radius before it is used, e.g. rounding to the float32 that a Blender
-        property stores, so the preview shows exactly the patch a replay will measure.
+    quantize : callable ``(value) -> value``, optional
+        Applied to every radius and λ before it is used, e.g. rounding to the float32 that a
+        Blender property stores, so the preview shows exactly what a replay will measure.
     parse : callable ``(text) -> radius``, optional
         Turns typed digits into a radius (default ``float``; Blender passes a unit-aware parser).
     min_vertices : int, optional
@@ -221,7 +221,7 @@ class DragMachine:
         """Set λ (clamped at 0) and re-measure the current patch when it is big enough."""
         if self.phase is not Phase.DRAGGING:
             return
-        self.lam = max(0.0, float(lam))
+        self.lam = self._quantize(max(0.0, float(lam)))
         self.measurement = None
         if self.n_vertices >= self.min_vertices:
             try:

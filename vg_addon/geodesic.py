@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .ranges import expand_ranges
+
 
 class EdgeGraph:
     """The undirected edges of a triangle mesh in compressed sparse row form, built once.
@@ -39,9 +41,7 @@ class EdgeGraph:
         local[vertices] = np.arange(vertices.size)
         try:
             lengths = self.starts[vertices + 1] - self.starts[vertices]
-            count = int(lengths.sum())
-            firsts = np.cumsum(lengths) - lengths
-            edges = np.repeat(self.starts[vertices] - firsts, lengths) + np.arange(count)
+            edges = expand_ranges(self.starts[vertices], lengths)
             u = np.repeat(np.arange(vertices.size), lengths)
             v = local[self.target[edges]]
             keep = v >= 0
@@ -54,10 +54,9 @@ class EdgeGraph:
         distance[start] = 0.0
         changed = np.array([start])
         while changed.size:
-            counts = edge_starts[changed + 1] - edge_starts[changed]
-            total = int(counts.sum())
-            firsts = np.cumsum(counts) - counts
-            active = np.repeat(edge_starts[changed] - firsts, counts) + np.arange(total)
+            active = expand_ranges(
+                edge_starts[changed], edge_starts[changed + 1] - edge_starts[changed]
+            )
             candidate = distance[u[active]] + w[active]
             useful = (candidate < distance[v[active]]) & (candidate <= radius)
             if not useful.any():

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .ranges import expand_ranges
 from .spatial import GridIndex
 
 
@@ -42,7 +43,12 @@ def vertex_normals(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarra
         Where the normal is defined.
     """
     n = points.shape[0]
-    weighted = face_normals(points, triangles)
+    # In units of the mesh's extent (min and max do not depend on vertex order), so that a scan
+    # in kilometres or in nanometres neither overflows nor underflows the cross products.
+    origin = points.min(axis=0)
+    extent = float(np.max(points.max(axis=0) - origin))
+    scaled = (points - origin) / extent if extent > 0 else points - origin
+    weighted = face_normals(scaled, triangles)
     summed = np.zeros((n, 3), dtype=np.float64)
     for axis in range(3):
         for corner in range(3):
@@ -50,8 +56,7 @@ def vertex_normals(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarra
                 triangles[:, corner], weights=weighted[:, axis], minlength=n
             )
     lengths = np.linalg.norm(summed, axis=1)
-    scale = np.sqrt(np.finfo(np.float64).tiny)
-    valid = lengths > scale * max(float(np.abs(points).max(initial=0.0)) ** 2, scale)
+    valid = lengths > 1e-150
     normals = np.zeros_like(summed)
     normals[valid] = summed[valid] / lengths[valid, None]
     return normals, valid
@@ -79,11 +84,9 @@ def _neighbour_pairs(index: GridIndex, radius: float, chunk: int = 20_000):
             lo = np.searchsorted(index.keys, key, side="left")
             hi = np.searchsorted(index.keys, key, side="right")
             lengths = np.where(inside, hi - lo, 0)
-            count = int(lengths.sum())
-            if count == 0:
+            if not lengths.any():
                 continue
-            firsts = np.cumsum(lengths) - lengths
-            cols = np.repeat(lo - firsts, lengths) + np.arange(count, dtype=np.int64)
+            cols = expand_ranges(lo, lengths)
             rows = np.repeat(own, lengths)
             gap = index.points[rows] - index.points[cols]
             close = np.einsum("ij,ij->i", gap, gap) <= radius * radius
@@ -112,9 +115,8 @@ def pca_normals(points: np.ndarray, index: GridIndex, radius: float | None = Non
 
     Notes
     -----
-    Orientation: each connected piece of the neighbourhood graph is seeded at its point farthest
-    from the piece's centroid, where the outward normal of a closed surface points away from the
-    centroid, and spread to neighbours through smooth links (see :func:`orient_normals`).
+    Orientation: made consistent along smooth, in-plane links, then each connected piece is turned
+    to point away from the cloud's centroid by a majority vote (see :func:`orient_normals`).
     """
     n = points.shape[0]
     radius = index.cell_size if radius is None else min(radius, index.cell_size)
@@ -123,7 +125,7 @@ def pca_normals(points: np.ndarray, index: GridIndex, radius: float | None = Non
     counts = np.zeros(n)
     pair_rows, pair_cols = [], []
     for rows, cols in _neighbour_pairs(index, radius):
-        neighbours = points[cols]
+        neighbours = points[cols] - points[rows]  # relative: no cancellation far from the origin
         counts += np.bincount(rows, minlength=n)
         for a in range(3):
             sums[:, a] += np.bincount(rows, weights=neighbours[:, a], minlength=n)
@@ -147,54 +149,82 @@ def pca_normals(points: np.ndarray, index: GridIndex, radius: float | None = Non
     normals[~valid] = 0.0
     rows = np.concatenate(pair_rows)
     cols = np.concatenate(pair_cols)
-    orient_normals(points, normals, valid, rows, cols)
+    # Surface variation: near 0 on a smooth piece, larger where the neighbourhood straddles a
+    # crease, whose PCA normal belongs to neither face and must not carry orientation across.
+    variation = values[:, 0] / np.maximum(values.sum(axis=1), 1e-300)
+    orient_normals(points, normals, valid & (variation <= 0.01), rows, cols)
+    crease = valid & (variation > 0.01)
+    if crease.any():
+        _orient_from_neighbours(normals, crease, rows, cols)
     return normals, valid
 
 
-def orient_normals(points, normals, valid, rows, cols, smooth: float = 0.5) -> None:
-    """Flip normals in place so that neighbours agree, spreading outward from extreme points.
+def orient_normals(
+    points, normals, valid, rows, cols, smooth: float = 0.9, planar: float = 0.3
+) -> None:
+    """Flip normals in place so that they agree within each smooth piece and point outward.
 
-    Breadth-first over the neighbour links whose normals are nearly parallel (``|n_i . n_j| >=
-    smooth``), each newly reached point copying the orientation of its smoothest link to the
-    frontier. Each unreached piece is seeded at its point farthest from the centroid of the
-    unreached points, oriented away from that centroid.
+    Orientation spreads breadth-first only along links between nearly parallel normals
+    (``|n_i . n_j| >= smooth``) that lie in each other's tangent plane (``|n . d| <= planar |d|``
+    at both ends, for ``d = p_j - p_i``), so it never jumps between the two faces of a sharp
+    wedge. Each piece is then flipped as a whole if most of its normals point towards the
+    centroid of the whole cloud: the outward direction of a closed or wedge-shaped scan.
     """
     n = points.shape[0]
+    gap = points[cols] - points[rows]
+    length = np.linalg.norm(gap, axis=1)
     link = valid[rows] & valid[cols]
-    rows, cols = rows[link], cols[link]
-    weight = np.abs(np.einsum("ij,ij->i", normals[rows], normals[cols]))
-    strong = weight >= smooth
-    source = np.concatenate([rows[strong], cols[strong]])
-    target = np.concatenate([cols[strong], rows[strong]])
-    weight = np.concatenate([weight[strong], weight[strong]])
-    order = np.lexsort((-weight, source))
-    source, target, weight = source[order], target[order], weight[order]
+    link &= np.abs(np.einsum("ij,ij->i", normals[rows], normals[cols])) >= smooth
+    link &= np.abs(np.einsum("ij,ij->i", normals[rows], gap)) <= planar * length
+    link &= np.abs(np.einsum("ij,ij->i", normals[cols], gap)) <= planar * length
+    source = np.concatenate([rows[link], cols[link]])
+    target = np.concatenate([cols[link], rows[link]])
+    order = np.argsort(source, kind="stable")
+    source, target = source[order], target[order]
     starts = np.searchsorted(source, np.arange(n + 1))
-    oriented = ~valid
-    while not oriented.all():
-        free = np.flatnonzero(~oriented)
-        outward = points[free] - points[free].mean(axis=0)
-        pick = int(np.argmax(np.einsum("ij,ij->i", outward, outward)))
-        seed = free[pick]
-        if normals[seed] @ outward[pick] < 0:
-            normals[seed] = -normals[seed]
-        oriented[seed] = True
+    piece = np.full(n, -1, dtype=np.int64)
+    has_links = starts[1:] > starts[:-1]
+    pieces = 0
+    seeds = np.flatnonzero(has_links)
+    position = 0
+    while True:
+        unassigned = piece[seeds[position:]] < 0
+        if not unassigned.any():
+            break
+        position += int(np.argmax(unassigned))
+        seed = seeds[position]
+        piece[seed] = pieces
         frontier = np.array([seed])
         while frontier.size:
-            lengths = starts[frontier + 1] - starts[frontier]
-            count = int(lengths.sum())
-            firsts = np.cumsum(lengths) - lengths
-            links = np.repeat(starts[frontier] - firsts, lengths) + np.arange(count)
-            links = links[~oriented[target[links]]]
+            links = expand_ranges(starts[frontier], starts[frontier + 1] - starts[frontier])
+            links = links[piece[target[links]] < 0]
             if links.size == 0:
                 break
-            pick = np.lexsort((-weight[links], target[links]))
-            links = links[pick]
-            first = np.ones(links.size, dtype=bool)
-            first[1:] = target[links[1:]] != target[links[:-1]]
-            links = links[first]
-            reached, origin = target[links], source[links]
+            reached, first = np.unique(target[links], return_index=True)
+            origin = source[links][first]
             flip = np.einsum("ij,ij->i", normals[origin], normals[reached]) < 0
             normals[reached[flip]] = -normals[reached[flip]]
-            oriented[reached] = True
+            piece[reached] = pieces
             frontier = reached
+        pieces += 1
+    alone = valid & (piece < 0)
+    piece[alone] = pieces + np.arange(int(alone.sum()))
+    members = valid & (piece >= 0)
+    outward = np.einsum("ij,ij->i", normals[members], points[members] - points[valid].mean(axis=0))
+    votes = np.bincount(piece[members], weights=outward, minlength=int(piece.max()) + 1)
+    flip = members & (votes[np.maximum(piece, 0)] < 0)
+    normals[flip] = -normals[flip]
+
+
+def _orient_from_neighbours(normals, todo, rows, cols) -> None:
+    """Orient each ``todo`` normal like the sum of its already oriented neighbours' normals."""
+    source = np.concatenate([rows, cols])
+    target = np.concatenate([cols, rows])
+    use = todo[target] & ~todo[source]
+    total = np.zeros_like(normals)
+    for axis in range(3):
+        total[:, axis] = np.bincount(
+            target[use], weights=normals[source[use], axis], minlength=normals.shape[0]
+        )
+    flip = todo & (np.einsum("ij,ij->i", normals, total) < 0)
+    normals[flip] = -normals[flip]

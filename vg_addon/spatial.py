@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import GoniometerError
+from .ranges import expand_ranges
 
 _MAX_CELLS_PER_AXIS = 1 << 20
 
@@ -86,12 +87,7 @@ class GridIndex:
         column = ((ix[:, None] * self.dims[1] + iy[None, :]) * self.dims[2]).ravel()
         starts = np.searchsorted(self.keys, column + low[2], side="left")
         ends = np.searchsorted(self.keys, column + high[2], side="right")
-        lengths = ends - starts
-        total = int(lengths.sum())
-        if total == 0:
-            return np.empty(0, dtype=np.int64)
-        offsets = np.cumsum(lengths) - lengths
-        return np.repeat(starts - offsets, lengths) + np.arange(total, dtype=np.int64)
+        return expand_ranges(starts, ends - starts)
 
     def ball(self, center, radius: float) -> tuple[np.ndarray, np.ndarray]:
         """Ids of the points within ``radius`` of ``center`` (boundary included), and their distances."""

@@ -24,10 +24,12 @@ PATCH_MODES = ("euclidean", "geodesic")
 
 
 def _as_triangles(triangles, n_points: int) -> np.ndarray:
-    try:
-        array = np.ascontiguousarray(np.asarray(triangles, dtype=np.int64))
-    except (TypeError, ValueError, OverflowError) as error:
-        raise GoniometerError(f"The triangles must be integer vertex indices: {error}") from None
+    given = np.asarray(triangles)
+    if given.size and not np.issubdtype(given.dtype, np.integer):
+        raise GoniometerError(
+            f"The triangles must be integer vertex indices; got {given.dtype} values."
+        )
+    array = np.ascontiguousarray(given, dtype=np.int64)
     if array.size == 0:
         return array.reshape(0, 3)
     if array.ndim != 2 or array.shape[1] != 3:
@@ -115,6 +117,11 @@ class Surface:
         """
         radius = as_radius(radius)
         mode = check_patch_mode(patch)
+        if not (0 <= int(center_index) < self.n_points and self.valid[center_index]):
+            raise GoniometerError(
+                f"Vertex {center_index} cannot be a patch centre: it is not a vertex of this "
+                "surface with a normal. Use Surface.snap to find one."
+            )
         center = self.points[center_index]
         indices, _ = self.index.ball(center, radius)
         if mode == "geodesic":

@@ -61,7 +61,11 @@ def installed_extension(extension_zip):
         filepath=str(extension_zip), repo=REPO, enable_on_install=True
     )
     assert (extensions / REPO / "virtual_goniometer" / "blender_manifest.toml").is_file()
-    return importlib.import_module(MODULE)
+    yield importlib.import_module(MODULE)
+    # Blender 4.2's bpy module crashes at interpreter exit while add-on classes are still
+    # registered; a user's Blender unregisters on quit, so do the same.
+    if MODULE in bpy.context.preferences.addons:
+        addon_utils.disable(MODULE, default_set=True, handle_error=_raise)
 
 
 def enable_extension() -> None:
@@ -81,3 +85,20 @@ def vg(installed_extension):
     bpy.ops.wm.read_homefile(use_empty=True)
     yield installed_extension
     enable_extension()
+
+
+_exit_status = {"code": 0}
+
+
+def pytest_sessionfinish(session, exitstatus):
+    _exit_status["code"] = int(exitstatus)
+
+
+def pytest_unconfigure(config):
+    """Blender 4.2's bpy module can crash (SIGSEGV) while the interpreter shuts down, after
+    every test has run and pytest has printed its summary. End the process with pytest's own
+    status instead of the crash's; later bpy lines exit cleanly and are left alone."""
+    if bpy.app.version < (4, 3, 0):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(_exit_status["code"])

@@ -144,7 +144,7 @@ class TestErrors:
         with pytest.raises(GoniometerError, match="radius"):
             self.surface.measure([0, 0, 0], radius)
 
-    @pytest.mark.parametrize("lam", [-1, float("nan")])
+    @pytest.mark.parametrize("lam", [-1, float("nan"), 1e300])
     def test_bad_lambda(self, lam):
         with pytest.raises(GoniometerError, match="λ"):
             self.surface.measure([0, 0, 0], 0.5, lam=lam)
@@ -166,6 +166,20 @@ class TestErrors:
         surface = Surface(mesh.points, mesh.triangles)
         with pytest.raises(GoniometerError, match="break edge"):
             surface.measure(mesh.points[np.argmax(mesh.points[:, 1])] * 0.8, 0.1)
+
+    def test_extreme_scales_measure_or_refuse_clearly(self):
+        mesh = wedge(70, n=40)
+        for scale in (1e-150, 1e150):
+            m = Surface(mesh.points * scale, mesh.triangles).measure([0, 0, 0], 0.5 * scale)
+            assert m.angle == pytest.approx(70, abs=0.5)
+
+    def test_float_triangle_indices_are_refused(self):
+        with pytest.raises(GoniometerError, match="integer"):
+            Surface(np.zeros((3, 3)), [[0.0, 1.5, 2.0]])
+
+    def test_patch_centre_must_be_a_vertex(self):
+        with pytest.raises(GoniometerError, match="cannot be a patch centre"):
+            self.surface.patch(10**9, 0.5)
 
     def test_non_finite_points(self):
         mesh = wedge(90, n=20)
@@ -194,7 +208,7 @@ class TestErrors:
             Surface(np.zeros((3, 3)), [[0, 1, 7]])
 
     def test_collinear_side(self):
-        points = np.array([[x, 0.0, 0.0] for x in range(5)] + [[0, y, 1.0] for y in range(5)])
-        normals = np.array([[0, 0, 1.0]] * 5 + [[1.0, 0, 0]] * 5)
+        points = np.array([[x, 0.0, 0.0] for x in range(6)] + [[0, y, 1.0] for y in range(6)])
+        normals = np.array([[0, 0, 1.0]] * 6 + [[1.0, 0, 0]] * 6)
         with pytest.raises(GoniometerError, match="line"):
-            goniometer(points, normals)
+            goniometer(points, normals, lam=0.0)
