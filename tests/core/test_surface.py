@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from vg_addon.synth import wedge
 
 from vg_addon import GoniometerError, GridIndex, Surface
 from vg_addon.normals import vertex_normals
+from vg_addon.synth import wedge
 
 
 @settings(max_examples=60, deadline=None)
