@@ -115,8 +115,8 @@ def pca_normals(points: np.ndarray, index: GridIndex, radius: float | None = Non
 
     Notes
     -----
-    Orientation: made consistent along smooth, in-plane links, then each connected piece is turned
-    to point away from the cloud's centroid by a majority vote (see :func:`orient_normals`).
+    Orientation: spread from the point farthest from the centroid (whose outward normal points
+    away from it) through the most reliable neighbour links first (see :func:`orient_normals`).
     """
     n = points.shape[0]
     radius = index.cell_size if radius is None else min(radius, index.cell_size)
@@ -149,82 +149,86 @@ def pca_normals(points: np.ndarray, index: GridIndex, radius: float | None = Non
     normals[~valid] = 0.0
     rows = np.concatenate(pair_rows)
     cols = np.concatenate(pair_cols)
-    # Surface variation: near 0 on a smooth piece, larger where the neighbourhood straddles a
-    # crease, whose PCA normal belongs to neither face and must not carry orientation across.
+    # Surface variation: 0 on a flat neighbourhood, up to 1/3 where it straddles a crease, whose
+    # PCA normal belongs to neither face: such points make poor seeds.
     variation = values[:, 0] / np.maximum(values.sum(axis=1), 1e-300)
-    orient_normals(points, normals, valid & (variation <= 0.01), rows, cols)
-    crease = valid & (variation > 0.01)
-    if crease.any():
-        _orient_from_neighbours(normals, crease, rows, cols)
+    orient_normals(points, normals, valid, rows, cols, seedable=variation <= 0.01)
     return normals, valid
 
 
 def orient_normals(
-    points, normals, valid, rows, cols, smooth: float = 0.9, planar: float = 0.3
+    points,
+    normals,
+    valid,
+    rows,
+    cols,
+    seedable=None,
+    tiers=(0.95, 0.85, 0.7, 0.5, 0.0),
+    max_seeds: int = 64,
 ) -> None:
-    """Flip normals in place so that they agree within each smooth piece and point outward.
+    """Flip normals in place so that neighbours agree and closed surfaces face outward.
 
-    Orientation spreads breadth-first only along links between nearly parallel normals
-    (``|n_i . n_j| >= smooth``) that lie in each other's tangent plane (``|n . d| <= planar |d|``
-    at both ends, for ``d = p_j - p_i``), so it never jumps between the two faces of a sharp
-    wedge. Each piece is then flipped as a whole if most of its normals point towards the
-    centroid of the whole cloud: the outward direction of a closed or wedge-shaped scan.
+    Two neighbours ``i, j`` are consistently oriented when ``n_i`` agrees with ``n_j`` mirrored
+    in the plane halfway between them: ``a = n_i . n_j - 2 (n_i . d)(n_j . d)`` with ``d`` the
+    unit vector from ``p_i`` to ``p_j`` is then positive. On a flat piece this is the plain dot
+    product; across a crease, convex or concave, and between the two faces of a thin plate it
+    stays right where the dot product is not. ``|a|`` is the link's reliability.
+
+    Orientation starts at the point farthest from the centroid (among the ``seedable`` ones, the
+    smooth points, when there are any), where the outward normal of a closed surface points away
+    from the centroid, and spreads breadth-first through links of
+    reliability at least 0.95, then 0.85, and so on, so that the most reliable links decide
+    first (an approximation of Hoppe et al.'s minimum spanning tree, vectorised per step). A
+    piece no link reaches gets its own seed; after ``max_seeds`` seeds, the remaining points
+    are oriented away from the centroid one by one.
     """
     n = points.shape[0]
     gap = points[cols] - points[rows]
-    length = np.linalg.norm(gap, axis=1)
-    link = valid[rows] & valid[cols]
-    link &= np.abs(np.einsum("ij,ij->i", normals[rows], normals[cols])) >= smooth
-    link &= np.abs(np.einsum("ij,ij->i", normals[rows], gap)) <= planar * length
-    link &= np.abs(np.einsum("ij,ij->i", normals[cols], gap)) <= planar * length
+    unit = gap / np.maximum(np.linalg.norm(gap, axis=1), 1e-300)[:, None]
+    first_normals, second_normals = normals[rows], normals[cols]
+    agreement = np.einsum("ij,ij->i", first_normals, second_normals) - 2.0 * np.einsum(
+        "ij,ij->i", first_normals, unit
+    ) * np.einsum("ij,ij->i", second_normals, unit)
+    link = valid[rows] & valid[cols] & (agreement != 0)
     source = np.concatenate([rows[link], cols[link]])
     target = np.concatenate([cols[link], rows[link]])
-    order = np.argsort(source, kind="stable")
-    source, target = source[order], target[order]
+    sign = np.tile(np.sign(agreement[link]), 2)
+    weight = np.tile(np.abs(agreement[link]), 2)
+    order = np.lexsort((-weight, source))
+    source, target, sign, weight = source[order], target[order], sign[order], weight[order]
     starts = np.searchsorted(source, np.arange(n + 1))
-    piece = np.full(n, -1, dtype=np.int64)
-    has_links = starts[1:] > starts[:-1]
-    pieces = 0
-    seeds = np.flatnonzero(has_links)
-    position = 0
-    while True:
-        unassigned = piece[seeds[position:]] < 0
-        if not unassigned.any():
-            break
-        position += int(np.argmax(unassigned))
-        seed = seeds[position]
-        piece[seed] = pieces
-        frontier = np.array([seed])
+
+    flips = np.zeros(n)  # +1 keep, -1 flip, 0 not decided yet
+    flips[~valid] = 1.0
+    centre = points[valid].mean(axis=0)
+
+    def spread(frontier, min_weight):
         while frontier.size:
             links = expand_ranges(starts[frontier], starts[frontier + 1] - starts[frontier])
-            links = links[piece[target[links]] < 0]
+            links = links[(weight[links] >= min_weight) & (flips[target[links]] == 0)]
             if links.size == 0:
-                break
-            reached, first = np.unique(target[links], return_index=True)
-            origin = source[links][first]
-            flip = np.einsum("ij,ij->i", normals[origin], normals[reached]) < 0
-            normals[reached[flip]] = -normals[reached[flip]]
-            piece[reached] = pieces
-            frontier = reached
-        pieces += 1
-    alone = valid & (piece < 0)
-    piece[alone] = pieces + np.arange(int(alone.sum()))
-    members = valid & (piece >= 0)
-    outward = np.einsum("ij,ij->i", normals[members], points[members] - points[valid].mean(axis=0))
-    votes = np.bincount(piece[members], weights=outward, minlength=int(piece.max()) + 1)
-    flip = members & (votes[np.maximum(piece, 0)] < 0)
-    normals[flip] = -normals[flip]
+                return
+            links = links[np.lexsort((-weight[links], target[links]))]
+            best = np.ones(links.size, dtype=bool)
+            best[1:] = target[links[1:]] != target[links[:-1]]
+            links = links[best]
+            flips[target[links]] = flips[source[links]] * sign[links]
+            frontier = target[links]
 
-
-def _orient_from_neighbours(normals, todo, rows, cols) -> None:
-    """Orient each ``todo`` normal like the sum of its already oriented neighbours' normals."""
-    source = np.concatenate([rows, cols])
-    target = np.concatenate([cols, rows])
-    use = todo[target] & ~todo[source]
-    total = np.zeros_like(normals)
-    for axis in range(3):
-        total[:, axis] = np.bincount(
-            target[use], weights=normals[source[use], axis], minlength=normals.shape[0]
-        )
-    flip = todo & (np.einsum("ij,ij->i", normals, total) < 0)
-    normals[flip] = -normals[flip]
+    for _ in range(max_seeds):
+        free = np.flatnonzero(flips == 0)
+        if free.size == 0:
+            break
+        if seedable is not None and seedable[free].any():
+            free = free[seedable[free]]
+        away = points[free] - centre
+        pick = int(np.argmax(np.einsum("ij,ij->i", away, away)))
+        seed = free[pick]
+        flips[seed] = 1.0 if normals[seed] @ away[pick] >= 0 else -1.0
+        for tier in tiers:
+            spread(np.flatnonzero(flips != 0), tier)
+    rest = np.flatnonzero(flips == 0)
+    if rest.size:
+        outward = np.einsum("ij,ij->i", normals[rest], points[rest] - centre)
+        flips[rest] = np.where(outward >= 0, 1.0, -1.0)
+    normals *= flips[:, None]

@@ -104,3 +104,14 @@ def test_intersecting_spheres_rim_approaches_exact_as_radius_shrinks(spheres):
     errors = [abs(surface.measure(center, r).angle - 70.53) for r in radii]
     assert errors[0] > errors[1] > errors[2], errors
     assert errors[2] < 5.0, errors
+
+
+@pytest.mark.parametrize("name", ["HalfAnnulus", "IntersectingSpheres", "sample_mesh"])
+def test_point_cloud_normals_agree_with_the_mesh(shared_data, name):
+    """Dropping the faces: PCA normals, oriented without them, match the mesh's normals."""
+    mesh = read_mesh(shared_data / f"{name}.ply")
+    cloud = Surface(mesh.points)
+    with_faces = Surface(mesh.points, mesh.triangles)
+    both = cloud.valid & with_faces.valid
+    agree = np.einsum("ij,ij->i", cloud.normals[both], with_faces.normals[both])
+    assert (agree > 0.5).mean() > 0.98

@@ -159,3 +159,16 @@ def test_point_cloud_normals_point_outward_on_a_sphere():
     surface = Surface(points + np.array([3.0, -1.0, 2.0]))
     outward = np.einsum("ij,ij->i", surface.normals, points)
     assert (outward[surface.valid] > 0.9).all()
+
+
+def test_point_cloud_normals_face_outward_on_a_hollow_shaft():
+    """The medullary wall of a shaft faces its centroid: a centroid rule alone would flip it."""
+    from vg_addon.synth import bone_fragment
+
+    fragment = bone_fragment()
+    cloud = Surface(fragment.points)
+    mesh = Surface(fragment.points, fragment.triangles)
+    agree = np.einsum("ij,ij->i", cloud.normals, mesh.normals)[cloud.valid]
+    assert (agree > 0.5).mean() > 0.99
+    for site in fragment.sites:
+        assert cloud.measure(site.point, 1.0).angle == pytest.approx(site.angle, abs=2.5)
