@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..vg_addon import GoniometerError, Measurement, csvio
+from ..vg_addon.errors import bounded_list
 from . import colors, records
 from .mesh_data import Geometry, check_measurable, evaluated_geometry, surface_for
 
@@ -20,7 +21,6 @@ from .mesh_data import Geometry, check_measurable, evaluated_geometry, surface_f
 # already computed for the same geometry and inputs.
 _SIDES_CACHE_SIZE = 256
 _SIDES_CACHE_VERTICES = 5_000_000  # patch vertices kept in all: bounds the memory, not the count
-_MAX_LISTED = 20  # rows named in an error message
 _sides: OrderedDict[tuple, Measurement] = OrderedDict()
 
 
@@ -205,13 +205,7 @@ def replicate_rows(
     if failures:
         raise GoniometerError(
             f"{len(failures)} of {len(rows)} rows of {source} could not be measured on "
-            f"'{obj.name}'; nothing was imported.\n"
-            + "\n".join(failures[:_MAX_LISTED])
-            + (
-                f"\n... and {len(failures) - _MAX_LISTED} more"
-                if len(failures) > _MAX_LISTED
-                else ""
-            )
+            f"'{obj.name}'; nothing was imported.\n" + bounded_list(failures, lines=True)
         )
     numbers = []
     for row, m in results:

@@ -15,14 +15,13 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from .algorithm import as_center, as_lambda, as_radius
 from .csvio import ReplicationRow, mesh_name_matches
-from .errors import GoniometerError
-from .surface import PATCH_MODES
+from .errors import GoniometerError, bounded_list
+from .surface import check_patch_mode
 
 #: Mesh file types a batch run reads (by file name extension, case-insensitive).
 MESH_SUFFIXES = (".ply", ".obj", ".stl")
-
-_MAX_LISTED = 20
 
 
 @dataclass(frozen=True)
@@ -317,37 +316,28 @@ def _match(row: ReplicationRow, meshes: Sequence[Sequence[str]]) -> tuple[int, s
 
 
 def _check_defaults(radius, lam, patch) -> tuple[float | None, float, str]:
-    """The defaults as float, float, lower-case mode; ``radius`` may be None (no default)."""
-    problems = []
-    if radius is not None:
+    """The defaults validated by the core's own rules; ``radius`` may be None (no default).
+
+    Every problem is reported at once, in the core's words.
+    """
+    checks = (
+        ("radius", as_radius if radius is not None else (lambda value: None), radius),
+        ("lam", as_lambda, lam),
+        ("patch", check_patch_mode, patch),
+    )
+    values, problems = {}, []
+    for name, check, value in checks:
         try:
-            radius = float(radius)
-            if not radius > 0 or radius == float("inf"):
-                problems.append(f"the radius must be a positive number (got {radius!r})")
-        except (TypeError, ValueError):
-            problems.append(f"the radius must be a number (got {radius!r})")
-    try:
-        lam = float(lam)
-        if not lam >= 0 or lam == float("inf"):
-            problems.append(f"λ must be 0 or more (got {lam!r})")
-    except (TypeError, ValueError):
-        problems.append(f"λ must be a number (got {lam!r})")
-    mode = str(patch).lower()
-    if mode not in PATCH_MODES:
-        problems.append(f"unknown patch mode {patch!r} (use {' or '.join(PATCH_MODES)})")
+            values[name] = check(value)
+        except GoniometerError as error:
+            problems.append(str(error))
     if problems:
-        message = "; ".join(problems)
-        raise GoniometerError(message[0].upper() + message[1:] + ".")
-    return radius, lam, mode
+        raise GoniometerError(" ".join(problems))
+    return values["radius"], values["lam"], values["patch"]
 
 
 def _xyz(point) -> tuple[float, float, float]:
-    try:
-        x, y, z = (float(v) for v in point)
-    except (TypeError, ValueError):
-        raise GoniometerError(f"A point needs three numbers x y z; got {point!r}.") from None
-    if not all(abs(v) < float("inf") for v in (x, y, z)):
-        raise GoniometerError(f"A point's coordinates must be finite numbers; got {point!r}.")
+    x, y, z = (float(v) for v in as_center(point))
     return x, y, z
 
 
@@ -387,11 +377,8 @@ def exit_code(failed_rows: int, bad_files: int) -> int:
 
 
 def _numbers(numbers: Sequence[int]) -> str:
-    shown = ", ".join(str(n) for n in numbers[:_MAX_LISTED])
-    return shown + (f" and {len(numbers) - _MAX_LISTED} more" if len(numbers) > _MAX_LISTED else "")
+    return bounded_list(numbers)
 
 
 def _listing(what: str, problems: Sequence[str]) -> str:
-    lines = "\n".join(f"  {p}" for p in problems[:_MAX_LISTED])
-    more = f"\n  ... and {len(problems) - _MAX_LISTED} more" if len(problems) > _MAX_LISTED else ""
-    return f"{len(problems)} {what}:\n{lines}{more}"
+    return f"{len(problems)} {what}:\n" + bounded_list(problems, lines=True)

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
-from .errors import GoniometerError
+from .errors import GoniometerError, bounded_list
 from .palette import OKABE_ITO
 from .surface import PATCH_MODES
 
@@ -100,7 +100,6 @@ SOURCE_FORMATS = ("extension", "meshlab", "points")
 
 _TRUE = "TRUE"
 _FALSE = "FALSE"
-_MAX_LISTED = 20
 
 # Leading characters that make a spreadsheet treat a cell as a formula (OWASP's list). The
 # apostrophe is included so that escaping is reversible: a text that starts with one is
@@ -383,10 +382,9 @@ def check_mesh_names(rows: Sequence[ReplicationRow], mesh_name, *, source="the C
     if not others:
         return
     shown = next(iter(_split_names(mesh_name)), "")
-    listed = ", ".join(f"{row.row_number} ({row.mesh_name!r})" for row in others[:_MAX_LISTED])
-    more = f" and {len(others) - _MAX_LISTED} more" if len(others) > _MAX_LISTED else ""
+    listed = bounded_list(f"{row.row_number} ({row.mesh_name!r})" for row in others)
     raise GoniometerError(
-        f"{len(others)} row(s) of {source} name another mesh than '{shown}': rows {listed}{more}. "
+        f"{len(others)} row(s) of {source} name another mesh than '{shown}': rows {listed}. "
         "Nothing was imported. Select the mesh they were measured on, or tick 'Ignore mesh "
         "names' to measure them on this one."
     )
@@ -610,12 +608,9 @@ def _normalise(header: str) -> str:
 
 
 def _problems_error(source: str, problems: list[str]) -> GoniometerError:
-    shown = problems[:_MAX_LISTED]
-    lines = "\n".join(f"  {problem}" for problem in shown)
-    more = f"\n  ... and {len(problems) - _MAX_LISTED} more" if len(problems) > _MAX_LISTED else ""
     return GoniometerError(
         f"{source} has {len(problems)} problem(s); nothing was read. Fix them and try again:\n"
-        f"{lines}{more}"
+        + bounded_list(problems, lines=True)
     )
 
 

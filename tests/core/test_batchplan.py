@@ -93,8 +93,8 @@ def test_plan_points_measures_every_point_on_every_mesh():
     ("radius", "lam", "patch", "match"),
     [
         (None, 2, "euclidean", "(?i)--at needs --radius"),
-        (0, 2, "euclidean", "(?i)radius must be a positive"),
-        (1, -1, "euclidean", "(?i)λ must be 0 or more"),
+        (0, 2, "euclidean", "(?i)radius must be a finite number greater than 0"),
+        (1, -1, "euclidean", "(?i)λ \\(SegParam\\) must be a number from 0"),
         (1, 2, "ball", "(?i)unknown patch mode 'ball'"),
     ],
 )
