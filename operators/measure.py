@@ -152,14 +152,16 @@ class VG_OT_delete_measurement(bpy.types.Operator):
     )
 
     def execute(self, context):
+        obj = context.active_object
+        data = getattr(obj, "vg", None)
+        index = -1 if data is None else (data.active_index if self.index < 0 else self.index)
+        if data is not None and not 0 <= index < len(data.measurements):
+            self.report({"ERROR"}, f"'{obj.name}' has no measurement at list position {index}.")
+            return {"CANCELLED"}
         obj, geometry = _active_geometry(self, context)
         if obj is None:
             return {"CANCELLED"}
         data = obj.vg
-        index = data.active_index if self.index < 0 else self.index
-        if not 0 <= index < len(data.measurements):
-            self.report({"ERROR"}, f"'{obj.name}' has no measurement at list position {index}.")
-            return {"CANCELLED"}
         number = data.measurements[index].number
         data.measurements.remove(index)
         data.active_index = min(index, max(len(data.measurements) - 1, 0))

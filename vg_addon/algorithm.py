@@ -161,7 +161,7 @@ def as_radius(radius) -> float:
 
 
 def as_lambda(lam) -> float:
-    """Validate the segmentation parameter λ: a finite number, zero or more."""
+    """Validate the segmentation parameter λ: a number from 0 to :data:`MAX_LAMBDA`."""
     try:
         value = float(lam)
     except (TypeError, ValueError):

@@ -385,8 +385,8 @@ def check_mesh_names(rows: Sequence[ReplicationRow], mesh_name, *, source="the C
     listed = bounded_list(f"{row.row_number} ({row.mesh_name!r})" for row in others)
     raise GoniometerError(
         f"{len(others)} row(s) of {source} name another mesh than '{shown}': rows {listed}. "
-        "Nothing was imported. Select the mesh they were measured on, or tick 'Ignore mesh "
-        "names' to measure them on this one."
+        "Nothing was imported. Select the mesh they were measured on, or ignore the mesh names "
+        "to measure them on this one."
     )
 
 

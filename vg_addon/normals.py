@@ -183,6 +183,8 @@ def orient_normals(
     are oriented away from the centroid one by one.
     """
     n = points.shape[0]
+    if not valid.any():
+        return
     gap = points[cols] - points[rows]
     unit = gap / np.maximum(np.linalg.norm(gap, axis=1), 1e-300)[:, None]
     first_normals, second_normals = normals[rows], normals[cols]
@@ -224,9 +226,10 @@ def orient_normals(
         away = points[free] - centre
         pick = int(np.argmax(np.einsum("ij,ij->i", away, away)))
         seed = free[pick]
+        decided_before = flips != 0  # finished pieces have no links left to undecided points
         flips[seed] = 1.0 if normals[seed] @ away[pick] >= 0 else -1.0
         for tier in tiers:
-            spread(np.flatnonzero(flips != 0), tier)
+            spread(np.flatnonzero((flips != 0) & ~decided_before), tier)
     rest = np.flatnonzero(flips == 0)
     if rest.size:
         outward = np.einsum("ij,ij->i", normals[rest], points[rest] - centre)

@@ -17,9 +17,9 @@ def estimate_spacing(points: np.ndarray) -> float:
     of area A sampled by n points at spacing h occupies about A / c^2 cells of size c, so
     h ~ c * sqrt(occupied / n).
     """
-    if points.shape[0] > 200_000:  # a regular subsample estimates the same density faster
+    if points.shape[0] > 200_000:  # a subsample estimates the same density faster
         stride = points.shape[0] // 100_000
-        return estimate_spacing(points[::stride]) / np.sqrt(stride)
+        return estimate_spacing(points[_sample_by_position(points, stride)]) / np.sqrt(stride)
     n = points.shape[0]
     origin = points.min(axis=0)
     extent = float((points.max(axis=0) - origin).max())
@@ -33,6 +33,18 @@ def estimate_spacing(points: np.ndarray) -> float:
         if occupied <= n / 4 or cell >= extent:
             return cell * float(np.sqrt(occupied / n))
         cell *= 2.0
+
+
+def _sample_by_position(points: np.ndarray, stride: int) -> np.ndarray:
+    """About one point in ``stride``, chosen by a hash of its coordinates: the same points
+    whatever order they come in."""
+    bits = np.ascontiguousarray(points, dtype=np.float64).view(np.uint64)
+    mixed = (
+        bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
+        ^ bits[:, 1] * np.uint64(0xC2B2AE3D27D4EB4F)
+        ^ bits[:, 2] * np.uint64(0x165667B19E3779F9)
+    )
+    return (mixed >> np.uint64(33)) % np.uint64(stride) == 0
 
 
 class GridIndex:
@@ -64,7 +76,7 @@ class GridIndex:
         self.dims = (np.floor(extent / cell_size).astype(np.int64) + 1).astype(np.int64)
         ijk = self._cells(points)
         keys = (ijk[:, 0] * self.dims[1] + ijk[:, 1]) * self.dims[2] + ijk[:, 2]
-        order = np.argsort(keys)
+        order = np.argsort(keys, kind="stable")
         self.keys = keys[order]
         self.points = np.ascontiguousarray(points[order])
         ids = np.arange(points.shape[0], dtype=np.int64) if ids is None else np.asarray(ids)

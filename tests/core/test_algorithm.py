@@ -167,6 +167,20 @@ class TestErrors:
         with pytest.raises(GoniometerError, match="break edge"):
             surface.measure(mesh.points[np.argmax(mesh.points[:, 1])] * 0.8, 0.1)
 
+    def test_lambda_limit(self):
+        assert self.surface.measure([0, 0, 0], 0.5, lam=1e6).lam == 1e6
+        with pytest.raises(GoniometerError, match="λ"):
+            self.surface.measure([0, 0, 0], 0.5, lam=1.0000001e6)
+
+    def test_folded_sides_are_refused(self):
+        points = np.array(
+            [[x, y, 0.0] for x in range(4) for y in range(3)]
+            + [[x, y, 1e-3 * y] for x in range(4) for y in range(3)]
+        )
+        normals = np.array([[0, 0, 1.0]] * 12 + [[0, -1e-3, -1.0]] * 12)
+        with pytest.raises(GoniometerError, match="folded"):
+            goniometer(points, normals, lam=0.0)
+
     def test_extreme_scales_measure_or_refuse_clearly(self):
         mesh = wedge(70, n=40)
         for scale in (1e-150, 1e150):
