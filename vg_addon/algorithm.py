@@ -198,6 +198,16 @@ def unit_normals(name: str, normals: np.ndarray) -> np.ndarray:
     return normals / lengths[:, None]
 
 
+def as_normals(normals, n_points: int) -> np.ndarray:
+    """Validate given normals: one finite, non-zero 3-vector per point; returned normalised."""
+    normals = as_points("normals", normals)
+    if normals.shape[0] != n_points:
+        raise GoniometerError(
+            f"There must be one normal per point: {n_points} points, {normals.shape[0]} normals."
+        )
+    return unit_normals("normals", normals)
+
+
 def goniometer(points, normals, lam: float = 2.0, center=None, radius=None) -> Measurement:
     """Measure the break angle of a patch you already have (Algorithm 1 of the paper).
 
@@ -226,12 +236,7 @@ def goniometer(points, normals, lam: float = 2.0, center=None, radius=None) -> M
         or a side whose vertices are collinear.
     """
     points = as_points("points", points)
-    normals = as_points("normals", normals)
-    if normals.shape != points.shape:
-        raise GoniometerError(
-            f"There must be one normal per point: {points.shape[0]} points, {normals.shape[0]} normals."
-        )
-    normals = unit_normals("normals", normals)
+    normals = as_normals(normals, points.shape[0])
     lam = as_lambda(lam)
     order = canonical_order(points, normals)
     ordered_points, ordered_normals = points[order], normals[order]

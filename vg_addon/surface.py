@@ -8,11 +8,11 @@ from .algorithm import (
     MIN_SIDE_VERTICES,
     as_center,
     as_lambda,
+    as_normals,
     as_points,
     as_radius,
     canonical_order,
     measure_patch,
-    unit_normals,
 )
 from .errors import GoniometerError
 from .geodesic import EdgeGraph
@@ -24,7 +24,12 @@ PATCH_MODES = ("euclidean", "geodesic")
 
 
 def _as_triangles(triangles, n_points: int) -> np.ndarray:
-    given = np.asarray(triangles)
+    try:
+        given = np.asarray(triangles)
+    except ValueError as error:  # ragged nested lists
+        raise GoniometerError(
+            f"The triangles must be an (m, 3) array of vertex indices: {error}"
+        ) from None
     if given.size and not np.issubdtype(given.dtype, np.integer):
         raise GoniometerError(
             f"The triangles must be integer vertex indices; got {given.dtype} values."
@@ -70,26 +75,25 @@ class Surface:
         if self.triangles is not None and self.triangles.shape[0] == 0:
             self.triangles = None
         self._graph = None
+        full_index = None
         if normals is not None:
-            given = as_points("normals", normals)
-            if given.shape != self.points.shape:
-                raise GoniometerError(
-                    f"There must be one normal per point: {n} points, {given.shape[0]} normals."
-                )
-            self.normals = unit_normals("normals", given)
+            self.normals = as_normals(normals, n)
             self.valid = np.ones(n, dtype=bool)
         elif self.triangles is not None:
             self.normals, self.valid = vertex_normals(self.points, self.triangles)
         else:
-            cloud_index = GridIndex(self.points)
-            self.normals, self.valid = pca_normals(self.points, cloud_index)
+            full_index = GridIndex(self.points)
+            self.normals, self.valid = pca_normals(self.points, full_index)
         self.valid_ids = np.flatnonzero(self.valid)
         if self.valid_ids.size == 0:
             raise GoniometerError(
                 "No vertex of this mesh has a normal (no faces with area, or an empty point cloud): "
                 "nothing can be measured."
             )
-        self.index = GridIndex(self.points[self.valid_ids], ids=self.valid_ids)
+        if full_index is not None and self.valid_ids.size == n:
+            self.index = full_index  # the same points: the normals' index serves the queries
+        else:
+            self.index = GridIndex(self.points[self.valid_ids], ids=self.valid_ids)
 
     @property
     def n_points(self) -> int:
