@@ -7,7 +7,7 @@ The extension root: registers the properties saved in the .blend, the ``vg.*`` o
 import bpy
 
 from . import operators, properties, ui
-from .operators import measuring, mesh_data, watch
+from .bridge import measuring, mesh_data, watch
 
 classes = (*properties.classes, *operators.classes, *ui.classes)
 

@@ -279,13 +279,13 @@ class Context:
         self.package = package
         self.bpy = importlib.import_module("bpy")
         name = package.__name__
-        self.csvio = importlib.import_module(f"{name}.vg_addon.csvio")
-        self.meshio = importlib.import_module(f"{name}.vg_addon.meshio")
-        self.batchplan = importlib.import_module(f"{name}.vg_addon.batchplan")
-        self.mesh_data = importlib.import_module(f"{name}.operators.mesh_data")
-        self.measuring = importlib.import_module(f"{name}.operators.measuring")
-        self.records = importlib.import_module(f"{name}.operators.records")
-        self.colors = importlib.import_module(f"{name}.operators.colors")
+        self.csvio = importlib.import_module(f"{name}.vg_addon.formats.csvio")
+        self.meshio = importlib.import_module(f"{name}.vg_addon.formats.meshio")
+        self.batchplan = importlib.import_module(f"{name}.vg_addon.workflow.batchplan")
+        self.mesh_data = importlib.import_module(f"{name}.bridge.mesh_data")
+        self.measuring = importlib.import_module(f"{name}.bridge.measuring")
+        self.records = importlib.import_module(f"{name}.bridge.records")
+        self.colors = importlib.import_module(f"{name}.bridge.colors")
         self.GoniometerError = package.vg_addon.GoniometerError
 
 
@@ -1218,7 +1218,7 @@ def run_demo(args) -> int:
     bpy = import_bpy()
     bpy.ops.wm.read_homefile(use_empty=True)
     ctx = load_extension()
-    synth = importlib.import_module(f"{ctx.package.__name__}.vg_addon.synth")
+    synth = importlib.import_module(f"{ctx.package.__name__}.vg_addon.synthetic_meshes")
     out = Path(args.out_dir or DEMO_DIR).resolve()
     out.mkdir(parents=True, exist_ok=True)
     say = lambda text: print(f"vg_batch: {text}", file=sys.stderr, flush=True)  # noqa: E731

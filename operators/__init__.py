@@ -1,7 +1,6 @@
-"""Blender operators (``vg.*``) and the helper modules that turn a bpy mesh into core input.
-
-``measuring`` holds the one measuring pipeline every operator and tool calls.
-"""
+"""Blender operators (``vg.*``): thin wrappers that check their input, call the bpy bridge
+(``bridge.measuring``) and report. ``drag`` is the click-and-drag tool's modal operator, with
+its viewport preview in ``drag_overlay``."""
 
 from . import csv_ops, drag, measure
 

@@ -6,10 +6,11 @@ import bpy
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from ..vg_addon import GoniometerError, csvio
-from . import measuring
+from ..bridge import measuring
+from ..bridge.mesh_data import check_measurable
+from ..vg_addon import GoniometerError
+from ..vg_addon.formats import csvio
 from .measure import typed_value
-from .mesh_data import check_measurable
 
 
 def _path(operator) -> str:

@@ -1,7 +1,7 @@
 """Click-and-drag measuring: the modal operator ``vg.measure_drag`` and its viewport tool.
 
 Press on the active mesh, drag out the radius while the patch is previewed, release to measure.
-The interaction itself is :class:`~vg_addon.drag_state.DragMachine` (pure, tested without a
+The interaction itself is :class:`~vg_addon.workflow.drag_state.DragMachine` (pure, tested without a
 screen); this module ray-casts, turns events into machine events, draws and records. A release
 records through the same ``execute`` as ``vg.measure_xyz``, with the snapped centre vertex, so
 ``vg.measure_xyz`` with the recorded numbers reproduces the measurement bit for bit.
@@ -16,11 +16,11 @@ import numpy as np
 from bpy_extras import view3d_utils
 from mathutils import Vector
 
-from ..ui.drag_overlay import DragOverlay, patch_vertex_data
+from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
 from ..vg_addon import GoniometerError
-from ..vg_addon.drag_state import DragMachine, Phase, surface_callbacks
+from ..vg_addon.workflow.drag_state import DragMachine, Phase, surface_callbacks
+from .drag_overlay import DragOverlay, patch_vertex_data
 from .measure import MeasureProperties, VG_OT_measure_xyz, typed_value
-from .mesh_data import check_measurable, evaluated_geometry, surface_for
 
 TOOL_ID = "vg.measure_drag_tool"
 

@@ -6,10 +6,10 @@ import bpy
 import numpy as np
 from bpy.props import EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, StringProperty
 
+from ..bridge import measuring
+from ..bridge.mesh_data import check_measurable, evaluated_geometry
 from ..properties import PATCH_ITEMS
 from ..vg_addon import GoniometerError
-from . import measuring
-from .mesh_data import check_measurable, evaluated_geometry
 
 
 def typed_value(value: float) -> float:

@@ -19,7 +19,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from vg_addon import GridIndex, Surface, withinss_split
-from vg_addon.synth import wedge
+from vg_addon.synthetic_meshes import wedge
 
 
 def best_of(function, repeats: int) -> float:

@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from vg_addon import Surface  # noqa: E402
-from vg_addon.drag_state import DragMachine, surface_callbacks  # noqa: E402
+from vg_addon.workflow.drag_state import DragMachine, surface_callbacks  # noqa: E402
 
 
 def ridge_mesh(side: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -122,7 +122,7 @@ def extension_costs(points, triangles, center, radius) -> None:
     sys.modules[spec.name] = extension
     spec.loader.exec_module(extension)
     extension.register()
-    from virtual_goniometer.operators import measuring, mesh_data
+    from virtual_goniometer.bridge import measuring, mesh_data
 
     mesh = bpy.data.meshes.new("Benchmark")
     mesh.vertices.add(len(points))

@@ -4,17 +4,18 @@ The method is Algorithm 1 of Yezzi-Woodley et al., "The Virtual Goniometer: demo
 method for measuring angles on archaeological materials using fragmentary bone". Nothing in this
 package imports Blender.
 
+Layout: ``method`` is the measuring method (Algorithm 1, the patch index, the normals);
+``formats`` reads and writes mesh files and measurement CSVs; ``workflow`` plans batch runs and
+holds the drag tool's state machine; ``palette`` gives the side colours; ``synthetic_meshes``
+makes the exact test and demo shapes; ``errors`` is the one error type every refusal raises.
+
 >>> from vg_addon import Surface
 >>> surface = Surface(points, triangles)          # doctest: +SKIP
 >>> surface.measure(center, radius=0.4).angle     # doctest: +SKIP
 """
 
-from .algorithm import goniometer
 from .errors import GoniometerError
-from .result import Measurement
-from .spatial import GridIndex
-from .surface import PATCH_MODES, Surface
-from .withinss import withinss_split
+from .method import PATCH_MODES, GridIndex, Measurement, Surface, goniometer, withinss_split
 
 __version__ = "0.1.0"
 

@@ -110,7 +110,7 @@ def expected_colours(vg_module, n, sides) -> np.ndarray:
 def wedge_object(angle, name="Wedge", *, n=40, irregular=True, **transform):
     """A synthetic wedge (two planes meeting at ``angle`` degrees along an edge through the
     origin) as a mesh object; the true angle is in ``obj["true_angle"]``."""
-    from vg_addon.synth import wedge
+    from vg_addon.synthetic_meshes import wedge
 
     shape = wedge(angle, n=n, irregular=irregular)
     obj = mesh_object(name, shape.points, shape.triangles, **transform)

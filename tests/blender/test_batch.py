@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 from bpy_helpers import colours, exact, mesh_object
 
-from vg_addon import csvio, meshio
-from vg_addon.synth import bone_fragment, wedge
+from vg_addon.formats import csvio, meshio
+from vg_addon.synthetic_meshes import bone_fragment, wedge
 
 ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = ROOT / "vg_batch.py"

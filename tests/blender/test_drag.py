@@ -362,7 +362,7 @@ def test_radius_is_shown_in_scene_units(drag, vg):
 
 
 def test_overlay_data_and_handler_lifecycle(vg, drag):
-    overlay_module = importlib.import_module(f"{vg.__name__}.ui.drag_overlay")
+    overlay_module = importlib.import_module(f"{vg.__name__}.operators.drag_overlay")
     points = np.random.default_rng(0).normal(size=(50, 3))
     data = overlay_module.patch_vertex_data(points, np.array([3, 1, 4]))
     assert data.dtype == np.float32 and data.flags.c_contiguous and data.shape == (3, 3)

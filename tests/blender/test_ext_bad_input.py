@@ -92,7 +92,7 @@ def test_bad_numbers_through_the_pipeline_function(vg, kwargs, match):
     before = snapshot(obj)
     args = {"location": (0, 0, 0), "radius": 0.5, "lam": 2.0, "patch": "euclidean"} | kwargs
     with pytest.raises(vg.vg_addon.GoniometerError, match=match):
-        vg.operators.measuring.measure_on_object(obj, **args)
+        vg.bridge.measuring.measure_on_object(obj, **args)
     assert snapshot(obj) == before
 
 
@@ -164,7 +164,7 @@ def test_stale_measurement_is_kept_but_not_painted(vg, capfd):
 def test_edits_are_noticed_without_running_an_operator(vg):
     """A handler notes edited objects; a timer (which needs Blender's event loop, so it is
     called by hand here) then flags their stale measurements and repaints."""
-    watch = vg.operators.watch
+    watch = vg.bridge.watch
     obj = measured_wedge()
     assert not watch.refresh(obj)  # nothing to do yet
     edit_a_vertex(obj)

@@ -8,7 +8,7 @@ import pytest
 from bpy_helpers import exact, snapshot, wedge_object
 from conftest import ROOT
 
-from vg_addon import csvio
+from vg_addon.formats import csvio
 
 with open(ROOT / "blender_manifest.toml", "rb") as _handle:
     MANIFEST = tomllib.load(_handle)

@@ -226,12 +226,12 @@ def test_geodesic_patch(vg):
 
 def test_measure_on_object_keeps_float64_inputs_exactly(vg):
     """The pipeline function other tools call takes float64 as it is."""
-    from vg_addon.synth import wedge
+    from vg_addon.synthetic_meshes import wedge
 
     shape = wedge(88.0, n=30, irregular=True)
     obj = mesh_object("Exact", shape.points, shape.triangles, location=(0.1, 0.2, 0.3))
     location = world(np.zeros((1, 3)), obj)[0] + 1e-9  # on the edge, between vertices
-    item = vg.operators.measuring.measure_on_object(obj, location, 0.123456789, 1.5, note="hi")
+    item = vg.bridge.measuring.measure_on_object(obj, location, 0.123456789, 1.5, note="hi")
     m = core_surface(obj).measure(location, 0.123456789, 1.5)
     assert_same(item, m)
     assert item.note == "hi"
@@ -243,7 +243,7 @@ TOP, OUTER = 4, 2
 
 
 def reference_object(path):
-    from vg_addon.meshio import read_mesh
+    from vg_addon.formats.meshio import read_mesh
 
     mesh = read_mesh(path)
     return mesh, mesh_object(path.stem, mesh.points, mesh.triangles)
@@ -259,7 +259,7 @@ def test_half_annulus_right_angle(vg, shared_data):
     centre = mesh.points[
         vertices[np.argmin(np.linalg.norm(mesh.points[vertices] - middle, axis=1))]
     ]
-    item = vg.operators.measuring.measure_on_object(obj, centre, 0.4)
+    item = vg.bridge.measuring.measure_on_object(obj, centre, 0.4)
     assert_same(item, core_surface(obj).measure(centre, 0.4))
     assert abs(item.angle - 90.0) < 10.0
 
@@ -272,7 +272,7 @@ def test_intersecting_spheres_rim(vg, shared_data):
     radial = np.linalg.norm(centred - np.outer(centred @ axis, axis), axis=1)
     centre = points[np.argmax(radial)]
     radius = 0.06 * float(np.ptp(points, axis=0).max())
-    item = vg.operators.measuring.measure_on_object(obj, centre, radius)
+    item = vg.bridge.measuring.measure_on_object(obj, centre, radius)
     assert_same(item, core_surface(obj).measure(centre, radius))
     assert abs(item.angle - 70.53) < 5.0
 
@@ -285,6 +285,6 @@ def test_sample_bone_scan(vg, shared_data):
     axis = np.linalg.svd(centred, full_matrices=False)[2][0]
     centre = points[np.argmax(centred @ axis)]
     radius = 0.05 * float(np.ptp(points, axis=0).max())
-    item = vg.operators.measuring.measure_on_object(obj, centre, radius)
+    item = vg.bridge.measuring.measure_on_object(obj, centre, radius)
     assert_same(item, core_surface(obj).measure(centre, radius))
     assert 0.0 < item.angle < 180.0

@@ -17,11 +17,11 @@ def test_zip_holds_the_extension_and_nothing_else(extension_zip):
         "__init__.py",
         "properties.py",
         "LICENSE",
-        "operators/measuring.py",
+        "bridge/measuring.py",
         "ui/panels.py",
-        "vg_addon/surface.py",
+        "vg_addon/method/surface.py",
         "vg_addon/palette.py",
-        "vg_addon/csvio.py",
+        "vg_addon/formats/csvio.py",
     ):
         assert needed in names, needed
     for name in names:

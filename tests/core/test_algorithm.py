@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vg_addon import GoniometerError, Surface, goniometer
-from vg_addon.synth import wedge
+from vg_addon.synthetic_meshes import wedge
 
 ANGLES = [5, 10, 20, 30, 45, 60, 75, 90, 105, 120, 135, 150, 165, 170, 175]
 

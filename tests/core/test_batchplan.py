@@ -5,7 +5,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from vg_addon import GoniometerError
-from vg_addon.batchplan import (
+from vg_addon.formats.csvio import ReplicationRow
+from vg_addon.workflow.batchplan import (
     Task,
     by_mesh,
     exit_code,
@@ -16,7 +17,6 @@ from vg_addon.batchplan import (
     plan_rows,
     shard,
 )
-from vg_addon.csvio import ReplicationRow
 
 
 def row(n, mesh=None, radius=None, lam=None, patch=None, label=None, break_number=None):

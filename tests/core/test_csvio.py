@@ -12,8 +12,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from vg_addon import GoniometerError, csvio
-from vg_addon.csvio import MeasurementRow, ReplicationRow
+from vg_addon import GoniometerError
+from vg_addon.formats import csvio
+from vg_addon.formats.csvio import MeasurementRow, ReplicationRow
 
 MESHLAB_HEADER = (
     "Mesh Name,Date,Measurement #,Break #,Colors,User Data,Angle,Number of Vertices,Radius,"

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vg_addon import GoniometerError, Surface
-from vg_addon.drag_state import (
+from vg_addon.workflow.drag_state import (
     LAM_STEP,
     MIN_PATCH_VERTICES,
     MISSED,

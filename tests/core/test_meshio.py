@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from vg_addon import GoniometerError
-from vg_addon.meshio import MeshData, read_mesh, write_ply
+from vg_addon.formats.meshio import MeshData, read_mesh, write_ply
 
 STRUCT_CODES = {
     "char": "b", "int8": "b", "uchar": "B", "uint8": "B", "short": "h", "int16": "h",

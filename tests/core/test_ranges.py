@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from vg_addon.ranges import expand_ranges
+from vg_addon.method.ranges import expand_ranges
 
 
 @given(st.lists(st.tuples(st.integers(-50, 1000), st.integers(0, 20)), max_size=30))

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from vg_addon import Surface
-from vg_addon.meshio import read_mesh
+from vg_addon.formats.meshio import read_mesh
 
 # HalfAnnulus: a half ring (outer and inner cylinders, flat top and bottom) cut by the plane
 # x = 0.5. Labels in HalfAnnulus_Labels.npz: 0 and 5 the cut face, 1 bottom, 2 outer, 3 inner, 4 top.

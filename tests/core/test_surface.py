@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vg_addon import GoniometerError, GridIndex, Surface
-from vg_addon.normals import vertex_normals
-from vg_addon.synth import wedge
+from vg_addon.method.normals import vertex_normals
+from vg_addon.synthetic_meshes import wedge
 
 
 @settings(max_examples=60, deadline=None)
@@ -163,7 +163,7 @@ def test_point_cloud_normals_point_outward_on_a_sphere():
 
 def test_point_cloud_normals_face_outward_on_a_hollow_shaft():
     """The medullary wall of a shaft faces its centroid: a centroid rule alone would flip it."""
-    from vg_addon.synth import bone_fragment
+    from vg_addon.synthetic_meshes import bone_fragment
 
     fragment = bone_fragment()
     cloud = Surface(fragment.points)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from vg_addon import GoniometerError
-from vg_addon.synth import (
+from vg_addon.synthetic_meshes import (
     REGION_INNER,
     REGION_OBLIQUE,
     REGION_OUTER,

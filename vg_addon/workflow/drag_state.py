@@ -18,8 +18,8 @@ from enum import StrEnum
 
 import numpy as np
 
-from .algorithm import MIN_SIDE_VERTICES
-from .errors import GoniometerError
+from ..errors import GoniometerError
+from ..method.algorithm import MIN_SIDE_VERTICES
 
 MIN_PATCH_VERTICES = 2 * MIN_SIDE_VERTICES
 """The fewest patch vertices that can be measured (three per side)."""

@@ -1,5 +1,8 @@
 """The drag preview in the 3D viewport: the patch's outline circle and its vertices.
 
+It belongs to the drag tool's modal operator, which installs and removes it (the pattern of
+Blender's modal-draw operator template), so it lives beside the operator, not in ``ui/``.
+
 The operator owns one :class:`DragOverlay`; it starts drawing when the drag starts and must be
 stopped on every way out (release, cancel, error, the window manager cancelling the operator).
 Mouse moves only hand over new data (NumPy arrays); the GPU batch is built lazily in the draw

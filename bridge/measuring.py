@@ -12,8 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..vg_addon import GoniometerError, Measurement, csvio
+from ..vg_addon import GoniometerError, Measurement
 from ..vg_addon.errors import bounded_list
+from ..vg_addon.formats import csvio
 from . import colors, records
 from .mesh_data import Geometry, check_measurable, evaluated_geometry, surface_for
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import GoniometerError
+from ..errors import GoniometerError
 from .ranges import expand_ranges
 
 _MAX_CELLS_PER_AXIS = 1 << 20

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import GoniometerError
+from ..errors import GoniometerError
 from .result import Measurement
 from .withinss import withinss_split
 

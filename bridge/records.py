@@ -12,7 +12,8 @@ import bpy
 import numpy as np
 
 from ..properties import exact_numbers
-from ..vg_addon import GoniometerError, csvio, palette
+from ..vg_addon import GoniometerError, palette
+from ..vg_addon.formats import csvio
 
 _MANIFEST = Path(__file__).resolve().parents[1] / "blender_manifest.toml"
 

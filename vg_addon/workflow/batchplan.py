@@ -15,10 +15,10 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from .algorithm import as_center, as_lambda, as_radius
-from .csvio import ReplicationRow, mesh_name_matches
-from .errors import GoniometerError, bounded_list
-from .surface import check_patch_mode
+from ..errors import GoniometerError, bounded_list
+from ..formats.csvio import ReplicationRow, mesh_name_matches
+from ..method.algorithm import as_center, as_lambda, as_radius
+from ..method.surface import check_patch_mode
 
 #: Mesh file types a batch run reads (by file name extension, case-insensitive).
 MESH_SUFFIXES = (".ply", ".obj", ".stl")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import GoniometerError
+from ..errors import GoniometerError
 
 
 def withinss_split(values, min_size: int = 1) -> tuple[float, float]:

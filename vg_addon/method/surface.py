@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import GoniometerError
 from .algorithm import (
     MIN_SIDE_VERTICES,
     as_center,
@@ -14,7 +15,6 @@ from .algorithm import (
     canonical_order,
     measure_patch,
 )
-from .errors import GoniometerError
 from .geodesic import EdgeGraph
 from .normals import pca_normals, vertex_normals
 from .result import Measurement

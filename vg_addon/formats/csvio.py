@@ -37,9 +37,9 @@ from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
-from .errors import GoniometerError, bounded_list
-from .palette import OKABE_ITO
-from .surface import PATCH_MODES
+from ..errors import GoniometerError, bounded_list
+from ..method.surface import PATCH_MODES
+from ..palette import OKABE_ITO
 
 #: The MeshLab Virtual Goniometer plugin's header, exactly (``SegParam`` is λ).
 MESHLAB_COLUMNS = (

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import GoniometerError
+from ..errors import GoniometerError
 
 __all__ = [
     "MESH_EXTENSIONS",

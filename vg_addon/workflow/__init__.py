@@ -1,0 +1,2 @@
+"""How measurements are driven, without Blender: the batch plan (``batchplan``: which rows are
+measured on which mesh) and the click-and-drag tool's state machine (``drag_state``)."""
