@@ -92,6 +92,7 @@ def wedge(
     irregular: bool = False,
     seed: int = 0,
     imbalance: float = 1.0,
+    concave: bool = False,
 ) -> SynthMesh:
     """Two planar faces meeting at a straight crease with interior angle ``angle_deg``.
 
@@ -121,6 +122,11 @@ def wedge(
     imbalance : float
         Extent of face -1 relative to face +1 (same grid spacing), so a ball centred on the
         crease can hold unequal vertex counts per side.
+    concave : bool
+        Mirror the wedge in the plane ``z = 0``: the faces rise from the crease (a valley) and the
+        solid lies below them, so the edge is concave and ``angle_deg`` is the angle of the open
+        wedge above it (the solid's interior angle is ``360 - angle_deg``). Normals stay outward
+        (upward).
 
     Returns
     -------
@@ -197,13 +203,17 @@ def wedge(
             tris = tris[:, [0, 2, 1]]  # e_x x u points into the solid on face -1
         triangles.append(tris)
 
+    normal_plus, normal_minus = np.array([0.0, c, s]), np.array([0.0, -c, s])
+    if concave:  # a reflection also turns the winding, so the same triangles stay outward
+        points[:, 2] = -points[:, 2]
+        normal_plus, normal_minus = normal_minus, normal_plus
     return SynthMesh(
         points=points,
         triangles=np.vstack(triangles).astype(np.int64),
         angle=angle,
         side=side,
-        normal_plus=np.array([0.0, c, s]),
-        normal_minus=np.array([0.0, -c, s]),
+        normal_plus=normal_plus,
+        normal_minus=normal_minus,
     )
 
 
