@@ -38,6 +38,7 @@ from datetime import datetime
 from pathlib import Path
 
 from ..errors import GoniometerError, bounded_list
+from ..method.algorithm import RULES
 from ..method.surface import PATCH_MODES
 from ..palette import OKABE_ITO
 
@@ -89,7 +90,34 @@ _SCHEMA = (
     ("stale", "bool", ("Stale",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
+    ("rule", "text", ("Rule",)),
+    ("convexity", "text", ("Convexity",)),
+    ("correlation", "float", ("Convexity Correlation",)),
+    ("stability", "float", ("Stability",)),
+    ("stability_center", "float", ("Stability Centre",)),
+    ("stability_radius", "float", ("Stability Radius",)),
+    ("stability_lam", "float", ("Stability SegParam",)),
+    ("stability_bootstrap", "float", ("Stability Bootstrap",)),
+    ("stability_orientation", "float", ("Stability Orientation",)),
+    ("stability_runs", "int", ("Stability Runs",)),
+    ("stability_refused", "int", ("Stability Refused",)),
     ("error", "text", ("error",)),
+)
+
+#: Columns added with the oriented rule (issue 8). Exports written before lack them; such a file
+#: still reads, and its rows replicate with the paper's rule, the only one there was then.
+RULE_COLUMNS = (
+    "Rule",
+    "Convexity",
+    "Convexity Correlation",
+    "Stability",
+    "Stability Centre",
+    "Stability Radius",
+    "Stability SegParam",
+    "Stability Bootstrap",
+    "Stability Orientation",
+    "Stability Runs",
+    "Stability Refused",
 )
 
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
@@ -177,6 +205,19 @@ class MeasurementRow:
     stale : bool
         The mesh changed since the measurement was taken.
     extension_version, blender_version : str
+    rule : str
+        ``"oriented"`` or ``"paper"``: how the projection was signed (see ``vg_addon.method``).
+    convexity : str
+        ``"convex"``, ``"concave"`` (the angle is then the open wedge's) or ``"unclear"``.
+    correlation : float or None
+        The correlation whose sign gives the convexity (its size: how clearly).
+    stability : float or None
+        The stability figure, degrees (the "±"); empty when it was not computed.
+    stability_center, stability_radius, stability_lam, stability_bootstrap, stability_orientation : float or None
+        Its parts: the largest change of the angle with the centre moved, the radius ±10%, λ from
+        1 to 3, the bootstrap's 95% half-width, and the other sign's reading where unclear.
+    stability_runs, stability_refused : int or None
+        Perturbed measurements tried, and how many of them were refused.
     error : str
         Empty for a good row; why it failed otherwise.
     """
@@ -208,6 +249,17 @@ class MeasurementRow:
     stale: bool = False
     extension_version: str = ""
     blender_version: str = ""
+    rule: str = ""
+    convexity: str = ""
+    correlation: float | None = None
+    stability: float | None = None
+    stability_center: float | None = None
+    stability_radius: float | None = None
+    stability_lam: float | None = None
+    stability_bootstrap: float | None = None
+    stability_orientation: float | None = None
+    stability_runs: int | None = None
+    stability_refused: int | None = None
     error: str = ""
 
 
@@ -241,6 +293,11 @@ class ReplicationRow:
         ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
         columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
         else with x, y, z columns).
+    rule : str or None
+        The rule to replicate with: the ``Rule`` cell of an export; ``"paper"`` for MeshLab and
+        earlier add-on files and for exports written before the ``Rule`` column existed (they
+        were all measured with the paper's rule); a points file's ``rule`` column, else ``None``
+        (the current default).
     """
 
     row_number: int
@@ -255,6 +312,7 @@ class ReplicationRow:
     number: int | float | None = None
     break_number: int | None = None
     source_format: str = "points"
+    rule: str | None = None
 
 
 # --------------------------------------------------------------------------- small helpers
@@ -652,6 +710,7 @@ _REPLICATION_ALIASES = {
     "label": ("label", "user data", "note", "notes"),
     "number": ("measurement #", "measurement number", "measurement", "number"),
     "break_number": ("break #", "break number", "break"),
+    "rule": ("rule",),
     "error": ("error",),
 }
 _REQUIRED = ("x", "y", "z")
@@ -783,6 +842,15 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                     f"row {number}: unknown patch mode {cell('patch').strip()!r} "
                     f"(use {' or '.join(PATCH_MODES)})"
                 )
+        rule = _parse_optional_text(cell("rule"))
+        if rule is not None:
+            rule = rule.casefold()
+            if rule not in RULES:
+                problems.append(
+                    f"row {number}: unknown rule {cell('rule').strip()!r} (use {' or '.join(RULES)})"
+                )
+        elif fmt != "points":
+            rule = "paper"  # MeshLab, the earlier add-on, exports from before the Rule column
         if problems:
             continue  # nothing is returned anyway; keep collecting
         break_number = _lenient_number(cell("break_number"))
@@ -800,6 +868,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 number=_lenient_number(cell("number")),
                 break_number=break_number if isinstance(break_number, int) else None,
                 source_format=fmt,
+                rule=rule,
             )
         )
     if problems:
@@ -834,7 +903,10 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
     aliases: ``Mesh Name``/``Mesh``/``Object``; ``x``/``Center x``; ``Radius``/``r``;
     ``SegParam``/``Seg Param``/``lambda``/``λ``/``Segmentation Parameter``;
     ``Patch Mode``/``patch``; ``label``/``User Data``/``note`` (``label`` wins over
-    ``User Data``); ``Measurement #``; ``Break #``; ``error``. Only x, y and z are required.
+    ``User Data``); ``Measurement #``; ``Break #``; ``Rule`` (``oriented`` or ``paper``);
+    ``error``. Only x, y and z are required. Rows of MeshLab and earlier add-on files, and of
+    exports without a ``Rule`` column, replicate with the paper's rule (see
+    :attr:`ReplicationRow.rule`).
     A UTF-8 byte-order mark is ignored; cells are read without surrounding whitespace, and the
     apostrophe the writer puts before formula-like text is removed.
 
@@ -883,7 +955,9 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     problems: list[str] = []
     aliases = {column: (_normalise(column),) for column in EXPORT_COLUMNS}
     columns = _resolve_columns(header, aliases, problems)
-    missing = [column for column in EXPORT_COLUMNS if column not in columns]
+    missing = [
+        column for column in EXPORT_COLUMNS if column not in columns and column not in RULE_COLUMNS
+    ]
     if missing:
         problems.insert(
             0,
@@ -899,8 +973,8 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
             continue
 
         def cell(column: str, cells=cells) -> str:
-            index = columns[column]
-            return cells[index] if index < len(cells) else ""
+            index = columns.get(column)
+            return cells[index] if index is not None and index < len(cells) else ""
 
         def number_of(column: str, number=number) -> float | None:
             raw = cell(column)

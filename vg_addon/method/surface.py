@@ -23,6 +23,7 @@ from .normals import pca_normals, vertex_normals
 from .result import Measurement
 from .spatial import GridIndex
 from .stability import estimate_stability
+from .winding import mesh_winding
 
 PATCH_MODES = ("euclidean", "geodesic")
 
@@ -79,6 +80,7 @@ class Surface:
         if self.triangles is not None and self.triangles.shape[0] == 0:
             self.triangles = None
         self._graph = None
+        self._winding = None
         full_index = None
         if normals is not None:
             self.normals = as_normals(normals, n)
@@ -103,6 +105,14 @@ class Surface:
     def n_points(self) -> int:
         """Number of vertices (including any without a normal)."""
         return self.points.shape[0]
+
+    @property
+    def winding(self) -> str:
+        """``"outward"``, ``"inward"``, ``"mixed"`` or ``"open"`` (see ``winding.WINDINGS``);
+        computed on first use. On an ``"inward"`` surface convex edges are labelled concave."""
+        if self._winding is None:
+            self._winding = mesh_winding(self.points, self.triangles)
+        return self._winding
 
     def snap(self, center, radius: float) -> tuple[int, float]:
         """Index of the vertex nearest ``center`` and its distance; an error if farther than ``radius``."""
