@@ -535,7 +535,9 @@ def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
     return "".join(lines)
 
 
-def _replace_atomically(path: str, data: bytes) -> None:
+def replace_atomically(path: str, data: bytes) -> None:
+    """Write ``data`` to a temporary file beside ``path`` and move it over ``path`` in one step:
+    ``path`` holds its old content or the new one, never part of it."""
     folder = os.path.dirname(os.path.abspath(path)) or "."
     if not os.path.isdir(folder):
         raise GoniometerError(
@@ -591,7 +593,7 @@ def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
         Other file-system errors (disk full, no permission to create the file, ...).
     """
     data = format_measurements_csv(rows).encode("utf-8")
-    _replace_atomically(os.fspath(path), data)
+    replace_atomically(os.fspath(path), data)
 
 
 # --------------------------------------------------------------------------- reading
@@ -1022,3 +1024,67 @@ def read_measurements_csv(path_or_text) -> list[MeasurementRow]:
     """
     text, source = _load(path_or_text)
     return parse_measurements_csv(text, source)
+
+
+# --------------------------------------------------------------------------- radius sweeps
+
+#: The columns of a radius-sweep CSV: one row per radius, refused radii with their message.
+SWEEP_COLUMNS = (
+    "Mesh Name",
+    "Radius",
+    "Angle",
+    "fit",
+    "Number of Vertices",
+    "Vertices +",
+    "Vertices -",
+    "Convexity",
+    "x",
+    "y",
+    "z",
+    "Requested x",
+    "Requested y",
+    "Requested z",
+    "SegParam",
+    "Patch Mode",
+    "Rule",
+    "error",
+)
+
+
+def format_sweep_csv(mesh_name: str, points) -> str:
+    """The text of a radius-sweep CSV (:data:`SWEEP_COLUMNS`) for ``vg_addon.method.sweep`` points.
+
+    A refused radius keeps its radius and message; its measured cells are empty.
+    """
+    lines = [_csv_line(SWEEP_COLUMNS)]
+    for index, point in enumerate(points):
+        m = point.measurement
+
+        def number(value, column, index=index, point=point):
+            return _float_cell(value, index, point, column)
+
+        cells = [_escape_text(str(mesh_name)), number(point.radius, "Radius")]
+        if m is None:
+            cells += [""] * (len(SWEEP_COLUMNS) - 3)
+        else:
+            cells += [
+                number(m.angle, "Angle"),
+                number(m.fit_error, "fit"),
+                str(int(m.n_vertices)),
+                str(int(m.n_plus)),
+                str(int(m.n_minus)),
+                m.convexity,
+                *(number(v, "x") for v in m.center),
+                *(number(v, "Requested x") for v in m.requested_center),
+                number(m.lam, "SegParam"),
+                m.patch,
+                m.rule,
+            ]
+        cells.append(_escape_text(point.error))
+        lines.append(_csv_line(cells))
+    return "".join(lines)
+
+
+def write_sweep_csv(path, mesh_name: str, points) -> None:
+    """Write :func:`format_sweep_csv` to ``path`` atomically (as :func:`write_measurements_csv`)."""
+    replace_atomically(os.fspath(path), format_sweep_csv(mesh_name, points).encode("utf-8"))
