@@ -32,6 +32,19 @@ def _floats(vector) -> list[float]:
     return [float(v) for v in np.asarray(vector, dtype=np.float64)]
 
 
+def _stability(stability) -> dict:
+    return {
+        "spread": float(stability.spread),
+        "center": float(stability.center),
+        "radius": float(stability.radius),
+        "lam": float(stability.lam),
+        "bootstrap": float(stability.bootstrap),
+        "orientation": float(stability.orientation),
+        "runs": int(stability.n_runs),
+        "refused": int(stability.n_failed),
+    }
+
+
 def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_number=None):
     """Append measurement ``m`` to ``obj.vg.measurements`` and make it the active one.
 
@@ -69,6 +82,10 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
             "requested": _floats(m.requested_center),
             "normal_plus": _floats(m.normal_plus),
             "normal_minus": _floats(m.normal_minus),
+            "rule": m.rule,
+            "convexity": m.convexity,
+            "correlation": float(m.correlation),
+            "stability": None if m.stability is None else _stability(m.stability),
         }
     )
     item.patch = m.patch
@@ -112,13 +129,15 @@ def numbers_of(item) -> dict:
 
 
 def replay_args(item) -> dict:
-    """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``."""
+    """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``,
+    ``rule`` (``"paper"`` for records from before the rule existed: that is what they used)."""
     numbers = numbers_of(item)
     return {
         "center": np.array(numbers["center"], dtype=np.float64),
         "radius": float(numbers["radius"]),
         "lam": float(numbers["lam"]),
         "patch": item.patch,
+        "rule": numbers.get("rule", "paper"),
     }
 
 
@@ -134,6 +153,7 @@ def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
     """The CSV row of ``item``, measured on ``obj``."""
     numbers = numbers_of(item)
     x, y, z = numbers["center"]
+    stability = numbers.get("stability") or {}
     return csvio.MeasurementRow(
         mesh_name=obj.name,
         date=item.date,
@@ -162,5 +182,16 @@ def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
         stale=stale,
         extension_version=extension_version(),
         blender_version=bpy.app.version_string,
+        rule=numbers.get("rule", "paper"),
+        convexity=numbers.get("convexity", ""),
+        correlation=numbers.get("correlation"),
+        stability=stability.get("spread"),
+        stability_center=stability.get("center"),
+        stability_radius=stability.get("radius"),
+        stability_lam=stability.get("lam"),
+        stability_bootstrap=stability.get("bootstrap"),
+        stability_orientation=stability.get("orientation"),
+        stability_runs=stability.get("runs"),
+        stability_refused=stability.get("refused"),
         error="",
     )

@@ -53,3 +53,27 @@ def mesh_winding(points: np.ndarray, triangles: np.ndarray | None) -> str:
     if volume == 0.0:
         return "open"
     return "outward" if volume > 0 else "inward"
+
+
+def winding_message(name: str, winding: str) -> str:
+    """What to tell the user about a mesh's winding, or ``""`` when there is nothing to say.
+
+    Parameters
+    ----------
+    name : str
+        The mesh's name, as the user knows it.
+    winding : str
+        One of :data:`WINDINGS`.
+    """
+    if winding == "inward":
+        return (
+            f"'{name}' is wound inward (its normals point into the solid): the angles are right, "
+            "but every convex edge is labelled concave and every concave edge convex. Flip its "
+            "normals to fix the labels."
+        )
+    if winding == "mixed":
+        return (
+            f"Some faces of '{name}' are wound against their neighbours: convex/concave labels "
+            "near them may be wrong. Recalculate its normals (outside) to fix them."
+        )
+    return ""
