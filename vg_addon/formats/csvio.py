@@ -1031,6 +1031,7 @@ def read_measurements_csv(path_or_text) -> list[MeasurementRow]:
 #: The columns of a radius-sweep CSV: one row per radius, refused radii with their message.
 SWEEP_COLUMNS = (
     "Mesh Name",
+    "Measurement #",
     "Radius",
     "Angle",
     "fit",
@@ -1051,40 +1052,44 @@ SWEEP_COLUMNS = (
 )
 
 
-def format_sweep_csv(mesh_name: str, points) -> str:
-    """The text of a radius-sweep CSV (:data:`SWEEP_COLUMNS`) for ``vg_addon.method.sweep`` points.
+def sweep_cells(mesh_name: str, number: int | None, point) -> list[str]:
+    """The cells of one :data:`SWEEP_COLUMNS` row for a ``vg_addon.method.sweep.SweepPoint``.
 
     A refused radius keeps its radius and message; its measured cells are empty.
     """
-    lines = [_csv_line(SWEEP_COLUMNS)]
-    for index, point in enumerate(points):
-        m = point.measurement
+    m = point.measurement
 
-        def number(value, column, index=index, point=point):
-            return _float_cell(value, index, point, column)
+    def cell(value, column):
+        return _float_cell(value, 0, point, column)
 
-        cells = [_escape_text(str(mesh_name)), number(point.radius, "Radius")]
-        if m is None:
-            cells += [""] * (len(SWEEP_COLUMNS) - 3)
-        else:
-            cells += [
-                number(m.angle, "Angle"),
-                number(m.fit_error, "fit"),
-                str(int(m.n_vertices)),
-                str(int(m.n_plus)),
-                str(int(m.n_minus)),
-                m.convexity,
-                *(number(v, "x") for v in m.center),
-                *(number(v, "Requested x") for v in m.requested_center),
-                number(m.lam, "SegParam"),
-                m.patch,
-                m.rule,
-            ]
-        cells.append(_escape_text(point.error))
-        lines.append(_csv_line(cells))
-    return "".join(lines)
+    cells = [_escape_text(str(mesh_name)), "" if number is None else str(int(number))]
+    cells.append(cell(point.radius, "Radius"))
+    if m is None:
+        cells += [""] * (len(SWEEP_COLUMNS) - 4)
+    else:
+        cells += [
+            cell(m.angle, "Angle"),
+            cell(m.fit_error, "fit"),
+            str(int(m.n_vertices)),
+            str(int(m.n_plus)),
+            str(int(m.n_minus)),
+            m.convexity,
+            *(cell(v, "x") for v in m.center),
+            *(cell(v, "Requested x") for v in m.requested_center),
+            cell(m.lam, "SegParam"),
+            m.patch,
+            m.rule,
+        ]
+    cells.append(_escape_text(point.error))
+    return cells
 
 
-def write_sweep_csv(path, mesh_name: str, points) -> None:
-    """Write :func:`format_sweep_csv` to ``path`` atomically (as :func:`write_measurements_csv`)."""
-    replace_atomically(os.fspath(path), format_sweep_csv(mesh_name, points).encode("utf-8"))
+def format_sweep_rows(rows: Iterable[Sequence[str]]) -> str:
+    """A sweep CSV's text: the :data:`SWEEP_COLUMNS` header, then rows from :func:`sweep_cells`."""
+    return _csv_line(SWEEP_COLUMNS) + "".join(_csv_line(cells) for cells in rows)
+
+
+def write_sweep_csv(path, mesh_name: str, points, number: int | None = None) -> None:
+    """Write one site's sweep to ``path`` atomically (as :func:`write_measurements_csv`)."""
+    text = format_sweep_rows(sweep_cells(mesh_name, number, point) for point in points)
+    replace_atomically(os.fspath(path), text.encode("utf-8"))
