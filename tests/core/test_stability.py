@@ -116,14 +116,34 @@ def test_mean_edge_length_of_a_regular_wedge():
 def test_bootstrap_of_exact_planes_is_exact_and_reproducible():
     surface = noisy_wedge(60, 0.0)
     m = surface.measure([0.0, 0.0, 0.0], 0.4)
-    assert np.abs(bootstrap_angles(surface, m) - 60.0).max() < 1e-9
+    angles, measured = bootstrap_angles(surface, m)
+    assert measured.all() and np.abs(angles - 60.0).max() < 1e-9
     noisy = noisy_wedge(60, 0.003)
     m = noisy.measure([0.0, 0.0, 0.0], 0.4, stability=True)
     again = noisy.measure([0.0, 0.0, 0.0], 0.4, stability=True)
     assert m.stability == again.stability
-    assert np.array_equal(bootstrap_angles(noisy, m), bootstrap_angles(noisy, again))
+    assert np.array_equal(bootstrap_angles(noisy, m)[0], bootstrap_angles(noisy, again)[0])
 
 
 def test_plain_measurements_carry_no_figure():
     surface = noisy_wedge(60, 0.0)
     assert surface.measure([0.0, 0.0, 0.0], 0.4).stability is None
+
+
+def test_bootstrap_redoes_the_whole_method_on_each_resample():
+    """Oracle: a resample given to the core's own ``goniometer`` as a patch (duplicates kept)."""
+    from vg_addon import goniometer
+    from vg_addon.method import stability
+
+    surface = noisy_wedge(120, 0.004, seed=6, concave=True)
+    m = surface.measure([0.0, 0.0, 0.0], 0.4)
+    angles, measured = bootstrap_angles(surface, m, n_resamples=6)
+    rng = np.random.default_rng(stability.BOOTSTRAP_SEED)
+    size = m.indices.size
+    draws = rng.integers(0, size, size=(6, size))
+    for row, (angle, ok) in enumerate(zip(angles, measured, strict=True)):
+        chosen = m.indices[draws[row]]
+        single = goniometer(
+            surface.points[chosen], surface.normals[chosen], m.lam, m.center, m.radius
+        )
+        assert ok and angle == pytest.approx(single.angle, abs=1e-6)

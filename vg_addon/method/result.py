@@ -27,12 +27,12 @@ class Stability:
         λ at 1, 1.5, 2, 2.5 and 3.
     bootstrap : float
         Half the width of the central 95% interval of the angle over bootstrap resamples of the
-        patch's vertices (each side's plane refitted, the split kept).
+        patch's vertices (Algorithm 1 redone on each: tangent, split and planes).
     orientation : float
         :attr:`Measurement.orientation_difference`: where convex or concave is unclear, how far
         the reading with the other sign of the position term was.
     n_runs : int
-        Perturbed measurements tried (centre, radius and λ; the bootstrap not counted).
+        Perturbed measurements tried: centre, radius, λ and the bootstrap resamples.
     n_failed : int
         Of those, how many were refused (too few vertices, no edge, ...); they add nothing to
         the parts, so a large count means the figure is optimistic.
