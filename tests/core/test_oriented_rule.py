@@ -158,3 +158,32 @@ def test_real_scan_matches_the_paper_rule_on_oriented_normals(shared_data):
                 difference = abs(plus.angle - minus.angle)
                 assert m.orientation_difference == pytest.approx(difference, abs=1e-9)
     assert all(count > 0 for count in seen.values()), seen
+
+
+@pytest.mark.parametrize("angle", [20, 45, 90, 135, 160])
+def test_a_bevelled_valley_reads_what_the_bevelled_ridge_reads(angle):
+    """The rounded valley is the rounded ridge's complement (mirrored, normals outward): the same
+    two planes, so the oriented rule must read the same angle; the paper's rule does not."""
+    from vg_addon.synthetic_meshes import bevelled_wedge
+
+    readings = []
+    for concave in (False, True):
+        mesh = bevelled_wedge(angle, 0.02, concave=concave)
+        top = mesh.points[np.argmin(np.abs(mesh.points[:, 0]) + np.abs(mesh.points[:, 1]))]
+        readings.append(Surface(mesh.points, mesh.triangles).measure(top, 0.5))
+    ridge, valley = readings
+    assert valley.angle == pytest.approx(ridge.angle, abs=1e-9)
+    assert (ridge.convexity, valley.convexity) == ("convex", "concave")
+    assert abs(ridge.angle - angle) < 1.0
+
+
+def test_bevel_error_shrinks_with_the_fillet_and_vanishes_without_it():
+    from vg_addon.synthetic_meshes import bevelled_wedge
+
+    errors = []
+    for fillet in (0.0, 0.01, 0.03, 0.06):
+        mesh = bevelled_wedge(60, fillet, concave=True)
+        top = mesh.points[np.argmin(np.abs(mesh.points[:, 0]) + np.abs(mesh.points[:, 1]))]
+        errors.append(abs(Surface(mesh.points, mesh.triangles).measure(top, 0.5).angle - 60))
+    assert errors[0] < 1e-9
+    assert errors[0] < errors[1] < errors[2] < errors[3]
