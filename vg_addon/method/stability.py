@@ -2,8 +2,9 @@
 and λ that make two drag measurements of one edge differ, and under a bootstrap of its vertices.
 
 All perturbed measurements run at once on one pool of vertices (the ball that holds every
-perturbed patch): Algorithm 1 batched over rows of a ``(runs, vertices)`` membership matrix, with
-the WithinSS split done by a row-wise sort and prefix sums. No Python loop runs over vertices.
+perturbed patch; for the bootstrap, the patch itself): Algorithm 1 batched over the rows of a
+``(runs, vertices)`` weight matrix (0/1 for a patch, counts for a resample), every sum a matrix
+product and the WithinSS split a row-wise sort and prefix sums. No Python loop runs over vertices.
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ width; each costs about a tenth of a measurement, batched)."""
 BOOTSTRAP_SEED = 0
 """A fixed seed: the same measurement always gets the same figure."""
 
-_RANK_TOLERANCE = 1e-10
+_RANK_TOLERANCE = 1e-10  # as Algorithm 1's test for a side on a line
 
 
 def mean_edge_length(radius: float, n_vertices: int) -> float:
@@ -62,8 +63,7 @@ def _features(local: np.ndarray, normals: np.ndarray) -> np.ndarray:
 
     One matrix product of a weight matrix with these gives every sum a plane fit needs.
     """
-    outer = (local[:, :, None] * local[:, None, :]).reshape(-1, 9)
-    return np.hstack([local, outer, normals])
+    return np.hstack([local, _outer_pairs(local, local), normals])
 
 
 def _outer_pairs(first: np.ndarray, second: np.ndarray) -> np.ndarray:
@@ -119,8 +119,7 @@ def batched_angles(
     ok = count >= 2 * MIN_SIDE_VERTICES
     safe = np.maximum(count, 1.0)
 
-    normal_outer = (normals[:, :, None] * normals[:, None, :]).reshape(-1, 9)
-    values, vectors = np.linalg.eigh((weights @ normal_outer).reshape(-1, 3, 3))
+    values, vectors = np.linalg.eigh((weights @ _outer_pairs(normals, normals)).reshape(-1, 3, 3))
     tangent = vectors[:, :, 0]
     mean_normal = weights @ normals / safe[:, None]
     cross = np.cross(tangent, mean_normal)
