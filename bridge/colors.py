@@ -48,38 +48,24 @@ def _nearest_labels(candidates: np.ndarray, patch_points: np.ndarray, labels: np
     return out
 
 
-def original_vertex_colours(obj, geometry, measured) -> np.ndarray:
-    """RGBA for the vertices of ``obj.data`` (the original mesh) from measurements on the
-    evaluated mesh.
-
-    Parameters
-    ----------
-    obj : bpy.types.Object
-    geometry : mesh_data.Geometry
-        The evaluated geometry the measurements were taken on.
-    measured : list of (Measurement, break_number)
-        In painting order.
+def original_sides(obj, geometry, m) -> tuple[np.ndarray, np.ndarray]:
+    """The vertices of ``obj.data`` (the original mesh) that measurement ``m``, taken on the
+    evaluated ``geometry``, paints, and their side labels (True = "+").
 
     Notes
     -----
     When the modifiers keep the vertex count (no modifier, or deforming ones), evaluated vertex
     ``i`` is original vertex ``i``. When they change it (e.g. Subdivision Surface), each original
-    vertex within a patch's radius takes the side of the nearest evaluated patch vertex: the
+    vertex within the patch's radius takes the side of the nearest evaluated patch vertex: the
     colours then approximate the measured sides, the numbers are unaffected.
     """
     mesh = obj.data
-    n_original = len(mesh.vertices)
-    n_evaluated = geometry.points.shape[0]
-    if n_original == n_evaluated:
-        return side_colours(n_original, [(m.indices, m.labels, b) for m, b in measured])
+    if len(mesh.vertices) == geometry.points.shape[0]:
+        return m.indices, m.labels
     original = world_points(read_positions(mesh), geometry.matrix)
-    sides = []
-    for m, break_number in measured:
-        offsets = original - m.center
-        inside = np.flatnonzero(np.einsum("ij,ij->i", offsets, offsets) <= m.radius * m.radius)
-        labels = _nearest_labels(original[inside], geometry.points[m.indices], m.labels)
-        sides.append((inside, labels, break_number))
-    return side_colours(n_original, sides)
+    offsets = original - m.center
+    inside = np.flatnonzero(np.einsum("ij,ij->i", offsets, offsets) <= m.radius * m.radius)
+    return inside, _nearest_labels(original[inside], geometry.points[m.indices], m.labels)
 
 
 def write_attribute(mesh, rgba: np.ndarray) -> None:
@@ -94,6 +80,14 @@ def write_attribute(mesh, rgba: np.ndarray) -> None:
     attribute.data.foreach_set("color", np.ascontiguousarray(rgba, dtype=np.float32).ravel())
     mesh.color_attributes.active_color = mesh.color_attributes[ATTRIBUTE_NAME]
     mesh.update()
+
+
+def has_attribute(mesh) -> bool:
+    """Whether the mesh has the "VG Sides" attribute as :func:`write_attribute` makes it."""
+    existing = mesh.attributes.get(ATTRIBUTE_NAME)
+    return (
+        existing is not None and existing.domain == "POINT" and existing.data_type == "FLOAT_COLOR"
+    )
 
 
 def read_attribute(mesh) -> np.ndarray | None:
