@@ -9,32 +9,12 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-from ..vg_addon import palette
 from .mesh_data import read_positions, world_points
 
 ATTRIBUTE_NAME = "VG Sides"
 
 # Rows of candidate vertices matched against a patch at once (bounds the temporary matrix).
 _CHUNK = 1024
-
-
-def side_colours(n: int, sides) -> np.ndarray:
-    """RGBA (scene-linear float32, shape (n, 4)) of ``n`` vertices painted by ``sides``.
-
-    Parameters
-    ----------
-    n : int
-        Number of vertices.
-    sides : iterable of (indices, labels, break_number)
-        Per measurement, in painting order (later over earlier): the patch vertex indices, their
-        side labels (True = "+") and the break number that picks the colour pair.
-    """
-    colours = np.tile(palette.neutral_linear(), (n, 1))
-    for indices, labels, break_number in sides:
-        plus, minus = palette.pair_linear(break_number)
-        colours[indices[labels]] = plus
-        colours[indices[~labels]] = minus
-    return colours.astype(np.float32)
 
 
 def _nearest_labels(candidates: np.ndarray, patch_points: np.ndarray, labels: np.ndarray):

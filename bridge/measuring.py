@@ -32,6 +32,12 @@ def _sides(obj, geometry: Geometry, m: Measurement, break_number: int) -> painti
     )
 
 
+def keep_sides(obj, geometry: Geometry, item, m: Measurement) -> None:
+    """Keep the sides of ``m``, just recorded as ``item``, so that painting it measures
+    nothing again."""
+    painting.keep(_sides_key(obj, geometry, item), _sides(obj, geometry, m, item.break_number))
+
+
 def _sides_of_item(obj, geometry: Geometry, item, key: tuple) -> painting.Sides:
     sides = painting.kept_sides(key)
     if sides is None:
@@ -87,7 +93,7 @@ def measure_on_object(
     """
     m, geometry = measure(obj, location, radius, lam, patch, depsgraph=depsgraph)
     item = records.add_measurement(obj, m, geometry.fingerprint, note=note)
-    painting.keep(_sides_key(obj, geometry, item), _sides(obj, geometry, m, item.break_number))
+    keep_sides(obj, geometry, item, m)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
     return obj.vg.measurements[obj.vg.active_index]
 
@@ -241,7 +247,7 @@ def replicate_rows(
         item = records.add_measurement(
             obj, m, geometry.fingerprint, note=row.label or "", break_number=row.break_number
         )
-        painting.keep(_sides_key(obj, geometry, item), _sides(obj, geometry, m, item.break_number))
+        keep_sides(obj, geometry, item, m)
         numbers.append(item.number)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
     return numbers

@@ -93,7 +93,8 @@ def _digest(digest, arrays) -> None:
     for array in arrays:
         array = np.ascontiguousarray(array)
         digest.update(f"{array.dtype.str}{array.shape}".encode())
-        digest.update(memoryview(array).cast("B"))
+        if array.size:
+            digest.update(memoryview(array).cast("B"))
 
 
 def fingerprint(local: np.ndarray, corners: np.ndarray, faces, matrix: np.ndarray) -> str:
@@ -242,6 +243,8 @@ def _read_geometry(obj, obj_eval, kept: Geometry | None) -> Geometry:
     mesh = obj_eval.to_mesh()
     try:
         local = read_positions(mesh)
+        if local.shape[0] == 0:
+            raise GoniometerError(f"'{obj.name}' has no vertices: there is nothing to measure.")
         corners, faces = read_corners(mesh)
         matrix = np.array(obj_eval.matrix_world, dtype=np.float64)
         key = fingerprint(local, corners, faces, matrix)
@@ -250,8 +253,6 @@ def _read_geometry(obj, obj_eval, kept: Geometry | None) -> Geometry:
         triangles = read_triangles(mesh, corners, faces)
     finally:
         obj_eval.to_mesh_clear()
-    if local.shape[0] == 0:
-        raise GoniometerError(f"'{obj.name}' has no vertices: there is nothing to measure.")
     triangles = triangles.astype(np.int64)
     if np.linalg.det(matrix[:3, :3]) < 0.0:
         # A mirroring transform turns the faces inside out in world space: flip the winding so

@@ -15,8 +15,9 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import colours, exact, mesh_object
+from bpy_helpers import colours, exact, expected_colours, mesh_object
 
+from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
 from vg_addon.synthetic_meshes import bone_fragment, wedge
 
@@ -419,3 +420,28 @@ def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
     assert png_size(out / "bone_fragment.png") == (800, 600)
     assert (out / "bone_fragment.blend").stat().st_size > 0
     assert meshio.read_mesh(out / "bone_fragment.ply").n_vertices > 200_000
+
+
+def test_batch_paints_as_the_extension_does_break_0_included(vg, meshes, tmp_path):
+    """The batch paints through the extension's own painter: every measured row is painted,
+    later over earlier, a row of break 0 too (the batch's former painter skipped it)."""
+    points = write_csv(
+        tmp_path / "points.csv",
+        ["x", "y", "z", "break", "label"],
+        [["-0.3", "0", "0", "0", "a"], ["-0.1", "0", "0", "2", "b"], ["0.05", "0", "0", "0", "c"]],
+    )
+    out, saved = tmp_path / "out.csv", tmp_path / "saved.blend"
+    ok(batch(meshes["ply"], "--points", points, "--radius", RADIUS, "--out", out,
+             "--save-blend", saved))  # fmt: skip
+    bpy.ops.wm.open_mainfile(filepath=str(saved))
+    obj = bpy.data.objects["w90"]
+    assert [i.break_number for i in obj.vg.measurements] == [0, 2, 0]
+    co = np.empty(len(obj.data.vertices) * 3, dtype=np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    mesh = meshio.read_mesh(meshes["ply"])
+    surface = Surface(co.reshape(-1, 3).astype(np.float64), mesh.triangles)
+    sides = []
+    for item in obj.vg.measurements:
+        m = surface.measure(exact(item)["center"], RADIUS)
+        sides.append((m.indices, m.labels, item.break_number))
+    np.testing.assert_array_equal(colours(obj), expected_colours(vg, len(obj.data.vertices), sides))
