@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import importlib
 import os
 import struct
 import subprocess
@@ -445,3 +446,43 @@ def test_batch_paints_as_the_extension_does_break_0_included(vg, meshes, tmp_pat
         m = surface.measure(exact(item)["center"], RADIUS)
         sides.append((m.indices, m.labels, item.break_number))
     np.testing.assert_array_equal(colours(obj), expected_colours(vg, len(obj.data.vertices), sides))
+
+
+@pytest.mark.parametrize("flaw", ["none", "degenerate", "duplicate"])
+def test_imported_mesh_is_blenders_own_ply_import(vg, tmp_path, flaw):
+    """The batch's import gives the mesh File > Import > PLY gives (Blender's C++ importer),
+    for a clean triangle list and for ones Blender has to repair."""
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    shape = wedge(70.0, n=12, irregular=True, seed=1)
+    triangles = shape.triangles.copy()
+    if flaw == "degenerate":
+        triangles = np.vstack([triangles, [[3, 3, 7]]])
+    elif flaw == "duplicate":
+        triangles = np.vstack([triangles, triangles[5][[1, 2, 0]]])
+    path = meshio.write_ply(tmp_path / f"{flaw}.ply", shape.points, triangles)
+    ours = sources.import_mesh(sources.MeshSource("ours", str(path)))
+    assert bpy.ops.wm.ply_import(filepath=str(path)) == {"FINISHED"}
+    blenders = bpy.context.selected_objects[0]
+    assert blenders != ours
+    for attribute, kind, width in (("position", "vector", 3), (".corner_vert", "value", 1)):
+        got, want = (
+            np.empty(len(o.data.attributes[attribute].data) * width) for o in (ours, blenders)
+        )
+        ours.data.attributes[attribute].data.foreach_get(kind, got)
+        blenders.data.attributes[attribute].data.foreach_get(kind, want)
+        np.testing.assert_array_equal(got, want, attribute)
+    assert len(ours.data.polygons) == len(shape.triangles)  # the flaw is gone
+
+
+def test_needs_validation_agrees_with_brute_force(vg):
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    rng = np.random.default_rng(0)
+    for n in (6, 40, 3_000_000):  # the last packs no key into 63 bits
+        for _ in range(30):
+            triangles = rng.integers(0, min(n, 40), size=(int(rng.integers(1, 12)), 3))
+            triangles[0, 0] = n - 1  # fixes the largest index
+            seen, flawed = set(), False
+            for row in triangles.tolist():
+                flawed |= len(set(row)) < 3 or frozenset(row) in seen
+                seen.add(frozenset(row))
+            assert sources.needs_validation(triangles) == flawed, triangles

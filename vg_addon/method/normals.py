@@ -8,17 +8,24 @@ from .ranges import expand_ranges
 from .spatial import GridIndex
 
 
-def face_normals(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Unnormalised face normals: the cross product of two edges, of length twice the face's area."""
-    a = points[triangles[:, 0]]
-    u = points[triangles[:, 1]] - a
-    v = points[triangles[:, 2]] - a
-    # Written out: np.cross is several times slower on millions of rows.
-    normals = np.empty_like(u)
-    normals[:, 0] = u[:, 1] * v[:, 2] - u[:, 2] * v[:, 1]
-    normals[:, 1] = u[:, 2] * v[:, 0] - u[:, 0] * v[:, 2]
-    normals[:, 2] = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
-    return normals
+def face_normals(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Unnormalised face normals: the cross product of two edges, of length twice the face's area.
+
+    Returns the x, y and z components as three contiguous arrays of shape (m,).
+    """
+    # Written out on contiguous coordinate columns (np.take on 1-D arrays): np.cross and row
+    # gathers of (n, 3) arrays are several times slower on millions of rows. The arithmetic is
+    # the same, element for element.
+    columns = np.ascontiguousarray(points.T)
+    corners = [np.ascontiguousarray(triangles[:, k]) for k in range(3)]
+    a = [column.take(corners[0]) for column in columns]
+    u = [column.take(corners[1]) - start for column, start in zip(columns, a, strict=True)]
+    v = [column.take(corners[2]) - start for column, start in zip(columns, a, strict=True)]
+    return (
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    )
 
 
 def vertex_normals(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -49,12 +56,11 @@ def vertex_normals(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarra
     extent = float(np.max(points.max(axis=0) - origin))
     scaled = (points - origin) / extent if extent > 0 else points - origin
     weighted = face_normals(scaled, triangles)
+    corners = [np.ascontiguousarray(triangles[:, k]) for k in range(3)]
     summed = np.zeros((n, 3), dtype=np.float64)
     for axis in range(3):
-        for corner in range(3):
-            summed[:, axis] += np.bincount(
-                triangles[:, corner], weights=weighted[:, axis], minlength=n
-            )
+        for corner in corners:
+            summed[:, axis] += np.bincount(corner, weights=weighted[axis], minlength=n)
     lengths = np.linalg.norm(summed, axis=1)
     valid = lengths > 1e-150
     normals = np.zeros_like(summed)
