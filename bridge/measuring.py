@@ -98,7 +98,26 @@ def measure_on_object(
     return obj.vg.measurements[obj.vg.active_index]
 
 
-def repaint(obj, *, depsgraph=None, geometry: Geometry | None = None) -> list[int]:
+# Per measurement, what changes whenever it is replaced by another one; read for the whole list
+# at once (foreach_get) to recognise the measurements already painted without reading them.
+_SIGNATURE = ("number", "break_number", "n_vertices", "n_plus", "n_minus")
+
+
+def _signatures(items) -> list[tuple]:
+    columns = []
+    for name in _SIGNATURE:
+        values = np.empty(len(items), dtype=np.int64)
+        items.foreach_get(name, values)
+        columns.append(values.tolist())
+    stale = np.empty(len(items), dtype=bool)
+    items.foreach_get("stale", stale)
+    columns.append(stale.tolist())
+    return list(zip(*columns, strict=True))
+
+
+def repaint(
+    obj, *, depsgraph=None, geometry: Geometry | None = None, verify: bool = False
+) -> list[int]:
     """Update the stale flags and repaint the "VG Sides" colours of ``obj`` from its records.
 
     Every measurement whose geometry fingerprint still matches the evaluated mesh is painted,
@@ -106,6 +125,13 @@ def repaint(obj, *, depsgraph=None, geometry: Geometry | None = None) -> list[in
     radius, λ and patch mode (kept from when it was measured, or measured again once). The
     others are flagged stale and left unpainted. Only what changed since the last painting of
     this object is repainted (see ``painting``).
+
+    Parameters
+    ----------
+    verify : bool
+        Read every record again, instead of recognising the ones painted last time (on the
+        same geometry, with no undo or file load since) by their number, break and vertex
+        counts. For records changed by other means than this module's functions.
 
     Returns
     -------
@@ -115,34 +141,47 @@ def repaint(obj, *, depsgraph=None, geometry: Geometry | None = None) -> list[in
     check_measurable(obj)
     if geometry is None:
         geometry = evaluated_geometry(obj, depsgraph)
-    keys, sides, stale = [], {}, []
-    for item in obj.vg.measurements:
-        is_stale = not geometry.matches(item.fingerprint)
-        if not is_stale:
-            key = _sides_key(obj, geometry, item)
-            try:
-                sides[key] = _sides_of_item(obj, geometry, item, key)
-                keys.append(key)
-            except GoniometerError:
-                is_stale = True
-        if item.stale != is_stale:
-            item.stale = is_stale
-        if is_stale:
-            stale.append(item.number)
     mesh = obj.data
     n = len(mesh.vertices)
+    items = obj.vg.measurements
     state = painting.state_for(obj)
-    if (
-        state is None
-        or state.fingerprint != geometry.fingerprint
-        or state.colours.shape[0] != n
-        or not colors.has_attribute(mesh)
-        or not state.update_to(keys, sides.__getitem__)
-    ):
+    usable = (
+        state is not None
+        and state.fingerprint == geometry.fingerprint
+        and state.colours.shape[0] == n
+        and colors.has_attribute(mesh)
+    )
+    trusted = usable and not verify and state.generation == painting.generation()
+    known = state.known if trusted else {}
+    keys, sides, stale, remembered = [], {}, [], {}
+    for position, signature in enumerate(_signatures(items)):
+        entry = known.get(signature)
+        if entry is None:
+            item = items[position]
+            is_stale, key = not geometry.matches(item.fingerprint), None
+            if not is_stale:
+                key = _sides_key(obj, geometry, item)
+                try:
+                    sides[key] = _sides_of_item(obj, geometry, item, key)
+                except GoniometerError:
+                    is_stale, key = True, None
+            if item.stale != is_stale:
+                item.stale = is_stale
+            signature = (*signature[:-1], is_stale)
+            entry = (key, sides.get(key))
+        remembered[signature] = entry
+        key, kept = entry
+        if key is None:
+            stale.append(signature[0])
+        else:
+            keys.append(key)
+            sides[key] = kept
+    if not usable or not state.update_to(keys, sides.__getitem__):
         state = painting.PaintState.blank(geometry.fingerprint, n)
         for key in keys:
             state.add(key, sides[key])
         painting.set_state(obj, state)
+    state.known, state.generation = remembered, painting.generation()
     with own_write(mesh, depsgraph):
         colors.write_attribute(mesh, state.colours)
     colors.show_in_viewports()

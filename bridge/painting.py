@@ -79,6 +79,10 @@ class PaintState:
     owner: np.ndarray  # int32 (n,): 1 + position in ``painted`` of the owning entry, 0 for none
     painted: list = field(default_factory=list)  # keys, in painting order
     sides: list = field(default_factory=list)  # their Sides, aligned with ``painted``
+    # The records as last painted: signature -> (key, Sides), or (None, None) for a stale one;
+    # trusted only in the generation it was made in (see ``generation``).
+    known: dict = field(default_factory=dict)
+    generation: int = -1
 
     @classmethod
     def blank(cls, fingerprint: str, n: int) -> PaintState:
@@ -146,6 +150,17 @@ class PaintState:
 
 
 _states: dict[int, PaintState] = {}
+_generation = 0
+
+
+def generation() -> int:
+    """Changes whenever records may have changed behind this module's back (undo, redo)."""
+    return _generation
+
+
+def new_generation() -> None:
+    global _generation
+    _generation += 1
 
 
 def state_for(obj) -> PaintState | None:

@@ -16,7 +16,7 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..vg_addon import GoniometerError
-from . import mesh_data
+from . import mesh_data, painting
 from .measuring import forget_paint, migrate_fingerprints, repaint
 from .mesh_data import check_measurable, evaluated_geometry
 
@@ -43,7 +43,7 @@ def refresh(obj, depsgraph=None) -> bool:
         (item.fingerprint != geometry.fingerprint) == item.stale for item in obj.vg.measurements
     ):
         return False
-    repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    repaint(obj, depsgraph=depsgraph, geometry=geometry, verify=True)
     return True
 
 
@@ -79,8 +79,10 @@ def on_depsgraph_update(scene, depsgraph):
 
 @persistent
 def on_undo_or_redo(*_args):
-    """Undo and redo may restore any geometry: read every mesh again before trusting it."""
+    """Undo and redo may restore any geometry and any records: read them again before
+    trusting what was kept."""
     mesh_data.invalidate_all()
+    painting.new_generation()
 
 
 @persistent

@@ -91,6 +91,21 @@ def test_undo_restores_a_geometry_that_is_read_again(vg):
     np.testing.assert_array_equal(colours(obj), painted_from_scratch(vg, obj))
 
 
+def test_undone_measurements_are_unpainted_by_the_next_click(vg):
+    obj = wedge_object(80.0)
+    bpy.ops.ed.undo_push(message="start")
+    for x in (-0.3, 0.0, 0.3):
+        bpy.ops.vg.measure_xyz("EXEC_DEFAULT", True, location=(x, 0, 0), radius=0.3)
+    bpy.ops.vg.delete_measurement("EXEC_DEFAULT", True, index=0)
+    bpy.ops.ed.undo()  # the delete
+    bpy.ops.ed.undo()  # the third measurement
+    obj = bpy.data.objects["Wedge"]
+    assert [item.number for item in obj.vg.measurements] == [1, 2]
+    bpy.ops.vg.measure_xyz(location=(0.15, 0, 0), radius=0.25)  # number 3 again, elsewhere
+    assert [item.number for item in obj.vg.measurements] == [1, 2, 3]
+    np.testing.assert_array_equal(colours(obj), painted_from_scratch(vg, obj))
+
+
 @pytest.mark.parametrize("seed", [0, 1])
 def test_incremental_painting_equals_painting_from_scratch(vg, seed):
     """Measures, deletes (first, middle, last, active), next breaks and a stale measurement in
