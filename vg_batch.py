@@ -7,7 +7,7 @@ Runs inside Blender or with the ``bpy`` module from PyPI, with the same argument
 
 The repository root is the extension package: this script imports it from the folder it sits in
 and registers it, so the measurements are taken, stored and coloured exactly as the extension
-does it (see the README, "Batch runs from the command line").
+does it (see docs/BATCH.md).
 """
 
 import importlib.util
