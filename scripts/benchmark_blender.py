@@ -116,6 +116,9 @@ def run_size(label: str, stored: int, repeats: int) -> dict:
     start = time.perf_counter()
     obj = make_object(bpy, points, triangles)
     out["mesh_build_s"] = time.perf_counter() - start
+    if label != "1M":  # only the 1M run writes them to a file again: free the memory now
+        del points, triangles
+        points = triangles = None
     spacing = 2.0 / (side - 1)
     # A radius whose patch holds about PATCH_VERTICES vertices: the ridge's faces are a grid of
     # this spacing, and a ball on the crease cuts a half disc from each.
