@@ -161,9 +161,17 @@ def run_size(label: str, stored: int, repeats: int) -> dict:
         )
         assert result == {"FINISHED"}, result
 
+    def drags(count):
+        """Press and release times of ``count`` drags in a row (each press follows the previous
+        release's repaint, as when measuring one break after another)."""
+        presses, releases = [], []
+        for _ in range(count):
+            presses.append(timed(press))
+            releases.append(timed(release))
+        return stats(presses), stats(releases)
+
     press()  # the first press builds Blender's ray-cast tree
-    out["press_1"] = stats([timed(press) for _ in range(repeats)])
-    out["release_1"] = stats([timed(release) for _ in range(repeats)])
+    out["press_1"], out["release_1"] = drags(repeats)
 
     # Fill up to `stored` measurements (no undo steps: a script, not clicks).
     start = time.perf_counter()
@@ -173,8 +181,7 @@ def run_size(label: str, stored: int, repeats: int) -> dict:
     out["stored"] = len(obj.vg.measurements)
     bpy.ops.ed.undo_push(message="filled")
     out[f"repeat_click_{stored}"] = stats([timed(click) for _ in range(repeats)])
-    out[f"press_{stored}"] = stats([timed(press) for _ in range(repeats)])
-    out[f"release_{stored}"] = stats([timed(release) for _ in range(repeats)])
+    out[f"press_{stored}"], out[f"release_{stored}"] = drags(repeats)
 
     deletes, undos = [], []
     for k in range(repeats):

@@ -6,6 +6,8 @@ re-measuring at their stored centre, radius, λ and patch mode, so these outputs
 bit what that code gave. Each case records the patch (snapped vertex, snap distance, the vertex
 indices in the order Algorithm 1 summed them, their labels) apart from the numbers Algorithm 1
 derived from it, so a change to the algorithm's own arithmetic shows as a change of numbers only.
+The numbers are pinned for the NumPy they were computed with (another NumPy's linear algebra
+and sums may round differently); the patches for every NumPy.
 """
 
 from __future__ import annotations
@@ -93,11 +95,13 @@ def record(surface: Surface, center, radius, lam, patch) -> dict:
     return entry
 
 
-def compute_all() -> dict[str, list[dict]]:
-    return {
+def compute_all() -> dict:
+    pins = {
         name: [record(surface, *case) for case in cases(surface, name)]
         for name, surface in surfaces().items()
     }
+    pins["numpy"] = np.__version__
+    return pins
 
 
 if __name__ == "__main__":
