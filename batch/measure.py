@@ -81,8 +81,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
 
     The numbers come from the extension's own pipeline: the object's evaluated mesh in world
     space (``mesh_data.evaluated_geometry``), its cached ``Surface`` (``mesh_data.surface_for``)
-    and ``records.add_measurement``; ``measuring.measure_on_object`` does the same per click,
-    re-evaluating the mesh and repainting each time, which a batch does once per mesh instead.
+    and ``records.add_measurement``; the colours are painted once per mesh at the end by
+    ``measuring.repaint``, the extension's own painter, from the sides kept while measuring.
     """
     result = MeshResult(mesh=index)
     units = records.units_label(bpy.context.scene)
@@ -119,11 +119,6 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
 
     data = obj.vg
     base = data.next_number - 1  # measurements already on a .blend object keep their numbers
-    fresh = len(data.measurements) == 0
-    # Per vertex, the break number and side of the last measurement covering it (0: none), so
-    # the colours are painted once at the end without keeping every measurement in memory.
-    painter = np.zeros(result.n_vertices, dtype=np.int64)
-    plus_side = np.zeros(result.n_vertices, dtype=bool)
     view = np.zeros(3)
     last_report = start = time.perf_counter()
     for done, task in enumerate(tasks, start=1):
@@ -145,8 +140,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
                 obj, m, geometry.fingerprint, note=task.label, break_number=task.break_number
             )
             result.rows.append((task.index, records.to_row(obj, item, stale=False, units=units)))
-            painter[m.indices] = item.break_number
-            plus_side[m.indices] = m.labels
+            measuring.keep_sides(obj, geometry, item, m)
             view += m.mean_normal
             result.measured += 1
         now = time.perf_counter()
@@ -160,19 +154,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         data.next_number = max(item.number for item in data.measurements) + 1
 
     if result.measured:
-        if fresh and len(obj.data.vertices) == result.n_vertices:
-            # Every measurement is this run's, on these vertices: paint them as repaint() would
-            # (later over earlier), without measuring each one again.
-            painted = np.flatnonzero(painter)
-            sides = [
-                (vertices, plus_side[vertices], int(number))
-                for number in np.unique(painter[painted])
-                for vertices in [painted[painter[painted] == number]]
-            ]
-            rgba = colors.side_colours(result.n_vertices, sides)
-            colors.write_attribute(obj.data, rgba)
-        else:
-            measuring.repaint(obj, geometry=geometry)
+        measuring.repaint(obj, geometry=geometry)
         add_sides_material(obj, colors.ATTRIBUTE_NAME)
 
     if options.get("render"):

@@ -226,7 +226,7 @@ class VG_OT_repaint(bpy.types.Operator):
         if obj is None:
             return {"CANCELLED"}
         try:
-            measuring.repaint(obj, depsgraph=context.evaluated_depsgraph_get())
+            measuring.repaint(obj, depsgraph=context.evaluated_depsgraph_get(), verify=True)
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
