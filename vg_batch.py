@@ -567,6 +567,7 @@ def measure_mesh(ctx: Context, index: int, source: MeshSource, tasks, options, p
     result.measure_seconds = time.perf_counter() - start
     if len(data.measurements):
         data.next_number = max(item.number for item in data.measurements) + 1
+        ctx.records.continue_after_recorded_breaks(obj)
 
     if result.measured:
         if fresh and len(obj.data.vertices) == result.n_vertices:

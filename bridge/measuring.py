@@ -215,6 +215,7 @@ def replicate_rows(
             obj, m, geometry.fingerprint, note=row.label or "", break_number=row.break_number
         )
         numbers.append(item.number)
+    records.continue_after_recorded_breaks(obj)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
     return numbers
 
