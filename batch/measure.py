@@ -152,6 +152,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         sweep_sites(result, surface, obj.name, tasks, options)
     if len(data.measurements):
         data.next_number = max(item.number for item in data.measurements) + 1
+        records.continue_after_recorded_breaks(obj)
 
     if result.measured:
         measuring.repaint(obj, geometry=geometry)

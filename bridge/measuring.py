@@ -350,6 +350,7 @@ def replicate_rows(
         )
         keep_sides(obj, geometry, item, m)
         numbers.append(item.number)
+    records.continue_after_recorded_breaks(obj)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
     return numbers
 

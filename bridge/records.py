@@ -101,6 +101,21 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
     return item
 
 
+def next_free_break(obj) -> int:
+    """The break after the current one: one past the highest the object uses or is on."""
+    data = obj.vg
+    return max([data.break_number, *(item.break_number for item in data.measurements)]) + 1
+
+
+def continue_after_recorded_breaks(obj) -> None:
+    """After recording many measurements at once (a batch run, a CSV import): make the current
+    break one past the highest in use, so the next click starts a break of its own instead of
+    joining a recorded one (and its colours)."""
+    data = obj.vg
+    highest = max((item.break_number for item in data.measurements), default=0)
+    data.break_number = max(data.break_number, highest + 1)
+
+
 _KEYS = (
     "angle",
     "fit",

@@ -13,7 +13,7 @@ from bpy.props import (
     StringProperty,
 )
 
-from ..bridge import measuring
+from ..bridge import measuring, records
 from ..bridge.mesh_data import check_measurable, evaluated_geometry
 from ..properties import PATCH_ITEMS, RULE_ITEMS
 from ..vg_addon import GoniometerError
@@ -145,7 +145,8 @@ def _active_geometry(operator, context):
 
 
 class VG_OT_next_break(bpy.types.Operator):
-    """Start a new break: the next measurements get the next break number and colour pair"""
+    """Start a new break: the next measurements get a break number no measurement has yet, and
+    its colour pair"""
 
     bl_idname = "vg.next_break"
     bl_label = "Next Break"
@@ -155,7 +156,7 @@ class VG_OT_next_break(bpy.types.Operator):
         obj = _active_measurable(self, context)
         if obj is None:
             return {"CANCELLED"}
-        obj.vg.break_number += 1
+        obj.vg.break_number = records.next_free_break(obj)
         self.report({"INFO"}, f"Break {obj.vg.break_number} on '{obj.name}'")
         return {"FINISHED"}
 
