@@ -477,6 +477,10 @@ def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
     return "".join(lines)
 
 
+#: The path that means standard output.
+STDOUT = "-"
+
+
 def _replace_atomically(path: str, data: bytes) -> None:
     folder = os.path.dirname(os.path.abspath(path)) or "."
     if not os.path.isdir(folder):
@@ -517,23 +521,120 @@ def _replace_atomically(path: str, data: bytes) -> None:
         raise
 
 
-def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
-    """Write an export to ``path`` (UTF-8, comma-delimited, ``\\n`` line ends), atomically.
+def _write_into(path: str, data: bytes) -> None:
+    """Write ``data`` into an open-ended target (a pipe, a terminal, standard output), in place."""
+    try:
+        if path == STDOUT:
+            handle = os.dup(1)
+        else:
+            # No O_CREAT and no O_TRUNC: the target exists and is never replaced or emptied;
+            # O_APPEND keeps what a shell's ">>" already put in a file behind /dev/stdout.
+            handle = os.open(path, os.O_WRONLY | os.O_APPEND | getattr(os, "O_BINARY", 0))
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+            stream.flush()
+    except OSError as error:
+        where = "standard output" if path == STDOUT else repr(path)
+        raise GoniometerError(
+            f"Could not write the CSV to {where}: {error.strerror or error}."
+        ) from error
 
-    The whole text is formatted first (see :func:`format_measurements_csv`), then written to a
-    temporary file in the same folder and moved over ``path`` in one step, so ``path`` holds
-    either its old content or the complete new one; on any failure the temporary file is
-    removed. An existing file's permissions are kept.
+
+def _is_descriptor_alias(path: str) -> bool:
+    """Whether ``path`` reaches, through its symbolic links, a name of an open file descriptor
+    (``/dev/stdout`` -> ``/proc/self/fd/1``, ``/dev/fd/1``): writing to it means writing into
+    the file this process already has open, never replacing it."""
+    current = os.path.abspath(path)
+    for _ in range(40):  # the kernel's own limit on links followed
+        if current.startswith(("/proc/", "/dev/fd/")):
+            return True
+        if not os.path.islink(current):
+            return False
+        current = os.path.normpath(os.path.join(os.path.dirname(current), os.readlink(current)))
+    return False
+
+
+def output_target(path) -> str:
+    """How :func:`write_measurements_csv` will write to ``path``, or why it cannot.
+
+    Returns
+    -------
+    str
+        ``"file"``: a regular file (new, or replaced atomically; through a symbolic link, its
+        target is replaced and the link kept). ``"stream"``: ``"-"`` (standard output), a pipe,
+        a terminal or another character device such as ``/dev/null``, or a name of an open file
+        descriptor such as ``/dev/stdout``: the text is written into it, once, never replacing
+        it.
 
     Raises
     ------
     GoniometerError
-        A row that cannot be written, a missing folder, or a target that cannot be replaced.
+        A folder, a block device or a socket, or a folder that does not exist.
+    """
+    path = os.fspath(path)
+    if path == STDOUT:
+        return "stream"
+    try:
+        info = os.stat(path)  # follows symbolic links
+    except FileNotFoundError:
+        target = os.path.realpath(path)  # a dangling link is created at its target
+        folder = os.path.dirname(target) or "."
+        if not os.path.isdir(folder):
+            raise GoniometerError(
+                f"The folder {folder!r} does not exist: choose an existing folder to write "
+                f"{os.path.basename(path)!r} to."
+            ) from None
+        return "file"
+    except OSError as error:
+        raise GoniometerError(f"Cannot write to {path!r}: {error.strerror or error}.") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise GoniometerError(
+            f"{path!r} is a folder: give a file name for the CSV, e.g. "
+            f"{os.path.join(path, 'measurements.csv')!r}."
+        )
+    if stat.S_ISREG(info.st_mode):
+        if _is_descriptor_alias(path):
+            return "stream"
+        if not os.access(path, os.W_OK):
+            raise GoniometerError(
+                f"{path!r} is read-only: it is left as it is. Choose another file name, or make "
+                "it writable first."
+            )
+        return "file"
+    if stat.S_ISCHR(info.st_mode) or stat.S_ISFIFO(info.st_mode):
+        return "stream"
+    kind = "a block device" if stat.S_ISBLK(info.st_mode) else "a socket or other special file"
+    raise GoniometerError(
+        f"{path!r} is {kind}, not a file: choose a file name, or '-' for standard output."
+    )
+
+
+def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
+    """Write an export to ``path`` (UTF-8, comma-delimited, ``\\n`` line ends).
+
+    The whole text is formatted first (see :func:`format_measurements_csv`). A regular file is
+    written atomically: to a temporary file in the same folder, then moved over ``path`` in one
+    step, so ``path`` holds either its old content or the complete new one; on any failure the
+    temporary file is removed. An existing file's permissions are kept; through a symbolic link,
+    the link's target is replaced and the link stays. ``"-"``, a pipe, a terminal, a character
+    device (``/dev/null``) or a name of an open descriptor (``/dev/stdout``) is written into,
+    never replaced (see :func:`output_target`).
+
+    Raises
+    ------
+    GoniometerError
+        A row that cannot be written, a missing folder, a folder or other target that is not a
+        file, a target that cannot be replaced, or a stream that refuses the data (e.g.
+        ``/dev/full``).
     OSError
         Other file-system errors (disk full, no permission to create the file, ...).
     """
     data = format_measurements_csv(rows).encode("utf-8")
-    _replace_atomically(os.fspath(path), data)
+    path = os.fspath(path)
+    if output_target(path) == "stream":
+        _write_into(path, data)
+    else:
+        _replace_atomically(os.path.realpath(path), data)
 
 
 # --------------------------------------------------------------------------- reading
