@@ -59,7 +59,9 @@ def fingerprint(local: np.ndarray, triangles: np.ndarray, matrix: np.ndarray) ->
     for array in (local, triangles, matrix):
         array = np.ascontiguousarray(array)
         digest.update(f"{array.dtype.str}{array.shape}".encode())
-        digest.update(memoryview(array).cast("B"))
+        # Flat, because a memoryview with a zero in its shape (no faces) cannot be cast; the
+        # bytes, and so the digests of recorded measurements, are the same.
+        digest.update(memoryview(array.reshape(-1)).cast("B"))
     return digest.hexdigest()
 
 

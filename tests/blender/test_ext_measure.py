@@ -288,3 +288,34 @@ def test_sample_bone_scan(vg, shared_data):
     item = vg.bridge.measuring.measure_on_object(obj, centre, radius)
     assert_same(item, core_surface(obj).measure(centre, radius))
     assert 0.0 < item.angle < 180.0
+
+
+def cloud_object(name, points, edges=()):
+    """A mesh object with vertices (and optionally edges) but no faces: a point cloud."""
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(np.asarray(points, dtype=np.float64).tolist(), list(edges), [])
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.context.view_layer.update()
+    return obj
+
+
+@pytest.mark.parametrize("with_edges", [False, True], ids=["vertices only", "edges only"])
+def test_a_mesh_without_faces_is_measured_as_a_point_cloud(vg, with_edges):
+    from vg_addon.synthetic_meshes import wedge
+
+    shape = wedge(100.0, n=40)
+    edges = [(int(a), int(b)) for a, b, _ in shape.triangles[:50]] if with_edges else ()
+    obj = cloud_object("Cloud", shape.points, edges)
+    assert len(obj.data.polygons) == 0 and len(obj.data.edges) == len(edges)
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.5)
+    (item,) = obj.vg.measurements
+    # The core on the same world points, without triangles (PCA normals), is the oracle.
+    m = Surface(world(local_points(obj), obj)).measure([0.0, 0.0, 0.0], 0.5)
+    assert_same(item, m)
+    assert abs(item.angle - 100.0) < 1.0
+    painted = colours(obj)
+    assert painted is not None and painted.shape == (len(shape.points), 4)

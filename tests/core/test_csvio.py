@@ -615,3 +615,31 @@ def test_format_colors():
     for bad in [("orange",), ("orange", "mauve"), ((256, 0, 0), (0, 0, 0)), ((1, 2), "blue")]:
         with pytest.raises(GoniometerError):
             csvio.format_colors(bad)
+
+
+# --------------------------------------------------------------------------- break numbers
+
+
+@pytest.mark.parametrize("cell", ["2147483648", "99999999999999999999", "abc", "1.5", "0", "-1"])
+def test_a_break_number_that_blender_cannot_store_is_refused(cell):
+    text = f"x,y,z,Break #\n1,2,3,2\n4,5,6,{cell}\n"
+    with pytest.raises(GoniometerError) as info:
+        csvio.read_replication_csv(text)
+    message = str(info.value)
+    assert "nothing was read" in message
+    assert f"row 3: Break # must be a whole number from 1 to 2147483647 (got '{cell}')" in message
+    assert "row 2" not in message
+
+
+def test_break_numbers_at_the_limits_and_blank():
+    text = "x,y,z,Break #\n1,2,3,1\n4,5,6,2147483647\n7,8,9,\n"
+    rows = csvio.read_replication_csv(text)
+    assert [row.break_number for row in rows] == [1, 2**31 - 1, None]
+
+
+def test_an_integer_too_long_for_python_is_a_clear_problem():
+    digits = "9" * 5000  # int() refuses text this long
+    rows = csvio.read_replication_csv(f"x,y,z,Measurement #\n1,2,3,{digits}\n")
+    assert rows[0].number is None  # Measurement # is informative only: not a number then
+    with pytest.raises(GoniometerError, match="row 2: Break # must be a whole number"):
+        csvio.read_replication_csv(f"x,y,z,Break #\n1,2,3,{digits}\n")

@@ -107,7 +107,9 @@ _FALSE = "FALSE"
 _FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "'")
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_INTEGER = re.compile(r"[+-]?\d+")
+# At most 18 digits: every such integer fits 64 bits, and int() never meets Python's limit on
+# the length of integer text.
+_INTEGER = re.compile(r"[+-]?\d{1,18}")
 
 # File extensions a CSV's mesh name may carry (MeshLab writes the scan's file name).
 _MESH_FILE_SUFFIXES = frozenset(
@@ -236,7 +238,7 @@ class ReplicationRow:
         The original ``Measurement #`` (MeshLab's burst measurements are fractional, e.g. 3.05);
         ``None`` when absent, blank or not a number.
     break_number : int or None
-        The original ``Break #``; ``None`` when absent, blank or not a whole number.
+        The original ``Break #`` (1 to :data:`MAX_BREAK_NUMBER`); ``None`` when absent or blank.
     source_format : str
         ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
         columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
@@ -805,6 +807,20 @@ def _lenient_number(raw: str) -> int | float | None:
     return None
 
 
+#: The largest ``Break #`` (Blender stores it as a 32-bit signed integer).
+MAX_BREAK_NUMBER = 2**31 - 1
+
+
+def _parse_break_number(raw: str) -> int | str | None:
+    """The break number of a cell, ``None`` when blank, or why it is not one (a str)."""
+    text = raw.strip()
+    if not text:
+        return None
+    if _INTEGER.fullmatch(text) and 1 <= int(text) <= MAX_BREAK_NUMBER:
+        return int(text)
+    return f"must be a whole number from 1 to {MAX_BREAK_NUMBER} (got {text!r})"
+
+
 def parse_replication_csv(text: str, source: str = "The CSV text") -> list[ReplicationRow]:
     """Parse CSV text into replication rows; see :func:`read_replication_csv`.
 
@@ -876,6 +892,9 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
             problems.append(
                 f"row {number}: {name_of('lam')} (λ) must be 0 or more (got {cell('lam').strip()})"
             )
+        break_number = _parse_break_number(cell("break_number"))
+        if isinstance(break_number, str):
+            problems.append(f"row {number}: {name_of('break_number')} {break_number}")
         patch = _parse_optional_text(cell("patch"))
         if patch is not None:
             patch = patch.casefold()
@@ -886,7 +905,6 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 )
         if problems:
             continue  # nothing is returned anyway; keep collecting
-        break_number = _lenient_number(cell("break_number"))
         rows.append(
             ReplicationRow(
                 row_number=number,
@@ -899,7 +917,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 patch=patch,
                 label=_parse_optional_text(cell("label")),
                 number=_lenient_number(cell("number")),
-                break_number=break_number if isinstance(break_number, int) else None,
+                break_number=break_number,
                 source_format=fmt,
             )
         )
@@ -948,7 +966,8 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
         One error listing every problem (the first 20, then "and N more") with its row number
         and column name: missing x/y/z columns (naming those found), duplicate columns, a blank,
         non-numeric or non-finite x/y/z/radius/lambda, radius ≤ 0, λ < 0, an unknown patch
-        mode, a row with more cells than the header; or: an empty file, a header without data
+        mode, a ``Break #`` that is not a whole number from 1 to :data:`MAX_BREAK_NUMBER`, a row
+        with more cells than the header; or: an empty file, a header without data
         rows, only failed rows, a ``;`` or tab delimiter, text that is not UTF-8. Nothing is
         returned then.
     OSError
