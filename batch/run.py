@@ -211,6 +211,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             if parallel:
                 plan = {
                     "folder": folder,
+                    "parent_session": bpy.app.tempdir,  # removed by the workers if this dies
                     "sources": [dataclasses.asdict(s) for s in sources],
                     "tasks": {
                         str(m): [dataclasses.asdict(t) for t in ts] for m, ts in groups.items()
