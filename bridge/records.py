@@ -145,8 +145,11 @@ def units_label(scene) -> str:
     return f"BU (1 BU = {units.scale_length:g} m, shown in {units.length_unit.lower()})"
 
 
-def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
-    """The CSV row of ``item``, measured on ``obj``."""
+def to_row(
+    obj, item, *, stale: bool, units: str, precision: str = "float32"
+) -> csvio.MeasurementRow:
+    """The CSV row of ``item``, measured on ``obj``; ``precision``: the coordinates measured
+    (``"float32"``, Blender's mesh, unless a batch run measured a file's float64 ones)."""
     numbers = numbers_of(item)
     x, y, z = numbers["center"]
     return csvio.MeasurementRow(
@@ -174,6 +177,7 @@ def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
         requested=tuple(numbers["requested"]),
         snap_distance=numbers["snap_distance"],
         units=units,
+        precision=precision,
         stale=stale,
         extension_version=extension_version(),
         blender_version=bpy.app.version_string,

@@ -37,6 +37,7 @@ OUR_EXTRA_COLUMNS = [
     "Requested z",
     "Snap Distance",
     "Units",
+    "Precision",
     "Stale",
     "Extension Version",
     "Blender Version",
@@ -643,3 +644,16 @@ def test_an_integer_too_long_for_python_is_a_clear_problem():
     assert rows[0].number is None  # Measurement # is informative only: not a number then
     with pytest.raises(GoniometerError, match="row 2: Break # must be a whole number"):
         csvio.read_replication_csv(f"x,y,z,Break #\n1,2,3,{digits}\n")
+
+
+def test_an_export_written_before_the_precision_column_still_reads_back():
+    text = csvio.format_measurements_csv([good_row(precision="float64")])
+    header, row = csv.reader(io.StringIO(text))
+    at = header.index("Precision")
+    assert row[at] == "float64"
+    stream = io.StringIO()
+    csv.writer(stream, lineterminator="\n").writerows(
+        cells[:at] + cells[at + 1 :] for cells in (header, row)
+    )
+    (read,) = csvio.read_measurements_csv(stream.getvalue())
+    assert read.precision == "" and read.angle == good_row().angle

@@ -86,6 +86,7 @@ _SCHEMA = (
     ("requested", "vec3", ("Requested x", "Requested y", "Requested z")),
     ("snap_distance", "float", ("Snap Distance",)),
     ("units", "text", ("Units",)),
+    ("precision", "text", ("Precision",)),
     ("stale", "bool", ("Stale",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
@@ -94,6 +95,10 @@ _SCHEMA = (
 
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
 EXPORT_COLUMNS = tuple(column for _, _, columns in _SCHEMA for column in columns)
+
+# Columns added after the first release: an export written before them still reads back
+# (their cells read as empty).
+_LATER_COLUMNS = frozenset(["Precision"])
 
 #: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
 SOURCE_FORMATS = ("extension", "meshlab", "points")
@@ -176,6 +181,10 @@ class MeasurementRow:
         Distance from ``requested`` to ``(x, y, z)``.
     units : str
         What one coordinate unit is.
+    precision : str
+        The coordinates measured: ``"float32"`` (a Blender mesh, as Blender stores it) or
+        ``"float64"`` (a mesh file's double-precision coordinates, measured as the file holds
+        them); empty for a failed row.
     stale : bool
         The mesh changed since the measurement was taken.
     extension_version, blender_version : str
@@ -207,6 +216,7 @@ class MeasurementRow:
     requested: tuple[float, float, float] | None = None
     snap_distance: float | None = None
     units: str = ""
+    precision: str = ""
     stale: bool = False
     extension_version: str = ""
     blender_version: str = ""
@@ -990,7 +1000,7 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     """Parse an export written by :func:`format_measurements_csv` back into rows.
 
     Every column of :data:`EXPORT_COLUMNS` must be present (in any order; names are matched
-    case-insensitively); text cells are kept as written (only the formula-guard apostrophe is
+    case-insensitively), except ``Precision`` (added later: empty when absent); text cells are kept as written (only the formula-guard apostrophe is
     removed), numbers read back bit-identical. Blank lines are skipped.
 
     Raises
@@ -1003,7 +1013,11 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     problems: list[str] = []
     aliases = {column: (_normalise(column),) for column in EXPORT_COLUMNS}
     columns = _resolve_columns(header, aliases, problems)
-    missing = [column for column in EXPORT_COLUMNS if column not in columns]
+    missing = [
+        column
+        for column in EXPORT_COLUMNS
+        if column not in columns and column not in _LATER_COLUMNS
+    ]
     if missing:
         problems.insert(
             0,
@@ -1019,8 +1033,8 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
             continue
 
         def cell(column: str, cells=cells) -> str:
-            index = columns[column]
-            return cells[index] if index < len(cells) else ""
+            index = columns.get(column)
+            return cells[index] if index is not None and index < len(cells) else ""
 
         def number_of(column: str, number=number) -> float | None:
             raw = cell(column)
