@@ -188,3 +188,13 @@ def test_unprivileged_outputs_in_a_read_only_folder_are_refused_early(vg, user_f
     assert "no permission to create" in said["render"]
     assert said["fine"] == "accepted"
     assert sorted(p.name for p in read_only.iterdir()) == ["old.blend"]
+
+
+@pytest.mark.parametrize("cell", ["2147483648", "abc", "1.5"])
+def test_a_break_number_blender_cannot_store_refuses_the_points_csv(scan, tmp_path, cell):
+    points = tmp_path / "points.csv"
+    points.write_text(f"x,y,z,Break #\n0.05,0,0,1\n0.1,0,0,{cell}\n")
+    out = tmp_path / "o.csv"
+    refused(batch(scan, "--points", points, "--radius", "0.3", "--out", out),
+            f"row 3: Break # must be a whole number from 1 to 2147483647 (got '{cell}')")  # fmt: skip
+    assert not out.exists()

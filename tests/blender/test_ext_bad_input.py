@@ -148,7 +148,7 @@ def test_stale_measurement_is_kept_but_not_painted(vg, capfd):
     surface = Surface(world(local_points(obj), obj), _triangles(obj))
     m = surface.measure([0.2, 0, 0], 0.4)
     np.testing.assert_array_equal(
-        colours(obj), expected_colours(vg, len(obj.data.vertices), [(m.indices, m.labels, 1)])
+        colours(obj), expected_colours(len(obj.data.vertices), [(m.indices, m.labels, 1)])
     )
     assert [i.stale for i in obj.vg.measurements] == [True, False]
 
