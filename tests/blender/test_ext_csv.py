@@ -1,6 +1,7 @@
 """CSV export and import (replication): the MeshLab header, bit-identical angles, all or nothing."""
 
 import csv
+import os
 import tomllib
 
 import bpy
@@ -276,3 +277,14 @@ def test_replicating_rows_with_a_break_number_blender_cannot_store_records_nothi
     with pytest.raises(vg.vg_addon.GoniometerError, match=r"row 3: Break # 2147483648"):
         vg.bridge.measuring.replicate_rows(obj, rows)
     assert snapshot(obj) == before
+
+
+def test_export_through_a_symbolic_link_updates_its_target_and_keeps_the_link(vg, tmp_path):
+    obj = measured_wedge()
+    target = tmp_path / "real.csv"
+    target.write_text("old\n")
+    link = tmp_path / "link.csv"
+    link.symlink_to(target)
+    bpy.ops.vg.export_csv(filepath=str(link))
+    assert link.is_symlink() and os.readlink(link) == str(target)
+    assert len(read_rows(target)) == 1 + len(obj.vg.measurements)
