@@ -46,12 +46,15 @@ output:
   --out CSV gets one row per requested point, in input order, in the extension's export
   schema (MeshLab's 14 columns first). A row that cannot be measured has its message in the
   `error` column and the run goes on. While meshes finish, the CSV is rewritten every few
-  seconds, so a run that is stopped keeps what it measured.
+  seconds, so a run that is stopped keeps what it measured. --out - writes it to standard
+  output (once, at the end). An output that is an input, or cannot be written, is refused
+  before anything is read or written.
 
 exit status:
   0  every point measured
   1  some rows failed (see their `error` column)
-  2  bad arguments, missing or unreadable files, a malformed points CSV
+  2  bad arguments, missing or unreadable files, a malformed points CSV, an output refused
+     or a .blend/picture that could not be written
 
 scaling:
   --jobs N measures N meshes at a time, each in its own Blender/bpy process (a crash in one
@@ -161,7 +164,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="with a single mesh, measure every CSV row on it whatever mesh the row names",
     )
     out = parser.add_argument_group("output")
-    out.add_argument("--out", metavar="CSV", help="the measurements CSV to write (required)")
+    out.add_argument(
+        "--out", metavar="CSV", help="the measurements CSV to write (required; - for stdout)"
+    )
     out.add_argument(
         "--save-blend",
         metavar="PATH",

@@ -21,6 +21,7 @@ from . import extension
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
+from .outputs import check_outputs, make_folders
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
 from .workers import run_workers
@@ -44,6 +45,10 @@ class Run:
         self.write_seconds = 0.0  # how long that took
         self.in_flight: dict[int, int] = {}  # mesh -> points done so far (running meshes)
         self.units = records.units_label(bpy.context.scene)
+        # A pipe or standard output gets the CSV once, at the end; a file is rewritten as the
+        # meshes finish, so a run that is stopped keeps what it measured.
+        self.stream = csvio.output_target(args.out) == "stream"
+        self.failed_outputs: list[str] = []  # .blend or pictures that could not be written
         for task in tasks:
             if task.mesh < 0:
                 self.rows[task.index] = error_row(task, task.mesh_name, task.error, self.units)
@@ -77,9 +82,14 @@ class Run:
             self.sweep_rows.extend(result.sweep_rows)
             if result.bad_file:
                 self.bad_files.append(result.bad_file)
+            if result.render_error:
+                name = self.sources[result.mesh].name
+                self.failed_outputs.append(f"render of {name}: {result.render_error}")
             # Rewrite the CSV now and then (each write costs more as rows accumulate), so a run
             # that is killed keeps what it measured; finish() always writes.
-            if time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds):
+            if not self.stream and (
+                time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds)
+            ):
                 self.write_csv()
         source = self.sources[result.mesh]
         rate = result.measured / result.measure_seconds if result.measure_seconds > 0 else 0
@@ -109,7 +119,12 @@ class Run:
             self.rows[task.index] = error_row(
                 task, name, "not measured: the run stopped before this mesh", self.units
             )
-        self.write_csv()
+        try:
+            self.write_csv()
+        except (OSError, GoniometerError) as error:
+            where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+            self.say(f"could not write the CSV to {where}: {error}")
+            return 2
         if self.args.sweep:
             csv_path, plots = sweep_paths(self.args.out)
             rows = [cells for _, cells in sorted(self.sweep_rows, key=lambda pair: pair[0])]
@@ -142,7 +157,8 @@ class Run:
             self.say(f"  ... and {len(failed) - 10} more failed rows (see the error column)")
         for message in self.bad_files:
             self.say(f"  unreadable mesh: {message}")
-        self.say(f"wrote {self.args.out}")
+        where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+        self.say(f"wrote the CSV to {where}")
         return batchplan.exit_code(len(failed), len(self.bad_files))
 
 
@@ -158,6 +174,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     ``file_ready``: the caller has already opened the file to measure in (and activated the
     extension), as the demo does; otherwise the .blend among the inputs is opened here.
     """
+    check_outputs(args)  # before anything is read or written
     blend = ""
     if file_ready:
         inputs = list(args.inputs)
@@ -206,9 +223,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     groups = {mesh: ts for mesh, ts in bp.by_mesh(tasks).items() if mesh >= 0}
     units = args.units or ("none" if not blend else None)
     set_units(bpy.context.scene, units)
-    for path in (args.out, args.save_blend):
-        if path:
-            Path(path).resolve().parent.mkdir(parents=True, exist_ok=True)
+    make_folders(args)
     options = {
         "render": str(Path(args.render).resolve()) if args.render else "",
         "render_size": list(args.render_size),
@@ -224,10 +239,11 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     run = Run(args, sources, tasks, len(groups))
     if args.shard and not args.quiet:
         run.say(f"shard {args.shard}: {len(tasks):,} point(s) on {len(groups)} mesh(es)")
-    try:
-        run.write_csv()
-    except (OSError, GoniometerError) as error:
-        raise UsageError(f"cannot write {args.out}: {error}") from None
+    if not run.stream:
+        try:
+            run.write_csv()  # the header now: a place that cannot be written fails here
+        except (OSError, GoniometerError) as error:
+            raise UsageError(f"cannot write {args.out}: {error}") from None
 
     parallel = args.jobs > 1 and len(groups) > 1 and not blend
     if args.jobs > 1 and blend and not args.quiet:
@@ -239,6 +255,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             if parallel:
                 plan = {
                     "folder": folder,
+                    "parent_session": bpy.app.tempdir,  # removed by the workers if this dies
                     "sources": [dataclasses.asdict(s) for s in sources],
                     "tasks": {
                         str(m): [dataclasses.asdict(t) for t in ts] for m, ts in groups.items()
@@ -263,13 +280,20 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                 objects = append_objects(run.results)
             else:
                 objects = [bpy.data.objects.get(name) for name in kept if name]
-            save_blend(args.save_blend, objects)
+            try:
+                save_blend(args.save_blend, objects)
+            except (RuntimeError, OSError) as error:
+                run.failed_outputs.append(f".blend {args.save_blend}: {str(error).strip()}")
+            else:
+                run.say(f"wrote {args.save_blend}")
     finally:
         if folder:
             shutil.rmtree(folder, ignore_errors=True)
-    if args.save_blend:
-        run.say(f"wrote {args.save_blend}")
     if args.render:
         rendered = sum(1 for r in run.results if r.render)
         run.say(f"wrote {rendered} render(s) to {args.render}")
+    for message in run.failed_outputs:
+        run.say(f"  could not write the {message}")
+    if run.failed_outputs:
+        code = max(code, 2)  # the CSV is complete, but an output asked for is missing
     return code, run

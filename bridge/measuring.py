@@ -324,6 +324,12 @@ def replicate_rows(
     for row in rows:
         try:
             row_radius = radius if row.radius is None else row.radius
+            if row.break_number is not None and not (
+                1 <= row.break_number <= csvio.MAX_BREAK_NUMBER
+            ):
+                raise GoniometerError(
+                    f"Break # {row.break_number} is not from 1 to {csvio.MAX_BREAK_NUMBER}"
+                )
             if row_radius is None:
                 raise GoniometerError("no radius (the CSV has no Radius for this row)")
             m = surface.measure(

@@ -53,13 +53,15 @@ class MeasureProperties:
     radius: FloatProperty(
         name="Radius",
         description="Patch radius, world space; default: the panel's radius",
-        min=0.0,
+        soft_min=0.0,  # not min: a negative radius is refused, not quietly made 0
         precision=4,
         subtype="DISTANCE",
         unit="LENGTH",
     )
     seg_param: FloatProperty(
-        name="λ (SegParam)", description="Segmentation parameter; default: the panel's", min=0.0
+        name="λ (SegParam)",
+        description="Segmentation parameter; default: the panel's",
+        soft_min=0.0,  # not min: a negative λ is refused, as in a CSV, not quietly made 0
     )
     patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
     rule: EnumProperty(name="Rule", items=RULE_ITEMS, description="Default: the panel's")

@@ -37,6 +37,7 @@ OUR_EXTRA_COLUMNS = [
     "Requested z",
     "Snap Distance",
     "Units",
+    "Precision",
     "Stale",
     "Extension Version",
     "Blender Version",
@@ -677,3 +678,44 @@ def test_points_files_take_the_default_rule_or_their_own():
     rows = csvio.read_replication_csv("x,y,z,rule\n1,2,3,Paper\n1,2,3,\n")
     assert [r.rule for r in rows] == ["paper", None]
     raises_with("x,y,z,rule\n1,2,3,literal\n", "row 2", "unknown rule 'literal'")
+
+
+# --------------------------------------------------------------------------- break numbers
+
+
+@pytest.mark.parametrize("cell", ["2147483648", "99999999999999999999", "abc", "1.5", "0", "-1"])
+def test_a_break_number_that_blender_cannot_store_is_refused(cell):
+    text = f"x,y,z,Break #\n1,2,3,2\n4,5,6,{cell}\n"
+    with pytest.raises(GoniometerError) as info:
+        csvio.read_replication_csv(text)
+    message = str(info.value)
+    assert "nothing was read" in message
+    assert f"row 3: Break # must be a whole number from 1 to 2147483647 (got '{cell}')" in message
+    assert "row 2" not in message
+
+
+def test_break_numbers_at_the_limits_and_blank():
+    text = "x,y,z,Break #\n1,2,3,1\n4,5,6,2147483647\n7,8,9,\n"
+    rows = csvio.read_replication_csv(text)
+    assert [row.break_number for row in rows] == [1, 2**31 - 1, None]
+
+
+def test_an_integer_too_long_for_python_is_a_clear_problem():
+    digits = "9" * 5000  # int() refuses text this long
+    rows = csvio.read_replication_csv(f"x,y,z,Measurement #\n1,2,3,{digits}\n")
+    assert rows[0].number is None  # Measurement # is informative only: not a number then
+    with pytest.raises(GoniometerError, match="row 2: Break # must be a whole number"):
+        csvio.read_replication_csv(f"x,y,z,Break #\n1,2,3,{digits}\n")
+
+
+def test_an_export_written_before_the_precision_column_still_reads_back():
+    text = csvio.format_measurements_csv([good_row(precision="float64")])
+    header, row = csv.reader(io.StringIO(text))
+    at = header.index("Precision")
+    assert row[at] == "float64"
+    stream = io.StringIO()
+    csv.writer(stream, lineterminator="\n").writerows(
+        cells[:at] + cells[at + 1 :] for cells in (header, row)
+    )
+    (read,) = csvio.read_measurements_csv(stream.getvalue())
+    assert read.precision == "" and read.angle == good_row().angle

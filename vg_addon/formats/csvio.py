@@ -87,6 +87,7 @@ _SCHEMA = (
     ("requested", "vec3", ("Requested x", "Requested y", "Requested z")),
     ("snap_distance", "float", ("Snap Distance",)),
     ("units", "text", ("Units",)),
+    ("precision", "text", ("Precision",)),
     ("stale", "bool", ("Stale",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
@@ -123,6 +124,10 @@ RULE_COLUMNS = (
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
 EXPORT_COLUMNS = tuple(column for _, _, columns in _SCHEMA for column in columns)
 
+# Columns added after the first release: an export written before them still reads back
+# (their cells read as empty).
+_LATER_COLUMNS = frozenset(["Precision", *RULE_COLUMNS])
+
 #: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
 SOURCE_FORMATS = ("extension", "meshlab", "points")
 
@@ -135,7 +140,9 @@ _FALSE = "FALSE"
 _FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "'")
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_INTEGER = re.compile(r"[+-]?\d+")
+# At most 18 digits: every such integer fits 64 bits, and int() never meets Python's limit on
+# the length of integer text.
+_INTEGER = re.compile(r"[+-]?\d{1,18}")
 
 # File extensions a CSV's mesh name may carry (MeshLab writes the scan's file name).
 _MESH_FILE_SUFFIXES = frozenset(
@@ -202,6 +209,10 @@ class MeasurementRow:
         Distance from ``requested`` to ``(x, y, z)``.
     units : str
         What one coordinate unit is.
+    precision : str
+        The coordinates measured: ``"float32"`` (a Blender mesh, as Blender stores it) or
+        ``"float64"`` (a mesh file's double-precision coordinates, measured as the file holds
+        them); empty for a failed row.
     stale : bool
         The mesh changed since the measurement was taken.
     extension_version, blender_version : str
@@ -246,6 +257,7 @@ class MeasurementRow:
     requested: tuple[float, float, float] | None = None
     snap_distance: float | None = None
     units: str = ""
+    precision: str = ""
     stale: bool = False
     extension_version: str = ""
     blender_version: str = ""
@@ -288,7 +300,7 @@ class ReplicationRow:
         The original ``Measurement #`` (MeshLab's burst measurements are fractional, e.g. 3.05);
         ``None`` when absent, blank or not a number.
     break_number : int or None
-        The original ``Break #``; ``None`` when absent, blank or not a whole number.
+        The original ``Break #`` (1 to :data:`MAX_BREAK_NUMBER`); ``None`` when absent or blank.
     source_format : str
         ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
         columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
@@ -535,9 +547,11 @@ def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
     return "".join(lines)
 
 
-def replace_atomically(path: str, data: bytes) -> None:
-    """Write ``data`` to a temporary file beside ``path`` and move it over ``path`` in one step:
-    ``path`` holds its old content or the new one, never part of it."""
+#: The path that means standard output.
+STDOUT = "-"
+
+
+def _replace_atomically(path: str, data: bytes) -> None:
     folder = os.path.dirname(os.path.abspath(path)) or "."
     if not os.path.isdir(folder):
         raise GoniometerError(
@@ -577,23 +591,131 @@ def replace_atomically(path: str, data: bytes) -> None:
         raise
 
 
-def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
-    """Write an export to ``path`` (UTF-8, comma-delimited, ``\\n`` line ends), atomically.
+def _write_into(path: str, data: bytes) -> None:
+    """Write ``data`` into an open-ended target (a pipe, a terminal, standard output), in place."""
+    try:
+        if path == STDOUT:
+            handle = os.dup(1)
+        else:
+            # No O_CREAT and no O_TRUNC: the target exists and is never replaced or emptied;
+            # O_APPEND keeps what a shell's ">>" already put in a file behind /dev/stdout.
+            handle = os.open(path, os.O_WRONLY | os.O_APPEND | getattr(os, "O_BINARY", 0))
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+            stream.flush()
+    except OSError as error:
+        where = "standard output" if path == STDOUT else repr(path)
+        raise GoniometerError(
+            f"Could not write the CSV to {where}: {error.strerror or error}."
+        ) from error
 
-    The whole text is formatted first (see :func:`format_measurements_csv`), then written to a
-    temporary file in the same folder and moved over ``path`` in one step, so ``path`` holds
-    either its old content or the complete new one; on any failure the temporary file is
-    removed. An existing file's permissions are kept.
+
+def _is_descriptor_alias(path: str) -> bool:
+    """Whether ``path`` reaches, through its symbolic links, a name of an open file descriptor
+    (``/dev/stdout`` -> ``/proc/self/fd/1``, ``/dev/fd/1``): writing to it means writing into
+    the file this process already has open, never replacing it."""
+    current = os.path.abspath(path)
+    for _ in range(40):  # the kernel's own limit on links followed
+        if current.startswith(("/proc/", "/dev/fd/")):
+            return True
+        if not os.path.islink(current):
+            return False
+        current = os.path.normpath(os.path.join(os.path.dirname(current), os.readlink(current)))
+    return False
+
+
+def output_target(path) -> str:
+    """How :func:`write_measurements_csv` will write to ``path``, or why it cannot.
+
+    Returns
+    -------
+    str
+        ``"file"``: a regular file (new, or replaced atomically; through a symbolic link, its
+        target is replaced and the link kept). ``"stream"``: ``"-"`` (standard output), a pipe,
+        a terminal or another character device such as ``/dev/null``, or a name of an open file
+        descriptor such as ``/dev/stdout``: the text is written into it, once, never replacing
+        it.
 
     Raises
     ------
     GoniometerError
-        A row that cannot be written, a missing folder, or a target that cannot be replaced.
+        A folder, a block device or a socket, or a folder that does not exist.
+    """
+    path = os.fspath(path)
+    if path == STDOUT:
+        return "stream"
+    try:
+        info = os.stat(path)  # follows symbolic links
+    except FileNotFoundError:
+        target = os.path.realpath(path)  # a dangling link is created at its target
+        folder = os.path.dirname(target) or "."
+        if not os.path.isdir(folder):
+            raise GoniometerError(
+                f"The folder {folder!r} does not exist: choose an existing folder to write "
+                f"{os.path.basename(path)!r} to."
+            ) from None
+        return "file"
+    except OSError as error:
+        raise GoniometerError(f"Cannot write to {path!r}: {error.strerror or error}.") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise GoniometerError(
+            f"{path!r} is a folder: give a file name for the CSV, e.g. "
+            f"{os.path.join(path, 'measurements.csv')!r}."
+        )
+    if stat.S_ISREG(info.st_mode):
+        if _is_descriptor_alias(path):
+            return "stream"
+        if not os.access(path, os.W_OK):
+            raise GoniometerError(
+                f"{path!r} is read-only: it is left as it is. Choose another file name, or make "
+                "it writable first."
+            )
+        return "file"
+    if stat.S_ISCHR(info.st_mode) or stat.S_ISFIFO(info.st_mode):
+        return "stream"
+    kind = "a block device" if stat.S_ISBLK(info.st_mode) else "a socket or other special file"
+    raise GoniometerError(
+        f"{path!r} is {kind}, not a file: choose a file name, or '-' for standard output."
+    )
+
+
+def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
+    """Write an export to ``path`` (UTF-8, comma-delimited, ``\\n`` line ends).
+
+    The whole text is formatted first (see :func:`format_measurements_csv`). A regular file is
+    written atomically: to a temporary file in the same folder, then moved over ``path`` in one
+    step, so ``path`` holds either its old content or the complete new one; on any failure the
+    temporary file is removed. An existing file's permissions are kept; through a symbolic link,
+    the link's target is replaced and the link stays. ``"-"``, a pipe, a terminal, a character
+    device (``/dev/null``) or a name of an open descriptor (``/dev/stdout``) is written into,
+    never replaced (see :func:`output_target`).
+
+    Raises
+    ------
+    GoniometerError
+        A row that cannot be written, a missing folder, a folder or other target that is not a
+        file, a target that cannot be replaced, or a stream that refuses the data (e.g.
+        ``/dev/full``).
     OSError
         Other file-system errors (disk full, no permission to create the file, ...).
     """
     data = format_measurements_csv(rows).encode("utf-8")
-    replace_atomically(os.fspath(path), data)
+    replace_atomically(path, data)
+
+
+def replace_atomically(path, data: bytes) -> None:
+    """Write ``data`` to ``path``, the way every output file of the project is written.
+
+    A regular file (or a new one) is replaced in one step, through a temporary file beside it,
+    so it holds its old content or the new one, never part of it; a symbolic link keeps its link
+    and its target is replaced. ``-`` (standard output), devices and pipes are written into,
+    never replaced. See :func:`output_target` for what is refused.
+    """
+    path = os.fspath(path)
+    if output_target(path) == "stream":
+        _write_into(path, data)
+    else:
+        _replace_atomically(os.path.realpath(path), data)
 
 
 # --------------------------------------------------------------------------- reading
@@ -765,6 +887,20 @@ def _lenient_number(raw: str) -> int | float | None:
     return None
 
 
+#: The largest ``Break #`` (Blender stores it as a 32-bit signed integer).
+MAX_BREAK_NUMBER = 2**31 - 1
+
+
+def _parse_break_number(raw: str) -> int | str | None:
+    """The break number of a cell, ``None`` when blank, or why it is not one (a str)."""
+    text = raw.strip()
+    if not text:
+        return None
+    if _INTEGER.fullmatch(text) and 1 <= int(text) <= MAX_BREAK_NUMBER:
+        return int(text)
+    return f"must be a whole number from 1 to {MAX_BREAK_NUMBER} (got {text!r})"
+
+
 def parse_replication_csv(text: str, source: str = "The CSV text") -> list[ReplicationRow]:
     """Parse CSV text into replication rows; see :func:`read_replication_csv`.
 
@@ -836,6 +972,9 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
             problems.append(
                 f"row {number}: {name_of('lam')} (λ) must be 0 or more (got {cell('lam').strip()})"
             )
+        break_number = _parse_break_number(cell("break_number"))
+        if isinstance(break_number, str):
+            problems.append(f"row {number}: {name_of('break_number')} {break_number}")
         patch = _parse_optional_text(cell("patch"))
         if patch is not None:
             patch = patch.casefold()
@@ -855,7 +994,6 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
             rule = "paper"  # MeshLab, the earlier add-on, exports from before the Rule column
         if problems:
             continue  # nothing is returned anyway; keep collecting
-        break_number = _lenient_number(cell("break_number"))
         rows.append(
             ReplicationRow(
                 row_number=number,
@@ -868,7 +1006,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 patch=patch,
                 label=_parse_optional_text(cell("label")),
                 number=_lenient_number(cell("number")),
-                break_number=break_number if isinstance(break_number, int) else None,
+                break_number=break_number,
                 source_format=fmt,
                 rule=rule,
             )
@@ -921,7 +1059,8 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
         One error listing every problem (the first 20, then "and N more") with its row number
         and column name: missing x/y/z columns (naming those found), duplicate columns, a blank,
         non-numeric or non-finite x/y/z/radius/lambda, radius ≤ 0, λ < 0, an unknown patch
-        mode, a row with more cells than the header; or: an empty file, a header without data
+        mode, a ``Break #`` that is not a whole number from 1 to :data:`MAX_BREAK_NUMBER`, a row
+        with more cells than the header; or: an empty file, a header without data
         rows, only failed rows, a ``;`` or tab delimiter, text that is not UTF-8. Nothing is
         returned then.
     OSError
@@ -944,7 +1083,7 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     """Parse an export written by :func:`format_measurements_csv` back into rows.
 
     Every column of :data:`EXPORT_COLUMNS` must be present (in any order; names are matched
-    case-insensitively); text cells are kept as written (only the formula-guard apostrophe is
+    case-insensitively), except ``Precision`` (added later: empty when absent); text cells are kept as written (only the formula-guard apostrophe is
     removed), numbers read back bit-identical. Blank lines are skipped.
 
     Raises
@@ -958,7 +1097,9 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     aliases = {column: (_normalise(column),) for column in EXPORT_COLUMNS}
     columns = _resolve_columns(header, aliases, problems)
     missing = [
-        column for column in EXPORT_COLUMNS if column not in columns and column not in RULE_COLUMNS
+        column
+        for column in EXPORT_COLUMNS
+        if column not in columns and column not in _LATER_COLUMNS
     ]
     if missing:
         problems.insert(
