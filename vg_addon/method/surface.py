@@ -195,6 +195,20 @@ class Surface:
             patch=mode,
         )
 
+    def trace_edge(self, start, end, via=()):
+        """The break edge from ``start`` through ``via`` to ``end``, as an ``EdgePath`` of mesh
+        vertices following the ridge; see :func:`vg_addon.method.edge_profile.trace_edge`."""
+        from .edge_profile import trace_edge
+
+        return trace_edge(self, start, end, via)
+
+    def measure_along(self, path, spacing, radius, lam=2.0, patch="euclidean"):
+        """Measure stations every ``spacing`` along ``path``: an ``EdgeProfile``; see
+        :func:`vg_addon.method.edge_profile.measure_along`."""
+        from .edge_profile import measure_along
+
+        return measure_along(self, path, spacing, radius, lam, patch)
+
 
 def check_patch_mode(patch) -> str:
     """Return the patch mode in lower case, or raise if it is not one of :data:`PATCH_MODES`."""
