@@ -272,4 +272,3 @@ def test_profile_does_not_depend_on_vertex_order(ramp):
     assert a.angles.tolist() == b.angles.tolist()
     assert np.array_equal(a.path.points, b.path.points)
     assert a.pooled_angle == b.pooled_angle
-

@@ -247,9 +247,7 @@ def _leg(surface, graph: RidgeGraph, start: int, end: int) -> np.ndarray:
         targets = graph.target[edges]
         candidate = cost[sources] + graph.costs[edges]
         useful = candidate < cost[targets]
-        edges, sources, targets, candidate = (
-            edges[useful], sources[useful], targets[useful], candidate[useful]
-        )
+        sources, targets, candidate = sources[useful], targets[useful], candidate[useful]
         target_points = points[targets]
         useful = (
             np.linalg.norm(target_points - a, axis=1) + np.linalg.norm(target_points - b, axis=1)
