@@ -288,46 +288,44 @@ def _flat_spans(on_ridge: np.ndarray, arc: np.ndarray) -> tuple:
     )
 
 
-def trace_edge(surface, start, end, via=()) -> EdgePath:
-    """Trace the break edge from ``start`` through each ``via`` point to ``end``.
+def snap_click(surface, click, number: int = 1) -> int:
+    """The vertex a click on the edge snaps to (the nearest one, however far).
+
+    ``number`` names the click in the message (1 = the start).
+    """
+    click = as_center(click)
+    graph = ridge_graph(surface)
+    reach = max(float(np.ptp(surface.points, axis=0).max()), graph.mean_edge_length, 1e-300)
+    vertex, _ = surface.index.nearest(click, reach)
+    if vertex < 0:
+        raise GoniometerError(
+            f"Point {number} of the edge ({click[0]:g}, {click[1]:g}, {click[2]:g}) is far from "
+            "every vertex of the surface: check that the coordinates are in the mesh's units and "
+            "frame."
+        )
+    return int(vertex)
+
+
+def trace_leg(surface, start: int, end: int) -> np.ndarray:
+    """Vertices of the cheapest ridge path from vertex ``start`` to vertex ``end`` (both included)."""
+    return _leg(surface, ridge_graph(surface), int(start), int(end))
+
+
+def assemble_path(surface, legs) -> EdgePath:
+    """The :class:`EdgePath` made of consecutive legs (each starts where the previous ended).
 
     Parameters
     ----------
-    surface : Surface
-        A triangle mesh.
-    start, end : array_like, shape (3,)
-        Points on (or near) the break edge; each snaps to the nearest vertex.
-    via : sequence of array_like, shape (3,), optional
-        Points the path must pass through, in order.
-
-    Returns
-    -------
-    EdgePath
-
-    Raises
-    ------
-    GoniometerError
-        A point cloud (no faces), a point far from the surface, or points no path joins.
+    legs : sequence of ndarray of int64
+        Vertex arrays from :func:`trace_leg`; a single one-vertex array is a path not yet long
+        enough (an error).
     """
-    clicks = [as_center(start), *(as_center(p) for p in via), as_center(end)]
     graph = ridge_graph(surface)
-    reach = max(float(np.ptp(surface.points, axis=0).max()), graph.mean_edge_length, 1e-300)
-    snapped = []
-    for number, click in enumerate(clicks):
-        vertex, _ = surface.index.nearest(click, reach)
-        if vertex < 0:
-            raise GoniometerError(
-                f"Point {number + 1} of the edge ({click[0]:g}, {click[1]:g}, {click[2]:g}) is "
-                "far from every vertex of the surface: check that the coordinates are in the "
-                "mesh's units and frame."
-            )
-        snapped.append(int(vertex))
-    pieces = [np.array([snapped[0]], dtype=np.int64)]
-    waypoints = [0]
-    for a, b in itertools.pairwise(snapped):
-        leg = _leg(surface, graph, a, b)
-        pieces.append(leg[1:])
-        waypoints.append(waypoints[-1] + leg.size - 1)
+    pieces = [np.asarray(legs[0], dtype=np.int64)]
+    waypoints = [0, pieces[0].size - 1]
+    for leg in legs[1:]:
+        pieces.append(np.asarray(leg[1:], dtype=np.int64))
+        waypoints.append(waypoints[-1] + len(leg) - 1)
     vertices = np.concatenate(pieces)
     if vertices.size < 2:
         raise GoniometerError(
@@ -351,6 +349,33 @@ def trace_edge(surface, start, end, via=()) -> EdgePath:
     )
 
 
+def trace_edge(surface, start, end, via=()) -> EdgePath:
+    """Trace the break edge from ``start`` through each ``via`` point to ``end``.
+
+    Parameters
+    ----------
+    surface : Surface
+        A triangle mesh.
+    start, end : array_like, shape (3,)
+        Points on (or near) the break edge; each snaps to the nearest vertex.
+    via : sequence of array_like, shape (3,), optional
+        Points the path must pass through, in order.
+
+    Returns
+    -------
+    EdgePath
+
+    Raises
+    ------
+    GoniometerError
+        A point cloud (no faces), a point far from the surface, or points no path joins.
+    """
+    clicks = [start, *via, end]
+    snapped = [snap_click(surface, click, number) for number, click in enumerate(clicks, 1)]
+    legs = [trace_leg(surface, a, b) for a, b in itertools.pairwise(snapped)]
+    return assemble_path(surface, legs)
+
+
 @dataclass(frozen=True, eq=False)
 class EdgeProfile:
     """The angle of a break edge along its length.
@@ -366,14 +391,9 @@ class EdgeProfile:
         One measurement per station, in order along the path; each centre is a path vertex.
     arc_lengths : ndarray, shape (s,)
         Arc length of each station's centre along the path.
-    angles : ndarray, shape (s,)
-        The stations' angles (degrees).
-    mean, std, min, max : float
-        Of ``angles``; ``std`` is the sample standard deviation (0 for one station).
-    pooled_angle, pooled_fit_error : float
-        One plane pair fitted to all stations' sides at once, each station's patch expressed in
-        its own frame (along the edge, across it, along its mean normal) so that a curved edge
-        pools like a straight one: the whole-edge mean angle and its summed plane-fit error.
+    figures : EdgeSummary
+        Mean, standard deviation, min, max and pooled angle (also read-only properties of the
+        profile: ``profile.mean`` is ``profile.figures.mean``).
     """
 
     path: EdgePath
@@ -383,25 +403,30 @@ class EdgeProfile:
     patch: str
     stations: tuple
     arc_lengths: np.ndarray
-    angles: np.ndarray
-    mean: float
-    std: float
-    min: float
-    max: float
-    pooled_angle: float
-    pooled_fit_error: float
+    figures: EdgeSummary
+
+    n_stations = property(lambda self: self.figures.n_stations, doc="Number of stations.")
+    mean = property(lambda self: self.figures.mean, doc="Mean station angle (degrees).")
+    std = property(lambda self: self.figures.std, doc="Sample standard deviation (degrees).")
+    min = property(lambda self: self.figures.min, doc="Smallest station angle (degrees).")
+    max = property(lambda self: self.figures.max, doc="Largest station angle (degrees).")
+    pooled_angle = property(lambda self: self.figures.pooled_angle, doc="Whole-edge angle.")
+    pooled_fit_error = property(
+        lambda self: self.figures.pooled_fit_error, doc="Fit error of the pooled planes."
+    )
 
     @property
-    def n_stations(self) -> int:
-        """Number of stations."""
-        return len(self.stations)
+    def angles(self) -> np.ndarray:
+        """The stations' angles (degrees), in order along the path."""
+        return np.array([m.angle for m in self.stations])
 
     def summary(self) -> str:
         """One line for reports."""
+        f = self.figures
         return (
-            f"{self.n_stations} stations every {self.spacing:g} over {self.path.length:.4g}: "
-            f"mean {self.mean:.2f}° ± {self.std:.2f}° (min {self.min:.2f}°, max {self.max:.2f}°), "
-            f"pooled {self.pooled_angle:.2f}° (r={self.radius:g}, λ={self.lam:g})"
+            f"{f.n_stations} stations every {self.spacing:g} over {self.path.length:.4g}: "
+            f"mean {f.mean:.2f}° ± {f.std:.2f}° (min {f.min:.2f}°, max {f.max:.2f}°), "
+            f"pooled {f.pooled_angle:.2f}° (r={self.radius:g}, λ={self.lam:g})"
         )
 
 
@@ -438,6 +463,32 @@ def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
     return positions
 
 
+@dataclass(frozen=True)
+class EdgeSummary:
+    """What the stations of one edge say together (see :func:`summarize`).
+
+    Attributes
+    ----------
+    n_stations : int
+    mean, std, min, max : float
+        Of the stations' angles (degrees); ``std`` is the sample standard deviation (0 for one
+        station).
+    pooled_angle, pooled_fit_error : float
+        One plane pair fitted to all stations' sides at once, each station's patch expressed in
+        its own frame (along the edge, across it, along its mean normal), so that a curved edge
+        pools like a straight one: the whole-edge mean angle, and its summed mean squared
+        plane-fit distance.
+    """
+
+    n_stations: int
+    mean: float
+    std: float
+    min: float
+    max: float
+    pooled_angle: float
+    pooled_fit_error: float
+
+
 def _frame(m: Measurement, direction: np.ndarray) -> np.ndarray:
     """Rows: along the edge (oriented like ``direction``), across it, and the mean normal."""
     tangent = m.tangent if m.tangent @ direction >= 0 else -m.tangent
@@ -455,13 +506,21 @@ def _plane(points: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, float]:
     return normal, max(float(values[0]), 0.0)
 
 
-def pooled_planes(surface, path: EdgePath, stations, positions) -> tuple[float, float]:
-    """The pooled angle and fit error of :class:`EdgeProfile` (see there)."""
+def summarize(surface, stations) -> EdgeSummary:
+    """Summary figures of an edge's station measurements, in order along the edge.
+
+    The direction along the edge at each station comes from its neighbours' centres; it only
+    orients each station's frame, so that every station's left side pools with the others' left.
+    """
+    if not stations:
+        raise GoniometerError("An edge profile needs at least one station.")
+    angles = np.array([m.angle for m in stations])
+    centers = np.array([m.center for m in stations])
     sides = {True: ([], []), False: ([], [])}
-    for m, position in zip(stations, positions, strict=True):
-        ahead = path.points[min(position + 1, path.points.shape[0] - 1)]
-        behind = path.points[max(position - 1, 0)]
-        frame = _frame(m, ahead - behind)
+    for k, m in enumerate(stations):
+        ahead, behind = centers[min(k + 1, len(stations) - 1)], centers[max(k - 1, 0)]
+        direction = ahead - behind if len(stations) > 1 else m.tangent
+        frame = _frame(m, direction)
         local = (surface.points[m.indices] - m.center) @ frame.T
         normals = surface.normals[m.indices] @ frame.T
         plus_is_left = local[m.labels, 1].mean() >= local[~m.labels, 1].mean()
@@ -473,8 +532,16 @@ def pooled_planes(surface, path: EdgePath, stations, positions) -> tuple[float, 
         _plane(np.concatenate(sides[key][0]), np.concatenate(sides[key][1]))
         for key in (True, False)
     )
-    angle = 180.0 - float(np.degrees(np.arccos(np.clip(left @ right, -1.0, 1.0))))
-    return angle, left_error + right_error
+    pooled = 180.0 - float(np.degrees(np.arccos(np.clip(left @ right, -1.0, 1.0))))
+    return EdgeSummary(
+        n_stations=len(stations),
+        mean=float(angles.mean()),
+        std=float(angles.std(ddof=1)) if angles.size > 1 else 0.0,
+        min=float(angles.min()),
+        max=float(angles.max()),
+        pooled_angle=pooled,
+        pooled_fit_error=left_error + right_error,
+    )
 
 
 def measure_along(
@@ -523,8 +590,6 @@ def measure_along(
             f"{len(failures)} of {positions.size} stations along the edge could not be "
             f"measured; nothing was measured.\n" + bounded_list(failures, lines=True) + hint
         )
-    angles = np.array([m.angle for m in stations])
-    pooled, pooled_error = pooled_planes(surface, path, stations, positions)
     first = stations[0]
     return EdgeProfile(
         path=path,
@@ -534,11 +599,5 @@ def measure_along(
         patch=first.patch,
         stations=tuple(stations),
         arc_lengths=path.arc_lengths[positions].copy(),
-        angles=angles,
-        mean=float(angles.mean()),
-        std=float(angles.std(ddof=1)) if angles.size > 1 else 0.0,
-        min=float(angles.min()),
-        max=float(angles.max()),
-        pooled_angle=pooled,
-        pooled_fit_error=pooled_error,
+        figures=summarize(surface, stations),
     )
