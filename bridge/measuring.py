@@ -29,7 +29,8 @@ def _key(fingerprint: str, center, radius: float, lam: float, patch: str) -> tup
     return (fingerprint, np.asarray(center, dtype=np.float64).tobytes(), radius, lam, patch)
 
 
-def _remember(fingerprint: str, m: Measurement) -> None:
+def remember(fingerprint: str, m: Measurement) -> None:
+    """Keep ``m`` so a repaint of the same geometry reuses its sides instead of re-measuring."""
     _sides[_key(fingerprint, m.center, m.radius, m.lam, m.patch)] = m
     while len(_sides) > 1 and (
         len(_sides) > _SIDES_CACHE_SIZE
@@ -44,7 +45,7 @@ def _replay(obj, geometry: Geometry, item) -> Measurement:
     m = _sides.get(key)
     if m is None:
         m = surface_for(obj, geometry).measure(**args)
-        _remember(geometry.fingerprint, m)
+        remember(geometry.fingerprint, m)
     return m
 
 
@@ -56,7 +57,7 @@ def measure(obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None
     check_measurable(obj)
     geometry = evaluated_geometry(obj, depsgraph)
     m = surface_for(obj, geometry).measure(location, radius, lam, patch)
-    _remember(geometry.fingerprint, m)
+    remember(geometry.fingerprint, m)
     return m, geometry
 
 
@@ -168,7 +169,9 @@ def replicate_rows(
         How to name the rows' origin in messages (e.g. the file name).
 
     Each new measurement keeps the row's break number when it has one (else the object's
-    current break) and takes the row's label or User Data as its note.
+    current break) and takes the row's label or User Data as its note. Rows that are stations
+    of an edge profile (an ``Edge #``) are grouped back into one edge per edge number, with a
+    new edge record whose summary is recomputed from the re-measured stations.
 
     Returns
     -------
@@ -209,12 +212,37 @@ def replicate_rows(
             f"'{obj.name}'; nothing was imported.\n" + bounded_list(failures, lines=True)
         )
     numbers = []
+    stations: dict[int, list] = {}
     for row, m in results:
-        _remember(geometry.fingerprint, m)
+        remember(geometry.fingerprint, m)
+        station = None
+        if row.edge_number is not None:  # re-numbered below, when its edge is rebuilt
+            station = (0, row.arc_length or 0.0, row.spacing or 0.0)
         item = records.add_measurement(
-            obj, m, geometry.fingerprint, note=row.label or "", break_number=row.break_number
+            obj,
+            m,
+            geometry.fingerprint,
+            note=row.label or "",
+            break_number=row.break_number,
+            station=station,
         )
         numbers.append(item.number)
+        if station is not None:
+            stations.setdefault(row.edge_number, []).append(
+                (item.number, m, station[1], station[2])
+            )
+    if stations:
+        from . import edges  # edges records through this module: imported when needed
+
+        by_number = {item.number: item for item in obj.vg.measurements}
+        edges.edges_from_stations(
+            obj,
+            {
+                key: [(by_number[entry[0]], *entry[1:]) for entry in group]
+                for key, group in stations.items()
+            },
+            geometry,
+        )
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
     return numbers
 
@@ -237,6 +265,12 @@ def export_rows(objects, scene, *, depsgraph=None) -> list:
             for item in obj.vg.measurements
         )
     return rows
+
+
+def export_edge_rows(objects, scene) -> list:
+    """Edge summary CSV rows of every edge profile of ``objects``, in list order."""
+    units = records.units_label(scene)
+    return [records.edge_row(obj, edge, units=units) for obj in objects for edge in obj.vg.edges]
 
 
 def clear_cache() -> None:

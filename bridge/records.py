@@ -32,7 +32,9 @@ def _floats(vector) -> list[float]:
     return [float(v) for v in np.asarray(vector, dtype=np.float64)]
 
 
-def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_number=None):
+def add_measurement(
+    obj, m, geometry_fingerprint: str, *, note: str = "", break_number=None, station=None
+):
     """Append measurement ``m`` to ``obj.vg.measurements`` and make it the active one.
 
     Parameters
@@ -46,6 +48,9 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
         Free text (the CSV's User Data).
     break_number : int, optional
         Default: the object's current break.
+    station : tuple (edge_number, arc_length, spacing), optional
+        For a station of an edge profile: its edge, its arc length along the path and the
+        edge's spacing.
 
     Returns
     -------
@@ -56,8 +61,14 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
     item.number = data.next_number
     data.next_number += 1
     item.break_number = data.break_number if break_number is None else int(break_number)
+    numbers = {}
+    if station is not None:
+        edge_number, arc_length, spacing = station
+        item.edge_number = int(edge_number)
+        numbers = {"arc_length": float(arc_length), "spacing": float(spacing)}
     item.exact = json.dumps(
         {
+            **numbers,
             "angle": float(m.angle),
             "fit": float(m.fit_error),
             "fit_plus": float(m.fit_error_plus),
@@ -134,6 +145,7 @@ def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
     """The CSV row of ``item``, measured on ``obj``."""
     numbers = numbers_of(item)
     x, y, z = numbers["center"]
+    station = item.edge_number > 0
     return csvio.MeasurementRow(
         mesh_name=obj.name,
         date=item.date,
@@ -158,9 +170,113 @@ def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
         normal_minus=tuple(numbers["normal_minus"]),
         requested=tuple(numbers["requested"]),
         snap_distance=numbers["snap_distance"],
+        edge_number=item.edge_number if station else None,
+        arc_length=numbers.get("arc_length") if station else None,
+        spacing=numbers.get("spacing") if station else None,
         units=units,
         stale=stale,
         extension_version=extension_version(),
         blender_version=bpy.app.version_string,
         error="",
+    )
+
+
+def add_edge(obj, profile, clicks, geometry_fingerprint: str, *, break_number: int, note: str = ""):
+    """Append an edge profile record to ``obj.vg.edges`` and make it the active one.
+
+    Parameters
+    ----------
+    profile : vg_addon.EdgeProfile
+        The measured profile.
+    clicks : sequence of array_like, shape (3,)
+        The points that define the path (start, via points, end).
+    break_number : int
+        The break its stations were recorded in.
+
+    Returns
+    -------
+    The new ``VG_EdgeProfile`` item; its ``number`` is the stations' ``edge_number``.
+    """
+    numbers = edge_numbers(profile, clicks)
+    return _add_edge(
+        obj, numbers, profile.patch, geometry_fingerprint, break_number=break_number, note=note
+    )
+
+
+def edge_numbers(profile, clicks) -> dict:
+    """The exact numbers an edge record stores (JSON-ready) for ``profile`` and its ``clicks``."""
+    figures = profile.figures
+    spans = profile.path.flat_spans
+    return {
+        "points": [_floats(p) for p in clicks],
+        "path": [_floats(p) for p in profile.path.points],
+        "spacing": float(profile.spacing),
+        "radius": float(profile.radius),
+        "lam": float(profile.lam),
+        "length": float(profile.path.length),
+        "arc_lengths": [float(a) for a in profile.arc_lengths],
+        "angles": [float(a) for a in profile.angles],
+        "mean": float(figures.mean),
+        "std": float(figures.std),
+        "min": float(figures.min),
+        "max": float(figures.max),
+        "pooled_angle": float(figures.pooled_angle),
+        "pooled_fit": float(figures.pooled_fit_error),
+        "flat_spans": [[float(a), float(b)] for a, b in spans],
+    }
+
+
+def _add_edge(obj, numbers: dict, patch: str, fingerprint: str, *, break_number: int, note=""):
+    data = obj.vg
+    edge = data.edges.add()
+    edge.number = data.next_edge_number
+    data.next_edge_number += 1
+    edge.break_number = int(break_number)
+    edge.exact = json.dumps(numbers)
+    edge.patch = patch
+    edge.n_stations = len(numbers["angles"])
+    edge.date = csvio.now_iso()
+    edge.note = note
+    edge.colors = "/".join(palette.pair_names(edge.break_number))
+    edge.fingerprint = fingerprint
+    data.active_edge_index = len(data.edges) - 1
+    return edge
+
+
+def add_edge_from_numbers(
+    obj, numbers: dict, patch: str, fingerprint: str, *, break_number, note=""
+):
+    """Append an edge record from ready numbers (see :func:`edge_numbers`); used when an edge is
+    rebuilt from re-measured stations."""
+    return _add_edge(obj, numbers, patch, fingerprint, break_number=break_number, note=note)
+
+
+def edge_row(obj, edge, *, units: str) -> csvio.EdgeRow:
+    """The edge summary CSV row of ``edge``, measured on ``obj``."""
+    numbers = exact_numbers(edge)
+    spans = numbers.get("flat_spans", [])
+    return csvio.EdgeRow(
+        mesh_name=obj.name,
+        date=edge.date,
+        edge_number=edge.number,
+        break_number=edge.break_number,
+        colors=csvio.format_colors(tuple(edge.colors.split("/"))),
+        user_data=edge.note,
+        n_stations=edge.n_stations,
+        spacing=numbers.get("spacing"),
+        radius=numbers.get("radius"),
+        seg_param=numbers.get("lam"),
+        patch=edge.patch,
+        length=numbers.get("length"),
+        mean=numbers.get("mean"),
+        std=numbers.get("std"),
+        min=numbers.get("min"),
+        max=numbers.get("max"),
+        pooled_angle=numbers.get("pooled_angle"),
+        pooled_fit=numbers.get("pooled_fit"),
+        points=csvio.format_points(numbers.get("points", [])),
+        flat_spans="; ".join(f"{a!r}-{b!r}" for a, b in spans),
+        units=units,
+        extension_version=extension_version(),
+        blender_version=bpy.app.version_string,
     )

@@ -63,6 +63,9 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
                 objects, context.scene, depsgraph=context.evaluated_depsgraph_get()
             )
             csvio.write_measurements_csv(path, rows)
+            edge_rows = measuring.export_edge_rows(objects, context.scene)
+            if edge_rows:
+                csvio.write_edges_csv(csvio.edges_path_for(path), edge_rows)
         except OSError as error:
             self.report({"ERROR"}, f"Could not write {path}: {error}")
             return {"CANCELLED"}
@@ -71,7 +74,11 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
             return {"CANCELLED"}
         stale = sum(row.stale for row in rows)
         note = f" ({stale} stale)" if stale else ""
-        self.report({"INFO"}, f"Wrote {len(rows)} measurement(s){note} to {path}")
+        edges = f" and {len(edge_rows)} edge profile(s) to {csvio.edges_path_for(path)}"
+        self.report(
+            {"INFO"},
+            f"Wrote {len(rows)} measurement(s){note} to {path}" + (edges if edge_rows else ""),
+        )
         return {"FINISHED"}
 
 

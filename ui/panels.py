@@ -79,6 +79,12 @@ class VIEW3D_PT_vg_selected(_GoniometerPanel, bpy.types.Panel):
         column.use_property_split = True
         column.use_property_decorate = False
         _text(column, "Measurement", f"{item.number}, break {item.break_number}")
+        if item.edge_number:
+            _text(
+                column,
+                "Station of edge",
+                f"{item.edge_number}, at arc length {item.arc_length:.4g}",
+            )
         for name in ("angle", "fit_error", "fit_error_plus", "fit_error_minus"):
             column.prop(item, name)
         column.prop(item, "radius")
@@ -102,6 +108,50 @@ def _text(layout, label, value):
     split.label(text=value)
 
 
+class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
+    """Whole edges: spacing, the Edge Profile button, the list, and the selected one's plot."""
+
+    bl_label = "Edge Profiles"
+    bl_parent_id = "VIEW3D_PT_vg_measure"
+
+    @classmethod
+    def poll(cls, context):
+        return _active_mesh(context) is not None
+
+    def draw(self, context):
+        obj = _active_mesh(context)
+        settings = context.scene.vg_settings
+        layout = self.layout
+        column = layout.column(align=True)
+        column.use_property_split = True
+        column.use_property_decorate = False
+        column.prop(settings, "edge_spacing")
+        column.prop(settings, "radius", text="Radius")
+        layout.operator("vg.measure_edge", text="Edge Profile", icon="CURVE_PATH")
+        layout.label(text="Click start, via points, end; Enter measures")
+        if not len(obj.vg.edges):
+            return
+        row = layout.row()
+        row.template_list("VG_UL_edges", "", obj.vg, "edges", obj.vg, "active_edge_index", rows=3)
+        row.column(align=True).operator("vg.delete_edge", text="", icon="REMOVE")
+        if not 0 <= obj.vg.active_edge_index < len(obj.vg.edges):
+            return
+        edge = obj.vg.edges[obj.vg.active_edge_index]
+        column = layout.column(align=True)
+        _text(column, "Edge", f"{edge.number}, break {edge.break_number}")
+        _text(
+            column, "Stations", f"{edge.n_stations} every {edge.spacing:.4g} over {edge.length:.4g}"
+        )
+        _text(column, "Mean ± SD", f"{edge.mean:.2f}° ± {edge.std:.2f}°")
+        _text(column, "Min, max", f"{edge.min:.2f}°, {edge.max:.2f}°")
+        _text(column, "Pooled", f"{edge.pooled_angle:.2f}°")
+        image = bpy.data.images.get(edge.plot)
+        if image is not None and image.preview is not None:
+            layout.template_icon(icon_value=image.preview.icon_id, scale=10.0)
+            layout.label(text="Angle (°) against arc length")
+        layout.prop(edge, "note")
+
+
 class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
     """Export the measurements, or replicate a CSV's measurements on this mesh."""
 
@@ -122,4 +172,4 @@ class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
         row.prop(settings, "ignore_mesh_names", text="Ignore Names")
 
 
-classes = (VIEW3D_PT_vg_measure, VIEW3D_PT_vg_selected, VIEW3D_PT_vg_csv)
+classes = (VIEW3D_PT_vg_measure, VIEW3D_PT_vg_selected, VIEW3D_PT_vg_edges, VIEW3D_PT_vg_csv)

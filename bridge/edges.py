@@ -1,0 +1,186 @@
+"""Edge profiles on Blender objects: measure a whole edge, record its stations as one break,
+keep its summary and plot, rebuild an edge from re-measured stations, delete one.
+
+Each raises :class:`GoniometerError` for bad input before changing anything.
+"""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+
+from ..properties import exact_numbers
+from ..vg_addon import GoniometerError
+from ..vg_addon.formats import profile_plot
+from ..vg_addon.method.edge_profile import summarize
+from . import measuring, records
+from .mesh_data import check_measurable, evaluated_geometry, surface_for
+
+PLOT_SIZE = (480, 240)
+
+
+def free_break(obj) -> int:
+    """The object's current break number if no measurement uses it yet, else the next unused."""
+    used = {item.break_number for item in obj.vg.measurements}
+    number = obj.vg.break_number
+    while number in used:
+        number += 1
+    return number
+
+
+def measure_edge(obj, points, spacing, radius, lam=2.0, patch="euclidean", *, depsgraph=None):
+    """Trace and measure the edge through ``points`` on ``obj`` without recording anything:
+    ``(EdgeProfile, Geometry)``."""
+    check_measurable(obj)
+    points = np.asarray(points, dtype=np.float64)
+    if points.ndim != 2 or points.shape[1] != 3 or points.shape[0] < 2:
+        raise GoniometerError(
+            "An edge needs at least two points (start and end, optionally via points between), "
+            "each x, y, z."
+        )
+    geometry = evaluated_geometry(obj, depsgraph)
+    surface = surface_for(obj, geometry)
+    profile = surface.measure_along(points, spacing, radius, lam, patch)
+    return profile, geometry
+
+
+def measure_edge_on_object(
+    obj, points, spacing, radius, lam=2.0, patch="euclidean", *, depsgraph=None, note=""
+):
+    """Measure the edge through ``points`` and record every station as a measurement of one new
+    break (its own colour pair), plus the edge's record with its summary and plot.
+
+    Parameters
+    ----------
+    obj : bpy.types.Object
+    points : array_like, shape (k, 3)
+        Start, via points and end, world space (float64 is kept exactly); each snaps to the
+        nearest vertex and the path is traced along the ridge between them.
+    spacing, radius, lam, patch
+        Station spacing (arc length) and the measuring settings of every station.
+    note : str
+        Free text stored with the edge and each station.
+
+    Returns
+    -------
+    The new ``VG_EdgeProfile`` item (now the active edge).
+
+    Raises
+    ------
+    GoniometerError
+        Anything that stops the edge being traced or any station being measured; nothing is
+        recorded then.
+    """
+    profile, geometry = measure_edge(obj, points, spacing, radius, lam, patch, depsgraph=depsgraph)
+    break_number = free_break(obj)
+    edge_number = obj.vg.next_edge_number
+    for m, arc in zip(profile.stations, profile.arc_lengths, strict=True):
+        measuring.remember(geometry.fingerprint, m)
+        records.add_measurement(
+            obj,
+            m,
+            geometry.fingerprint,
+            note=note,
+            break_number=break_number,
+            station=(edge_number, arc, profile.spacing),
+        )
+    clicks = np.asarray(points, dtype=np.float64)
+    edge = records.add_edge(
+        obj, profile, clicks, geometry.fingerprint, break_number=break_number, note=note
+    )
+    obj.vg.break_number = break_number + 1  # the next measurement starts a new break
+    edge.plot = make_plot(obj, edge).name
+    measuring.repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    return edge
+
+
+def make_plot(obj, edge):
+    """The profile plot of ``edge`` as a packed image (saved inside the .blend)."""
+    numbers = exact_numbers(edge)
+    rgba = profile_plot.render_profile(
+        numbers["arc_lengths"], numbers["angles"], width=PLOT_SIZE[0], height=PLOT_SIZE[1]
+    )
+    width, height = PLOT_SIZE
+    image = bpy.data.images.new(f"VG {obj.name} edge {edge.number}", width, height, alpha=True)
+    # Blender's rows run bottom-up.
+    image.pixels.foreach_set((rgba[::-1].astype(np.float32) / 255.0).ravel())
+    image.pack()
+    image.preview_ensure()  # the panel shows the plot as the image's preview icon
+    return image
+
+
+def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
+    """Rebuild edge records from re-measured stations (a CSV import).
+
+    Parameters
+    ----------
+    stations : dict
+        ``{csv edge number: [(measurement item, Measurement, arc length, spacing), ...]}``;
+        the items are already recorded, in the order the CSV listed them.
+
+    Returns
+    -------
+    list of int
+        The new edges' numbers. Each item's ``edge_number`` is set to its new edge.
+    """
+    surface = surface_for(obj, geometry)
+    numbers_made = []
+    for _, group in sorted(stations.items()):
+        group = sorted(group, key=lambda entry: entry[2])
+        items, measurements = [g[0] for g in group], [g[1] for g in group]
+        figures = summarize(surface, measurements)
+        centers = [records._floats(m.center) for m in measurements]
+        numbers = {
+            "points": [centers[0], centers[-1]] if len(centers) > 1 else centers,
+            "path": centers,
+            "spacing": float(group[0][3]),
+            "radius": float(measurements[0].radius),
+            "lam": float(measurements[0].lam),
+            "length": float(group[-1][2] - group[0][2]),
+            "arc_lengths": [float(g[2]) for g in group],
+            "angles": [float(m.angle) for m in measurements],
+            "mean": figures.mean,
+            "std": figures.std,
+            "min": figures.min,
+            "max": figures.max,
+            "pooled_angle": figures.pooled_angle,
+            "pooled_fit": figures.pooled_fit_error,
+            "flat_spans": [],
+        }
+        edge = records.add_edge_from_numbers(
+            obj,
+            numbers,
+            measurements[0].patch,
+            geometry.fingerprint,
+            break_number=items[0].break_number,
+            note=items[0].note,
+        )
+        for item in items:
+            item.edge_number = edge.number
+        edge.plot = make_plot(obj, edge).name
+        numbers_made.append(edge.number)
+    return numbers_made
+
+
+def delete_edge(obj, index: int, *, depsgraph=None) -> int:
+    """Delete the edge at list position ``index``, its stations and its plot; repaint.
+
+    Returns the deleted edge's number.
+    """
+    data = obj.vg
+    if not 0 <= index < len(data.edges):
+        raise GoniometerError(f"'{obj.name}' has no edge profile at list position {index}.")
+    geometry = evaluated_geometry(obj, depsgraph)
+    edge = data.edges[index]
+    number = edge.number
+    image = bpy.data.images.get(edge.plot)
+    for position in reversed(range(len(data.measurements))):
+        if data.measurements[position].edge_number == number:
+            data.measurements.remove(position)
+    data.active_index = min(data.active_index, max(len(data.measurements) - 1, 0))
+    data.edges.remove(index)
+    data.active_edge_index = min(index, max(len(data.edges) - 1, 0))
+    if image is not None:
+        bpy.data.images.remove(image)
+    measuring.repaint(obj, geometry=geometry)
+    return number
