@@ -14,6 +14,7 @@ from ..bridge import colors, measuring, mesh_data, records
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
 from .cli import UNITS
+from .edges import failed_edge_row, measure_edges
 from .render import add_sides_material, render_object
 from .sources import MeshSource, import_mesh
 
@@ -24,6 +25,8 @@ class MeshResult:
 
     mesh: int
     rows: list = dataclasses.field(default_factory=list)  # [(task index, MeasurementRow)]
+    station_rows: list = dataclasses.field(default_factory=list)  # --edge stations (in-process)
+    edge_rows: list = dataclasses.field(default_factory=list)  # --edge summaries (in-process)
     object_name: str = ""
     bad_file: str = ""  # why the mesh file could not be read
     n_vertices: int = 0
@@ -87,6 +90,11 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         name = result.object_name or source.name
         result.rows = [(t.index, error_row(t, name, message, units)) for t in tasks]
         result.failed = len(tasks)
+        settings = options.get("edge_settings")
+        result.station_rows = [
+            failed_edge_row(number, spec, name, settings, message, units)
+            for number, spec in enumerate(options.get("edges", ()), start=1)
+        ]
         return result
 
     start = time.perf_counter()
@@ -159,6 +167,11 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         else:
             measuring.repaint(obj, geometry=geometry)
         add_sides_material(obj, colors.ATTRIBUTE_NAME)
+
+    if options.get("edges"):
+        result.station_rows, result.edge_rows = measure_edges(
+            obj, options, units, safe_file_name(obj.name)
+        )
 
     if options.get("render"):
         path = Path(options["render"]) / f"{safe_file_name(obj.name)}.png"

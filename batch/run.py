@@ -33,6 +33,8 @@ class Run:
         self.total_meshes = total_meshes
         self.jobs = 1  # processes measuring at once
         self.rows: dict[int, object] = {}
+        self.station_rows: list = []  # edge profiles' stations (and failed edges), after the rows
+        self.edge_rows: list = []  # one summary per edge profile, for OUT_edges.csv
         self.results: list[MeshResult] = []
         self.bad_files: list[str] = []
         self.lock = threading.Lock()
@@ -72,6 +74,8 @@ class Run:
             self.results.append(result)
             for index, row in result.rows:
                 self.rows[index] = row
+            self.station_rows.extend(result.station_rows)
+            self.edge_rows.extend(result.edge_rows)
             if result.bad_file:
                 self.bad_files.append(result.bad_file)
             # Rewrite the CSV now and then (each write costs more as rows accumulate), so a run
@@ -92,8 +96,10 @@ class Run:
 
     def write_csv(self) -> None:
         start = time.perf_counter()
-        rows = [self.rows[i] for i in sorted(self.rows)]
+        rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
         csvio.write_measurements_csv(self.args.out, rows)
+        if self.args.edge:
+            csvio.write_edges_csv(csvio.edges_path_for(self.args.out), self.edge_rows)
         self.last_write = time.perf_counter()
         self.write_seconds = self.last_write - start
 
@@ -106,6 +112,7 @@ class Run:
             )
         self.write_csv()
         failed = [(i, row) for i, row in sorted(self.rows.items()) if row.error]
+        failed_edges = [row for row in self.station_rows if row.error]
         measured = len(self.rows) - len(failed)
         elapsed = time.perf_counter() - self.started
         load = sum(r.load_seconds for r in self.results)
@@ -129,10 +136,25 @@ class Run:
             self.say(f"  failed: {where} on {row.mesh_name!r}: {row.error}")
         if len(failed) > 10:
             self.say(f"  ... and {len(failed) - 10} more failed rows (see the error column)")
+        for edge in self.edge_rows:
+            self.say(
+                f"edge {edge.edge_number} on {edge.mesh_name!r}: {edge.n_stations} stations every "
+                f"{edge.spacing:g} over {edge.length:.4g}: mean {edge.mean:.2f}° ± {edge.std:.2f}° "
+                f"(min {edge.min:.2f}°, max {edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°"
+                + (
+                    f"; the path crosses no ridge at arc lengths {edge.flat_spans}"
+                    if edge.flat_spans
+                    else ""
+                )
+            )
+        for row in failed_edges:
+            self.say(f"  failed: edge {row.edge_number} on {row.mesh_name!r}: {row.error}")
+        if self.edge_rows or failed_edges:
+            self.say(f"wrote {csvio.edges_path_for(self.args.out)}")
         for message in self.bad_files:
             self.say(f"  unreadable mesh: {message}")
         self.say(f"wrote {self.args.out}")
-        return batchplan.exit_code(len(failed), len(self.bad_files))
+        return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
 
 
 def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
@@ -161,6 +183,8 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             tasks = bp.plan_points(
                 len(sources), args.at, radius=args.radius, lam=args.lam, patch=args.patch
             )
+        elif not args.points:
+            tasks = []  # edges only
         else:
             try:
                 rows = csvio.read_replication_csv(args.points)
@@ -181,6 +205,8 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     except GoniometerError as error:
         raise UsageError(str(error)) from None
     groups = {mesh: ts for mesh, ts in bp.by_mesh(tasks).items() if mesh >= 0}
+    if args.edge:  # every mesh measures the edges, whether or not it has points
+        groups = {mesh: groups.get(mesh, []) for mesh in range(len(sources))}
     units = args.units or ("none" if not blend else None)
     set_units(bpy.context.scene, units)
     for path in (args.out, args.save_blend):
@@ -192,6 +218,14 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "render_samples": args.render_samples,
         "save_blend": bool(args.save_blend),
         "units": units,
+        "edges": list(args.edge),
+        "edge_settings": {
+            "spacing": args.spacing,
+            "radius": args.radius,
+            "lam": args.lam,
+            "patch": args.patch,
+        },
+        "plots": str(Path(args.out).resolve().parent / Path(args.out).stem) if args.edge else "",
     }
     run = Run(args, sources, tasks, len(groups))
     if args.shard and not args.quiet:

@@ -184,11 +184,12 @@ def png_bytes(image: np.ndarray) -> bytes:
     )
 
 
-def write_png(path, image: np.ndarray) -> None:
-    """Write ``image`` as a PNG file at ``path`` (a new file; an existing one is refused)."""
+def write_png(path, image: np.ndarray, *, overwrite: bool = False) -> None:
+    """Write ``image`` as a PNG file at ``path``: a new file, unless ``overwrite`` (an output
+    being regenerated, like a batch run's); an existing one is refused otherwise."""
     path = os.fspath(path)
     try:
-        with open(path, "xb") as handle:
+        with open(path, "wb" if overwrite else "xb") as handle:
             handle.write(png_bytes(image))
     except FileExistsError:
         raise GoniometerError(
