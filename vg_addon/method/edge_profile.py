@@ -60,19 +60,19 @@ _graphs: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 class RidgeGraph:
-    """The directed mesh edges of a surface in CSR form with their lengths, bends and costs.
+    """The directed mesh edges of a surface in CSR form with their ridge costs.
 
     Built once per surface (see :func:`ridge_graph`).
 
     Attributes
     ----------
-    source, target : ndarray of int64
-        Directed edges sorted by source (each undirected edge appears both ways).
     starts : ndarray of int64, shape (n + 1,)
-        ``source[starts[v]:starts[v + 1]] == v``.
-    lengths, bends, costs : ndarray of float64
-        Edge length, bend (radians, angle between its two faces' normals; 0 on a boundary edge)
-        and the ridge cost ``length * (FLOOR + exp(-bend / BEND_SCALE))``.
+        The edges leaving vertex ``v`` are ``starts[v]:starts[v + 1]``.
+    target : ndarray of int64
+        Where each directed edge goes (each undirected edge appears both ways).
+    costs : ndarray of float64
+        The ridge cost ``length * (FLOOR + exp(-bend / BEND_SCALE))``; ``bend`` is the angle
+        between the normals of the edge's two faces (0 on a boundary edge).
     vertex_bend : ndarray of float64, shape (n,)
         The largest bend of the edges at each vertex (radians).
     ridge_min : float
@@ -118,10 +118,9 @@ class RidgeGraph:
         source = np.concatenate([u, v])
         order = np.argsort(source, kind="stable")
         edge = np.concatenate([np.arange(u.size), np.arange(u.size)])[order]
-        self.source = source[order]
         self.target = np.concatenate([v, u])[order]
-        self.bends, self.lengths, self.costs = bend[edge], lengths[edge], costs[edge]
-        self.starts = np.searchsorted(self.source, np.arange(n + 1, dtype=np.int64))
+        self.costs = costs[edge]
+        self.starts = np.searchsorted(source[order], np.arange(n + 1, dtype=np.int64))
         self.vertex_bend = np.zeros(n)
         np.maximum.at(self.vertex_bend, u, bend)
         np.maximum.at(self.vertex_bend, v, bend)
@@ -242,8 +241,9 @@ def _leg(surface, graph: RidgeGraph, start: int, end: int) -> np.ndarray:
             open_ids = open_ids[rest]
         else:
             batch, open_ids = open_ids, open_ids[:0]
-        edges = expand_ranges(graph.starts[batch], graph.starts[batch + 1] - graph.starts[batch])
-        sources = graph.source[edges]
+        counts = graph.starts[batch + 1] - graph.starts[batch]
+        edges = expand_ranges(graph.starts[batch], counts)
+        sources = np.repeat(batch, counts)
         targets = graph.target[edges]
         candidate = cost[sources] + graph.costs[edges]
         useful = candidate < cost[targets]
