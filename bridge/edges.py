@@ -6,6 +6,8 @@ Each raises :class:`GoniometerError` for bad input before changing anything.
 
 from __future__ import annotations
 
+import json
+
 import bpy
 import numpy as np
 
@@ -74,7 +76,8 @@ def measure_edge_on_object(
     profile, geometry = measure_edge(obj, points, spacing, radius, lam, patch, depsgraph=depsgraph)
     break_number = free_break(obj)
     edge_number = obj.vg.next_edge_number
-    for m, arc in zip(profile.stations, profile.arc_lengths, strict=True):
+    sides = profile.figures.plus_left
+    for m, arc, left in zip(profile.stations, profile.arc_lengths, sides, strict=True):
         measuring.remember(geometry.fingerprint, m)
         records.add_measurement(
             obj,
@@ -82,7 +85,7 @@ def measure_edge_on_object(
             geometry.fingerprint,
             note=note,
             break_number=break_number,
-            station=(edge_number, arc, profile.spacing),
+            station=(edge_number, arc, profile.spacing, left),
         )
     clicks = np.asarray(points, dtype=np.float64)
     edge = records.add_edge(
@@ -129,7 +132,7 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
         group = sorted(group, key=lambda entry: entry[2])
         items, measurements = [g[0] for g in group], [g[1] for g in group]
         figures = summarize(surface, measurements)
-        centers = [records._floats(m.center) for m in measurements]
+        centers = [[float(v) for v in m.center] for m in measurements]
         numbers = {
             "points": [centers[0], centers[-1]] if len(centers) > 1 else centers,
             "path": centers,
@@ -155,8 +158,12 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
             break_number=items[0].break_number,
             note=items[0].note,
         )
-        for item in items:
+        for item, left in zip(items, figures.plus_left, strict=True):
             item.edge_number = edge.number
+            numbers = exact_numbers(item)
+            numbers["plus_left"] = bool(left)
+            item.exact = json.dumps(numbers)
+            item.colors = "/".join(records.station_colours(item.break_number, left))
         edge.plot = make_plot(obj, edge).name
         numbers_made.append(edge.number)
     return numbers_made

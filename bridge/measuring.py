@@ -7,6 +7,7 @@ raises :class:`GoniometerError` for bad input before changing anything.
 
 from __future__ import annotations
 
+import dataclasses
 from collections import OrderedDict
 from pathlib import Path
 
@@ -120,9 +121,13 @@ def repaint(obj, *, depsgraph=None, geometry: Geometry | None = None) -> list[in
         is_stale = item.fingerprint != geometry.fingerprint
         if not is_stale:
             try:
-                measured.append((_replay(obj, geometry, item), item.break_number))
+                m = _replay(obj, geometry, item)
             except GoniometerError:
                 is_stale = True
+            else:
+                if not records.plus_on_pair_side(item):  # an edge station, painted edge-wise
+                    m = dataclasses.replace(m, labels=~m.labels)
+                measured.append((m, item.break_number))
         if item.stale != is_stale:
             item.stale = is_stale
         if is_stale:
@@ -216,8 +221,8 @@ def replicate_rows(
     for row, m in results:
         remember(geometry.fingerprint, m)
         station = None
-        if row.edge_number is not None:  # re-numbered below, when its edge is rebuilt
-            station = (0, row.arc_length or 0.0, row.spacing or 0.0)
+        if row.edge_number is not None:  # numbered and oriented when its edge is rebuilt
+            station = (0, row.arc_length or 0.0, row.spacing or 0.0, True)
         item = records.add_measurement(
             obj,
             m,

@@ -48,9 +48,10 @@ def add_measurement(
         Free text (the CSV's User Data).
     break_number : int, optional
         Default: the object's current break.
-    station : tuple (edge_number, arc_length, spacing), optional
-        For a station of an edge profile: its edge, its arc length along the path and the
-        edge's spacing.
+    station : tuple (edge_number, arc_length, spacing, plus_left), optional
+        For a station of an edge profile: its edge, its arc length along the path, the edge's
+        spacing, and whether its "+" side lies left of the path (if not, its colours are
+        recorded the other way round, so that one side of the whole edge has one colour).
 
     Returns
     -------
@@ -63,9 +64,13 @@ def add_measurement(
     item.break_number = data.break_number if break_number is None else int(break_number)
     numbers = {}
     if station is not None:
-        edge_number, arc_length, spacing = station
+        edge_number, arc_length, spacing, plus_left = station
         item.edge_number = int(edge_number)
-        numbers = {"arc_length": float(arc_length), "spacing": float(spacing)}
+        numbers = {
+            "arc_length": float(arc_length),
+            "spacing": float(spacing),
+            "plus_left": bool(plus_left),
+        }
     item.exact = json.dumps(
         {
             **numbers,
@@ -88,11 +93,23 @@ def add_measurement(
     item.n_minus = int(m.n_minus)
     item.date = csvio.now_iso()
     item.note = note
-    item.colors = "/".join(palette.pair_names(item.break_number))
+    item.colors = "/".join(station_colours(item.break_number, numbers.get("plus_left", True)))
     item.fingerprint = geometry_fingerprint
     item.stale = False
     data.active_index = len(data.measurements) - 1
     return item
+
+
+def station_colours(break_number: int, plus_left: bool = True) -> tuple[str, str]:
+    """The "+"/"-" colour names of a measurement: its break's pair, swapped for an edge station
+    whose "+" side lies right of the path (the edge's left side always gets the first colour)."""
+    names = tuple(palette.pair_names(break_number))
+    return names if plus_left else names[::-1]
+
+
+def plus_on_pair_side(item) -> bool:
+    """Whether ``item``'s "+" side is painted in the first colour of its break's pair."""
+    return bool(exact_numbers(item).get("plus_left", True))
 
 
 _KEYS = (

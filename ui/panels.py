@@ -137,6 +137,11 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         if not 0 <= obj.vg.active_edge_index < len(obj.vg.edges):
             return
         edge = obj.vg.edges[obj.vg.active_edge_index]
+        stations = [m for m in obj.vg.measurements if m.edge_number == edge.number]
+        if any(m.stale for m in stations) or len(stations) != edge.n_stations:
+            box = layout.box()
+            box.label(text="Stations stale or deleted since measured", icon="ERROR")
+            box.label(text="The summary is kept as it was recorded")
         column = layout.column(align=True)
         _text(column, "Edge", f"{edge.number}, break {edge.break_number}")
         _text(

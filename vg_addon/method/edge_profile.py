@@ -478,6 +478,11 @@ class EdgeSummary:
         its own frame (along the edge, across it, along its mean normal), so that a curved edge
         pools like a straight one: the whole-edge mean angle, and its summed mean squared
         plane-fit distance.
+    plus_left : tuple of bool
+        Per station, whether its "+" side lies to the left of the path's direction (seen from
+        outside, along the mean normal). A station's "+" side follows its own binormal, which can
+        turn over along a curved edge; painting the left side in one colour keeps the sides of
+        the whole edge consistent.
     """
 
     n_stations: int
@@ -487,6 +492,7 @@ class EdgeSummary:
     max: float
     pooled_angle: float
     pooled_fit_error: float
+    plus_left: tuple = ()
 
 
 def _frame(m: Measurement, direction: np.ndarray) -> np.ndarray:
@@ -517,13 +523,15 @@ def summarize(surface, stations) -> EdgeSummary:
     angles = np.array([m.angle for m in stations])
     centers = np.array([m.center for m in stations])
     sides = {True: ([], []), False: ([], [])}
+    plus_left = []
     for k, m in enumerate(stations):
         ahead, behind = centers[min(k + 1, len(stations) - 1)], centers[max(k - 1, 0)]
         direction = ahead - behind if len(stations) > 1 else m.tangent
         frame = _frame(m, direction)
         local = (surface.points[m.indices] - m.center) @ frame.T
         normals = surface.normals[m.indices] @ frame.T
-        plus_is_left = local[m.labels, 1].mean() >= local[~m.labels, 1].mean()
+        plus_is_left = bool(local[m.labels, 1].mean() >= local[~m.labels, 1].mean())
+        plus_left.append(plus_is_left)
         for mask, is_plus in ((m.labels, True), (~m.labels, False)):
             key = is_plus == plus_is_left
             sides[key][0].append(local[mask])
@@ -541,6 +549,7 @@ def summarize(surface, stations) -> EdgeSummary:
         max=float(angles.max()),
         pooled_angle=pooled,
         pooled_fit_error=left_error + right_error,
+        plus_left=tuple(plus_left),
     )
 
 

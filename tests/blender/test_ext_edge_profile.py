@@ -174,3 +174,27 @@ def test_local_points_are_measured_in_world_space(vg):
     assert all(
         exact(i)["center"] in world(local_points(obj), obj).tolist() for i in obj.vg.measurements
     )
+
+
+def test_each_side_of_a_curved_edge_is_painted_in_one_colour(vg):
+    from bpy_helpers import colours
+
+    from vg_addon import palette
+    from vg_addon.synthetic_meshes import lens
+
+    shape = lens(70.53, n_around=300)
+    obj = mesh_object("Lens", shape.points, shape.triangles)
+    rim = shape.points[shape.edge]
+    measure_edge(points=rim[[0, 150, 299]].tolist(), spacing=0.1, radius=0.04)
+    stations = [item for item in obj.vg.measurements if item.edge_number == 1]
+    # The binormal turns over somewhere along the rim: some stations' "+" side is the lower cap.
+    assert len({exact(item)["plus_left"] for item in stations}) == 2
+    rgba = colours(obj)
+    plus, minus = (np.asarray(c, dtype=np.float32) for c in palette.pair_linear(1))
+    painted = ~np.all(np.isclose(rgba, palette.neutral_linear()), axis=1)
+    upper = painted & (shape.points[:, 2] > 1e-9)
+    lower = painted & (shape.points[:, 2] < -1e-9)
+    for side in (upper, lower):
+        assert len(np.unique(rgba[side], axis=0)) == 1  # one colour along the whole rim
+    assert not np.array_equal(rgba[upper][0], rgba[lower][0])
+    assert {tuple(rgba[upper][0]), tuple(rgba[lower][0])} == {tuple(plus), tuple(minus)}
