@@ -99,15 +99,29 @@ class EdgeSession:
 
     def __init__(self, context, obj):
         self.obj = obj
+        area = context.area
+        # Started from the sidebar's button, the context's region is the sidebar: clicks are
+        # taken in the area's main (WINDOW) region, with its view.
+        self._region = next((r for r in area.regions if r.type == "WINDOW"), None)
+        self._region_data = getattr(area.spaces.active, "region_3d", None)
+        if self._region is None or self._region_data is None:
+            raise GoniometerError("Edge profiles are picked in a 3D viewport.")
         depsgraph = context.evaluated_depsgraph_get()
         self.machine = EdgeMachine(surface_for(obj, evaluated_geometry(obj, depsgraph)))
         self.overlay = EdgeOverlay()
-        self._area, self._workspace = context.area, context.workspace
+        self._area, self._workspace = area, context.workspace
         self.overlay.start()
         self.refresh(context)
 
-    def handle(self, context, action: str, coord=None) -> str:
-        """Apply one translated event; returns ``"running"``, ``"pass"`` or ``"done"``."""
+    def region_coord(self, mouse) -> tuple | None:
+        """Window-pixel ``mouse`` relative to the viewport's main region, or None if outside."""
+        x, y = mouse[0] - self._region.x, mouse[1] - self._region.y
+        inside = 0 <= x < self._region.width and 0 <= y < self._region.height
+        return (x, y) if inside else None
+
+    def handle(self, context, action: str, mouse=None) -> str:
+        """Apply one translated event (``mouse``: window pixel coordinates); returns
+        ``"running"``, ``"pass"`` or ``"done"``."""
         machine = self.machine
         if not object_alive(context, self.obj):
             machine.cancel("The object was deleted: nothing was recorded.")
@@ -115,11 +129,15 @@ class EdgeSession:
         if action == "pass":
             return "pass"
         if action == "click":
-            region, region_data = context.region, context.region_data
-            if region is None or region_data is None:
-                return "running"
+            coord = self.region_coord(mouse)
+            if coord is None:  # on the sidebar or a header: let Blender have it
+                return "pass"
             hit = ray_cast_object(
-                self.obj, context.evaluated_depsgraph_get(), region, region_data, coord
+                self.obj,
+                context.evaluated_depsgraph_get(),
+                self._region,
+                self._region_data,
+                coord,
             )
             machine.click(hit)
         elif action == "undo":
@@ -289,8 +307,7 @@ class VG_OT_measure_edge(bpy.types.Operator):
         session = self._session
         try:
             action = translate_edge_event(event.type, event.value, ctrl=event.ctrl, alt=event.alt)
-            coord = (event.mouse_region_x, event.mouse_region_y)
-            status = session.handle(context, action, coord)
+            status = session.handle(context, action, (event.mouse_x, event.mouse_y))
         except BaseException:
             session.finish()
             raise
