@@ -66,12 +66,16 @@ def test_summary_equals_what_the_stations_say(ramp):
     assert f"{profile.n_stations} stations" in profile.summary()
 
 
-def test_stations_replay_bit_for_bit(ramp):
+@pytest.mark.parametrize("patch", ["euclidean", "geodesic"])
+def test_stations_replay_bit_for_bit(ramp, patch):
     _, surface = ramp
-    profile = surface.measure_along([[-2, 0, 0], [2, 0, 0]], spacing=1.0, radius=0.3, lam=1.5)
+    profile = surface.measure_along(
+        [[-2, 0, 0], [2, 0, 0]], spacing=1.0, radius=0.3, lam=1.5, patch=patch
+    )
     fresh = Surface(surface.points, surface.triangles)  # nothing cached
     for station in profile.stations:
-        again = fresh.measure(station.center, 0.3, 1.5)
+        assert station.patch == patch
+        again = fresh.measure(station.center, 0.3, 1.5, patch)
         assert again.angle == station.angle
         assert again.fit_error == station.fit_error
         assert np.array_equal(again.indices, station.indices)

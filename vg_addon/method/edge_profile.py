@@ -14,12 +14,14 @@ costs a few percent of its length, across a flat face its full length, so the ch
 follows the ridge and takes at most ``1 / FLOOR`` times the straight route's length in detours.
 
 Limits: the cost only sees the sharpness of single edges. A ridge gentler than
-:data:`RIDGE_MIN_DEG` per edge (or than the scan's noise, see :data:`NOISE_FACTOR`), or rounded over so many triangles that no edge bends much, looks
-flat; where two clicks have no ridge between them the path is the plain shortest route. Such
-stretches are not hidden: :attr:`EdgePath.flat_spans` lists them and :attr:`EdgePath.warning`
-says so, and measuring a station there is refused as a flat patch. A ridge that leaves the
+:data:`RIDGE_MIN_DEG` per edge (or than the scan's noise, see :data:`NOISE_FACTOR`), or rounded
+over so many triangles that no edge bends much, looks flat; where two clicks have no ridge
+between them the path is the plain shortest route. Such stretches are not hidden:
+:attr:`EdgePath.flat_spans` lists them and :attr:`EdgePath.warning` says so, and measuring a
+station on truly flat surface is refused as a flat patch. A ridge that leaves the
 corridor (the ellipsoid around two consecutive clicks, :data:`CORRIDOR_STRETCH`) or that meets a
-sharper one nearby can be missed: add a via point on it.
+sharper one nearby can be missed: add a via point on it. Faces wound against their neighbours
+look like the sharpest ridge of all (a bend near 180°): repair the winding first.
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ RIDGE_MIN_DEG = 5.0
 bar is higher: :data:`NOISE_FACTOR` times the median of the mesh's vertex bends."""
 
 NOISE_FACTOR = 2.0
+"""On a scan whose every vertex has bent edges, a ridge must bend this many times the median."""
 
 MIN_FLAT_RUN = 3
 """Fewest consecutive off-ridge path vertices that make a flat span (one or two are the
