@@ -108,6 +108,7 @@ def make_plot(obj, edge):
     # Blender's rows run bottom-up.
     image.pixels.foreach_set((rgba[::-1].astype(np.float32) / 255.0).ravel())
     image.pack()
+    image.use_fake_user = True  # only the edge names it: without a user it would not be saved
     image.preview_ensure()  # the panel shows the plot as the image's preview icon
     return image
 

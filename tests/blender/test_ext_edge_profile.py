@@ -67,15 +67,26 @@ def test_stations_replay_with_measure_xyz(vg):
         assert (a["angle"], a["fit"], a["center"]) == (b["angle"], b["fit"], b["center"])
 
 
-def test_plot_image_is_made_and_packed(vg):
+def test_plot_image_is_made_packed_and_saved(vg, tmp_path):
+    from vg_addon.formats import profile_plot
+
     obj, _ = ramp_object()
     measure_edge()
     edge = obj.vg.edges[0]
     image = bpy.data.images[edge.plot]
     assert tuple(image.size) == (480, 240) and image.packed_file is not None
+    numbers = exact(edge)
+    expected = profile_plot.render_profile(numbers["arc_lengths"], numbers["angles"])
+    path = tmp_path / "edge.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.read_homefile(use_empty=True)
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    edge = bpy.data.objects["Ramp"].vg.edges[0]
+    image = bpy.data.images[edge.plot]
     pixels = np.empty(480 * 240 * 4, dtype=np.float32)
     image.pixels.foreach_get(pixels)
-    assert len(np.unique(pixels.reshape(-1, 4), axis=0)) > 3  # a drawing, not a blank
+    rgba = np.round(pixels.reshape(240, 480, 4)[::-1] * 255).astype(np.uint8)
+    assert np.array_equal(rgba, expected)  # the plot drawn from the recorded numbers
 
 
 def test_refusals_record_nothing(vg):
