@@ -225,25 +225,19 @@ def _leg(surface, graph: RidgeGraph, start: int, end: int) -> np.ndarray:
     a, b = points[start], points[end]
     reach = CORRIDOR_STRETCH * float(np.linalg.norm(b - a)) + 4.0 * graph.mean_edge_length
 
-    def bound(ids):
-        return FLOOR * np.linalg.norm(points[ids] - b, axis=1)
+    def distances(targets, to):
+        offsets = points[targets] - to
+        return np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
 
     cost = np.full(surface.n_points, np.inf)
+    remaining = np.zeros(surface.n_points)  # the lower bound FLOOR * |x - end|, once reached
     previous = np.full(surface.n_points, -1, dtype=np.int64)
     cost[start] = 0.0
+    remaining[start] = FLOOR * float(np.linalg.norm(b - a))
     open_ids = np.array([start], dtype=np.int64)
-    while open_ids.size:
-        estimate = cost[open_ids] + bound(open_ids)
-        if cost[end] <= estimate.min():
-            break
-        if open_ids.size > _BATCH:
-            pick = np.argpartition(estimate, _BATCH)[:_BATCH]
-            batch = open_ids[pick]
-            rest = np.ones(open_ids.size, dtype=bool)
-            rest[pick] = False
-            open_ids = open_ids[rest]
-        else:
-            batch, open_ids = open_ids, open_ids[:0]
+
+    def relax(batch):
+        """Relax the edges of ``batch``; the vertices whose cost improved."""
         counts = graph.starts[batch + 1] - graph.starts[batch]
         edges = expand_ranges(graph.starts[batch], counts)
         sources = np.repeat(batch, counts)
@@ -251,14 +245,12 @@ def _leg(surface, graph: RidgeGraph, start: int, end: int) -> np.ndarray:
         candidate = cost[sources] + graph.costs[edges]
         useful = candidate < cost[targets]
         sources, targets, candidate = sources[useful], targets[useful], candidate[useful]
-        target_points = points[targets]
-        useful = (
-            np.linalg.norm(target_points - a, axis=1) + np.linalg.norm(target_points - b, axis=1)
-            <= reach
-        ) & (candidate + FLOOR * np.linalg.norm(target_points - b, axis=1) < cost[end])
+        to_end = distances(targets, b)
+        useful = (distances(targets, a) + to_end <= reach) & (
+            candidate + FLOOR * to_end < cost[end]
+        )
         sources, targets, candidate = sources[useful], targets[useful], candidate[useful]
-        if targets.size == 0:
-            continue
+        remaining[targets] = FLOOR * to_end[useful]
         order = np.lexsort((sources, candidate, targets))  # the best per target, ties by vertex
         sources, targets, candidate = sources[order], targets[order], candidate[order]
         best = np.ones(targets.size, dtype=bool)
@@ -266,7 +258,30 @@ def _leg(surface, graph: RidgeGraph, start: int, end: int) -> np.ndarray:
         targets = targets[best]
         cost[targets] = candidate[best]
         previous[targets] = sources[best]
-        open_ids = np.union1d(open_ids, targets)
+        return targets
+
+    while open_ids.size:
+        estimate = cost[open_ids] + remaining[open_ids]
+        if cost[end] <= estimate.min():
+            break
+        if open_ids.size > _BATCH:
+            pick = np.argpartition(estimate, _BATCH)[:_BATCH]
+            rest = np.ones(open_ids.size, dtype=bool)
+            rest[pick] = False
+            batch, open_ids = open_ids[pick], open_ids[rest]
+        else:
+            pick = np.arange(open_ids.size)
+            batch, open_ids = open_ids, open_ids[:0]
+        # Improved vertices no worse than the batch are expanded at once (a cheap ridge is
+        # followed hop after hop on small arrays); the others wait in the open set.
+        threshold = estimate[pick].max()
+        waiting = [open_ids]
+        while batch.size:
+            improved = relax(batch)
+            now = cost[improved] + remaining[improved] <= threshold
+            waiting.append(improved[~now])
+            batch = improved[now]
+        open_ids = np.unique(np.concatenate(waiting))
     if not np.isfinite(cost[end]):
         raise GoniometerError(
             "No path along mesh edges joins the clicked points within the corridor around them "
