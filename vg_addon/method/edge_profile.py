@@ -88,11 +88,11 @@ class RidgeGraph:
         n = points.shape[0]
         first = triangles.ravel()
         second = triangles[:, [1, 2, 0]].ravel()
+        keys = np.minimum(first, second) * np.int64(n) + np.maximum(first, second)
+        face = np.repeat(np.arange(triangles.shape[0], dtype=np.int64), 3)
         keep = valid[first] & valid[second] & (first != second)
-        low = np.minimum(first, second)[keep]
-        high = np.maximum(first, second)[keep]
-        face = np.repeat(np.arange(triangles.shape[0], dtype=np.int64), 3)[keep]
-        keys = low * np.int64(n) + high
+        if not keep.all():
+            keys, face = keys[keep], face[keep]
         order = np.argsort(keys, kind="stable")
         keys, face = keys[order], face[order]
         is_first = np.ones(keys.size, dtype=bool)
@@ -116,14 +116,16 @@ class RidgeGraph:
         bend[shared] = np.arccos(np.clip(cosine, -1.0, 1.0))
 
         u, v = unique_keys // n, unique_keys % n
-        lengths = np.linalg.norm(points[u] - points[v], axis=1)
+        offsets = points[u] - points[v]
+        lengths = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
         costs = lengths * (FLOOR + np.exp(-bend / BEND_SCALE))
         source = np.concatenate([u, v])
         order = np.argsort(source, kind="stable")
         edge = np.concatenate([np.arange(u.size), np.arange(u.size)])[order]
         self.target = np.concatenate([v, u])[order]
         self.costs = costs[edge]
-        self.starts = np.searchsorted(source[order], np.arange(n + 1, dtype=np.int64))
+        self.starts = np.zeros(n + 1, dtype=np.int64)
+        np.cumsum(np.bincount(source, minlength=n), out=self.starts[1:])
         self.vertex_bend = np.zeros(n)
         np.maximum.at(self.vertex_bend, u, bend)
         np.maximum.at(self.vertex_bend, v, bend)
