@@ -35,8 +35,10 @@ edges:
   points that follow that --edge, in order) and measured at stations every --spacing D of arc
   length, each with --radius, --lambda and --patch. Its stations are rows of --out (after the
   points, with Edge #, Arc Length and Spacing), its summary a row of OUT_edges.csv, and its
-  profile plot OUT_<mesh>_edge<N>.png beside --out. An edge runs in this process (not with
-  --jobs or --shard).
+  profile plot OUT_<mesh>_edge<N>.png beside --out. --edges CSV re-measures the edges of an
+  edge summary file (an export's NAME_edges.csv): each row's Points with its own Spacing,
+  Radius, SegParam and Patch Mode, on the mesh its Mesh Name names. Edges run in this process
+  (not with --jobs or --shard).
 
 output:
   --out CSV gets one row per requested point, in input order, in the extension's export
@@ -92,7 +94,7 @@ def build_parser() -> argparse.ArgumentParser:
         usage="blender -b [file.blend] --python vg_batch.py -- ARGS\n"
         "       python vg_batch.py ARGS\n\n"
         "ARGS:  MESH... [--object NAME] (--at X Y Z ... | --points CSV) [--radius R]\n"
-        "       [--edge X1 Y1 Z1 X2 Y2 Z2 [--via X Y Z]... --spacing D]...\n"
+        "       [--edge X1 Y1 Z1 X2 Y2 Z2 [--via X Y Z]... --spacing D]... [--edges CSV]\n"
         "       [--lambda L] [--patch euclidean|geodesic] --out CSV [--save-blend PATH]\n"
         "       [--render DIR] [--jobs N] [--shard K/N]\n"
         "   or: --demo [--out-dir DIR]",
@@ -143,6 +145,12 @@ def build_parser() -> argparse.ArgumentParser:
         action=ViaAction,
         metavar=("X", "Y", "Z"),
         help="a point the path of the preceding --edge passes through (repeatable, in order)",
+    )
+    edges.add_argument(
+        "--edges",
+        dest="edges_csv",
+        metavar="CSV",
+        help="an edge summary CSV (NAME_edges.csv): re-measure each of its edges on its mesh",
     )
     edges.add_argument(
         "--spacing",
@@ -250,6 +258,7 @@ def check_args(args) -> None:
                 ("--at", args.at),
                 ("--points", args.points),
                 ("--edge", args.edge),
+                ("--edges", args.edges_csv),
                 ("--out", args.out),
                 ("--shard", args.shard),
             )
@@ -264,16 +273,15 @@ def check_args(args) -> None:
         raise UsageError(
             "give the points to measure with --at X Y Z (repeatable) or --points CSV, not both."
         )
-    if not (args.at or args.points or args.edge):
+    if not (args.at or args.points or args.edge or args.edges_csv):
         raise UsageError(
-            "give what to measure: --at X Y Z (repeatable), --points CSV, or --edge "
-            "X1 Y1 Z1 X2 Y2 Z2 (repeatable)."
+            "give what to measure: --at X Y Z (repeatable), --points CSV, --edge "
+            "X1 Y1 Z1 X2 Y2 Z2 (repeatable) or --edges CSV."
         )
-    if args.edge:
-        if args.spacing is None or args.radius is None:
-            raise UsageError("--edge needs --spacing D and --radius R (in the mesh's units).")
-        if args.jobs > 1 or args.shard:
-            raise UsageError("--edge is measured in this process: drop --jobs and --shard.")
+    if args.edge and (args.spacing is None or args.radius is None):
+        raise UsageError("--edge needs --spacing D and --radius R (in the mesh's units).")
+    if (args.edge or args.edges_csv) and (args.jobs > 1 or args.shard):
+        raise UsageError("edges are measured in this process: drop --jobs and --shard.")
     if not args.out:
         raise UsageError("--out CSV is required: the measurements CSV to write.")
     if args.jobs < 1:

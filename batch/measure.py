@@ -14,7 +14,7 @@ from ..bridge import colors, measuring, mesh_data, records
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
 from .cli import UNITS
-from .edges import failed_edge_row, measure_edges
+from .edges import failed_edge_row, measure_edges, spec_applies
 from .render import add_sides_material, render_object
 from .sources import MeshSource, import_mesh
 
@@ -90,10 +90,10 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         name = result.object_name or source.name
         result.rows = [(t.index, error_row(t, name, message, units)) for t in tasks]
         result.failed = len(tasks)
-        settings = options.get("edge_settings")
+        applying = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
         result.station_rows = [
-            failed_edge_row(number, spec, name, settings, message, units)
-            for number, spec in enumerate(options.get("edges", ()), start=1)
+            failed_edge_row(number, spec, name, message, units)
+            for number, spec in enumerate(applying, start=1)
         ]
         return result
 
@@ -170,7 +170,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
 
     if options.get("edges"):
         result.station_rows, result.edge_rows = measure_edges(
-            obj, options, units, safe_file_name(obj.name)
+            obj, source, options, units, safe_file_name(obj.name)
         )
 
     if options.get("render"):

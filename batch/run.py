@@ -19,6 +19,7 @@ from ..vg_addon.workflow import batchplan
 from . import extension
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
+from .edges import edge_specs, spec_applies
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
@@ -98,7 +99,7 @@ class Run:
         start = time.perf_counter()
         rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
         csvio.write_measurements_csv(self.args.out, rows)
-        if self.args.edge:
+        if self.args.edge or self.args.edges_csv:
             csvio.write_edges_csv(csvio.edges_path_for(self.args.out), self.edge_rows)
         self.last_write = time.perf_counter()
         self.write_seconds = self.last_write - start
@@ -204,9 +205,14 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             tasks = bp.shard(tasks, k, n)
     except GoniometerError as error:
         raise UsageError(str(error)) from None
+    edges = edge_specs(args, sources)
     groups = {mesh: ts for mesh, ts in bp.by_mesh(tasks).items() if mesh >= 0}
-    if args.edge:  # every mesh measures the edges, whether or not it has points
-        groups = {mesh: groups.get(mesh, []) for mesh in range(len(sources))}
+    if edges:  # every mesh with edges is measured, whether or not it has points
+        groups = {
+            mesh: groups.get(mesh, [])
+            for mesh in range(len(sources))
+            if mesh in groups or any(spec_applies(spec, sources[mesh]) for spec in edges)
+        }
     units = args.units or ("none" if not blend else None)
     set_units(bpy.context.scene, units)
     for path in (args.out, args.save_blend):
@@ -218,14 +224,8 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "render_samples": args.render_samples,
         "save_blend": bool(args.save_blend),
         "units": units,
-        "edges": list(args.edge),
-        "edge_settings": {
-            "spacing": args.spacing,
-            "radius": args.radius,
-            "lam": args.lam,
-            "patch": args.patch,
-        },
-        "plots": str(Path(args.out).resolve().parent / Path(args.out).stem) if args.edge else "",
+        "edges": edges,
+        "plots": str(Path(args.out).resolve().parent / Path(args.out).stem) if edges else "",
     }
     run = Run(args, sources, tasks, len(groups))
     if args.shard and not args.quiet:

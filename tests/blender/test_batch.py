@@ -480,6 +480,17 @@ def test_edges_write_station_rows_summaries_and_plots_equal_to_the_core(tmp_path
         assert png_size(tmp_path / f"out_ramp_edge{number}.png") == (480, 240)
         assert f"edge {number} on 'ramp'" in result.stderr + result.stdout
 
+    # The edge file replicates: --edges re-measures every edge with its own settings.
+    again = tmp_path / "again.csv"
+    ok(batch(mesh, "--edges", out.with_name("out_edges.csv"), "--out", again))
+    replayed = rows_of(again)
+    stations = [row for row in rows if row.edge_number is not None]
+    assert [(r.edge_number, r.angle, r.arc_length) for r in replayed] == [
+        (r.edge_number, r.angle, r.arc_length) for r in stations
+    ]
+    result = ok(batch(mesh, "--edges", out, "--out", again), 2)  # not an edge file
+    assert "missing the column(s)" in result.stderr
+
 
 def test_a_failed_edge_is_an_error_row_and_exit_1(tmp_path):
     shape = wedge(90.0, n=20)
@@ -503,3 +514,5 @@ def test_edge_arguments_are_checked(tmp_path):
               "--out", out), 2
     )  # fmt: skip
     assert "drop --jobs and --shard" in result.stderr
+    result = ok(batch("--demo", "--edge", 0, 0, 0, 1, 0, 0), 2)
+    assert "--demo takes no --edge" in result.stderr
