@@ -151,8 +151,8 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         _text(column, "Min, max", f"{edge.min:.2f}°, {edge.max:.2f}°")
         _text(column, "Pooled", f"{edge.pooled_angle:.2f}°")
         image = bpy.data.images.get(edge.plot)
-        if image is not None and image.preview is not None:
-            layout.template_icon(icon_value=image.preview.icon_id, scale=10.0)
+        if image is not None:  # the image's preview icon, made on demand by layout.icon
+            layout.template_icon(icon_value=layout.icon(image), scale=10.0)
             layout.label(text="Angle (°) against arc length")
         layout.prop(edge, "note")
 
