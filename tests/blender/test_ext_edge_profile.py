@@ -209,3 +209,15 @@ def test_each_side_of_a_curved_edge_is_painted_in_one_colour(vg):
         assert len(np.unique(rgba[side], axis=0)) == 1  # one colour along the whole rim
     assert not np.array_equal(rgba[upper][0], rgba[lower][0])
     assert {tuple(rgba[upper][0]), tuple(rgba[lower][0])} == {tuple(plus), tuple(minus)}
+
+
+def test_panel_shows_only_for_a_mesh_and_the_settings_have_lengths(vg):
+    panel = bpy.types.VIEW3D_PT_vg_edges
+    assert not panel.poll(bpy.context)  # no active mesh
+    ramp_object()
+    assert panel.poll(bpy.context)
+    settings = bpy.context.scene.vg_settings
+    assert settings.edge_spacing > 0
+    assert settings.bl_rna.properties["edge_spacing"].unit == "LENGTH"
+    assert bpy.types.VG_OT_measure_edge.poll(bpy.context)
+    assert not bpy.types.VG_OT_delete_edge.poll(bpy.context)  # no edge yet
