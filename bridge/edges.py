@@ -7,13 +7,15 @@ Each raises :class:`GoniometerError` for bad input before changing anything.
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import bpy
 import numpy as np
 
 from ..properties import exact_numbers
 from ..vg_addon import GoniometerError
-from ..vg_addon.formats import profile_plot
+from ..vg_addon.errors import bounded_list
+from ..vg_addon.formats import csvio, profile_plot
 from ..vg_addon.method.edge_profile import summarize
 from . import measuring, records
 from .mesh_data import check_measurable, evaluated_geometry, surface_for
@@ -95,6 +97,64 @@ def measure_edge_on_object(
     edge.plot = make_plot(obj, edge).name
     measuring.repaint(obj, depsgraph=depsgraph, geometry=geometry)
     return edge
+
+
+def import_edges_csv(
+    obj, path, *, ignore_mesh_names=False, lam=2.0, patch="euclidean", depsgraph=None
+):
+    """Re-measure every edge of an edge summary file on ``obj``: all of them, or none.
+
+    Each row's ``Points`` are traced again and measured with its ``Spacing``, ``Radius``,
+    ``SegParam`` and ``Patch Mode`` (``lam`` and ``patch`` for blank cells), and recorded like
+    an edge measured here, with the row's User Data as its note.
+
+    Returns
+    -------
+    list of int
+        The new edges' numbers.
+
+    Raises
+    ------
+    GoniometerError
+        Listing every row that names another mesh or cannot be measured; nothing is recorded.
+    """
+    check_measurable(obj)
+    rows = csvio.read_edges_csv(path)
+    source = f"'{Path(path).name}'"
+    if not rows:
+        raise GoniometerError(f"{source} has no edges: nothing to import.")
+    names = (obj.name, obj.data.name)
+    failures, jobs = [], []
+    for number, row in enumerate(rows, start=2):
+        try:
+            if not ignore_mesh_names and not csvio.mesh_name_matches(row.mesh_name, names):
+                raise GoniometerError(
+                    f"it names the mesh {row.mesh_name!r}, not '{obj.name}' (tick Ignore Names "
+                    "to measure it here)"
+                )
+            if row.spacing is None or row.radius is None:
+                raise GoniometerError("it has no Spacing or no Radius")
+            points = csvio.parse_points(row.points)
+            settings = (
+                row.spacing,
+                row.radius,
+                lam if row.seg_param is None else row.seg_param,
+                row.patch or patch,
+            )
+            measure_edge(obj, points, *settings, depsgraph=depsgraph)  # checked before recording
+        except GoniometerError as error:
+            failures.append(f"row {number}: {error}")
+            continue
+        jobs.append((points, settings, row.user_data))
+    if failures:
+        raise GoniometerError(
+            f"{len(failures)} of {len(rows)} edges of {source} could not be measured on "
+            f"'{obj.name}'; nothing was imported.\n" + bounded_list(failures, lines=True)
+        )
+    return [
+        measure_edge_on_object(obj, points, *settings, depsgraph=depsgraph, note=note).number
+        for points, settings, note in jobs
+    ]
 
 
 def make_plot(obj, edge):

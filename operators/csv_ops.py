@@ -6,7 +6,7 @@ import bpy
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from ..bridge import measuring
+from ..bridge import edges, measuring
 from ..bridge.mesh_data import check_measurable
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
@@ -85,7 +85,8 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
 class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
     """Re-measure every row of a measurement CSV on the active mesh (the paper's xyz method).
     Reads this extension's CSVs, the MeshLab plugin's, the earlier Blender add-on's and plain
-    x, y, z point lists (rows without radius, λ or patch mode take the panel's)"""
+    x, y, z point lists (rows without radius, λ or patch mode take the panel's); an edge summary
+    file (NAME_edges.csv) has each of its edges traced and measured again"""
 
     bl_idname = "vg.import_csv"
     bl_label = "Import Measurements CSV"
@@ -107,6 +108,21 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             if not path:
                 raise GoniometerError("No file name given: choose the CSV to import.")
             settings = context.scene.vg_settings
+            if csvio.is_edges_csv(path):  # an edge summary file: re-trace its edges
+                edge_numbers = edges.import_edges_csv(
+                    obj,
+                    path,
+                    ignore_mesh_names=self.ignore_mesh_names,
+                    lam=typed_value(settings.seg_param),
+                    patch=settings.patch,
+                    depsgraph=context.evaluated_depsgraph_get(),
+                )
+                self.report(
+                    {"INFO"},
+                    f"Re-measured {len(edge_numbers)} edge profile(s) of "
+                    f"{bpy.path.basename(path)} on '{obj.name}'",
+                )
+                return {"FINISHED"}
             numbers = measuring.import_csv(
                 obj,
                 path,

@@ -221,3 +221,27 @@ def test_panel_shows_only_for_a_mesh_and_the_settings_have_lengths(vg):
     assert settings.bl_rna.properties["edge_spacing"].unit == "LENGTH"
     assert bpy.types.VG_OT_measure_edge.poll(bpy.context)
     assert not bpy.types.VG_OT_delete_edge.poll(bpy.context)  # no edge yet
+
+
+def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):
+    obj, _ = ramp_object()
+    measure_edge(note="ridge A")
+    measure_edge(points=[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]], spacing=0.4, radius=0.25)
+    path = tmp_path / "m.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    edge_file = csvio.edges_path_for(path)
+    before = [exact(item) for item in obj.vg.measurements]
+
+    copy, _ = ramp_object("Ramp.copy")
+    assert bpy.ops.vg.import_csv(filepath=str(edge_file), ignore_mesh_names=True) == {"FINISHED"}
+    assert [e.note for e in copy.vg.edges] == ["ridge A", ""]
+    after = [exact(item) for item in copy.vg.measurements]
+    assert [(a["angle"], a["arc_length"]) for a in after] == [
+        (b["angle"], b["arc_length"]) for b in before
+    ]
+    assert [exact(e)["points"] for e in copy.vg.edges] == [exact(e)["points"] for e in obj.vg.edges]
+    # Another object's name without Ignore Names: refused, nothing recorded.
+    other, _ = ramp_object("Other")
+    with pytest.raises(RuntimeError, match="names the mesh 'Ramp'"):
+        bpy.ops.vg.import_csv(filepath=str(edge_file))
+    assert len(other.vg.edges) == 0 and len(other.vg.measurements) == 0

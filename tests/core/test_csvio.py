@@ -683,5 +683,7 @@ def test_edge_summary_file_round_trips_beside_the_export(tmp_path):
     assert back == edge
     assert csvio.parse_points(back.points) == points
     assert path.read_text().split("\n")[0] == ",".join(csvio.EDGE_COLUMNS)
+    assert csvio.is_edges_csv(path)
+    assert not csvio.is_edges_csv(csvio.format_measurements_csv([good_row()]))
     with pytest.raises(GoniometerError, match="three numbers"):
         csvio.parse_points("1 2")

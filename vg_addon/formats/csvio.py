@@ -1037,6 +1037,15 @@ def parse_edges_csv(text: str, source: str = "The CSV text") -> list[EdgeRow]:
     return _parse_table(text, source, _EDGE_SCHEMA, EdgeRow, (), "an edge summary file")
 
 
+def is_edges_csv(path_or_text) -> bool:
+    """Whether a CSV file (or text) is an edge summary file: its header has ``Edge #``,
+    ``Points`` and ``Spacing``."""
+    text, source = _load(path_or_text)
+    _, header = _header(_records(text, source), source)
+    names = {_normalise(name) for name in header}
+    return {"edge #", "points", "spacing"} <= names
+
+
 def read_edges_csv(path_or_text) -> list[EdgeRow]:
     """Read an edge summary file (see :func:`parse_edges_csv`); arguments as for
     :func:`read_replication_csv`."""
