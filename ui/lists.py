@@ -1,4 +1,4 @@
-"""The measurement list (a UIList: it only draws)."""
+"""The measurement and edge-profile lists (UILists: they only draw)."""
 
 import bpy
 
@@ -17,7 +17,8 @@ def row_texts(item) -> tuple[str, str]:
     """
     # A concave or unclear edge is named: its angle is not the solid's interior angle.
     kind = "" if item.convexity in ("convex", "not recorded") else f" {item.convexity}"
-    return f"{item.angle:.2f}°{kind}", f"#{item.number} B{item.break_number}"
+    edge = f" E{item.edge_number}" if item.edge_number else ""
+    return f"{item.angle:.2f}°{kind}", f"#{item.number} B{item.break_number}{edge}"
 
 
 class VG_UL_measurements(bpy.types.UIList):
@@ -39,4 +40,20 @@ class VG_UL_measurements(bpy.types.UIList):
         swatches.prop(item, "color_minus", text="")
 
 
-classes = (VG_UL_measurements,)
+class VG_UL_edges(bpy.types.UIList):
+    """One row per edge profile: number, break, stations, mean ± SD, pooled angle, colours."""
+
+    def draw_item(self, context, layout, data, item, icon, active_data, active_property, index):
+        if self.layout_type == "GRID":
+            layout.alignment = "CENTER"
+            layout.label(text=str(item.number))
+            return
+        row = layout.row(align=True)
+        row.label(text=f"E{item.number}")
+        row.label(text=f"B{item.break_number}")
+        row.label(text=f"{item.n_stations} st")
+        row.label(text=f"{item.mean:.1f}±{item.std:.1f}°")
+        row.label(text=f"pooled {item.pooled_angle:.1f}°")
+
+
+classes = (VG_UL_measurements, VG_UL_edges)

@@ -234,6 +234,20 @@ class Surface:
             measurement = replace(measurement, stability=estimate_stability(self, measurement))
         return measurement
 
+    def trace_edge(self, start, end, via=()):
+        """The break edge from ``start`` through ``via`` to ``end``, as an ``EdgePath`` of mesh
+        vertices following the ridge; see :func:`vg_addon.method.edge_profile.trace_edge`."""
+        from .edge_profile import trace_edge
+
+        return trace_edge(self, start, end, via)
+
+    def measure_along(self, path, spacing, radius, lam=2.0, patch="euclidean"):
+        """Measure stations every ``spacing`` along ``path``: an ``EdgeProfile``; see
+        :func:`vg_addon.method.edge_profile.measure_along`."""
+        from .edge_profile import measure_along
+
+        return measure_along(self, path, spacing, radius, lam, patch)
+
 
 def _too_far(center: np.ndarray, radius: float) -> GoniometerError:
     return GoniometerError(
