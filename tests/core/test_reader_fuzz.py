@@ -389,7 +389,9 @@ def test_the_bounds_catch_a_hang_and_a_runaway_allocation(tmp_path):
             pass
 
     def hog(_path):
-        return np.ones(EXTRA_BYTES // 8 + (1 << 20))
+        # Far past the cap: freed memory a long test session keeps mapped cannot absorb it
+        # (np.empty: were the cap ever missing, nothing would be touched).
+        return np.empty(EXTRA_BYTES // 8 + (1 << 31))
 
     for function, why in ((hang, "did not finish"), (hog, "tried to allocate")):
         with pytest.raises(pytest.fail.Exception, match=why):
