@@ -9,7 +9,7 @@ has no NumPy (a Linux distribution's Blender), it registers an explanation with 
 import bpy
 
 try:
-    import numpy  # noqa: F401  (every measurement needs it; checked first to say so clearly)
+    import numpy
 except ImportError as error:
     _numpy_error = error
 else:

@@ -175,12 +175,13 @@ class DragSession:
     call repeatedly) removes the drawing and the header and status texts on every way out.
     """
 
-    def __init__(self, obj, surface, patch: str, lam: float):
+    def __init__(self, obj, surface, patch: str, lam: float, rule: str = "oriented"):
         self.obj = obj
         self.surface = surface
         self.patch = patch
+        self.rule = rule
         self.machine = DragMachine(
-            **surface_callbacks(surface, patch), lam=lam, quantize=typed_value
+            **surface_callbacks(surface, patch, rule), lam=lam, quantize=typed_value
         )
         self.overlay = DragOverlay()
         self._area = None
@@ -211,7 +212,7 @@ class DragSession:
         settings = context.scene.vg_settings
         depsgraph = context.evaluated_depsgraph_get()
         surface = surface_for(obj, evaluated_geometry(obj, depsgraph))
-        session = cls(obj, surface, settings.patch, typed_value(settings.seg_param))
+        session = cls(obj, surface, settings.patch, typed_value(settings.seg_param), settings.rule)
         hit = ray_cast_object(obj, depsgraph, region, region_data, coord)
         if not session.machine.press(hit):
             raise GoniometerError(session.machine.message)
@@ -323,6 +324,7 @@ def record_properties(session: DragSession) -> dict | None:
         "radius": record.radius,
         "seg_param": record.lam,
         "patch": session.patch,
+        "rule": session.rule,
     }
 
 

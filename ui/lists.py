@@ -15,11 +15,14 @@ def row_texts(item) -> tuple[str, str]:
     A stale measurement keeps both (the angle gets a warning icon); every other number is in the
     Selected Measurement panel.
     """
-    return f"{item.angle:.2f}°", f"#{item.number} B{item.break_number}"
+    # A concave or unclear edge is named: its angle is not the solid's interior angle.
+    kind = "" if item.convexity in ("convex", "not recorded") else f" {item.convexity}"
+    return f"{item.angle:.2f}°{kind}", f"#{item.number} B{item.break_number}"
 
 
 class VG_UL_measurements(bpy.types.UIList):
-    """One row per measurement: angle, number and break, the colours of its two sides."""
+    """One row per measurement: angle (with "concave" or "unclear" where the edge is), number
+    and break, the colours of its two sides."""
 
     def draw_item(self, context, layout, data, item, icon, active_data, active_property, index):
         angle, number = row_texts(item)

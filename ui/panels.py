@@ -1,8 +1,18 @@
 """The "Goniometer" tab of the 3D viewport sidebar (panels only draw; operators do the work)."""
 
+import textwrap
+
 import bpy
 
 from ..properties import exact_numbers
+from ..vg_addon.method.winding import winding_message
+
+# What the angle of a measurement is, by its convexity label.
+ANGLE_MEANING = {
+    "convex": "Interior angle of the solid",
+    "concave": "Open wedge: 360° minus the solid's angle",
+    "unclear": "Convex or concave unclear here",
+}
 
 CATEGORY = "Goniometer"
 
@@ -32,11 +42,17 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
         column.prop(settings, "radius")
         column.prop(settings, "seg_param")
         column.prop(settings, "patch")
+        column.prop(settings, "rule")
+        column.prop(settings, "stability")
 
         obj = _active_mesh(context)
         if obj is None:
             layout.label(text="Select a mesh object to measure", icon="INFO")
             return
+        if message := winding_message(obj.name, obj.vg.winding):
+            box = layout.box()
+            for number, line in enumerate(textwrap.wrap(message, 42)):
+                box.label(text=line, icon="ERROR" if number == 0 else "BLANK1")
         layout.operator("vg.measure_xyz", text="Measure at 3D Cursor", icon="PIVOT_CURSOR")
         drag = layout.operator("wm.tool_set_by_id", text="Drag to Measure", icon="MOUSE_LMB_DRAG")
         drag.name = "vg.measure_drag_tool"
@@ -105,6 +121,9 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
     rows = [
         ("Measurement", f"{item.number}, break {item.break_number}"),
         ("Angle", number("angle", "°")),
+        ("Edge", f"{item.convexity}: {ANGLE_MEANING.get(item.convexity, '')}"),
+        ("Rule", item.rule),
+        ("Stability", item.stability_text),
         ("Fit error", number("fit")),
         ("Fit error +", number("fit_plus")),
         ("Fit error −", number("fit_minus")),
@@ -124,6 +143,16 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
             text = "missing" if value is None else exact_text(value)
             rows.append((label if axis == "X" else "", f"{axis}  {text}"))
     rows.append(("Snap distance", number("snap_distance")))
+    stability = numbers.get("stability") or {}
+    for label, key in (
+        ("± centre", "center"),
+        ("± radius", "radius"),
+        ("± λ", "lam"),
+        ("± bootstrap", "bootstrap"),
+        ("± orientation", "orientation"),
+    ):
+        if key in stability:
+            rows.append((label, exact_text(stability[key]) + "°"))
     units = scene.unit_settings
     scale = "" if units.system == "NONE" else f" (1 BU = {units.scale_length:g} m)"
     rows.append(("Lengths in", "BU" + scale))
@@ -159,4 +188,23 @@ class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
         row.prop(settings, "ignore_mesh_names", text="Ignore Names")
 
 
-classes = (VIEW3D_PT_vg_measure, VIEW3D_PT_vg_selected, VIEW3D_PT_vg_csv)
+class VIEW3D_PT_vg_sweep(_GoniometerPanel, bpy.types.Panel):
+    """Angle and fit error over a range of radii at the 3D cursor, written as a CSV and a plot."""
+
+    bl_label = "Radius Sweep"
+    bl_parent_id = "VIEW3D_PT_vg_measure"
+    bl_options = {"DEFAULT_CLOSED"}  # noqa: RUF012 (Blender wants a set)
+
+    def draw(self, context):
+        settings = context.scene.vg_settings
+        layout = self.layout
+        column = layout.column(align=True)
+        column.use_property_split = True
+        column.use_property_decorate = False
+        column.prop(settings, "sweep_start")
+        column.prop(settings, "sweep_stop")
+        column.prop(settings, "sweep_count")
+        layout.operator("vg.radius_sweep", text="Sweep at 3D Cursor", icon="GRAPH")
+
+
+classes = (VIEW3D_PT_vg_measure, VIEW3D_PT_vg_selected, VIEW3D_PT_vg_csv, VIEW3D_PT_vg_sweep)
