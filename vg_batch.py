@@ -65,6 +65,10 @@ def main() -> int:
         )
         return 2
     package = extension_package()
+    if package.numpy_import_error is not None:
+        message = package.numpy_missing.message(str(package.numpy_import_error))
+        print(f"vg_batch: error: {message}", file=sys.stderr)
+        return 2
     importlib.import_module(f"{package.__name__}.batch")
     try:
         return package.batch.main(script_argv())
