@@ -2,22 +2,23 @@
 
 import bpy
 
-# Shares of a row at the default sidebar width: the angle first and widest, then the number and
-# break, then the two side colours. Labels in a plain row share the width equally, which cut
-# every angle to "6…"; a split gives each its own share.
-ANGLE_SHARE = 0.46
-NUMBER_SHARE = 0.62  # of what the angle leaves
+# Shares of a row at the default sidebar width (about 170 pixels for the list at UI scale 1): the
+# angle first and widest (room for a warning icon, "179.99°" and a word such as "concave"), then
+# the number, then the two side colours (which also tell the break). Labels in a plain row share
+# the width equally, which cut every angle to "6…"; a split gives each its own share.
+ANGLE_SHARE = 0.6
+NUMBER_SHARE = 0.6  # of what the angle leaves
 
 
 def row_texts(item) -> tuple[str, str]:
-    """The two texts of a list row: the angle (2 decimals) and ``"#number B break"``.
+    """The two texts of a list row: the angle (2 decimals) and ``"#number"``.
 
-    A stale measurement keeps both (the angle gets a warning icon); every other number is in the
-    Selected Measurement panel.
+    A stale measurement keeps both (the angle gets a warning icon); the break is told by the
+    row's colour pair, and every number is in the Selected Measurement panel.
     """
     # A concave or unclear edge is named: its angle is not the solid's interior angle.
     kind = "" if item.convexity in ("convex", "not recorded") else f" {item.convexity}"
-    return f"{item.angle:.2f}°{kind}", f"#{item.number} B{item.break_number}"
+    return f"{item.angle:.2f}°{kind}", f"#{item.number}"
 
 
 class VG_UL_measurements(bpy.types.UIList):
