@@ -31,6 +31,23 @@ def script_argv() -> list[str]:
     return sys.argv[1:]
 
 
+def import_bpy() -> None:
+    """Import the bpy module with what it prints while starting sent to stderr: bpy 5.x logs on
+    stdout (e.g. "Using OCIO=..." where the OCIO variable is set, as it is in any child of a
+    process that runs bpy 5.x), and stdout may be the CSV (``--out -``)."""
+    if "bpy" in sys.modules:
+        return
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        import bpy  # noqa: F401
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def extension_package():
     """The extension package this script belongs to: the copy Blender already runs when it is
     this folder, else this folder imported as ``virtual_goniometer``."""
@@ -64,7 +81,12 @@ def main() -> int:
             file=sys.stderr,
         )
         return 2
+    import_bpy()
     package = extension_package()
+    if package.numpy_import_error is not None:
+        message = package.numpy_missing.message(str(package.numpy_import_error))
+        print(f"vg_batch: error: {message}", file=sys.stderr)
+        return 2
     importlib.import_module(f"{package.__name__}.batch")
     try:
         return package.batch.main(script_argv())

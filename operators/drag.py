@@ -194,7 +194,8 @@ class DragSession:
         Raises
         ------
         GoniometerError
-            Not a 3D viewport, no measurable active mesh, or the press missed it.
+            Not a 3D viewport, a press over the sidebar, toolbar or header, no measurable
+            active mesh, or the press missed it.
         """
         region, region_data = context.region, context.region_data
         if (
@@ -206,6 +207,11 @@ class DragSession:
             raise GoniometerError(
                 "Drag measuring works in the 3D viewport: choose the Goniometer tool in its "
                 "toolbar and press on the mesh."
+            )
+        if not pointer_in_view(context.area, region, coord):
+            raise GoniometerError(
+                "Press on the mesh in the 3D view itself, not over the sidebar, toolbar or "
+                "header drawn over it."
             )
         obj = context.active_object
         check_measurable(obj)

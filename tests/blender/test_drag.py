@@ -254,7 +254,7 @@ def test_small_drag_previews_too_few_and_records_nothing(drag, view):
 
 def test_press_that_misses_the_mesh_says_why(drag, view):
     with pytest.raises(ValueError, match="Missed the mesh"):
-        drag.DragSession.start(bpy.context, (3, 3))
+        drag.DragSession.start(bpy.context, (view.region.width - 5, 5))  # a corner of the view
 
 
 def test_non_mesh_active_object_is_refused(drag, view):
@@ -336,6 +336,9 @@ def test_release_over_a_region_drawn_over_the_view_records_nothing(drag, view):
             assert status == drag.DONE, (region.type, events)
             assert drag.record_properties(session) is None, (region.type, events)
             assert "Left the 3D view" in session.machine.message
+        # A press there (where Blender passes it through to the view) does not start a drag.
+        with pytest.raises(ValueError, match="not over the sidebar, toolbar or header"):
+            drag.DragSession.start(bpy.context, coord)
     assert snapshot(view.obj) == before
 
 
