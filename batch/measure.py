@@ -11,8 +11,9 @@ import bpy
 import numpy as np
 
 from ..bridge import colors, measuring, mesh_data, records
-from ..vg_addon import GoniometerError
-from ..vg_addon.formats import csvio
+from ..vg_addon import GoniometerError, Surface
+from ..vg_addon.formats import csvio, sweep_plot
+from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
 from .render import add_sides_material, render_object
 from .sources import MeshSource, import_mesh
@@ -35,6 +36,9 @@ class MeshResult:
     render: str = ""
     render_error: str = ""
     blend: str = ""  # a worker's one-object .blend, for --save-blend
+    winding: str = ""  # see vg_addon.method.winding.WINDINGS
+    sweep_rows: list = dataclasses.field(default_factory=list)  # [(task index, [cells])]
+    sweep_plots: int = 0
 
     def to_json(self) -> dict:
         out = dataclasses.asdict(self)
@@ -77,7 +81,9 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
 
     The numbers come from the extension's own pipeline: the object's evaluated mesh in world
     space (``mesh_data.evaluated_geometry``), its cached ``Surface`` (``mesh_data.surface_for``)
-    and ``records.add_measurement``; the colours are painted once per mesh at the end by
+    and ``records.add_measurement``; a mesh file whose float64 coordinates float32 would round
+    is measured at the file's coordinates instead (:func:`exact_surface`, ``Precision``
+    float64 in the CSV). The colours are painted once per mesh at the end by
     ``measuring.repaint``, the extension's own painter, from the sides kept while measuring.
     """
     result = MeshResult(mesh=index)
@@ -90,8 +96,12 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         return result
 
     start = time.perf_counter()
+    exact_points = None
     try:
-        obj = import_mesh(source) if source.path else bpy.data.objects[source.name]
+        if source.path:
+            obj, exact_points = import_mesh(source)
+        else:
+            obj = bpy.data.objects[source.name]
     except GoniometerError as error:
         result.bad_file = str(error)
         return fail_all(f"could not read the mesh: {error}")
@@ -105,11 +115,16 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     try:
         mesh_data.check_measurable(obj)
         geometry = mesh_data.evaluated_geometry(obj)
-        surface = mesh_data.surface_for(obj, geometry)
+        if exact_points is None:
+            surface, precision = mesh_data.surface_for(obj, geometry), "float32"
+        else:
+            surface, precision = exact_surface(source, exact_points, geometry), "float64"
     except GoniometerError as error:
         return fail_all(str(error))
     result.n_vertices = int(geometry.points.shape[0])
     result.prepare_seconds = time.perf_counter() - start
+    result.winding = surface.winding
+    measuring.note_winding(obj, surface)
 
     data = obj.vg
     base = data.next_number - 1  # measurements already on a .blend object keep their numbers
@@ -117,7 +132,14 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     last_report = start = time.perf_counter()
     for done, task in enumerate(tasks, start=1):
         try:
-            m = surface.measure(task.center, task.radius, task.lam, task.patch)
+            m = surface.measure(
+                task.center,
+                task.radius,
+                task.lam,
+                task.patch,
+                rule=task.rule,
+                stability=bool(options.get("stability")),
+            )
         except GoniometerError as error:
             result.rows.append((task.index, error_row(task, obj.name, str(error), units)))
             result.failed += 1
@@ -126,7 +148,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             item = records.add_measurement(
                 obj, m, geometry.fingerprint, note=task.label, break_number=task.break_number
             )
-            result.rows.append((task.index, records.to_row(obj, item, stale=False, units=units)))
+            row = records.to_row(obj, item, stale=False, units=units, precision=precision)
+            result.rows.append((task.index, row))
             measuring.keep_sides(obj, geometry, item, m)
             view += m.mean_normal
             result.measured += 1
@@ -135,8 +158,11 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             progress(done)
             last_report = now
     result.measure_seconds = time.perf_counter() - start
+    if options.get("sweep"):
+        sweep_sites(result, surface, obj.name, tasks, options)
     if len(data.measurements):
         data.next_number = max(item.number for item in data.measurements) + 1
+        records.continue_after_recorded_breaks(obj)
 
     if result.measured:
         measuring.repaint(obj, geometry=geometry)
@@ -150,6 +176,46 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         except Exception as error:  # a render problem must not lose the measurements
             result.render_error = f"{type(error).__name__}: {error}"
     return result
+
+
+def sweep_sites(result: MeshResult, surface, name: str, tasks, options) -> None:
+    """``--sweep``: each task's site at the sweep's radii, as CSV cells and a plot per site."""
+    start, stop, count = options["sweep"]
+    folder = Path(options["sweep_plots"])
+    for task in tasks:
+        try:
+            points = radius_sweep(
+                surface, task.center, start, stop, int(count), task.lam, task.patch, task.rule
+            )
+        except GoniometerError as error:
+            points = [
+                SweepPoint(float(r), None, str(error)) for r in sweep_radii(start, stop, count)
+            ]
+        else:
+            path = folder / f"{safe_file_name(name)}_{task.number}.png"
+            sweep_plot.write_sweep_png(path, points)
+            result.sweep_plots += 1
+        result.sweep_rows.extend(
+            (task.index, csvio.sweep_cells(name, task.number, point)) for point in points
+        )
+
+
+def exact_surface(source: MeshSource, points: np.ndarray, geometry) -> Surface:
+    """The surface of a mesh file at its own float64 coordinates, with the faces Blender kept.
+
+    The imported object sits at the world origin untransformed, so the file's coordinates are
+    its world coordinates; Blender's float32 copy would round them (by up to a few
+    thousandths of a unit at a thousand units from the origin, which tilts small patches).
+    """
+    if points.shape != geometry.points.shape:
+        raise GoniometerError(
+            f"'{source.path}' has float64 coordinates that Blender's float32 mesh rounds, and "
+            f"Blender's import changed its vertices ({points.shape[0]} in the file, "
+            f"{geometry.points.shape[0]} in Blender), so it cannot be measured at the file's "
+            "precision. Move the mesh near the origin (subtract an offset) and measure again."
+        )
+    triangles = geometry.triangles if geometry.triangles.size else None
+    return Surface(points, triangles)
 
 
 def set_units(scene, unit: str | None) -> None:

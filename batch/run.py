@@ -15,11 +15,13 @@ import bpy
 from ..bridge import records
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
+from ..vg_addon.method.winding import winding_message
 from ..vg_addon.workflow import batchplan
 from . import extension
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
+from .outputs import check_outputs, make_folders
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
 from .workers import run_workers
@@ -33,6 +35,7 @@ class Run:
         self.total_meshes = total_meshes
         self.jobs = 1  # processes measuring at once
         self.rows: dict[int, object] = {}
+        self.sweep_rows: list = []  # (task index, cells), --sweep
         self.results: list[MeshResult] = []
         self.bad_files: list[str] = []
         self.lock = threading.Lock()
@@ -42,6 +45,10 @@ class Run:
         self.write_seconds = 0.0  # how long that took
         self.in_flight: dict[int, int] = {}  # mesh -> points done so far (running meshes)
         self.units = records.units_label(bpy.context.scene)
+        # A pipe or standard output gets the CSV once, at the end; a file is rewritten as the
+        # meshes finish, so a run that is stopped keeps what it measured.
+        self.stream = csvio.output_target(args.out) == "stream"
+        self.failed_outputs: list[str] = []  # .blend or pictures that could not be written
         for task in tasks:
             if task.mesh < 0:
                 self.rows[task.index] = error_row(task, task.mesh_name, task.error, self.units)
@@ -72,11 +79,17 @@ class Run:
             self.results.append(result)
             for index, row in result.rows:
                 self.rows[index] = row
+            self.sweep_rows.extend(result.sweep_rows)
             if result.bad_file:
                 self.bad_files.append(result.bad_file)
+            if result.render_error:
+                name = self.sources[result.mesh].name
+                self.failed_outputs.append(f"render of {name}: {result.render_error}")
             # Rewrite the CSV now and then (each write costs more as rows accumulate), so a run
             # that is killed keeps what it measured; finish() always writes.
-            if time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds):
+            if not self.stream and (
+                time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds)
+            ):
                 self.write_csv()
         source = self.sources[result.mesh]
         rate = result.measured / result.measure_seconds if result.measure_seconds > 0 else 0
@@ -89,6 +102,8 @@ class Run:
             )
         elif note:
             self.say(f"{source.name}{note}")
+        if message := winding_message(result.object_name or source.name, result.winding):
+            self.say(f"note: {message}")  # once per mesh, also with --quiet
 
     def write_csv(self) -> None:
         start = time.perf_counter()
@@ -104,7 +119,18 @@ class Run:
             self.rows[task.index] = error_row(
                 task, name, "not measured: the run stopped before this mesh", self.units
             )
-        self.write_csv()
+        try:
+            self.write_csv()
+        except (OSError, GoniometerError) as error:
+            where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+            self.say(f"could not write the CSV to {where}: {error}")
+            return 2
+        if self.args.sweep:
+            csv_path, plots = sweep_paths(self.args.out)
+            rows = [cells for _, cells in sorted(self.sweep_rows, key=lambda pair: pair[0])]
+            csvio.replace_atomically(str(csv_path), csvio.format_sweep_rows(rows).encode("utf-8"))
+            drawn = sum(r.sweep_plots for r in self.results)
+            self.say(f"wrote {csv_path} ({len(rows):,} sweep rows) and {drawn} plot(s) in {plots}")
         failed = [(i, row) for i, row in sorted(self.rows.items()) if row.error]
         measured = len(self.rows) - len(failed)
         elapsed = time.perf_counter() - self.started
@@ -131,8 +157,15 @@ class Run:
             self.say(f"  ... and {len(failed) - 10} more failed rows (see the error column)")
         for message in self.bad_files:
             self.say(f"  unreadable mesh: {message}")
-        self.say(f"wrote {self.args.out}")
+        where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+        self.say(f"wrote the CSV to {where}")
         return batchplan.exit_code(len(failed), len(self.bad_files))
+
+
+def sweep_paths(out) -> tuple[Path, Path]:
+    """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``."""
+    out = Path(out).resolve()
+    return out.with_name(out.stem + "_sweep.csv"), out.with_name(out.stem + "_sweep")
 
 
 def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
@@ -141,6 +174,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     ``file_ready``: the caller has already opened the file to measure in (and activated the
     extension), as the demo does; otherwise the .blend among the inputs is opened here.
     """
+    check_outputs(args)  # before anything is read or written
     blend = ""
     if file_ready:
         inputs = list(args.inputs)
@@ -159,7 +193,12 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     try:
         if args.at:
             tasks = bp.plan_points(
-                len(sources), args.at, radius=args.radius, lam=args.lam, patch=args.patch
+                len(sources),
+                args.at,
+                radius=args.radius,
+                lam=args.lam,
+                patch=args.patch,
+                rule=args.rule,
             )
         else:
             try:
@@ -174,6 +213,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                 patch=args.patch,
                 ignore_mesh_names=args.ignore_mesh_names,
                 source=f"'{Path(args.points).name}'",
+                rule=args.rule,
             )
         if args.shard:
             k, n = bp.parse_shard(args.shard)
@@ -183,23 +223,27 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     groups = {mesh: ts for mesh, ts in bp.by_mesh(tasks).items() if mesh >= 0}
     units = args.units or ("none" if not blend else None)
     set_units(bpy.context.scene, units)
-    for path in (args.out, args.save_blend):
-        if path:
-            Path(path).resolve().parent.mkdir(parents=True, exist_ok=True)
+    make_folders(args)
     options = {
         "render": str(Path(args.render).resolve()) if args.render else "",
         "render_size": list(args.render_size),
         "render_samples": args.render_samples,
         "save_blend": bool(args.save_blend),
         "units": units,
+        "stability": bool(args.stability),
+        "sweep": list(args.sweep) if args.sweep else None,
+        "sweep_plots": str(sweep_paths(args.out)[1]) if args.sweep else "",
     }
+    if args.sweep:
+        sweep_paths(args.out)[1].mkdir(parents=True, exist_ok=True)
     run = Run(args, sources, tasks, len(groups))
     if args.shard and not args.quiet:
         run.say(f"shard {args.shard}: {len(tasks):,} point(s) on {len(groups)} mesh(es)")
-    try:
-        run.write_csv()
-    except (OSError, GoniometerError) as error:
-        raise UsageError(f"cannot write {args.out}: {error}") from None
+    if not run.stream:
+        try:
+            run.write_csv()  # the header now: a place that cannot be written fails here
+        except (OSError, GoniometerError) as error:
+            raise UsageError(f"cannot write {args.out}: {error}") from None
 
     parallel = args.jobs > 1 and len(groups) > 1 and not blend
     if args.jobs > 1 and blend and not args.quiet:
@@ -211,6 +255,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             if parallel:
                 plan = {
                     "folder": folder,
+                    "parent_session": bpy.app.tempdir,  # removed by the workers if this dies
                     "sources": [dataclasses.asdict(s) for s in sources],
                     "tasks": {
                         str(m): [dataclasses.asdict(t) for t in ts] for m, ts in groups.items()
@@ -235,13 +280,20 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                 objects = append_objects(run.results)
             else:
                 objects = [bpy.data.objects.get(name) for name in kept if name]
-            save_blend(args.save_blend, objects)
+            try:
+                save_blend(args.save_blend, objects)
+            except (RuntimeError, OSError) as error:
+                run.failed_outputs.append(f".blend {args.save_blend}: {str(error).strip()}")
+            else:
+                run.say(f"wrote {args.save_blend}")
     finally:
         if folder:
             shutil.rmtree(folder, ignore_errors=True)
-    if args.save_blend:
-        run.say(f"wrote {args.save_blend}")
     if args.render:
         rendered = sum(1 for r in run.results if r.render)
         run.say(f"wrote {rendered} render(s) to {args.render}")
+    for message in run.failed_outputs:
+        run.say(f"  could not write the {message}")
+    if run.failed_outputs:
+        code = max(code, 2)  # the CSV is complete, but an output asked for is missing
     return code, run

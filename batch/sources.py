@@ -100,9 +100,20 @@ def file_sources(inputs: list[str]) -> list[MeshSource]:
 
 def import_mesh(source: MeshSource):
     """A new mesh object made from ``source``'s file (float32 coordinates, as Blender stores
-    them), linked to the scene at the world origin."""
+    them), linked to the scene at the world origin.
+
+    Returns
+    -------
+    obj : bpy.types.Object
+    exact_points : ndarray of float64, shape (n, 3), or None
+        The file's own coordinates when they are float64 values that float32 rounds (e.g. a
+        scan far from the origin), to be measured at the file's precision; ``None`` when
+        Blender's float32 mesh holds them exactly.
+    """
     data = meshio.read_mesh(source.path)
     points = np.ascontiguousarray(data.points, dtype=np.float32)
+    rounded = not np.array_equal(points.astype(np.float64), data.points)
+    exact_points = data.points if rounded else None
     mesh = bpy.data.meshes.new(source.name)
     mesh.vertices.add(points.shape[0])
     # The attribute arrays take plain copies: much faster than the per-vertex properties.
@@ -121,7 +132,7 @@ def import_mesh(source: MeshSource):
         mesh.validate(verbose=False)
     obj = bpy.data.objects.new(source.name, mesh)
     bpy.context.scene.collection.objects.link(obj)
-    return obj
+    return obj, exact_points
 
 
 def needs_validation(triangles: np.ndarray) -> bool:

@@ -14,6 +14,7 @@ import numpy as np
 from ..vg_addon import GoniometerError, Measurement
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
+from ..vg_addon.method.sweep import radius_sweep
 from . import colors, painting, records
 from .mesh_data import Geometry, check_measurable, evaluated_geometry, own_write, surface_for
 
@@ -48,19 +49,66 @@ def _sides_of_item(obj, geometry: Geometry, item, key: tuple) -> painting.Sides:
     return sides
 
 
-def measure(obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None):
+def measure(
+    obj,
+    location,
+    radius,
+    lam=2.0,
+    patch="euclidean",
+    *,
+    depsgraph=None,
+    rule="oriented",
+    stability=False,
+):
     """Measure ``obj`` without recording anything: ``(Measurement, Geometry)``.
 
     The building block for previews (e.g. a drag tool) and for :func:`measure_on_object`.
     """
     check_measurable(obj)
     geometry = evaluated_geometry(obj, depsgraph)
-    m = surface_for(obj, geometry).measure(location, radius, lam, patch)
+    surface = surface_for(obj, geometry)
+    m = surface.measure(location, radius, lam, patch, rule=rule, stability=stability)
+    note_winding(obj, surface)
     return m, geometry
 
 
+def note_winding(obj, surface) -> None:
+    """Keep the surface's winding on the object, for the panel to say once if it is inward."""
+    if obj.vg.winding != surface.winding:
+        obj.vg.winding = surface.winding
+
+
+def sweep(
+    obj,
+    location,
+    start,
+    stop,
+    count,
+    lam=2.0,
+    patch="euclidean",
+    *,
+    depsgraph=None,
+    rule="oriented",
+):
+    """A radius sweep at ``location`` on ``obj`` (nothing is recorded): ``SweepPoint`` list."""
+    check_measurable(obj)
+    geometry = evaluated_geometry(obj, depsgraph)
+    surface = surface_for(obj, geometry)
+    note_winding(obj, surface)
+    return radius_sweep(surface, location, start, stop, count, lam, patch, rule)
+
+
 def measure_on_object(
-    obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None, note=""
+    obj,
+    location,
+    radius,
+    lam=2.0,
+    patch="euclidean",
+    *,
+    depsgraph=None,
+    note="",
+    rule="oriented",
+    stability=False,
 ):
     """Measure the active mesh at ``location``, record the measurement and repaint the sides.
 
@@ -80,6 +128,10 @@ def measure_on_object(
         Default: the context's evaluated depsgraph.
     note : str
         Free text stored with the measurement (the CSV's User Data).
+    rule : {"oriented", "paper"}
+        How the projection is signed (``vg_addon.method.algorithm.RULES``).
+    stability : bool
+        Also compute and record the stability figure.
 
     Returns
     -------
@@ -91,7 +143,9 @@ def measure_on_object(
         No object, not a mesh, linked data, Edit Mode, an empty mesh, a location farther than
         ``radius`` from the surface, too few vertices, ...; nothing is changed then.
     """
-    m, geometry = measure(obj, location, radius, lam, patch, depsgraph=depsgraph)
+    m, geometry = measure(
+        obj, location, radius, lam, patch, depsgraph=depsgraph, rule=rule, stability=stability
+    )
     item = records.add_measurement(obj, m, geometry.fingerprint, note=note)
     keep_sides(obj, geometry, item, m)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
@@ -226,6 +280,8 @@ def replicate_rows(
     patch="euclidean",
     depsgraph=None,
     source="the CSV",
+    rule="oriented",
+    stability=False,
 ):
     """Re-measure every replication row on ``obj`` and record them all, or nothing.
 
@@ -234,9 +290,12 @@ def replicate_rows(
     rows : list of csvio.ReplicationRow
     ignore_mesh_names : bool
         Accept rows whose mesh name is neither this object's nor its mesh's.
-    radius, lam, patch
+    radius, lam, patch, rule
         Used for rows that do not give their own (a plain points CSV); a row without a radius
-        is an error when ``radius`` is None.
+        is an error when ``radius`` is None. Rows of MeshLab and earlier add-on files carry the
+        paper's rule (see ``csvio.ReplicationRow.rule``).
+    stability : bool
+        Also compute and record each measurement's stability figure.
     source : str
         How to name the rows' origin in messages (e.g. the file name).
 
@@ -260,10 +319,17 @@ def replicate_rows(
         csvio.check_mesh_names(rows, (obj.name, obj.data.name), source=source)
     geometry = evaluated_geometry(obj, depsgraph)
     surface = surface_for(obj, geometry)
+    note_winding(obj, surface)
     results, failures = [], []
     for row in rows:
         try:
             row_radius = radius if row.radius is None else row.radius
+            if row.break_number is not None and not (
+                1 <= row.break_number <= csvio.MAX_BREAK_NUMBER
+            ):
+                raise GoniometerError(
+                    f"Break # {row.break_number} is not from 1 to {csvio.MAX_BREAK_NUMBER}"
+                )
             if row_radius is None:
                 raise GoniometerError("no radius (the CSV has no Radius for this row)")
             m = surface.measure(
@@ -271,6 +337,8 @@ def replicate_rows(
                 row_radius,
                 lam if row.lam is None else row.lam,
                 row.patch or patch,
+                rule=row.rule or rule,
+                stability=stability,
             )
         except GoniometerError as error:
             failures.append(f"row {row.row_number}: {error}")
@@ -288,6 +356,7 @@ def replicate_rows(
         )
         keep_sides(obj, geometry, item, m)
         numbers.append(item.number)
+    records.continue_after_recorded_breaks(obj)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
     return numbers
 

@@ -93,8 +93,9 @@ def _digest(digest, arrays) -> None:
     for array in arrays:
         array = np.ascontiguousarray(array)
         digest.update(f"{array.dtype.str}{array.shape}".encode())
-        if array.size:
-            digest.update(memoryview(array).cast("B"))
+        # Flat, because a memoryview with a zero in its shape (no faces) cannot be cast; the
+        # bytes, and so the digests of recorded measurements, are the same.
+        digest.update(memoryview(array.reshape(-1)).cast("B"))
 
 
 def fingerprint(local: np.ndarray, corners: np.ndarray, faces, matrix: np.ndarray) -> str:

@@ -32,6 +32,19 @@ def _floats(vector) -> list[float]:
     return [float(v) for v in np.asarray(vector, dtype=np.float64)]
 
 
+def _stability(stability) -> dict:
+    return {
+        "spread": float(stability.spread),
+        "center": float(stability.center),
+        "radius": float(stability.radius),
+        "lam": float(stability.lam),
+        "bootstrap": float(stability.bootstrap),
+        "orientation": float(stability.orientation),
+        "runs": int(stability.n_runs),
+        "refused": int(stability.n_failed),
+    }
+
+
 def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_number=None):
     """Append measurement ``m`` to ``obj.vg.measurements`` and make it the active one.
 
@@ -45,18 +58,27 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
     note : str
         Free text (the CSV's User Data).
     break_number : int, optional
-        Default: the object's current break.
+        1 to ``csvio.MAX_BREAK_NUMBER``. Default: the object's current break.
 
     Returns
     -------
     The new ``VG_Measurement`` item (valid until the collection changes again).
+
+    Raises
+    ------
+    GoniometerError
+        A break number out of range; nothing is added then.
     """
     data = obj.vg
-    item = data.measurements.add()
-    item.number = data.next_number
-    data.next_number += 1
-    item.break_number = data.break_number if break_number is None else int(break_number)
-    item.exact = json.dumps(
+    break_number = data.break_number if break_number is None else break_number
+    if not (
+        isinstance(break_number, int | np.integer) and 1 <= break_number <= csvio.MAX_BREAK_NUMBER
+    ):
+        raise GoniometerError(
+            f"Break # must be a whole number from 1 to {csvio.MAX_BREAK_NUMBER}; got "
+            f"{break_number!r}. Nothing was recorded."
+        )
+    exact = json.dumps(
         {
             "angle": float(m.angle),
             "fit": float(m.fit_error),
@@ -69,8 +91,18 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
             "requested": _floats(m.requested_center),
             "normal_plus": _floats(m.normal_plus),
             "normal_minus": _floats(m.normal_minus),
+            "rule": m.rule,
+            "convexity": m.convexity,
+            "correlation": float(m.correlation),
+            "stability": None if m.stability is None else _stability(m.stability),
         }
     )
+    # Everything that can fail is done: from here on the item is written whole.
+    item = data.measurements.add()
+    item.number = data.next_number
+    data.next_number += 1
+    item.break_number = int(break_number)
+    item.exact = exact
     item.patch = m.patch
     item.n_vertices = int(m.n_vertices)
     item.n_plus = int(m.n_plus)
@@ -82,6 +114,21 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
     item.stale = False
     data.active_index = len(data.measurements) - 1
     return item
+
+
+def next_free_break(obj) -> int:
+    """The break after the current one: one past the highest the object uses or is on."""
+    data = obj.vg
+    return max([data.break_number, *(item.break_number for item in data.measurements)]) + 1
+
+
+def continue_after_recorded_breaks(obj) -> None:
+    """After recording many measurements at once (a batch run, a CSV import): make the current
+    break one past the highest in use, so the next click starts a break of its own instead of
+    joining a recorded one (and its colours)."""
+    data = obj.vg
+    highest = max((item.break_number for item in data.measurements), default=0)
+    data.break_number = max(data.break_number, highest + 1)
 
 
 _KEYS = (
@@ -112,13 +159,15 @@ def numbers_of(item) -> dict:
 
 
 def replay_args(item) -> dict:
-    """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``."""
+    """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``,
+    ``rule`` (``"paper"`` for records from before the rule existed: that is what they used)."""
     numbers = numbers_of(item)
     return {
         "center": np.array(numbers["center"], dtype=np.float64),
         "radius": float(numbers["radius"]),
         "lam": float(numbers["lam"]),
         "patch": item.patch,
+        "rule": numbers.get("rule", "paper"),
     }
 
 
@@ -130,10 +179,14 @@ def units_label(scene) -> str:
     return f"BU (1 BU = {units.scale_length:g} m, shown in {units.length_unit.lower()})"
 
 
-def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
-    """The CSV row of ``item``, measured on ``obj``."""
+def to_row(
+    obj, item, *, stale: bool, units: str, precision: str = "float32"
+) -> csvio.MeasurementRow:
+    """The CSV row of ``item``, measured on ``obj``; ``precision``: the coordinates measured
+    (``"float32"``, Blender's mesh, unless a batch run measured a file's float64 ones)."""
     numbers = numbers_of(item)
     x, y, z = numbers["center"]
+    stability = numbers.get("stability") or {}
     return csvio.MeasurementRow(
         mesh_name=obj.name,
         date=item.date,
@@ -159,8 +212,20 @@ def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
         requested=tuple(numbers["requested"]),
         snap_distance=numbers["snap_distance"],
         units=units,
+        precision=precision,
         stale=stale,
         extension_version=extension_version(),
         blender_version=bpy.app.version_string,
+        rule=numbers.get("rule", "paper"),
+        convexity=numbers.get("convexity", ""),
+        correlation=numbers.get("correlation"),
+        stability=stability.get("spread"),
+        stability_center=stability.get("center"),
+        stability_radius=stability.get("radius"),
+        stability_lam=stability.get("lam"),
+        stability_bootstrap=stability.get("bootstrap"),
+        stability_orientation=stability.get("orientation"),
+        stability_runs=stability.get("runs"),
+        stability_refused=stability.get("refused"),
         error="",
     )

@@ -14,7 +14,21 @@ from .measure import typed_value
 
 
 def _path(operator) -> str:
-    return bpy.path.abspath(operator.filepath) if operator.filepath else ""
+    """The operator's file path made absolute; ``""`` when none was given.
+
+    Raises
+    ------
+    GoniometerError
+        A path relative to the .blend file (``//``) while the file has never been saved: it
+        would silently mean the process's working folder.
+    """
+    path = operator.filepath
+    if path.startswith("//") and not bpy.data.filepath:
+        raise GoniometerError(
+            f"{path!r} is relative to the .blend file ('//'), but this file has not been saved "
+            "yet: save the .blend file first, or choose a full path."
+        )
+    return bpy.path.abspath(path) if path else ""
 
 
 class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
@@ -33,7 +47,11 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
     )
 
     def execute(self, context):
-        path = _path(self)
+        try:
+            path = _path(self)
+        except GoniometerError as error:
+            self.report({"ERROR"}, f"{error} Nothing was written.")
+            return {"CANCELLED"}
         if not path:
             self.report({"ERROR"}, "No file name given: choose where to write the CSV.")
             return {"CANCELLED"}
@@ -78,7 +96,8 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
 class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
     """Re-measure every row of a measurement CSV on the active mesh (the paper's xyz method).
     Reads this extension's CSVs, the MeshLab plugin's, the earlier Blender add-on's and plain
-    x, y, z point lists (rows without radius, λ or patch mode take the panel's)"""
+    x, y, z point lists (rows without radius, λ or patch mode take the panel's; MeshLab and
+    earlier add-on rows are re-measured with the paper's rule they were taken with)"""
 
     bl_idname = "vg.import_csv"
     bl_label = "Import Measurements CSV"
@@ -93,9 +112,10 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
     )
 
     def execute(self, context):
-        path = _path(self)
+        path = self.filepath
         obj = context.active_object
         try:
+            path = _path(self)
             check_measurable(obj)
             if not path:
                 raise GoniometerError("No file name given: choose the CSV to import.")
@@ -108,6 +128,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                 lam=typed_value(settings.seg_param),
                 patch=settings.patch,
                 depsgraph=context.evaluated_depsgraph_get(),
+                rule=settings.rule,
+                stability=settings.stability,
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))

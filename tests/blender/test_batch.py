@@ -281,19 +281,6 @@ def test_an_unreadable_mesh_fails_alone_with_exit_2(meshes, tmp_path):
     assert "unreadable mesh" in result.stderr
 
 
-def test_a_crashing_worker_loses_only_its_mesh(two_meshes, meshes, tmp_path):
-    out = tmp_path / "out.csv"
-    ok(batch(meshes["ply"], meshes["ply60"], "--points", two_meshes["points"], "--radius", RADIUS,
-             "--jobs", "2", "--out", out, env={"VG_BATCH_ABORT_ON_MESH": "w60"}), 1)  # fmt: skip
-    rows = rows_of(out)
-    whole = two_meshes["rows"]
-    for row, expected in zip(rows, whole, strict=True):
-        if row.mesh_name == "w60":
-            assert "worker process measuring this mesh stopped" in row.error
-        else:
-            assert row.angle == expected.angle and not row.error
-
-
 def test_render_writes_a_png_per_mesh(meshes, tmp_path):
     renders = tmp_path / "renders"
     result = ok(batch(meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS, "--out",

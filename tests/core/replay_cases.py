@@ -75,7 +75,8 @@ def record(surface: Surface, center, radius, lam, patch) -> dict:
     """The pinned outputs of one measurement (or its refusal message)."""
     entry = {"center": _hex(center), "radius": float(radius).hex(), "lam": lam, "patch": patch}
     try:
-        m = surface.measure(center, radius, lam, patch)
+        # The pins predate the oriented rule: they replay with the rule they were made with.
+        m = surface.measure(center, radius, lam, patch, rule="paper")
     except GoniometerError as error:
         entry["error"] = str(error)
         return entry

@@ -38,6 +38,7 @@ from datetime import datetime
 from pathlib import Path
 
 from ..errors import GoniometerError, bounded_list
+from ..method.algorithm import RULES
 from ..method.surface import PATCH_MODES
 from ..palette import OKABE_ITO
 
@@ -86,14 +87,46 @@ _SCHEMA = (
     ("requested", "vec3", ("Requested x", "Requested y", "Requested z")),
     ("snap_distance", "float", ("Snap Distance",)),
     ("units", "text", ("Units",)),
+    ("precision", "text", ("Precision",)),
     ("stale", "bool", ("Stale",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
+    ("rule", "text", ("Rule",)),
+    ("convexity", "text", ("Convexity",)),
+    ("correlation", "float", ("Convexity Correlation",)),
+    ("stability", "float", ("Stability",)),
+    ("stability_center", "float", ("Stability Centre",)),
+    ("stability_radius", "float", ("Stability Radius",)),
+    ("stability_lam", "float", ("Stability SegParam",)),
+    ("stability_bootstrap", "float", ("Stability Bootstrap",)),
+    ("stability_orientation", "float", ("Stability Orientation",)),
+    ("stability_runs", "int", ("Stability Runs",)),
+    ("stability_refused", "int", ("Stability Refused",)),
     ("error", "text", ("error",)),
+)
+
+#: Columns added with the oriented rule (issue 8). Exports written before lack them; such a file
+#: still reads, and its rows replicate with the paper's rule, the only one there was then.
+RULE_COLUMNS = (
+    "Rule",
+    "Convexity",
+    "Convexity Correlation",
+    "Stability",
+    "Stability Centre",
+    "Stability Radius",
+    "Stability SegParam",
+    "Stability Bootstrap",
+    "Stability Orientation",
+    "Stability Runs",
+    "Stability Refused",
 )
 
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
 EXPORT_COLUMNS = tuple(column for _, _, columns in _SCHEMA for column in columns)
+
+# Columns added after the first release: an export written before them still reads back
+# (their cells read as empty).
+_LATER_COLUMNS = frozenset(["Precision", *RULE_COLUMNS])
 
 #: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
 SOURCE_FORMATS = ("extension", "meshlab", "points")
@@ -107,7 +140,9 @@ _FALSE = "FALSE"
 _FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "'")
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_INTEGER = re.compile(r"[+-]?\d+")
+# At most 18 digits: every such integer fits 64 bits, and int() never meets Python's limit on
+# the length of integer text.
+_INTEGER = re.compile(r"[+-]?\d{1,18}")
 
 # File extensions a CSV's mesh name may carry (MeshLab writes the scan's file name).
 _MESH_FILE_SUFFIXES = frozenset(
@@ -174,9 +209,26 @@ class MeasurementRow:
         Distance from ``requested`` to ``(x, y, z)``.
     units : str
         What one coordinate unit is.
+    precision : str
+        The coordinates measured: ``"float32"`` (a Blender mesh, as Blender stores it) or
+        ``"float64"`` (a mesh file's double-precision coordinates, measured as the file holds
+        them); empty for a failed row.
     stale : bool
         The mesh changed since the measurement was taken.
     extension_version, blender_version : str
+    rule : str
+        ``"oriented"`` or ``"paper"``: how the projection was signed (see ``vg_addon.method``).
+    convexity : str
+        ``"convex"``, ``"concave"`` (the angle is then the open wedge's) or ``"unclear"``.
+    correlation : float or None
+        The correlation whose sign gives the convexity (its size: how clearly).
+    stability : float or None
+        The stability figure, degrees (the "±"); empty when it was not computed.
+    stability_center, stability_radius, stability_lam, stability_bootstrap, stability_orientation : float or None
+        Its parts: the largest change of the angle with the centre moved, the radius ±10%, λ from
+        1 to 3, the bootstrap's 95% half-width, and the other sign's reading where unclear.
+    stability_runs, stability_refused : int or None
+        Perturbed measurements tried, and how many of them were refused.
     error : str
         Empty for a good row; why it failed otherwise.
     """
@@ -205,9 +257,21 @@ class MeasurementRow:
     requested: tuple[float, float, float] | None = None
     snap_distance: float | None = None
     units: str = ""
+    precision: str = ""
     stale: bool = False
     extension_version: str = ""
     blender_version: str = ""
+    rule: str = ""
+    convexity: str = ""
+    correlation: float | None = None
+    stability: float | None = None
+    stability_center: float | None = None
+    stability_radius: float | None = None
+    stability_lam: float | None = None
+    stability_bootstrap: float | None = None
+    stability_orientation: float | None = None
+    stability_runs: int | None = None
+    stability_refused: int | None = None
     error: str = ""
 
 
@@ -236,11 +300,16 @@ class ReplicationRow:
         The original ``Measurement #`` (MeshLab's burst measurements are fractional, e.g. 3.05);
         ``None`` when absent, blank or not a number.
     break_number : int or None
-        The original ``Break #``; ``None`` when absent, blank or not a whole number.
+        The original ``Break #`` (1 to :data:`MAX_BREAK_NUMBER`); ``None`` when absent or blank.
     source_format : str
         ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
         columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
         else with x, y, z columns).
+    rule : str or None
+        The rule to replicate with: the ``Rule`` cell of an export; ``"paper"`` for MeshLab and
+        earlier add-on files and for exports written before the ``Rule`` column existed (they
+        were all measured with the paper's rule); a points file's ``rule`` column, else ``None``
+        (the current default).
     """
 
     row_number: int
@@ -255,6 +324,7 @@ class ReplicationRow:
     number: int | float | None = None
     break_number: int | None = None
     source_format: str = "points"
+    rule: str | None = None
 
 
 # --------------------------------------------------------------------------- small helpers
@@ -477,6 +547,10 @@ def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
     return "".join(lines)
 
 
+#: The path that means standard output.
+STDOUT = "-"
+
+
 def _replace_atomically(path: str, data: bytes) -> None:
     folder = os.path.dirname(os.path.abspath(path)) or "."
     if not os.path.isdir(folder):
@@ -517,23 +591,131 @@ def _replace_atomically(path: str, data: bytes) -> None:
         raise
 
 
-def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
-    """Write an export to ``path`` (UTF-8, comma-delimited, ``\\n`` line ends), atomically.
+def _write_into(path: str, data: bytes) -> None:
+    """Write ``data`` into an open-ended target (a pipe, a terminal, standard output), in place."""
+    try:
+        if path == STDOUT:
+            handle = os.dup(1)
+        else:
+            # No O_CREAT and no O_TRUNC: the target exists and is never replaced or emptied;
+            # O_APPEND keeps what a shell's ">>" already put in a file behind /dev/stdout.
+            handle = os.open(path, os.O_WRONLY | os.O_APPEND | getattr(os, "O_BINARY", 0))
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+            stream.flush()
+    except OSError as error:
+        where = "standard output" if path == STDOUT else repr(path)
+        raise GoniometerError(
+            f"Could not write the CSV to {where}: {error.strerror or error}."
+        ) from error
 
-    The whole text is formatted first (see :func:`format_measurements_csv`), then written to a
-    temporary file in the same folder and moved over ``path`` in one step, so ``path`` holds
-    either its old content or the complete new one; on any failure the temporary file is
-    removed. An existing file's permissions are kept.
+
+def _is_descriptor_alias(path: str) -> bool:
+    """Whether ``path`` reaches, through its symbolic links, a name of an open file descriptor
+    (``/dev/stdout`` -> ``/proc/self/fd/1``, ``/dev/fd/1``): writing to it means writing into
+    the file this process already has open, never replacing it."""
+    current = os.path.abspath(path)
+    for _ in range(40):  # the kernel's own limit on links followed
+        if current.startswith(("/proc/", "/dev/fd/")):
+            return True
+        if not os.path.islink(current):
+            return False
+        current = os.path.normpath(os.path.join(os.path.dirname(current), os.readlink(current)))
+    return False
+
+
+def output_target(path) -> str:
+    """How :func:`write_measurements_csv` will write to ``path``, or why it cannot.
+
+    Returns
+    -------
+    str
+        ``"file"``: a regular file (new, or replaced atomically; through a symbolic link, its
+        target is replaced and the link kept). ``"stream"``: ``"-"`` (standard output), a pipe,
+        a terminal or another character device such as ``/dev/null``, or a name of an open file
+        descriptor such as ``/dev/stdout``: the text is written into it, once, never replacing
+        it.
 
     Raises
     ------
     GoniometerError
-        A row that cannot be written, a missing folder, or a target that cannot be replaced.
+        A folder, a block device or a socket, or a folder that does not exist.
+    """
+    path = os.fspath(path)
+    if path == STDOUT:
+        return "stream"
+    try:
+        info = os.stat(path)  # follows symbolic links
+    except FileNotFoundError:
+        target = os.path.realpath(path)  # a dangling link is created at its target
+        folder = os.path.dirname(target) or "."
+        if not os.path.isdir(folder):
+            raise GoniometerError(
+                f"The folder {folder!r} does not exist: choose an existing folder to write "
+                f"{os.path.basename(path)!r} to."
+            ) from None
+        return "file"
+    except OSError as error:
+        raise GoniometerError(f"Cannot write to {path!r}: {error.strerror or error}.") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise GoniometerError(
+            f"{path!r} is a folder: give a file name for the CSV, e.g. "
+            f"{os.path.join(path, 'measurements.csv')!r}."
+        )
+    if stat.S_ISREG(info.st_mode):
+        if _is_descriptor_alias(path):
+            return "stream"
+        if not os.access(path, os.W_OK):
+            raise GoniometerError(
+                f"{path!r} is read-only: it is left as it is. Choose another file name, or make "
+                "it writable first."
+            )
+        return "file"
+    if stat.S_ISCHR(info.st_mode) or stat.S_ISFIFO(info.st_mode):
+        return "stream"
+    kind = "a block device" if stat.S_ISBLK(info.st_mode) else "a socket or other special file"
+    raise GoniometerError(
+        f"{path!r} is {kind}, not a file: choose a file name, or '-' for standard output."
+    )
+
+
+def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
+    """Write an export to ``path`` (UTF-8, comma-delimited, ``\\n`` line ends).
+
+    The whole text is formatted first (see :func:`format_measurements_csv`). A regular file is
+    written atomically: to a temporary file in the same folder, then moved over ``path`` in one
+    step, so ``path`` holds either its old content or the complete new one; on any failure the
+    temporary file is removed. An existing file's permissions are kept; through a symbolic link,
+    the link's target is replaced and the link stays. ``"-"``, a pipe, a terminal, a character
+    device (``/dev/null``) or a name of an open descriptor (``/dev/stdout``) is written into,
+    never replaced (see :func:`output_target`).
+
+    Raises
+    ------
+    GoniometerError
+        A row that cannot be written, a missing folder, a folder or other target that is not a
+        file, a target that cannot be replaced, or a stream that refuses the data (e.g.
+        ``/dev/full``).
     OSError
         Other file-system errors (disk full, no permission to create the file, ...).
     """
     data = format_measurements_csv(rows).encode("utf-8")
-    _replace_atomically(os.fspath(path), data)
+    replace_atomically(path, data)
+
+
+def replace_atomically(path, data: bytes) -> None:
+    """Write ``data`` to ``path``, the way every output file of the project is written.
+
+    A regular file (or a new one) is replaced in one step, through a temporary file beside it,
+    so it holds its old content or the new one, never part of it; a symbolic link keeps its link
+    and its target is replaced. ``-`` (standard output), devices and pipes are written into,
+    never replaced. See :func:`output_target` for what is refused.
+    """
+    path = os.fspath(path)
+    if output_target(path) == "stream":
+        _write_into(path, data)
+    else:
+        _replace_atomically(os.path.realpath(path), data)
 
 
 # --------------------------------------------------------------------------- reading
@@ -652,6 +834,7 @@ _REPLICATION_ALIASES = {
     "label": ("label", "user data", "note", "notes"),
     "number": ("measurement #", "measurement number", "measurement", "number"),
     "break_number": ("break #", "break number", "break"),
+    "rule": ("rule",),
     "error": ("error",),
 }
 _REQUIRED = ("x", "y", "z")
@@ -702,6 +885,20 @@ def _lenient_number(raw: str) -> int | float | None:
         value = float(text)
         return value if math.isfinite(value) else None
     return None
+
+
+#: The largest ``Break #`` (Blender stores it as a 32-bit signed integer).
+MAX_BREAK_NUMBER = 2**31 - 1
+
+
+def _parse_break_number(raw: str) -> int | str | None:
+    """The break number of a cell, ``None`` when blank, or why it is not one (a str)."""
+    text = raw.strip()
+    if not text:
+        return None
+    if _INTEGER.fullmatch(text) and 1 <= int(text) <= MAX_BREAK_NUMBER:
+        return int(text)
+    return f"must be a whole number from 1 to {MAX_BREAK_NUMBER} (got {text!r})"
 
 
 def parse_replication_csv(text: str, source: str = "The CSV text") -> list[ReplicationRow]:
@@ -775,6 +972,9 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
             problems.append(
                 f"row {number}: {name_of('lam')} (λ) must be 0 or more (got {cell('lam').strip()})"
             )
+        break_number = _parse_break_number(cell("break_number"))
+        if isinstance(break_number, str):
+            problems.append(f"row {number}: {name_of('break_number')} {break_number}")
         patch = _parse_optional_text(cell("patch"))
         if patch is not None:
             patch = patch.casefold()
@@ -783,9 +983,17 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                     f"row {number}: unknown patch mode {cell('patch').strip()!r} "
                     f"(use {' or '.join(PATCH_MODES)})"
                 )
+        rule = _parse_optional_text(cell("rule"))
+        if rule is not None:
+            rule = rule.casefold()
+            if rule not in RULES:
+                problems.append(
+                    f"row {number}: unknown rule {cell('rule').strip()!r} (use {' or '.join(RULES)})"
+                )
+        elif fmt != "points":
+            rule = "paper"  # MeshLab, the earlier add-on, exports from before the Rule column
         if problems:
             continue  # nothing is returned anyway; keep collecting
-        break_number = _lenient_number(cell("break_number"))
         rows.append(
             ReplicationRow(
                 row_number=number,
@@ -798,8 +1006,9 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 patch=patch,
                 label=_parse_optional_text(cell("label")),
                 number=_lenient_number(cell("number")),
-                break_number=break_number if isinstance(break_number, int) else None,
+                break_number=break_number,
                 source_format=fmt,
+                rule=rule,
             )
         )
     if problems:
@@ -834,7 +1043,10 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
     aliases: ``Mesh Name``/``Mesh``/``Object``; ``x``/``Center x``; ``Radius``/``r``;
     ``SegParam``/``Seg Param``/``lambda``/``λ``/``Segmentation Parameter``;
     ``Patch Mode``/``patch``; ``label``/``User Data``/``note`` (``label`` wins over
-    ``User Data``); ``Measurement #``; ``Break #``; ``error``. Only x, y and z are required.
+    ``User Data``); ``Measurement #``; ``Break #``; ``Rule`` (``oriented`` or ``paper``);
+    ``error``. Only x, y and z are required. Rows of MeshLab and earlier add-on files, and of
+    exports without a ``Rule`` column, replicate with the paper's rule (see
+    :attr:`ReplicationRow.rule`).
     A UTF-8 byte-order mark is ignored; cells are read without surrounding whitespace, and the
     apostrophe the writer puts before formula-like text is removed.
 
@@ -847,7 +1059,8 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
         One error listing every problem (the first 20, then "and N more") with its row number
         and column name: missing x/y/z columns (naming those found), duplicate columns, a blank,
         non-numeric or non-finite x/y/z/radius/lambda, radius ≤ 0, λ < 0, an unknown patch
-        mode, a row with more cells than the header; or: an empty file, a header without data
+        mode, a ``Break #`` that is not a whole number from 1 to :data:`MAX_BREAK_NUMBER`, a row
+        with more cells than the header; or: an empty file, a header without data
         rows, only failed rows, a ``;`` or tab delimiter, text that is not UTF-8. Nothing is
         returned then.
     OSError
@@ -870,7 +1083,7 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     """Parse an export written by :func:`format_measurements_csv` back into rows.
 
     Every column of :data:`EXPORT_COLUMNS` must be present (in any order; names are matched
-    case-insensitively); text cells are kept as written (only the formula-guard apostrophe is
+    case-insensitively), except ``Precision`` (added later: empty when absent); text cells are kept as written (only the formula-guard apostrophe is
     removed), numbers read back bit-identical. Blank lines are skipped.
 
     Raises
@@ -883,7 +1096,11 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     problems: list[str] = []
     aliases = {column: (_normalise(column),) for column in EXPORT_COLUMNS}
     columns = _resolve_columns(header, aliases, problems)
-    missing = [column for column in EXPORT_COLUMNS if column not in columns]
+    missing = [
+        column
+        for column in EXPORT_COLUMNS
+        if column not in columns and column not in _LATER_COLUMNS
+    ]
     if missing:
         problems.insert(
             0,
@@ -899,8 +1116,8 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
             continue
 
         def cell(column: str, cells=cells) -> str:
-            index = columns[column]
-            return cells[index] if index < len(cells) else ""
+            index = columns.get(column)
+            return cells[index] if index is not None and index < len(cells) else ""
 
         def number_of(column: str, number=number) -> float | None:
             raw = cell(column)
@@ -948,3 +1165,72 @@ def read_measurements_csv(path_or_text) -> list[MeasurementRow]:
     """
     text, source = _load(path_or_text)
     return parse_measurements_csv(text, source)
+
+
+# --------------------------------------------------------------------------- radius sweeps
+
+#: The columns of a radius-sweep CSV: one row per radius, refused radii with their message.
+SWEEP_COLUMNS = (
+    "Mesh Name",
+    "Measurement #",
+    "Radius",
+    "Angle",
+    "fit",
+    "Number of Vertices",
+    "Vertices +",
+    "Vertices -",
+    "Convexity",
+    "x",
+    "y",
+    "z",
+    "Requested x",
+    "Requested y",
+    "Requested z",
+    "SegParam",
+    "Patch Mode",
+    "Rule",
+    "error",
+)
+
+
+def sweep_cells(mesh_name: str, number: int | None, point) -> list[str]:
+    """The cells of one :data:`SWEEP_COLUMNS` row for a ``vg_addon.method.sweep.SweepPoint``.
+
+    A refused radius keeps its radius and message; its measured cells are empty.
+    """
+    m = point.measurement
+
+    def cell(value, column):
+        return _float_cell(value, 0, point, column)
+
+    cells = [_escape_text(str(mesh_name)), "" if number is None else str(int(number))]
+    cells.append(cell(point.radius, "Radius"))
+    if m is None:
+        cells += [""] * (len(SWEEP_COLUMNS) - 4)
+    else:
+        cells += [
+            cell(m.angle, "Angle"),
+            cell(m.fit_error, "fit"),
+            str(int(m.n_vertices)),
+            str(int(m.n_plus)),
+            str(int(m.n_minus)),
+            m.convexity,
+            *(cell(v, "x") for v in m.center),
+            *(cell(v, "Requested x") for v in m.requested_center),
+            cell(m.lam, "SegParam"),
+            m.patch,
+            m.rule,
+        ]
+    cells.append(_escape_text(point.error))
+    return cells
+
+
+def format_sweep_rows(rows: Iterable[Sequence[str]]) -> str:
+    """A sweep CSV's text: the :data:`SWEEP_COLUMNS` header, then rows from :func:`sweep_cells`."""
+    return _csv_line(SWEEP_COLUMNS) + "".join(_csv_line(cells) for cells in rows)
+
+
+def write_sweep_csv(path, mesh_name: str, points, number: int | None = None) -> None:
+    """Write one site's sweep to ``path`` atomically (as :func:`write_measurements_csv`)."""
+    text = format_sweep_rows(sweep_cells(mesh_name, number, point) for point in points)
+    replace_atomically(os.fspath(path), text.encode("utf-8"))
