@@ -12,7 +12,8 @@ import numpy as np
 
 from ..bridge import colors, measuring, mesh_data, records
 from ..vg_addon import GoniometerError, Surface
-from ..vg_addon.formats import csvio
+from ..vg_addon.formats import csvio, sweep_plot
+from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
 from .render import add_sides_material, render_object
 from .sources import MeshSource, import_mesh
@@ -35,6 +36,9 @@ class MeshResult:
     render: str = ""
     render_error: str = ""
     blend: str = ""  # a worker's one-object .blend, for --save-blend
+    winding: str = ""  # see vg_addon.method.winding.WINDINGS
+    sweep_rows: list = dataclasses.field(default_factory=list)  # [(task index, [cells])]
+    sweep_plots: int = 0
 
     def to_json(self) -> dict:
         out = dataclasses.asdict(self)
@@ -79,8 +83,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     space (``mesh_data.evaluated_geometry``), its cached ``Surface`` (``mesh_data.surface_for``)
     and ``records.add_measurement``; a mesh file whose float64 coordinates float32 would round
     is measured at the file's coordinates instead (:func:`exact_surface`, ``Precision``
-    float64 in the CSV); ``measuring.measure_on_object`` does the same per click,
-    re-evaluating the mesh and repainting each time, which a batch does once per mesh instead.
+    float64 in the CSV). The colours are painted once per mesh at the end by
+    ``measuring.repaint``, the extension's own painter, from the sides kept while measuring.
     """
     result = MeshResult(mesh=index)
     units = records.units_label(bpy.context.scene)
@@ -119,19 +123,23 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         return fail_all(str(error))
     result.n_vertices = int(geometry.points.shape[0])
     result.prepare_seconds = time.perf_counter() - start
+    result.winding = surface.winding
+    measuring.note_winding(obj, surface)
 
     data = obj.vg
     base = data.next_number - 1  # measurements already on a .blend object keep their numbers
-    fresh = len(data.measurements) == 0
-    # Per vertex, the break number and side of the last measurement covering it (0: none), so
-    # the colours are painted once at the end without keeping every measurement in memory.
-    painter = np.zeros(result.n_vertices, dtype=np.int64)
-    plus_side = np.zeros(result.n_vertices, dtype=bool)
     view = np.zeros(3)
     last_report = start = time.perf_counter()
     for done, task in enumerate(tasks, start=1):
         try:
-            m = surface.measure(task.center, task.radius, task.lam, task.patch)
+            m = surface.measure(
+                task.center,
+                task.radius,
+                task.lam,
+                task.patch,
+                rule=task.rule,
+                stability=bool(options.get("stability")),
+            )
         except GoniometerError as error:
             result.rows.append((task.index, error_row(task, obj.name, str(error), units)))
             result.failed += 1
@@ -142,8 +150,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             )
             row = records.to_row(obj, item, stale=False, units=units, precision=precision)
             result.rows.append((task.index, row))
-            painter[m.indices] = item.break_number
-            plus_side[m.indices] = m.labels
+            measuring.keep_sides(obj, geometry, item, m)
             view += m.mean_normal
             result.measured += 1
         now = time.perf_counter()
@@ -151,23 +158,14 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             progress(done)
             last_report = now
     result.measure_seconds = time.perf_counter() - start
+    if options.get("sweep"):
+        sweep_sites(result, surface, obj.name, tasks, options)
     if len(data.measurements):
         data.next_number = max(item.number for item in data.measurements) + 1
+        records.continue_after_recorded_breaks(obj)
 
     if result.measured:
-        if fresh and len(obj.data.vertices) == result.n_vertices:
-            # Every measurement is this run's, on these vertices: paint them as repaint() would
-            # (later over earlier), without measuring each one again.
-            painted = np.flatnonzero(painter)
-            sides = [
-                (vertices, plus_side[vertices], int(number))
-                for number in np.unique(painter[painted])
-                for vertices in [painted[painter[painted] == number]]
-            ]
-            rgba = colors.side_colours(result.n_vertices, sides)
-            colors.write_attribute(obj.data, rgba)
-        else:
-            measuring.repaint(obj, geometry=geometry)
+        measuring.repaint(obj, geometry=geometry)
         add_sides_material(obj, colors.ATTRIBUTE_NAME)
 
     if options.get("render"):
@@ -178,6 +176,28 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         except Exception as error:  # a render problem must not lose the measurements
             result.render_error = f"{type(error).__name__}: {error}"
     return result
+
+
+def sweep_sites(result: MeshResult, surface, name: str, tasks, options) -> None:
+    """``--sweep``: each task's site at the sweep's radii, as CSV cells and a plot per site."""
+    start, stop, count = options["sweep"]
+    folder = Path(options["sweep_plots"])
+    for task in tasks:
+        try:
+            points = radius_sweep(
+                surface, task.center, start, stop, int(count), task.lam, task.patch, task.rule
+            )
+        except GoniometerError as error:
+            points = [
+                SweepPoint(float(r), None, str(error)) for r in sweep_radii(start, stop, count)
+            ]
+        else:
+            path = folder / f"{safe_file_name(name)}_{task.number}.png"
+            sweep_plot.write_sweep_png(path, points)
+            result.sweep_plots += 1
+        result.sweep_rows.extend(
+            (task.index, csvio.sweep_cells(name, task.number, point)) for point in points
+        )
 
 
 def exact_surface(source: MeshSource, points: np.ndarray, geometry) -> Surface:

@@ -32,6 +32,19 @@ def _floats(vector) -> list[float]:
     return [float(v) for v in np.asarray(vector, dtype=np.float64)]
 
 
+def _stability(stability) -> dict:
+    return {
+        "spread": float(stability.spread),
+        "center": float(stability.center),
+        "radius": float(stability.radius),
+        "lam": float(stability.lam),
+        "bootstrap": float(stability.bootstrap),
+        "orientation": float(stability.orientation),
+        "runs": int(stability.n_runs),
+        "refused": int(stability.n_failed),
+    }
+
+
 def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_number=None):
     """Append measurement ``m`` to ``obj.vg.measurements`` and make it the active one.
 
@@ -78,6 +91,10 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
             "requested": _floats(m.requested_center),
             "normal_plus": _floats(m.normal_plus),
             "normal_minus": _floats(m.normal_minus),
+            "rule": m.rule,
+            "convexity": m.convexity,
+            "correlation": float(m.correlation),
+            "stability": None if m.stability is None else _stability(m.stability),
         }
     )
     # Everything that can fail is done: from here on the item is written whole.
@@ -97,6 +114,21 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
     item.stale = False
     data.active_index = len(data.measurements) - 1
     return item
+
+
+def next_free_break(obj) -> int:
+    """The break after the current one: one past the highest the object uses or is on."""
+    data = obj.vg
+    return max([data.break_number, *(item.break_number for item in data.measurements)]) + 1
+
+
+def continue_after_recorded_breaks(obj) -> None:
+    """After recording many measurements at once (a batch run, a CSV import): make the current
+    break one past the highest in use, so the next click starts a break of its own instead of
+    joining a recorded one (and its colours)."""
+    data = obj.vg
+    highest = max((item.break_number for item in data.measurements), default=0)
+    data.break_number = max(data.break_number, highest + 1)
 
 
 _KEYS = (
@@ -127,13 +159,15 @@ def numbers_of(item) -> dict:
 
 
 def replay_args(item) -> dict:
-    """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``."""
+    """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``,
+    ``rule`` (``"paper"`` for records from before the rule existed: that is what they used)."""
     numbers = numbers_of(item)
     return {
         "center": np.array(numbers["center"], dtype=np.float64),
         "radius": float(numbers["radius"]),
         "lam": float(numbers["lam"]),
         "patch": item.patch,
+        "rule": numbers.get("rule", "paper"),
     }
 
 
@@ -152,6 +186,7 @@ def to_row(
     (``"float32"``, Blender's mesh, unless a batch run measured a file's float64 ones)."""
     numbers = numbers_of(item)
     x, y, z = numbers["center"]
+    stability = numbers.get("stability") or {}
     return csvio.MeasurementRow(
         mesh_name=obj.name,
         date=item.date,
@@ -181,5 +216,16 @@ def to_row(
         stale=stale,
         extension_version=extension_version(),
         blender_version=bpy.app.version_string,
+        rule=numbers.get("rule", "paper"),
+        convexity=numbers.get("convexity", ""),
+        correlation=numbers.get("correlation"),
+        stability=stability.get("spread"),
+        stability_center=stability.get("center"),
+        stability_radius=stability.get("radius"),
+        stability_lam=stability.get("lam"),
+        stability_bootstrap=stability.get("bootstrap"),
+        stability_orientation=stability.get("orientation"),
+        stability_runs=stability.get("runs"),
+        stability_refused=stability.get("refused"),
         error="",
     )

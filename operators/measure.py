@@ -4,11 +4,18 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, StringProperty
+from bpy.props import (
+    BoolProperty,
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    IntProperty,
+    StringProperty,
+)
 
-from ..bridge import measuring
+from ..bridge import measuring, records
 from ..bridge.mesh_data import check_measurable, evaluated_geometry
-from ..properties import PATCH_ITEMS
+from ..properties import PATCH_ITEMS, RULE_ITEMS
 from ..vg_addon import GoniometerError
 
 
@@ -57,6 +64,10 @@ class MeasureProperties:
         soft_min=0.0,  # not min: a negative λ is refused, as in a CSV, not quietly made 0
     )
     patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
+    rule: EnumProperty(name="Rule", items=RULE_ITEMS, description="Default: the panel's")
+    stability: BoolProperty(
+        name="Stability", description="Compute the stability figure; default: the panel's"
+    )
     note: StringProperty(name="Note", description="Free text stored with the measurement")
 
 
@@ -78,6 +89,10 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
             self.seg_param = settings.seg_param
         if not given("patch"):
             self.patch = settings.patch
+        if not given("rule"):
+            self.rule = settings.rule
+        if not given("stability"):
+            self.stability = settings.stability
         obj = context.active_object
         try:
             item = measuring.measure_on_object(
@@ -88,15 +103,20 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
                 self.patch,
                 depsgraph=context.evaluated_depsgraph_get(),
                 note=self.note,
+                rule=self.rule,
+                stability=self.stability,
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
+        spread = f" {item.stability_text}" if self.stability else ""
         self.report(
             {"INFO"},
             f"Measurement {item.number} (break {item.break_number}) on '{obj.name}': "
-            f"{item.angle:.2f}° (fit error {item.fit_error:.3g}, {item.n_vertices} vertices)",
+            f"{item.angle:.2f}°{spread}, {item.convexity} edge (fit error {item.fit_error:.3g}, "
+            f"{item.n_vertices} vertices)",
         )
+
         if warning := _stale_warning(obj):
             self.report({"WARNING"}, warning)
         return {"FINISHED"}
@@ -127,7 +147,8 @@ def _active_geometry(operator, context):
 
 
 class VG_OT_next_break(bpy.types.Operator):
-    """Start a new break: the next measurements get the next break number and colour pair"""
+    """Start a new break: the next measurements get a break number no measurement has yet, and
+    its colour pair"""
 
     bl_idname = "vg.next_break"
     bl_label = "Next Break"
@@ -137,7 +158,7 @@ class VG_OT_next_break(bpy.types.Operator):
         obj = _active_measurable(self, context)
         if obj is None:
             return {"CANCELLED"}
-        obj.vg.break_number += 1
+        obj.vg.break_number = records.next_free_break(obj)
         self.report({"INFO"}, f"Break {obj.vg.break_number} on '{obj.name}'")
         return {"FINISHED"}
 
@@ -208,7 +229,7 @@ class VG_OT_repaint(bpy.types.Operator):
         if obj is None:
             return {"CANCELLED"}
         try:
-            measuring.repaint(obj, depsgraph=context.evaluated_depsgraph_get())
+            measuring.repaint(obj, depsgraph=context.evaluated_depsgraph_get(), verify=True)
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import importlib
 import os
 import struct
 import subprocess
@@ -15,8 +16,9 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import colours, exact, mesh_object
+from bpy_helpers import colours, exact, expected_colours, mesh_object
 
+from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
 from vg_addon.synthetic_meshes import bone_fragment, wedge
 
@@ -413,3 +415,68 @@ def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
     assert png_size(out / "bone_fragment.png") == (800, 600)
     assert (out / "bone_fragment.blend").stat().st_size > 0
     assert meshio.read_mesh(out / "bone_fragment.ply").n_vertices > 200_000
+
+
+def test_batch_paints_as_the_extension_does_break_0_included(vg, meshes, tmp_path):
+    """The batch paints through the extension's own painter: every measured row is painted,
+    later over earlier, a row of break 0 too (the batch's former painter skipped it)."""
+    points = write_csv(
+        tmp_path / "points.csv",
+        ["x", "y", "z", "break", "label"],
+        [["-0.3", "0", "0", "0", "a"], ["-0.1", "0", "0", "2", "b"], ["0.05", "0", "0", "0", "c"]],
+    )
+    out, saved = tmp_path / "out.csv", tmp_path / "saved.blend"
+    ok(batch(meshes["ply"], "--points", points, "--radius", RADIUS, "--out", out,
+             "--save-blend", saved))  # fmt: skip
+    bpy.ops.wm.open_mainfile(filepath=str(saved))
+    obj = bpy.data.objects["w90"]
+    assert [i.break_number for i in obj.vg.measurements] == [0, 2, 0]
+    co = np.empty(len(obj.data.vertices) * 3, dtype=np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    mesh = meshio.read_mesh(meshes["ply"])
+    surface = Surface(co.reshape(-1, 3).astype(np.float64), mesh.triangles)
+    sides = []
+    for item in obj.vg.measurements:
+        m = surface.measure(exact(item)["center"], RADIUS)
+        sides.append((m.indices, m.labels, item.break_number))
+    np.testing.assert_array_equal(colours(obj), expected_colours(vg, len(obj.data.vertices), sides))
+
+
+@pytest.mark.parametrize("flaw", ["none", "degenerate", "duplicate"])
+def test_imported_mesh_is_blenders_own_ply_import(vg, tmp_path, flaw):
+    """The batch's import gives the mesh File > Import > PLY gives (Blender's C++ importer),
+    for a clean triangle list and for ones Blender has to repair."""
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    shape = wedge(70.0, n=12, irregular=True, seed=1)
+    triangles = shape.triangles.copy()
+    if flaw == "degenerate":
+        triangles = np.vstack([triangles, [[3, 3, 7]]])
+    elif flaw == "duplicate":
+        triangles = np.vstack([triangles, triangles[5][[1, 2, 0]]])
+    path = meshio.write_ply(tmp_path / f"{flaw}.ply", shape.points, triangles)
+    ours = sources.import_mesh(sources.MeshSource("ours", str(path)))
+    assert bpy.ops.wm.ply_import(filepath=str(path)) == {"FINISHED"}
+    blenders = bpy.context.selected_objects[0]
+    assert blenders != ours
+    for attribute, kind, width in (("position", "vector", 3), (".corner_vert", "value", 1)):
+        got, want = (
+            np.empty(len(o.data.attributes[attribute].data) * width) for o in (ours, blenders)
+        )
+        ours.data.attributes[attribute].data.foreach_get(kind, got)
+        blenders.data.attributes[attribute].data.foreach_get(kind, want)
+        np.testing.assert_array_equal(got, want, attribute)
+    assert len(ours.data.polygons) == len(shape.triangles)  # the flaw is gone
+
+
+def test_needs_validation_agrees_with_brute_force(vg):
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    rng = np.random.default_rng(0)
+    for n in (6, 40, 3_000_000):  # the last packs no key into 63 bits
+        for _ in range(30):
+            triangles = rng.integers(0, min(n, 40), size=(int(rng.integers(1, 12)), 3))
+            triangles[0, 0] = n - 1  # fixes the largest index
+            seen, flawed = set(), False
+            for row in triangles.tolist():
+                flawed |= len(set(row)) < 3 or frozenset(row) in seen
+                seen.add(frozenset(row))
+            assert sources.needs_validation(triangles) == flawed, triangles

@@ -16,6 +16,7 @@ def test_zip_holds_the_extension_and_nothing_else(extension_zip):
         "blender_manifest.toml",
         "__init__.py",
         "properties.py",
+        "numpy_missing.py",
         "LICENSE",
         "bridge/measuring.py",
         "ui/panels.py",

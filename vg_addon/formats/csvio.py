@@ -38,6 +38,7 @@ from datetime import datetime
 from pathlib import Path
 
 from ..errors import GoniometerError, bounded_list
+from ..method.algorithm import RULES
 from ..method.surface import PATCH_MODES
 from ..palette import OKABE_ITO
 
@@ -90,7 +91,34 @@ _SCHEMA = (
     ("stale", "bool", ("Stale",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
+    ("rule", "text", ("Rule",)),
+    ("convexity", "text", ("Convexity",)),
+    ("correlation", "float", ("Convexity Correlation",)),
+    ("stability", "float", ("Stability",)),
+    ("stability_center", "float", ("Stability Centre",)),
+    ("stability_radius", "float", ("Stability Radius",)),
+    ("stability_lam", "float", ("Stability SegParam",)),
+    ("stability_bootstrap", "float", ("Stability Bootstrap",)),
+    ("stability_orientation", "float", ("Stability Orientation",)),
+    ("stability_runs", "int", ("Stability Runs",)),
+    ("stability_refused", "int", ("Stability Refused",)),
     ("error", "text", ("error",)),
+)
+
+#: Columns added with the oriented rule (issue 8). Exports written before lack them; such a file
+#: still reads, and its rows replicate with the paper's rule, the only one there was then.
+RULE_COLUMNS = (
+    "Rule",
+    "Convexity",
+    "Convexity Correlation",
+    "Stability",
+    "Stability Centre",
+    "Stability Radius",
+    "Stability SegParam",
+    "Stability Bootstrap",
+    "Stability Orientation",
+    "Stability Runs",
+    "Stability Refused",
 )
 
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
@@ -98,7 +126,7 @@ EXPORT_COLUMNS = tuple(column for _, _, columns in _SCHEMA for column in columns
 
 # Columns added after the first release: an export written before them still reads back
 # (their cells read as empty).
-_LATER_COLUMNS = frozenset(["Precision"])
+_LATER_COLUMNS = frozenset(["Precision", *RULE_COLUMNS])
 
 #: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
 SOURCE_FORMATS = ("extension", "meshlab", "points")
@@ -188,6 +216,19 @@ class MeasurementRow:
     stale : bool
         The mesh changed since the measurement was taken.
     extension_version, blender_version : str
+    rule : str
+        ``"oriented"`` or ``"paper"``: how the projection was signed (see ``vg_addon.method``).
+    convexity : str
+        ``"convex"``, ``"concave"`` (the angle is then the open wedge's) or ``"unclear"``.
+    correlation : float or None
+        The correlation whose sign gives the convexity (its size: how clearly).
+    stability : float or None
+        The stability figure, degrees (the "±"); empty when it was not computed.
+    stability_center, stability_radius, stability_lam, stability_bootstrap, stability_orientation : float or None
+        Its parts: the largest change of the angle with the centre moved, the radius ±10%, λ from
+        1 to 3, the bootstrap's 95% half-width, and the other sign's reading where unclear.
+    stability_runs, stability_refused : int or None
+        Perturbed measurements tried, and how many of them were refused.
     error : str
         Empty for a good row; why it failed otherwise.
     """
@@ -220,6 +261,17 @@ class MeasurementRow:
     stale: bool = False
     extension_version: str = ""
     blender_version: str = ""
+    rule: str = ""
+    convexity: str = ""
+    correlation: float | None = None
+    stability: float | None = None
+    stability_center: float | None = None
+    stability_radius: float | None = None
+    stability_lam: float | None = None
+    stability_bootstrap: float | None = None
+    stability_orientation: float | None = None
+    stability_runs: int | None = None
+    stability_refused: int | None = None
     error: str = ""
 
 
@@ -253,6 +305,11 @@ class ReplicationRow:
         ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
         columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
         else with x, y, z columns).
+    rule : str or None
+        The rule to replicate with: the ``Rule`` cell of an export; ``"paper"`` for MeshLab and
+        earlier add-on files and for exports written before the ``Rule`` column existed (they
+        were all measured with the paper's rule); a points file's ``rule`` column, else ``None``
+        (the current default).
     """
 
     row_number: int
@@ -267,6 +324,7 @@ class ReplicationRow:
     number: int | float | None = None
     break_number: int | None = None
     source_format: str = "points"
+    rule: str | None = None
 
 
 # --------------------------------------------------------------------------- small helpers
@@ -642,6 +700,17 @@ def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
         Other file-system errors (disk full, no permission to create the file, ...).
     """
     data = format_measurements_csv(rows).encode("utf-8")
+    replace_atomically(path, data)
+
+
+def replace_atomically(path, data: bytes) -> None:
+    """Write ``data`` to ``path``, the way every output file of the project is written.
+
+    A regular file (or a new one) is replaced in one step, through a temporary file beside it,
+    so it holds its old content or the new one, never part of it; a symbolic link keeps its link
+    and its target is replaced. ``-`` (standard output), devices and pipes are written into,
+    never replaced. See :func:`output_target` for what is refused.
+    """
     path = os.fspath(path)
     if output_target(path) == "stream":
         _write_into(path, data)
@@ -765,6 +834,7 @@ _REPLICATION_ALIASES = {
     "label": ("label", "user data", "note", "notes"),
     "number": ("measurement #", "measurement number", "measurement", "number"),
     "break_number": ("break #", "break number", "break"),
+    "rule": ("rule",),
     "error": ("error",),
 }
 _REQUIRED = ("x", "y", "z")
@@ -913,6 +983,15 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                     f"row {number}: unknown patch mode {cell('patch').strip()!r} "
                     f"(use {' or '.join(PATCH_MODES)})"
                 )
+        rule = _parse_optional_text(cell("rule"))
+        if rule is not None:
+            rule = rule.casefold()
+            if rule not in RULES:
+                problems.append(
+                    f"row {number}: unknown rule {cell('rule').strip()!r} (use {' or '.join(RULES)})"
+                )
+        elif fmt != "points":
+            rule = "paper"  # MeshLab, the earlier add-on, exports from before the Rule column
         if problems:
             continue  # nothing is returned anyway; keep collecting
         rows.append(
@@ -929,6 +1008,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 number=_lenient_number(cell("number")),
                 break_number=break_number,
                 source_format=fmt,
+                rule=rule,
             )
         )
     if problems:
@@ -963,7 +1043,10 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
     aliases: ``Mesh Name``/``Mesh``/``Object``; ``x``/``Center x``; ``Radius``/``r``;
     ``SegParam``/``Seg Param``/``lambda``/``λ``/``Segmentation Parameter``;
     ``Patch Mode``/``patch``; ``label``/``User Data``/``note`` (``label`` wins over
-    ``User Data``); ``Measurement #``; ``Break #``; ``error``. Only x, y and z are required.
+    ``User Data``); ``Measurement #``; ``Break #``; ``Rule`` (``oriented`` or ``paper``);
+    ``error``. Only x, y and z are required. Rows of MeshLab and earlier add-on files, and of
+    exports without a ``Rule`` column, replicate with the paper's rule (see
+    :attr:`ReplicationRow.rule`).
     A UTF-8 byte-order mark is ignored; cells are read without surrounding whitespace, and the
     apostrophe the writer puts before formula-like text is removed.
 
@@ -1082,3 +1165,72 @@ def read_measurements_csv(path_or_text) -> list[MeasurementRow]:
     """
     text, source = _load(path_or_text)
     return parse_measurements_csv(text, source)
+
+
+# --------------------------------------------------------------------------- radius sweeps
+
+#: The columns of a radius-sweep CSV: one row per radius, refused radii with their message.
+SWEEP_COLUMNS = (
+    "Mesh Name",
+    "Measurement #",
+    "Radius",
+    "Angle",
+    "fit",
+    "Number of Vertices",
+    "Vertices +",
+    "Vertices -",
+    "Convexity",
+    "x",
+    "y",
+    "z",
+    "Requested x",
+    "Requested y",
+    "Requested z",
+    "SegParam",
+    "Patch Mode",
+    "Rule",
+    "error",
+)
+
+
+def sweep_cells(mesh_name: str, number: int | None, point) -> list[str]:
+    """The cells of one :data:`SWEEP_COLUMNS` row for a ``vg_addon.method.sweep.SweepPoint``.
+
+    A refused radius keeps its radius and message; its measured cells are empty.
+    """
+    m = point.measurement
+
+    def cell(value, column):
+        return _float_cell(value, 0, point, column)
+
+    cells = [_escape_text(str(mesh_name)), "" if number is None else str(int(number))]
+    cells.append(cell(point.radius, "Radius"))
+    if m is None:
+        cells += [""] * (len(SWEEP_COLUMNS) - 4)
+    else:
+        cells += [
+            cell(m.angle, "Angle"),
+            cell(m.fit_error, "fit"),
+            str(int(m.n_vertices)),
+            str(int(m.n_plus)),
+            str(int(m.n_minus)),
+            m.convexity,
+            *(cell(v, "x") for v in m.center),
+            *(cell(v, "Requested x") for v in m.requested_center),
+            cell(m.lam, "SegParam"),
+            m.patch,
+            m.rule,
+        ]
+    cells.append(_escape_text(point.error))
+    return cells
+
+
+def format_sweep_rows(rows: Iterable[Sequence[str]]) -> str:
+    """A sweep CSV's text: the :data:`SWEEP_COLUMNS` header, then rows from :func:`sweep_cells`."""
+    return _csv_line(SWEEP_COLUMNS) + "".join(_csv_line(cells) for cells in rows)
+
+
+def write_sweep_csv(path, mesh_name: str, points, number: int | None = None) -> None:
+    """Write one site's sweep to ``path`` atomically (as :func:`write_measurements_csv`)."""
+    text = format_sweep_rows(sweep_cells(mesh_name, number, point) for point in points)
+    replace_atomically(os.fspath(path), text.encode("utf-8"))
