@@ -149,7 +149,14 @@ def test_a_blend_that_fails_late_gives_a_nonzero_exit_and_keeps_the_csv(scan, tm
 
 
 def arguments(**given) -> argparse.Namespace:
-    values = {"inputs": [], "points": None, "out": None, "save_blend": None, "render": None}
+    values = {
+        "inputs": [],
+        "points": None,
+        "out": None,
+        "save_blend": None,
+        "render": None,
+        "sweep": None,
+    }
     return argparse.Namespace(**(values | given))
 
 
@@ -198,3 +205,17 @@ def test_a_break_number_blender_cannot_store_refuses_the_points_csv(scan, tmp_pa
     refused(batch(scan, "--points", points, "--radius", "0.3", "--out", out),
             f"row 3: Break # must be a whole number from 1 to 2147483647 (got '{cell}')")  # fmt: skip
     assert not out.exists()
+
+
+def test_sweep_outputs_are_checked_like_the_others(scan, tmp_path):
+    sweep = ("--sweep", "0.2", "0.4", "3")
+    refused(
+        batch(scan, *AT, *sweep, "--out", "-", cwd=tmp_path), "--sweep writes", "must be a file"
+    )
+    # <out>_sweep.csv would be the input scan: refused before anything is written.
+    victim = tmp_path / "o_sweep.csv"
+    victim.write_text("x,y,z\n0.05,0,0\n")
+    refused(batch(scan, "--points", victim, "--radius", "0.3", *sweep, "--out", tmp_path / "o.csv"),
+            "--sweep's CSV", "is the points CSV")  # fmt: skip
+    assert victim.read_text() == "x,y,z\n0.05,0,0\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["o_sweep.csv", "scan.ply"]
