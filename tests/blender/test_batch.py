@@ -152,11 +152,15 @@ def test_points_given_with_at_on_ply_obj_and_stl(meshes, tmp_path):
         assert abs(r.angle - 90.0) < 0.01
         assert (r.radius, r.seg_param, r.patch) == (RADIUS, 2.0, "euclidean")
         assert r.units == "BU" and r.extension_version and r.blender_version
-    # The same surface in three file formats: the same float32 vertices and faces in Blender,
-    # hence the same numbers, bit for bit.
-    for kind in ("obj", "stl"):
-        assert [r.angle for r in results[kind]] == [r.angle for r in rows]
-        assert [r.normal_plus for r in results[kind]] == [r.normal_plus for r in rows]
+    # The same surface in three file formats. PLY and OBJ carry the float64 coordinates, which
+    # float32 would round: both are measured at the file's precision, bit for bit alike. STL
+    # holds float32 coordinates: measured as Blender stores them, so equal to rounding only.
+    assert {r.precision for r in rows} == {r.precision for r in results["obj"]} == {"float64"}
+    assert [r.angle for r in results["obj"]] == [r.angle for r in rows]
+    assert [r.normal_plus for r in results["obj"]] == [r.normal_plus for r in rows]
+    assert {r.precision for r in results["stl"]} == {"float32"}
+    for stl, ply in zip(results["stl"], rows, strict=True):
+        assert abs(stl.angle - ply.angle) < 1e-6
 
 
 def test_points_csv_plain_our_export_and_meshlab_replicate_the_same_angles(meshes, tmp_path):
@@ -300,13 +304,18 @@ def test_render_writes_a_png_per_mesh(meshes, tmp_path):
 # --------------------------------------------------------------------------- against the extension
 
 
-def test_batch_angle_equals_measure_xyz_on_blenders_own_ply_import(vg, meshes, tmp_path):
+def test_batch_angle_equals_measure_xyz_on_blenders_own_ply_import(vg, tmp_path):
+    # Coordinates float32 holds exactly: Blender's mesh is then the file (a float64 file that
+    # float32 rounds is measured at the file's precision by the batch, not by Blender).
+    shape = wedge(90.0, n=24, irregular=True, seed=3)
+    ply = meshio.write_ply(tmp_path / "w90.ply", shape.points.astype(np.float32), shape.triangles)
     out = tmp_path / "out.csv"
-    ok(batch(meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS, "--lambda", "1.5",
+    ok(batch(ply, *("--at", *CREASE[1]), "--radius", RADIUS, "--lambda", "1.5",
              "--out", out))  # fmt: skip
     row = rows_of(out)[0]
+    assert row.precision == "float32"
 
-    bpy.ops.wm.ply_import(filepath=str(meshes["ply"]))
+    bpy.ops.wm.ply_import(filepath=str(ply))
     obj = bpy.data.objects["w90"]
     bpy.context.view_layer.objects.active = obj
     location = tuple(float(v) for v in CREASE[1])
@@ -417,20 +426,21 @@ def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
     assert meshio.read_mesh(out / "bone_fragment.ply").n_vertices > 200_000
 
 
-def test_batch_paints_as_the_extension_does_break_0_included(vg, meshes, tmp_path):
+def test_batch_paints_as_the_extension_does(vg, meshes, tmp_path):
     """The batch paints through the extension's own painter: every measured row is painted,
-    later over earlier, a row of break 0 too (the batch's former painter skipped it)."""
+    later over earlier (break 0, which the batch's former painter skipped, is now refused on
+    input: a break number is 1 or more)."""
     points = write_csv(
         tmp_path / "points.csv",
         ["x", "y", "z", "break", "label"],
-        [["-0.3", "0", "0", "0", "a"], ["-0.1", "0", "0", "2", "b"], ["0.05", "0", "0", "0", "c"]],
+        [["-0.3", "0", "0", "1", "a"], ["-0.1", "0", "0", "2", "b"], ["0.05", "0", "0", "1", "c"]],
     )
     out, saved = tmp_path / "out.csv", tmp_path / "saved.blend"
     ok(batch(meshes["ply"], "--points", points, "--radius", RADIUS, "--out", out,
              "--save-blend", saved))  # fmt: skip
     bpy.ops.wm.open_mainfile(filepath=str(saved))
     obj = bpy.data.objects["w90"]
-    assert [i.break_number for i in obj.vg.measurements] == [0, 2, 0]
+    assert [i.break_number for i in obj.vg.measurements] == [1, 2, 1]
     co = np.empty(len(obj.data.vertices) * 3, dtype=np.float32)
     obj.data.vertices.foreach_get("co", co)
     mesh = meshio.read_mesh(meshes["ply"])
@@ -439,7 +449,7 @@ def test_batch_paints_as_the_extension_does_break_0_included(vg, meshes, tmp_pat
     for item in obj.vg.measurements:
         m = surface.measure(exact(item)["center"], RADIUS)
         sides.append((m.indices, m.labels, item.break_number))
-    np.testing.assert_array_equal(colours(obj), expected_colours(vg, len(obj.data.vertices), sides))
+    np.testing.assert_array_equal(colours(obj), expected_colours(len(obj.data.vertices), sides))
 
 
 @pytest.mark.parametrize("flaw", ["none", "degenerate", "duplicate"])
@@ -454,7 +464,7 @@ def test_imported_mesh_is_blenders_own_ply_import(vg, tmp_path, flaw):
     elif flaw == "duplicate":
         triangles = np.vstack([triangles, triangles[5][[1, 2, 0]]])
     path = meshio.write_ply(tmp_path / f"{flaw}.ply", shape.points, triangles)
-    ours = sources.import_mesh(sources.MeshSource("ours", str(path)))
+    ours, _ = sources.import_mesh(sources.MeshSource("ours", str(path)))
     assert bpy.ops.wm.ply_import(filepath=str(path)) == {"FINISHED"}
     blenders = bpy.context.selected_objects[0]
     assert blenders != ours

@@ -33,7 +33,7 @@ def painted_from_scratch(vg, obj) -> np.ndarray:
         args = vg.bridge.records.replay_args(item)
         m = surface.measure(**args)
         sides.append((m.indices, m.labels, item.break_number))
-    return expected_colours(vg, len(obj.data.vertices), sides)
+    return expected_colours(len(obj.data.vertices), sides)
 
 
 def measure_at(x, radius=0.3, **kwargs):
