@@ -31,9 +31,25 @@ def script_argv() -> list[str]:
     return sys.argv[1:]
 
 
+def import_bpy_quietly():
+    """Import bpy with file descriptor 1 pointed at stderr: Blender logs to it while it starts
+    (e.g. "color_management | Using OCIO=..." when the OCIO variable is set), and standard
+    output is the batch's own (``--out -`` writes the CSV there)."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        import bpy  # noqa: F401
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def extension_package():
     """The extension package this script belongs to: the copy Blender already runs when it is
     this folder, else this folder imported as ``virtual_goniometer``."""
+    if "bpy" not in sys.modules:
+        import_bpy_quietly()
     import bpy
 
     for addon in bpy.context.preferences.addons:
