@@ -22,7 +22,7 @@ from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
 from .edges import edge_specs, spec_applies
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
-from .outputs import check_outputs, make_folders
+from .outputs import check_outputs, make_folders, sweep_paths
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
 from .workers import run_workers
@@ -183,12 +183,6 @@ class Run:
         where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
         self.say(f"wrote the CSV to {where}")
         return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
-
-
-def sweep_paths(out) -> tuple[Path, Path]:
-    """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``."""
-    out = Path(out).resolve()
-    return out.with_name(out.stem + "_sweep.csv"), out.with_name(out.stem + "_sweep")
 
 
 def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
