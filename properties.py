@@ -24,6 +24,7 @@ from bpy.props import (
     StringProperty,
 )
 from bpy.types import PropertyGroup
+from mathutils import Vector
 
 from .vg_addon import palette
 
@@ -60,6 +61,19 @@ def _vector(key):
     return get
 
 
+def _world_centre(self):
+    numbers = exact_numbers(self)
+    centre = numbers.get("center")
+    if not centre:
+        return (0.0, 0.0, 0.0)
+    if numbers.get("space", "world") == "world":
+        return tuple(centre)
+    matrix = getattr(self.id_data, "matrix_world", None)
+    if matrix is None:
+        return tuple(centre)
+    return tuple(matrix @ Vector(centre))
+
+
 def _side_colour(side):
     def get(self):
         names = self.colors.split("/")
@@ -90,12 +104,12 @@ class VG_Measurement(PropertyGroup):
     )
     fingerprint: StringProperty(
         name="Geometry fingerprint",
-        description="Hash of the evaluated mesh and transform the measurement was taken on",
+        description="Hash of the evaluated mesh the measurement was taken on",
         options={"HIDDEN"},
     )
     stale: BoolProperty(
         name="Stale",
-        description="The mesh or its transform changed since this measurement was taken: its "
+        description="The mesh or its modifiers changed since this measurement was taken: its "
         "numbers are kept as recorded, but it is no longer painted",
     )
 
@@ -110,10 +124,28 @@ class VG_Measurement(PropertyGroup):
         name="Snap distance", subtype="DISTANCE", unit="LENGTH", get=_number("snap_distance")
     )
     center: FloatVectorProperty(
-        name="Centre", size=3, subtype="XYZ", unit="LENGTH", get=_vector("center")
+        name="Centre (mesh)",
+        description="The vertex measured at, in the mesh's own coordinates (the CSV's x, y, z)",
+        size=3,
+        subtype="XYZ",
+        unit="LENGTH",
+        get=_vector("center"),
+    )
+    center_world: FloatVectorProperty(
+        name="Centre (world)",
+        description="The vertex measured at, in world space where the object is now",
+        size=3,
+        subtype="XYZ",
+        unit="LENGTH",
+        get=_world_centre,
     )
     requested_center: FloatVectorProperty(
-        name="Requested centre", size=3, subtype="XYZ", unit="LENGTH", get=_vector("requested")
+        name="Requested centre",
+        description="The point asked for before snapping, in mesh coordinates",
+        size=3,
+        subtype="XYZ",
+        unit="LENGTH",
+        get=_vector("requested"),
     )
     normal_plus: FloatVectorProperty(
         name="Plane normal +", size=3, subtype="DIRECTION", get=_vector("normal_plus")
@@ -140,6 +172,12 @@ class VG_ObjectData(PropertyGroup):
     next_number: IntProperty(
         name="Next measurement #", description="Number the next measurement gets", default=1, min=1
     )
+    sides_shown: BoolProperty(
+        name="Sides shown",
+        description="The viewports were switched to show the sides, on the first measurement",
+        default=False,
+        options={"HIDDEN"},
+    )
 
 
 class VG_SceneSettings(PropertyGroup):
@@ -147,7 +185,8 @@ class VG_SceneSettings(PropertyGroup):
 
     radius: FloatProperty(
         name="Radius",
-        description="Patch radius around the centre, in scene units (world space)",
+        description="Patch radius around the centre, in the mesh's own units (its coordinates, "
+        "whatever the object's scale)",
         default=1.0,
         min=0.0,
         soft_min=1e-4,

@@ -1,7 +1,9 @@
 """The "VG Sides" colour attribute: each measurement's two sides in a palette pair, the rest grey.
 
-Only this one attribute is ever written; the user's own colour attributes are left alone (the
-"VG Sides" attribute is made the active one so that the viewport shows it).
+Only this one attribute is ever written; the user's own colour attributes are left alone. The
+"VG Sides" attribute is made the active one, and solid viewports are switched to attribute
+colours, once per object, on its first measurement (:func:`show_sides_once`); a repaint never
+changes either, so a user who picks another attribute or shading keeps it.
 """
 
 from __future__ import annotations
@@ -10,7 +12,7 @@ import bpy
 import numpy as np
 
 from ..vg_addon import palette
-from .mesh_data import read_positions, world_points
+from .mesh_data import read_positions
 
 ATTRIBUTE_NAME = "VG Sides"
 
@@ -72,7 +74,7 @@ def original_vertex_colours(obj, geometry, measured) -> np.ndarray:
     n_evaluated = geometry.points.shape[0]
     if n_original == n_evaluated:
         return side_colours(n_original, [(m.indices, m.labels, b) for m, b in measured])
-    original = world_points(read_positions(mesh), geometry.matrix)
+    original = read_positions(mesh).astype(np.float64)
     sides = []
     for m, break_number in measured:
         offsets = original - m.center
@@ -83,7 +85,8 @@ def original_vertex_colours(obj, geometry, measured) -> np.ndarray:
 
 
 def write_attribute(mesh, rgba: np.ndarray) -> None:
-    """Write ``rgba`` into the mesh's "VG Sides" point colour attribute and make it active."""
+    """Write ``rgba`` into the mesh's "VG Sides" point colour attribute (the active colour
+    attribute is left as it is)."""
     existing = mesh.attributes.get(ATTRIBUTE_NAME)
     if existing is not None and (existing.domain != "POINT" or existing.data_type != "FLOAT_COLOR"):
         mesh.attributes.remove(existing)
@@ -92,8 +95,24 @@ def write_attribute(mesh, rgba: np.ndarray) -> None:
         mesh.color_attributes.new(ATTRIBUTE_NAME, "FLOAT_COLOR", "POINT")
     attribute = mesh.color_attributes[ATTRIBUTE_NAME]
     attribute.data.foreach_set("color", np.ascontiguousarray(rgba, dtype=np.float32).ravel())
-    mesh.color_attributes.active_color = mesh.color_attributes[ATTRIBUTE_NAME]
     mesh.update()
+
+
+def show_sides_once(obj, context=None) -> bool:
+    """On an object's first measurement, make "VG Sides" its active colour attribute and switch
+    solid viewports to attribute colours; afterwards do nothing (the user's choice stands).
+
+    Returns True when it switched.
+    """
+    if obj.vg.sides_shown:
+        return False
+    attribute = obj.data.color_attributes.get(ATTRIBUTE_NAME)
+    if attribute is None:
+        return False
+    obj.data.color_attributes.active_color = attribute
+    obj.vg.sides_shown = True
+    show_in_viewports(context)
+    return True
 
 
 def read_attribute(mesh) -> np.ndarray | None:

@@ -15,8 +15,15 @@ import numpy as np
 from ..vg_addon import GoniometerError, Measurement
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
-from . import colors, records
-from .mesh_data import Geometry, check_measurable, evaluated_geometry, surface_for
+from . import colors, legacy, records
+from .mesh_data import (
+    Geometry,
+    check_measurable,
+    evaluated_geometry,
+    mesh_points,
+    surface_for,
+    uniform_scale,
+)
 
 # Measurements are deterministic, so a repaint can reuse the sides of a measurement it has
 # already computed for the same geometry and inputs.
@@ -48,32 +55,40 @@ def _replay(obj, geometry: Geometry, item) -> Measurement:
     return m
 
 
-def measure(obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None):
+def measure(obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None, space="mesh"):
     """Measure ``obj`` without recording anything: ``(Measurement, Geometry)``.
 
-    The building block for previews (e.g. a drag tool) and for :func:`measure_on_object`.
+    The building block for previews (e.g. a drag tool) and for :func:`measure_on_object`;
+    the arguments are those of :func:`measure_on_object`.
     """
     check_measurable(obj)
     geometry = evaluated_geometry(obj, depsgraph)
+    if space == "world":
+        location = mesh_points(location, geometry.matrix)
+    elif space != "mesh":
+        raise GoniometerError(f"Unknown coordinate space {space!r}: use 'mesh' or 'world'.")
     m = surface_for(obj, geometry).measure(location, radius, lam, patch)
     _remember(geometry.fingerprint, m)
     return m, geometry
 
 
 def measure_on_object(
-    obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None, note=""
+    obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None, note="", space="mesh"
 ):
     """Measure the active mesh at ``location``, record the measurement and repaint the sides.
 
     Parameters
     ----------
     obj : bpy.types.Object
-        The mesh object; its evaluated mesh (modifiers applied) is measured in world space.
+        The mesh object; its evaluated mesh (modifiers applied) is measured in its own
+        coordinates (object space), so the object's transform changes nothing.
     location : array_like, shape (3,)
-        Requested centre, world space, scene units (float64 is kept exactly); it snaps to the
-        nearest vertex within ``radius``.
+        Requested centre, in mesh coordinates (float64 is kept exactly) or, with
+        ``space="world"``, in world space (converted by the object's ``matrix_world``); it snaps
+        to the nearest vertex within ``radius``.
     radius : float
-        Patch radius, world space, scene units.
+        Patch radius, in mesh units (the units of the mesh's coordinates, whatever the object's
+        scale).
     lam : float
         Segmentation parameter λ (MeshLab's SegParam).
     patch : {"euclidean", "geodesic"}
@@ -81,10 +96,14 @@ def measure_on_object(
         Default: the context's evaluated depsgraph.
     note : str
         Free text stored with the measurement (the CSV's User Data).
+    space : {"mesh", "world"}
+        The coordinates ``location`` is given in.
 
     Returns
     -------
-    The new ``VG_Measurement`` item on ``obj.vg.measurements`` (now the active one).
+    The new ``VG_Measurement`` item on ``obj.vg.measurements`` (now the active one). The first
+    measurement of an object also shows the sides in the viewports (``colors.show_sides_once``),
+    once per object.
 
     Raises
     ------
@@ -92,9 +111,10 @@ def measure_on_object(
         No object, not a mesh, linked data, Edit Mode, an empty mesh, a location farther than
         ``radius`` from the surface, too few vertices, ...; nothing is changed then.
     """
-    m, geometry = measure(obj, location, radius, lam, patch, depsgraph=depsgraph)
+    m, geometry = measure(obj, location, radius, lam, patch, depsgraph=depsgraph, space=space)
     records.add_measurement(obj, m, geometry.fingerprint, note=note)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    colors.show_sides_once(obj)
     return obj.vg.measurements[obj.vg.active_index]
 
 
@@ -104,7 +124,9 @@ def repaint(obj, *, depsgraph=None, geometry: Geometry | None = None) -> list[in
     Every measurement whose geometry fingerprint still matches the evaluated mesh is re-measured
     at its exact stored centre, radius, λ and patch mode (deterministic, so its sides are the
     ones it had) and painted, later measurements over earlier ones. The others are flagged
-    stale and left unpainted.
+    stale and left unpainted. Records from versions that measured in world space are first
+    brought into mesh coordinates where they still match (see ``legacy``). The viewports'
+    shading is left as the user set it.
 
     Returns
     -------
@@ -114,6 +136,8 @@ def repaint(obj, *, depsgraph=None, geometry: Geometry | None = None) -> list[in
     check_measurable(obj)
     if geometry is None:
         geometry = evaluated_geometry(obj, depsgraph)
+    if legacy.has_world_records(obj):
+        legacy.migrate(obj, geometry, surface_for(obj, geometry))
     measured, stale = [], []
     for item in obj.vg.measurements:
         is_stale = item.fingerprint != geometry.fingerprint
@@ -127,7 +151,6 @@ def repaint(obj, *, depsgraph=None, geometry: Geometry | None = None) -> list[in
         if is_stale:
             stale.append(item.number)
     colors.write_attribute(obj.data, colors.original_vertex_colours(obj, geometry, measured))
-    colors.show_in_viewports()
     return stale
 
 
@@ -153,6 +176,7 @@ def replicate_rows(
     patch="euclidean",
     depsgraph=None,
     source="the CSV",
+    progress=None,
 ):
     """Re-measure every replication row on ``obj`` and record them all, or nothing.
 
@@ -166,6 +190,14 @@ def replicate_rows(
         is an error when ``radius`` is None.
     source : str
         How to name the rows' origin in messages (e.g. the file name).
+    progress : callable, optional
+        Called as ``progress(done, total)`` before each row is measured; returning False
+        cancels the import (a GoniometerError; nothing is recorded).
+
+    Rows in mesh coordinates (``row.coordinates == "mesh"``: every file but this extension's
+    exports from before it measured in mesh coordinates) are measured as they are. Rows in
+    world space are brought into mesh coordinates by the object's current transform, the radius
+    divided by its scale; that needs a transform that scales every direction alike.
 
     Each new measurement keeps the row's break number when it has one (else the object's
     current break) and takes the row's label or User Data as its note.
@@ -187,14 +219,31 @@ def replicate_rows(
         csvio.check_mesh_names(rows, (obj.name, obj.data.name), source=source)
     geometry = evaluated_geometry(obj, depsgraph)
     surface = surface_for(obj, geometry)
+    scale = uniform_scale(geometry.matrix)
     results, failures = [], []
-    for row in rows:
+    for done, row in enumerate(rows):
+        if progress is not None and progress(done, len(rows)) is False:
+            raise GoniometerError(
+                f"Import of {source} cancelled after {done} of {len(rows)} rows: nothing was "
+                "imported."
+            )
         try:
             row_radius = radius if row.radius is None else row.radius
             if row_radius is None:
                 raise GoniometerError("no radius (the CSV has no Radius for this row)")
+            location = (row.x, row.y, row.z)
+            if row.coordinates == records.WORLD:
+                if scale is None:
+                    raise GoniometerError(
+                        "its coordinates are in world space and the object's scale is not "
+                        "uniform, so its radius has no single length on the mesh: re-export "
+                        "the CSV in mesh coordinates, or set a uniform scale"
+                    )
+                location = mesh_points(location, geometry.matrix)
+                if row.radius is not None:
+                    row_radius = row.radius / scale
             m = surface.measure(
-                (row.x, row.y, row.z),
+                location,
                 row_radius,
                 lam if row.lam is None else row.lam,
                 row.patch or patch,
@@ -216,6 +265,7 @@ def replicate_rows(
         )
         numbers.append(item.number)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    colors.show_sides_once(obj)
     return numbers
 
 

@@ -1,5 +1,10 @@
-"""From a Blender mesh object to NumPy: world-space float64 vertices, triangles, a fingerprint,
-and a cache of prepared :class:`~vg_addon.Surface` objects."""
+"""From a Blender mesh object to NumPy: float64 vertices in the mesh's own coordinates,
+triangles, a fingerprint, and a cache of prepared :class:`~vg_addon.Surface` objects.
+
+Measurements are taken in mesh coordinates (object space: the coordinates of the file the scan
+came from), so moving, rotating or scaling the object changes none of them; the object's
+``matrix_world`` only converts a world-space point (the 3D cursor, a click) into them and back.
+"""
 
 from __future__ import annotations
 
@@ -26,14 +31,14 @@ class Geometry:
     local : ndarray of float32, shape (n, 3)
         Vertex coordinates in object space, as Blender stores them.
     triangles : ndarray of int64, shape (m, 3)
-        Triangulated faces, wound so that normals point outward in world space.
+        Triangulated faces, as the mesh winds them.
     matrix : ndarray of float64, shape (4, 4)
-        The evaluated object's ``matrix_world``.
+        The evaluated object's ``matrix_world`` (not part of the measurement).
     points : ndarray of float64, shape (n, 3)
-        World-space vertex coordinates (see :func:`world_points`).
+        ``local`` as float64: the coordinates every measurement is taken in.
     fingerprint : str
-        Hash of ``local``, the face topology and ``matrix``: equal fingerprints mean equal
-        measurements.
+        Hash of ``local`` and the face topology: equal fingerprints mean equal measurements.
+        The object's transform is not part of it.
     """
 
     local: np.ndarray
@@ -53,10 +58,48 @@ def world_points(local: np.ndarray, matrix: np.ndarray) -> np.ndarray:
     return local @ matrix[:3, :3].T + matrix[:3, 3]
 
 
-def fingerprint(local: np.ndarray, triangles: np.ndarray, matrix: np.ndarray) -> str:
-    """A short hex digest of the geometry a measurement depends on."""
+def mesh_points(world: np.ndarray, matrix: np.ndarray) -> np.ndarray:
+    """Mesh (object-space) float64 coordinates of world-space points: the inverse of
+    :func:`world_points`.
+
+    Raises
+    ------
+    GoniometerError
+        The transform cannot be inverted (a scale of 0 on some axis).
+    """
+    matrix = np.asarray(matrix, dtype=np.float64)
+    linear = matrix[:3, :3]
+    if not np.isfinite(matrix).all() or abs(np.linalg.det(linear)) <= 1e-300:
+        raise GoniometerError(
+            "The object's transform flattens it (a scale of 0 on some axis): a point in world "
+            "space has no place on its mesh. Give it a non-zero scale."
+        )
+    world = np.asarray(world, dtype=np.float64)
+    return np.linalg.solve(linear, (world - matrix[:3, 3]).T).T
+
+
+def uniform_scale(matrix: np.ndarray, rtol: float = 1e-6) -> float | None:
+    """The scale factor of ``matrix`` if it scales every direction alike (a rotation, a
+    mirror, a uniform scale and a move), else None (a non-uniform scale or a shear).
+
+    A non-uniform object scale changes angles in world space; measurements are taken in mesh
+    coordinates and do not see it.
+    """
+    linear = np.asarray(matrix, dtype=np.float64)[:3, :3]
+    gram = linear.T @ linear
+    scale2 = float(np.trace(gram)) / 3.0
+    if not np.isfinite(scale2) or scale2 <= 0.0:
+        return None
+    if np.abs(gram - scale2 * np.eye(3)).max() > rtol * scale2:
+        return None
+    return float(np.sqrt(scale2))
+
+
+def fingerprint(*arrays: np.ndarray) -> str:
+    """A short hex digest of the geometry a measurement depends on (the vertex coordinates and
+    the triangles)."""
     digest = hashlib.blake2b(digest_size=16)
-    for array in (local, triangles, matrix):
+    for array in arrays:
         array = np.ascontiguousarray(array)
         digest.update(f"{array.dtype.str}{array.shape}".encode())
         digest.update(memoryview(array).cast("B"))
@@ -117,7 +160,7 @@ def check_measurable(obj) -> None:
 
 
 def evaluated_geometry(obj, depsgraph=None) -> Geometry:
-    """The evaluated mesh of ``obj`` (modifiers applied) in world space.
+    """The evaluated mesh of ``obj`` (modifiers applied) in its own coordinates.
 
     Parameters
     ----------
@@ -138,19 +181,13 @@ def evaluated_geometry(obj, depsgraph=None) -> Geometry:
     if local.shape[0] == 0:
         raise GoniometerError(f"'{obj.name}' has no vertices: there is nothing to measure.")
     matrix = np.array(obj_eval.matrix_world, dtype=np.float64)
-    key = fingerprint(local, triangles, matrix)
-    triangles = triangles.astype(np.int64)
-    if np.linalg.det(matrix[:3, :3]) < 0.0:
-        # A mirroring transform turns the faces inside out in world space: flip the winding so
-        # the normals the core derives from it still point outward.
-        triangles = triangles[:, ::-1].copy()
-    points = world_points(local, matrix)
+    key = fingerprint(local, triangles)
+    points = local.astype(np.float64)
     if not np.isfinite(points).all():
         raise GoniometerError(
-            f"'{obj.name}' has vertices with infinite or NaN coordinates (check its transform "
-            "and modifiers)."
+            f"'{obj.name}' has vertices with infinite or NaN coordinates (check its modifiers)."
         )
-    return Geometry(local, triangles, matrix, points, key)
+    return Geometry(local, triangles.astype(np.int64), matrix, points, key)
 
 
 def surface_for(obj, geometry: Geometry) -> Surface:

@@ -17,6 +17,12 @@ from ..vg_addon.formats import csvio
 
 _MANIFEST = Path(__file__).resolve().parents[1] / "blender_manifest.toml"
 
+# The coordinates a record's centre, radius and normals are in (its "space"): the mesh's own
+# since this extension measures in them; records made before that have no "space" and are in
+# world space (see ``legacy``).
+MESH = csvio.MESH_COORDINATES
+WORLD = csvio.WORLD_COORDINATES
+
 
 @cache
 def extension_version() -> str:
@@ -32,6 +38,24 @@ def _floats(vector) -> list[float]:
     return [float(v) for v in np.asarray(vector, dtype=np.float64)]
 
 
+def exact_record(m) -> dict:
+    """The exact numbers stored for measurement ``m`` (taken in mesh coordinates)."""
+    return {
+        "angle": float(m.angle),
+        "fit": float(m.fit_error),
+        "fit_plus": float(m.fit_error_plus),
+        "fit_minus": float(m.fit_error_minus),
+        "radius": float(m.radius),
+        "lam": float(m.lam),
+        "snap_distance": float(m.snap_distance),
+        "center": _floats(m.center),
+        "requested": _floats(m.requested_center),
+        "normal_plus": _floats(m.normal_plus),
+        "normal_minus": _floats(m.normal_minus),
+        "space": MESH,
+    }
+
+
 def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_number=None):
     """Append measurement ``m`` to ``obj.vg.measurements`` and make it the active one.
 
@@ -39,7 +63,7 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
     ----------
     obj : bpy.types.Object
     m : vg_addon.Measurement
-        A surface measurement (world space).
+        A surface measurement, in the mesh's own coordinates.
     geometry_fingerprint : str
         Fingerprint of the geometry it was taken on (see ``mesh_data.fingerprint``).
     note : str
@@ -56,21 +80,7 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
     item.number = data.next_number
     data.next_number += 1
     item.break_number = data.break_number if break_number is None else int(break_number)
-    item.exact = json.dumps(
-        {
-            "angle": float(m.angle),
-            "fit": float(m.fit_error),
-            "fit_plus": float(m.fit_error_plus),
-            "fit_minus": float(m.fit_error_minus),
-            "radius": float(m.radius),
-            "lam": float(m.lam),
-            "snap_distance": float(m.snap_distance),
-            "center": _floats(m.center),
-            "requested": _floats(m.requested_center),
-            "normal_plus": _floats(m.normal_plus),
-            "normal_minus": _floats(m.normal_minus),
-        }
-    )
+    item.exact = json.dumps(exact_record(m))
     item.patch = m.patch
     item.n_vertices = int(m.n_vertices)
     item.n_plus = int(m.n_plus)
@@ -109,6 +119,12 @@ def numbers_of(item) -> dict:
             "delete it and measure again."
         )
     return numbers
+
+
+def space_of(item) -> str:
+    """The coordinates ``item`` was recorded in: ``"mesh"``, or ``"world"`` for a record made
+    before measurements were taken in mesh coordinates."""
+    return exact_numbers(item).get("space", WORLD)
 
 
 def replay_args(item) -> dict:
@@ -159,6 +175,7 @@ def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
         requested=tuple(numbers["requested"]),
         snap_distance=numbers["snap_distance"],
         units=units,
+        coordinates=numbers.get("space", WORLD),
         stale=stale,
         extension_version=extension_version(),
         blender_version=bpy.app.version_string,

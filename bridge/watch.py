@@ -1,10 +1,20 @@
 """Keep stale flags and colours in step with the mesh while the user edits it.
 
-After an edit (or a move) of an object that has measurements, and once the edits pause, the
-object's measurements are checked against its geometry; if a stale flag no longer matches, the
-object is repainted, so the colours never show sides of a mesh that has changed. The check runs
-from a timer, not inside the depsgraph handler (writing data there would re-trigger it), and not
-in Edit Mode (leaving Edit Mode triggers it again).
+After an edit of the mesh or its modifiers of an object that has measurements, and once the
+edits pause, the object's measurements are checked against its geometry; if a stale flag no
+longer matches, the object is repainted, so the colours never show sides of a mesh that has
+changed. Moving, rotating or scaling the object changes no measurement (they are in mesh
+coordinates) and triggers nothing. The check runs from a timer, not inside the depsgraph
+handler (writing data there would re-trigger it), and not in Edit Mode (leaving Edit Mode
+triggers it again).
+
+The timer writes only what follows from the mesh the user edited (the stale flags and the "VG
+Sides" colours), never the viewport shading or the active colour attribute: undoing the edit
+brings the mesh back, and the next check brings the flags and colours back with it, so there is
+nothing of the timer's own for the user to undo. Its writes join the edit's undo step.
+
+On file load (``on_load_post``) the caches are emptied and measurements recorded in world space
+by earlier versions are brought into mesh coordinates (see ``legacy``).
 """
 
 from __future__ import annotations
@@ -13,6 +23,7 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..vg_addon import GoniometerError
+from . import legacy, measuring, mesh_data
 from .measuring import repaint
 from .mesh_data import check_measurable, evaluated_geometry
 
@@ -51,9 +62,9 @@ def _check_pending():
 
 @persistent
 def on_depsgraph_update(scene, depsgraph):
-    """Note the measured objects whose geometry or transform changed; check them soon."""
+    """Note the measured objects whose evaluated geometry changed; check them soon."""
     for update in depsgraph.updates:
-        if not (update.is_updated_geometry or update.is_updated_transform):
+        if not update.is_updated_geometry:
             continue
         obj = update.id.original
         if isinstance(obj, bpy.types.Object) and obj.type == "MESH":
@@ -66,14 +77,41 @@ def on_depsgraph_update(scene, depsgraph):
         bpy.app.timers.register(_check_pending, first_interval=_DELAY)
 
 
+def clear_caches() -> None:
+    """Forget every cached surface and measurement, and every pending check."""
+    mesh_data.clear_cache()
+    measuring.clear_cache()
+    _pending.clear()
+    if bpy.app.timers.is_registered(_check_pending):
+        bpy.app.timers.unregister(_check_pending)
+
+
+@persistent
+def on_load_post(*_args):
+    """A file was opened: empty the caches (they describe the previous file's meshes) and bring
+    world-space measurements of earlier versions into mesh coordinates."""
+    clear_caches()
+    for obj in bpy.data.objects:
+        if obj.type == "MESH" and legacy.has_world_records(obj):
+            refresh(obj)
+
+
+_HANDLERS = (
+    (bpy.app.handlers.depsgraph_update_post, on_depsgraph_update),
+    (bpy.app.handlers.load_post, on_load_post),
+)
+
+
 def register() -> None:
-    if on_depsgraph_update not in bpy.app.handlers.depsgraph_update_post:
-        bpy.app.handlers.depsgraph_update_post.append(on_depsgraph_update)
+    for handlers, handler in _HANDLERS:
+        if handler not in handlers:
+            handlers.append(handler)
 
 
 def unregister() -> None:
-    if on_depsgraph_update in bpy.app.handlers.depsgraph_update_post:
-        bpy.app.handlers.depsgraph_update_post.remove(on_depsgraph_update)
+    for handlers, handler in _HANDLERS:
+        if handler in handlers:
+            handlers.remove(handler)
     if bpy.app.timers.is_registered(_check_pending):
         bpy.app.timers.unregister(_check_pending)
     _pending.clear()

@@ -10,7 +10,8 @@ from ..bridge import measuring
 from ..bridge.mesh_data import check_measurable
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
-from .measure import typed_value
+from .measure import poll_measurable, typed_value
+from .progress import Progress
 
 
 def _path(operator) -> str:
@@ -31,6 +32,13 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
         description="Export the measurements of every object in the scene, not only the active one",
         default=False,
     )
+
+    @classmethod
+    def poll(cls, context):
+        if any(o.type == "MESH" and len(o.vg.measurements) for o in context.scene.objects):
+            return True
+        cls.poll_message_set("No object in this scene has measurements to export.")
+        return False
 
     def execute(self, context):
         path = _path(self)
@@ -92,6 +100,10 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         default=False,
     )
 
+    @classmethod
+    def poll(cls, context):
+        return poll_measurable(cls, context)
+
     def execute(self, context):
         path = _path(self)
         obj = context.active_object
@@ -100,15 +112,17 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             if not path:
                 raise GoniometerError("No file name given: choose the CSV to import.")
             settings = context.scene.vg_settings
-            numbers = measuring.import_csv(
-                obj,
-                path,
-                ignore_mesh_names=self.ignore_mesh_names,
-                radius=typed_value(settings.radius),
-                lam=typed_value(settings.seg_param),
-                patch=settings.patch,
-                depsgraph=context.evaluated_depsgraph_get(),
-            )
+            with Progress(context, f"Re-measuring {bpy.path.basename(path)}") as progress:
+                numbers = measuring.import_csv(
+                    obj,
+                    path,
+                    ignore_mesh_names=self.ignore_mesh_names,
+                    radius=typed_value(settings.radius),
+                    lam=typed_value(settings.seg_param),
+                    patch=settings.patch,
+                    depsgraph=context.evaluated_depsgraph_get(),
+                    progress=progress.step,
+                )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

@@ -325,16 +325,16 @@ def test_batch_angle_equals_measure_xyz_on_blenders_own_ply_import(vg, meshes, t
     assert obj.vg.measurements[0].n_vertices == row.n_vertices
 
 
-def test_blend_input_world_space_and_saved_measurements(vg, tmp_path):
-    """An object of a .blend, moved, turned and scaled: the batch measures it in world space
-    exactly as measure_xyz does, and the saved .blend lists the measurements, painted."""
+def test_blend_input_mesh_coordinates_and_saved_measurements(vg, tmp_path):
+    """An object of a .blend, moved, turned and scaled: the batch measures it in its mesh
+    coordinates exactly as measure_xyz does, and the saved .blend lists the measurements,
+    painted."""
     shape = wedge(75.0, n=30, irregular=True, seed=5)
     obj = mesh_object("Bone", shape.points, shape.triangles, location=(10.0, -2.0, 3.0),
                       rotation=(0.3, -0.2, 1.1), scale=(2.0, 2.0, 2.0))  # fmt: skip
     source = tmp_path / "study.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(source))
-    centre = np.array(obj.matrix_world) @ np.array([0.1, 0.0, 0.0, 1.0])
-    point = [str(np.float32(v)) for v in centre[:3]]  # as a user would type them
+    point = ["0.1", "0.0", "0.0"]  # mesh coordinates, as in a CSV of this mesh
 
     out, saved = tmp_path / "out.csv", tmp_path / "saved.blend"
     ok(batch(source, "--object", "Bone", "--at", *point, "--radius", "0.6", "--out", out,
@@ -342,7 +342,7 @@ def test_blend_input_world_space_and_saved_measurements(vg, tmp_path):
     row = rows_of(out)[0]
     assert abs(row.angle - 75.0) < 0.01
 
-    bpy.ops.vg.measure_xyz(location=[float(v) for v in point], radius=0.6)
+    bpy.ops.vg.measure_xyz(location=[float(v) for v in point], space="MESH", radius=0.6)
     mine = exact(obj.vg.measurements[0])
     assert (mine["angle"], mine["fit"]) == (row.angle, row.fit)
     assert tuple(mine["center"]) == (row.x, row.y, row.z)

@@ -86,6 +86,7 @@ _SCHEMA = (
     ("requested", "vec3", ("Requested x", "Requested y", "Requested z")),
     ("snap_distance", "float", ("Snap Distance",)),
     ("units", "text", ("Units",)),
+    ("coordinates", "text", ("Coordinates",)),
     ("stale", "bool", ("Stale",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
@@ -94,6 +95,16 @@ _SCHEMA = (
 
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
 EXPORT_COLUMNS = tuple(column for _, _, columns in _SCHEMA for column in columns)
+
+#: The values of the ``Coordinates`` column: the mesh's own coordinates (object space, those of
+#: the file the scan came from) and, in exports of versions before it existed, world space.
+MESH_COORDINATES = "mesh"
+WORLD_COORDINATES = "world"
+COORDINATE_SPACES = (MESH_COORDINATES, WORLD_COORDINATES)
+
+# Columns an export may lack because older versions of the extension did not write them, and
+# the value such an export means.
+_LEGACY_DEFAULTS = {"Coordinates": WORLD_COORDINATES}
 
 #: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
 SOURCE_FORMATS = ("extension", "meshlab", "points")
@@ -174,6 +185,10 @@ class MeasurementRow:
         Distance from ``requested`` to ``(x, y, z)``.
     units : str
         What one coordinate unit is.
+    coordinates : str
+        ``"mesh"``: x, y, z, the requested centre, the radius and the normals are in the mesh's
+        own coordinates (those of its file); ``"world"``: in Blender world space (exports of
+        versions before this column existed).
     stale : bool
         The mesh changed since the measurement was taken.
     extension_version, blender_version : str
@@ -205,6 +220,7 @@ class MeasurementRow:
     requested: tuple[float, float, float] | None = None
     snap_distance: float | None = None
     units: str = ""
+    coordinates: str = MESH_COORDINATES
     stale: bool = False
     extension_version: str = ""
     blender_version: str = ""
@@ -241,6 +257,10 @@ class ReplicationRow:
         ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
         columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
         else with x, y, z columns).
+    coordinates : str
+        ``"mesh"`` (the mesh's own coordinates: MeshLab's files, points files, exports with
+        ``Coordinates`` = mesh) or ``"world"`` (Blender world space: exports of this extension
+        written before the ``Coordinates`` column existed, or with ``Coordinates`` = world).
     """
 
     row_number: int
@@ -255,6 +275,7 @@ class ReplicationRow:
     number: int | float | None = None
     break_number: int | None = None
     source_format: str = "points"
+    coordinates: str = MESH_COORDINATES
 
 
 # --------------------------------------------------------------------------- small helpers
@@ -652,6 +673,7 @@ _REPLICATION_ALIASES = {
     "label": ("label", "user data", "note", "notes"),
     "number": ("measurement #", "measurement number", "measurement", "number"),
     "break_number": ("break #", "break number", "break"),
+    "coordinates": ("coordinates", "coordinate space"),
     "error": ("error",),
 }
 _REQUIRED = ("x", "y", "z")
@@ -783,6 +805,17 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                     f"row {number}: unknown patch mode {cell('patch').strip()!r} "
                     f"(use {' or '.join(PATCH_MODES)})"
                 )
+        coordinates = _parse_optional_text(cell("coordinates"))
+        if coordinates is None:
+            # This extension wrote world coordinates until it wrote the column; every other
+            # tool writes the mesh's own.
+            coordinates = WORLD_COORDINATES if fmt == "extension" else MESH_COORDINATES
+        coordinates = coordinates.casefold()
+        if coordinates not in COORDINATE_SPACES:
+            problems.append(
+                f"row {number}: unknown coordinates {cell('coordinates').strip()!r} "
+                f"(use {' or '.join(COORDINATE_SPACES)})"
+            )
         if problems:
             continue  # nothing is returned anyway; keep collecting
         break_number = _lenient_number(cell("break_number"))
@@ -800,6 +833,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 number=_lenient_number(cell("number")),
                 break_number=break_number if isinstance(break_number, int) else None,
                 source_format=fmt,
+                coordinates=coordinates,
             )
         )
     if problems:
@@ -834,7 +868,10 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
     aliases: ``Mesh Name``/``Mesh``/``Object``; ``x``/``Center x``; ``Radius``/``r``;
     ``SegParam``/``Seg Param``/``lambda``/``λ``/``Segmentation Parameter``;
     ``Patch Mode``/``patch``; ``label``/``User Data``/``note`` (``label`` wins over
-    ``User Data``); ``Measurement #``; ``Break #``; ``error``. Only x, y and z are required.
+    ``User Data``); ``Measurement #``; ``Break #``; ``Coordinates`` (``mesh`` or ``world``;
+    absent or blank: ``world`` in an export of this extension, which wrote world coordinates
+    before it had the column, ``mesh`` in every other file); ``error``. Only x, y and z are
+    required.
     A UTF-8 byte-order mark is ignored; cells are read without surrounding whitespace, and the
     apostrophe the writer puts before formula-like text is removed.
 
@@ -883,7 +920,11 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     problems: list[str] = []
     aliases = {column: (_normalise(column),) for column in EXPORT_COLUMNS}
     columns = _resolve_columns(header, aliases, problems)
-    missing = [column for column in EXPORT_COLUMNS if column not in columns]
+    missing = [
+        column
+        for column in EXPORT_COLUMNS
+        if column not in columns and column not in _LEGACY_DEFAULTS
+    ]
     if missing:
         problems.insert(
             0,
@@ -899,7 +940,9 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
             continue
 
         def cell(column: str, cells=cells) -> str:
-            index = columns[column]
+            index = columns.get(column)
+            if index is None:
+                return _LEGACY_DEFAULTS[column]
             return cells[index] if index < len(cells) else ""
 
         def number_of(column: str, number=number) -> float | None:
