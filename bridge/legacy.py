@@ -8,7 +8,8 @@ rotation, a mirror and a uniform scale, which keep angles), the record is re-mea
 vertex, with the radius divided by the scale, the same λ and patch mode, and its numbers are
 replaced by the new measurement's: the one it replays to from then on. The world-space numbers
 are kept in the record (``"world_record"``) so the change stays traceable. The angle is the same
-up to rounding (a similarity changes no angle; the test suite checks 1e-9°).
+up to the rounding the world-space coordinates carried (a similarity changes no angle; a few
+1e-6° in the test suite, far below the 0.01° angles are reported to).
 
 A record that cannot be brought over (the mesh or the transform changed since, or a non-uniform
 scale that the world-space angle depended on) keeps its numbers in world space and stays stale;

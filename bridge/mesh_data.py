@@ -83,7 +83,8 @@ def uniform_scale(matrix: np.ndarray, rtol: float = 1e-6) -> float | None:
     mirror, a uniform scale and a move), else None (a non-uniform scale or a shear).
 
     A non-uniform object scale changes angles in world space; measurements are taken in mesh
-    coordinates and do not see it.
+    coordinates and do not see it. The factor is rounded to float32, the precision Blender keeps
+    transforms in (so a scale of 3 under a rotation is 3, not 2.99999996).
     """
     linear = np.asarray(matrix, dtype=np.float64)[:3, :3]
     gram = linear.T @ linear
@@ -92,7 +93,7 @@ def uniform_scale(matrix: np.ndarray, rtol: float = 1e-6) -> float | None:
         return None
     if np.abs(gram - scale2 * np.eye(3)).max() > rtol * scale2:
         return None
-    return float(np.sqrt(scale2))
+    return float(np.float32(np.sqrt(scale2)))
 
 
 def fingerprint(*arrays: np.ndarray) -> str:
