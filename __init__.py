@@ -18,9 +18,11 @@ def register():
     properties.register_properties()
     operators.drag.register_tool()
     watch.register()
+    ui.labels.register()
 
 
 def unregister():
+    ui.labels.unregister()
     operators.drag.unregister_tool()
     watch.unregister()
     properties.unregister_properties()

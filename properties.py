@@ -28,6 +28,9 @@ from mathutils import Vector
 
 from .vg_addon import palette
 
+# Paths may start with // (the .blend's folder); Blender 4.5 and later want that declared.
+BLEND_RELATIVE = {"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else set()
+
 PATCH_ITEMS = (
     ("euclidean", "Euclidean", "All vertices within the radius (a ball around the centre)"),
     ("geodesic", "Geodesic", "Vertices reachable along mesh edges within the radius"),
@@ -210,6 +213,33 @@ class VG_SceneSettings(PropertyGroup):
         name="All objects",
         description="Export the measurements of every object in the scene, not only the active one",
         default=False,
+    )
+    show_labels: BoolProperty(
+        name="Labels",
+        description="Draw each current measurement's number and angle beside it in the viewport "
+        "(stale ones are not labelled; labels too close to a more important one are left out)",
+        default=True,
+    )
+    labels_active_break: BoolProperty(
+        name="Active Break Only",
+        description="Label only the measurements of the current break",
+        default=False,
+    )
+    map_views: EnumProperty(
+        name="Views",
+        items=(
+            ("SIX", "Six Views", "Front, back, right, left, top and bottom, orthographic"),
+            ("FLAKE", "Two Faces", "The two faces of a flat piece, seen along its thinnest axis"),
+        ),
+        default="SIX",
+        description="What the measurement map shows",
+    )
+    map_directory: StringProperty(
+        name="Map Folder",
+        description="Folder the map's pictures are written to (// is the .blend's folder)",
+        default="//vg_map",
+        subtype="DIR_PATH",
+        options=BLEND_RELATIVE,
     )
     ignore_mesh_names: BoolProperty(
         name="Ignore mesh names",

@@ -2,6 +2,6 @@
 (``bridge.measuring``) and report. ``drag`` is the click-and-drag tool's modal operator, with
 its viewport preview in ``drag_overlay``."""
 
-from . import csv_ops, drag, measure
+from . import csv_ops, drag, map_ops, measure
 
-classes = (*measure.classes, *csv_ops.classes, *drag.classes)
+classes = (*measure.classes, *csv_ops.classes, *drag.classes, *map_ops.classes)

@@ -2,6 +2,8 @@
 
 import bpy
 
+from ..operators.measure import non_uniform_scale_note
+
 CATEGORY = "Goniometer"
 
 
@@ -35,6 +37,11 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
         if obj is None:
             layout.label(text="Select a mesh object to measure", icon="INFO")
             return
+        if non_uniform_scale_note(obj):
+            box = layout.box()
+            box.label(text="Non-uniform scale: not measured", icon="INFO")
+            box.label(text="Angles are those of the mesh as stored;")
+            box.label(text="apply the scale (Ctrl A) to change its shape")
         layout.operator("vg.measure_xyz", text="Measure at 3D Cursor", icon="PIVOT_CURSOR")
         drag = layout.operator("wm.tool_set_by_id", text="Drag to Measure", icon="MOUSE_LMB_DRAG")
         drag.name = "vg.measure_drag_tool"
@@ -52,6 +59,11 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
         side.operator("vg.clear_measurements", text="", icon="TRASH")
         side.separator()
         side.operator("vg.repaint", text="", icon="FILE_REFRESH")
+        row = layout.row(align=True)
+        row.prop(settings, "show_labels", icon="FONT_DATA")
+        sub = row.row(align=True)
+        sub.active = settings.show_labels
+        sub.prop(settings, "labels_active_break", text="Current Break")
 
 
 class VIEW3D_PT_vg_selected(_GoniometerPanel, bpy.types.Panel):
@@ -85,7 +97,14 @@ class VIEW3D_PT_vg_selected(_GoniometerPanel, bpy.types.Panel):
         column.prop(item, "seg_param")
         _text(column, "Patch", item.patch.capitalize())
         _text(column, "Vertices", f"{item.n_vertices} ({item.n_plus} +, {item.n_minus} −)")
-        for name in ("center", "requested_center", "snap_distance", "normal_plus", "normal_minus"):
+        for name in (
+            "center",
+            "center_world",
+            "requested_center",
+            "snap_distance",
+            "normal_plus",
+            "normal_minus",
+        ):
             column.prop(item, name)
         row = column.row(align=True)
         row.prop(item, "color_plus")
@@ -122,4 +141,21 @@ class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
         row.prop(settings, "ignore_mesh_names", text="Ignore Names")
 
 
-classes = (VIEW3D_PT_vg_measure, VIEW3D_PT_vg_selected, VIEW3D_PT_vg_csv)
+class VIEW3D_PT_vg_map(_GoniometerPanel, bpy.types.Panel):
+    """Render the measurement map: the coloured sides with numbered labels, from chosen views."""
+
+    bl_label = "Measurement Map"
+    bl_parent_id = "VIEW3D_PT_vg_measure"
+    bl_options = {"DEFAULT_CLOSED"}  # noqa: RUF012 (Blender wants a set)
+
+    def draw(self, context):
+        settings = context.scene.vg_settings
+        layout = self.layout
+        layout.prop(settings, "map_views", expand=True)
+        layout.prop(settings, "map_directory", text="")
+        op = layout.operator("vg.render_map", text="Render Map", icon="RENDER_STILL")
+        op.views = settings.map_views
+        op.directory = settings.map_directory
+
+
+classes = (VIEW3D_PT_vg_measure, VIEW3D_PT_vg_selected, VIEW3D_PT_vg_csv, VIEW3D_PT_vg_map)

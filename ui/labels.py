@@ -1,0 +1,85 @@
+"""Measurement labels in the 3D viewport: each current measurement's number and angle beside
+its centre, white with a dark outline so they read on dark and light backgrounds alike.
+
+A ``POST_PIXEL`` draw handler, added on register; it only reads the records (through
+``bridge.label_data``) and the scene's label settings. The active object's measurements are
+labelled; with many, labels are decluttered by screen distance (the selected measurement and
+then the newest win), or limited to the current break.
+"""
+
+from __future__ import annotations
+
+import blf
+import bpy
+import numpy as np
+from bpy_extras import view3d_utils
+
+from ..bridge.label_data import labels_of
+from ..vg_addon.workflow.labels import declutter
+
+FONT_ID = 0
+TEXT_COLOR = (1.0, 1.0, 1.0, 1.0)
+ACTIVE_COLOR = (1.0, 0.85, 0.2, 1.0)
+OUTLINE_COLOR = (0.0, 0.0, 0.0, 0.9)
+OUTLINE_OFFSETS = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
+SPACING_EM = 2.5  # minimum distance between two labels, in text heights
+
+_handle = {"draw": None}
+
+
+def _draw() -> None:
+    context = bpy.context
+    scene = context.scene
+    settings = getattr(scene, "vg_settings", None)
+    obj = context.active_object
+    region, region_data = context.region, context.region_data
+    if settings is None or not settings.show_labels or obj is None or obj.type != "MESH":
+        return
+    if region is None or region_data is None or obj.mode == "EDIT":
+        return
+    labels = labels_of(obj, active_break_only=settings.labels_active_break)
+    if not labels:
+        return
+    size = max(11, round(13 * context.preferences.system.ui_scale))
+    placed = []
+    for label in labels:
+        coord = view3d_utils.location_3d_to_region_2d(region, region_data, label.position)
+        if coord is not None and 0 <= coord.x < region.width and 0 <= coord.y < region.height:
+            placed.append((label, (coord.x, coord.y)))
+    if not placed:
+        return
+    priority = [(2 * len(placed) if label.active else 0) + i for i, (label, _) in enumerate(placed)]
+    positions = np.array([coord for _, coord in placed])
+    blf.size(FONT_ID, size)
+    for index in declutter(positions, priority, SPACING_EM * size):
+        label, (x, y) = placed[index]
+        x, y = x + 0.6 * size, y + 0.3 * size  # beside the centre, not on it
+        _outlined(label.text, x, y, ACTIVE_COLOR if label.active else TEXT_COLOR)
+
+
+def _outlined(text: str, x: float, y: float, color) -> None:
+    blf.color(FONT_ID, *OUTLINE_COLOR)
+    for dx, dy in OUTLINE_OFFSETS:
+        blf.position(FONT_ID, x + dx, y + dy, 0)
+        blf.draw(FONT_ID, text)
+    blf.color(FONT_ID, *color)
+    blf.position(FONT_ID, x, y, 0)
+    blf.draw(FONT_ID, text)
+
+
+def register() -> None:
+    """Add the draw handler to every 3D viewport (once)."""
+    if _handle["draw"] is None:
+        _handle["draw"] = bpy.types.SpaceView3D.draw_handler_add(_draw, (), "WINDOW", "POST_PIXEL")
+
+
+def unregister() -> None:
+    """Remove the draw handler (a no-op when it is not there)."""
+    handle, _handle["draw"] = _handle["draw"], None
+    if handle is not None:
+        bpy.types.SpaceView3D.draw_handler_remove(handle, "WINDOW")
+
+
+def registered() -> bool:
+    """Whether the draw handler is installed."""
+    return _handle["draw"] is not None
