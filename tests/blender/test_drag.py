@@ -1,7 +1,7 @@
 """The drag tool in real bpy: ray cast through a real 3D-view region, the drag session driven by
 translated events, EXEC_DEFAULT equal to vg.measure_xyz, and clean exits.
 
-Headless limits (see the README, "Measuring by click and drag"): ``INVOKE_DEFAULT`` cannot run without an event loop,
+Headless limits (see docs/ARCHITECTURE.md, "Tests"): ``INVOKE_DEFAULT`` cannot run without an event loop,
 so ``invoke``/``modal`` themselves are not called; they only forward to ``DragSession`` and
 ``translate_event``, which are tested here. The view matrices cannot be recomputed in background
 mode, so the test mesh is placed in front of the startup file's saved perspective view.

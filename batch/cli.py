@@ -1,0 +1,213 @@
+"""The batch command line: the parser, its help text and the checks made before anything runs."""
+
+from __future__ import annotations
+
+import argparse
+
+# --units: Blender's unit system, unit scale and length unit for what one coordinate unit is.
+UNITS = {
+    "none": ("NONE", 1.0, None),
+    "m": ("METRIC", 1.0, "METERS"),
+    "cm": ("METRIC", 0.01, "CENTIMETERS"),
+    "mm": ("METRIC", 0.001, "MILLIMETERS"),
+    "um": ("METRIC", 1e-6, "MICROMETERS"),
+    "in": ("IMPERIAL", 0.0254, "INCHES"),
+}
+
+EPILOG = """\
+inputs:
+  MESH is a .ply, .obj or .stl file, a folder (its .ply/.obj/.stl files, not subfolders), or a
+  .blend file (then name the objects with --object; under `blender -b file.blend` the open file
+  is used). Coordinates and radii are in the mesh file's own units; the file's coordinates are
+  used as they are (no axis conversion).
+
+points:
+  --at X Y Z (repeatable) measures each point on every mesh given.
+  --points CSV reads a plain CSV (x,y,z and optional radius, lambda, patch, label, break, mesh
+  columns) or a measurements CSV exported by the extension, the MeshLab plugin or the earlier
+  Blender add-on: each row is re-measured with its own radius and lambda and matched to its
+  mesh by its mesh name (the file name without extension). --radius, --lambda and --patch are
+  the defaults for rows that carry none.
+
+output:
+  --out CSV gets one row per requested point, in input order, in the extension's export
+  schema (MeshLab's 14 columns first). A row that cannot be measured has its message in the
+  `error` column and the run goes on. While meshes finish, the CSV is rewritten every few
+  seconds, so a run that is stopped keeps what it measured.
+
+exit status:
+  0  every point measured
+  1  some rows failed (see their `error` column)
+  2  bad arguments, missing or unreadable files, a malformed points CSV
+
+scaling:
+  --jobs N measures N meshes at a time, each in its own Blender/bpy process (a crash in one
+  mesh loses only that mesh's rows). --shard K/N keeps the K-th of N equal, contiguous shares
+  of the rows: shard CSVs concatenated in K order (headers dropped after the first) equal the
+  unsharded CSV. Measurements per second are printed (mesh import and surface preparation
+  excluded).
+
+examples:
+  python vg_batch.py scan.ply --at 12.1 3.4 -7.9 --radius 2 --out angles.csv
+  python vg_batch.py scans/ --points sites.csv --radius 2 --jobs 2 --out angles.csv
+  python vg_batch.py scan.ply --points old_meshlab.csv --out replicated.csv --save-blend s.blend
+  blender -b study.blend --python vg_batch.py -- --object Bone_12 --points p.csv --out a.csv
+  python vg_batch.py --demo
+"""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="vg_batch.py",
+        usage="blender -b [file.blend] --python vg_batch.py -- ARGS\n"
+        "       python vg_batch.py ARGS\n\n"
+        "ARGS:  MESH... [--object NAME] (--at X Y Z ... | --points CSV) [--radius R]\n"
+        "       [--lambda L] [--patch euclidean|geodesic] --out CSV [--save-blend PATH]\n"
+        "       [--render DIR] [--jobs N] [--shard K/N]\n"
+        "   or: --demo [--out-dir DIR]",
+        description="Measure break-edge angles (the Virtual Goniometer) on meshes and point "
+        "lists, headless, and write them to a CSV.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "inputs",
+        nargs="*",
+        metavar="MESH",
+        help="mesh files (.ply .obj .stl), folders of them, or one .blend file",
+    )
+    parser.add_argument(
+        "--object",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="an object of the .blend to measure (repeatable; default: its only mesh object)",
+    )
+    where = parser.add_argument_group("points (one of)")
+    where.add_argument(
+        "--at",
+        nargs=3,
+        type=float,
+        action="append",
+        default=[],
+        metavar=("X", "Y", "Z"),
+        help="a point to measure at (repeatable); it snaps to the nearest vertex",
+    )
+    where.add_argument("--points", metavar="CSV", help="a points or measurements CSV")
+    how = parser.add_argument_group("measuring")
+    how.add_argument(
+        "--radius",
+        type=float,
+        metavar="R",
+        help="patch radius in the mesh's units (needed with --at; default for CSV rows without one)",
+    )
+    how.add_argument(
+        "--lambda",
+        dest="lam",
+        type=float,
+        default=2.0,
+        metavar="L",
+        help="segmentation parameter λ (MeshLab's SegParam); default 2",
+    )
+    how.add_argument(
+        "--patch",
+        choices=("euclidean", "geodesic"),
+        default="euclidean",
+        help="patch shape: a ball (euclidean, default) or along mesh edges (geodesic)",
+    )
+    how.add_argument(
+        "--units",
+        choices=tuple(UNITS),
+        help="what one coordinate unit of the meshes is, recorded in the CSV's Units column and "
+        "the .blend's scene units (default: none, i.e. the file's own units, unnamed; a .blend "
+        "input keeps its scene's units)",
+    )
+    how.add_argument(
+        "--ignore-mesh-names",
+        action="store_true",
+        help="with a single mesh, measure every CSV row on it whatever mesh the row names",
+    )
+    out = parser.add_argument_group("output")
+    out.add_argument("--out", metavar="CSV", help="the measurements CSV to write (required)")
+    out.add_argument(
+        "--save-blend",
+        metavar="PATH",
+        help="also save a .blend with the meshes, their side colours and stored measurements",
+    )
+    out.add_argument(
+        "--render",
+        metavar="DIR",
+        help="write DIR/<mesh>.png per mesh: the coloured sides, Cycles on the CPU",
+    )
+    out.add_argument(
+        "--render-size",
+        nargs=2,
+        type=int,
+        default=[640, 480],
+        metavar=("W", "H"),
+        help="render resolution in pixels (default 640 480)",
+    )
+    out.add_argument(
+        "--render-samples",
+        type=int,
+        default=16,
+        metavar="N",
+        help="Cycles samples per pixel (default 16)",
+    )
+    out.add_argument("--quiet", action="store_true", help="no progress lines (summary only)")
+    scale = parser.add_argument_group("scaling")
+    scale.add_argument(
+        "--jobs",
+        type=int,
+        default=1,
+        metavar="N",
+        help="meshes measured in parallel, one process each (default 1: in this process)",
+    )
+    scale.add_argument(
+        "--shard", metavar="K/N", help="do only the K-th of N equal shares of the rows"
+    )
+    demo = parser.add_argument_group("demo")
+    demo.add_argument(
+        "--demo",
+        action="store_true",
+        help="generate a bone-shaft fragment with known break angles, measure it, print true "
+        "against measured angles and write CSV, .blend and PNG",
+    )
+    demo.add_argument(
+        "--out-dir", metavar="DIR", help="the demo's output folder (default ./vg_demo_output)"
+    )
+    parser.add_argument("--worker", help=argparse.SUPPRESS)
+    return parser
+
+
+class UsageError(Exception):
+    """Bad arguments or input files: exit status 2."""
+
+
+def check_args(args) -> None:
+    if args.demo:
+        extra = [
+            name
+            for name, value in (
+                ("MESH", args.inputs),
+                ("--object", args.object),
+                ("--at", args.at),
+                ("--points", args.points),
+                ("--out", args.out),
+                ("--shard", args.shard),
+            )
+            if value
+        ]
+        if extra:
+            raise UsageError(f"--demo takes no {', '.join(extra)} (only --out-dir and --jobs).")
+        return
+    if args.out_dir:
+        raise UsageError("--out-dir is for --demo; use --out CSV for a batch run.")
+    if bool(args.at) == bool(args.points):
+        raise UsageError("give the points to measure: --at X Y Z (repeatable) or --points CSV.")
+    if not args.out:
+        raise UsageError("--out CSV is required: the measurements CSV to write.")
+    if args.jobs < 1:
+        raise UsageError(f"--jobs must be 1 or more (got {args.jobs}).")
+    if min(args.render_size) < 1 or args.render_samples < 1:
+        raise UsageError("--render-size and --render-samples must be positive.")

@@ -1,0 +1,203 @@
+"""Measuring one mesh's rows in a batch run, through the extension's own pipeline."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+import traceback
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from ..bridge import colors, measuring, mesh_data, records
+from ..vg_addon import GoniometerError
+from ..vg_addon.formats import csvio
+from .cli import UNITS
+from .render import add_sides_material, render_object
+from .sources import MeshSource, import_mesh
+
+
+@dataclasses.dataclass
+class MeshResult:
+    """What measuring one mesh produced (sent from a worker to its parent as JSON)."""
+
+    mesh: int
+    rows: list = dataclasses.field(default_factory=list)  # [(task index, MeasurementRow)]
+    object_name: str = ""
+    bad_file: str = ""  # why the mesh file could not be read
+    n_vertices: int = 0
+    measured: int = 0
+    failed: int = 0
+    load_seconds: float = 0.0
+    prepare_seconds: float = 0.0
+    measure_seconds: float = 0.0
+    render: str = ""
+    render_error: str = ""
+    blend: str = ""  # a worker's one-object .blend, for --save-blend
+
+    def to_json(self) -> dict:
+        out = dataclasses.asdict(self)
+        out["rows"] = [[index, dataclasses.asdict(row)] for index, row in self.rows]
+        return out
+
+    @classmethod
+    def from_json(cls, data: dict, row_type) -> MeshResult:
+        rows = []
+        for index, fields in data.pop("rows"):
+            for key in ("normal_plus", "normal_minus", "requested"):
+                if fields.get(key) is not None:
+                    fields[key] = tuple(fields[key])
+            rows.append((index, row_type(**fields)))
+        return cls(rows=rows, **data)
+
+
+def error_row(task, mesh_name: str, message: str, units: str):
+    """The output row of a task that could not be measured."""
+    return csvio.MeasurementRow(
+        mesh_name=mesh_name,
+        date=csvio.now_iso(),
+        number=task.number or None,
+        break_number=task.break_number,
+        user_data=task.label,
+        radius=task.radius,
+        seg_param=task.lam,
+        patch=task.patch,
+        requested=tuple(task.center),
+        units=units,
+        extension_version=records.extension_version(),
+        blender_version=bpy.app.version_string,
+        error=message,
+    )
+
+
+def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
+    """Load (or find) one mesh, measure its tasks, record them on the object, colour it and
+    optionally render it. Never raises for a problem of this mesh: it becomes the rows' error.
+
+    The numbers come from the extension's own pipeline: the object's evaluated mesh in world
+    space (``mesh_data.evaluated_geometry``), its cached ``Surface`` (``mesh_data.surface_for``)
+    and ``records.add_measurement``; ``measuring.measure_on_object`` does the same per click,
+    re-evaluating the mesh and repainting each time, which a batch does once per mesh instead.
+    """
+    result = MeshResult(mesh=index)
+    units = records.units_label(bpy.context.scene)
+
+    def fail_all(message: str) -> MeshResult:
+        name = result.object_name or source.name
+        result.rows = [(t.index, error_row(t, name, message, units)) for t in tasks]
+        result.failed = len(tasks)
+        return result
+
+    start = time.perf_counter()
+    try:
+        obj = import_mesh(source) if source.path else bpy.data.objects[source.name]
+    except GoniometerError as error:
+        result.bad_file = str(error)
+        return fail_all(f"could not read the mesh: {error}")
+    except MemoryError:
+        result.bad_file = f"'{source.path}' is too large for this machine's memory"
+        return fail_all(f"could not read the mesh: {result.bad_file}")
+    result.object_name = obj.name
+    result.load_seconds = time.perf_counter() - start
+
+    start = time.perf_counter()
+    try:
+        mesh_data.check_measurable(obj)
+        geometry = mesh_data.evaluated_geometry(obj)
+        surface = mesh_data.surface_for(obj, geometry)
+    except GoniometerError as error:
+        return fail_all(str(error))
+    result.n_vertices = int(geometry.points.shape[0])
+    result.prepare_seconds = time.perf_counter() - start
+
+    data = obj.vg
+    base = data.next_number - 1  # measurements already on a .blend object keep their numbers
+    fresh = len(data.measurements) == 0
+    # Per vertex, the break number and side of the last measurement covering it (0: none), so
+    # the colours are painted once at the end without keeping every measurement in memory.
+    painter = np.zeros(result.n_vertices, dtype=np.int64)
+    plus_side = np.zeros(result.n_vertices, dtype=bool)
+    view = np.zeros(3)
+    last_report = start = time.perf_counter()
+    for done, task in enumerate(tasks, start=1):
+        try:
+            m = surface.measure(task.center, task.radius, task.lam, task.patch)
+        except GoniometerError as error:
+            result.rows.append((task.index, error_row(task, obj.name, str(error), units)))
+            result.failed += 1
+        else:
+            data.next_number = base + task.number
+            item = records.add_measurement(
+                obj, m, geometry.fingerprint, note=task.label, break_number=task.break_number
+            )
+            result.rows.append((task.index, records.to_row(obj, item, stale=False, units=units)))
+            painter[m.indices] = item.break_number
+            plus_side[m.indices] = m.labels
+            view += m.mean_normal
+            result.measured += 1
+        now = time.perf_counter()
+        if progress is not None and now - last_report >= 1.0:
+            progress(done)
+            last_report = now
+    result.measure_seconds = time.perf_counter() - start
+    if len(data.measurements):
+        data.next_number = max(item.number for item in data.measurements) + 1
+
+    if result.measured:
+        if fresh and len(obj.data.vertices) == result.n_vertices:
+            # Every measurement is this run's, on these vertices: paint them as repaint() would
+            # (later over earlier), without measuring each one again.
+            painted = np.flatnonzero(painter)
+            sides = [
+                (vertices, plus_side[vertices], int(number))
+                for number in np.unique(painter[painted])
+                for vertices in [painted[painter[painted] == number]]
+            ]
+            rgba = colors.side_colours(result.n_vertices, sides)
+            colors.write_attribute(obj.data, rgba)
+        else:
+            measuring.repaint(obj, geometry=geometry)
+        add_sides_material(obj, colors.ATTRIBUTE_NAME)
+
+    if options.get("render"):
+        path = Path(options["render"]) / f"{safe_file_name(obj.name)}.png"
+        try:
+            render_object(obj, path, options, view.tolist())
+            result.render = str(path)
+        except Exception as error:  # a render problem must not lose the measurements
+            result.render_error = f"{type(error).__name__}: {error}"
+    return result
+
+
+def set_units(scene, unit: str | None) -> None:
+    """Set the scene's length units to ``unit`` (a key of :data:`UNITS`); None: leave them."""
+    if not unit:
+        return
+    system, scale, length = UNITS[unit]
+    settings = scene.unit_settings
+    settings.system = system
+    settings.scale_length = scale
+    if length is not None:
+        settings.length_unit = length
+
+
+def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress):
+    """:func:`measure_mesh`, with an unexpected error (a bug) turned into failed rows for this
+    mesh only, its traceback on stderr, so the other meshes are still measured."""
+    try:
+        return measure_mesh(index, source, tasks, options, progress)
+    except Exception as error:
+        traceback.print_exc()
+        message = (
+            f"internal error while measuring this mesh ({type(error).__name__}: {error}); "
+            "please report it with the traceback printed on stderr"
+        )
+        units = records.units_label(bpy.context.scene)
+        result = MeshResult(mesh=index, failed=len(tasks))
+        result.rows = [(t.index, error_row(t, source.name, message, units)) for t in tasks]
+        return result
+
+
+def safe_file_name(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_.+" else "_" for c in name) or "mesh"
