@@ -82,7 +82,7 @@ def run_demo(args) -> int:
         ply,
         points,
         *(p for p in outputs.values() if p != out),
-        out / "bone_fragment.png",
+        out / "bone_fragment_map.png",
     ):
         if path.is_file():
             print(f"  {path.name}")

@@ -14,7 +14,7 @@ from ..bridge import colors, measuring, mesh_data, records
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
 from .cli import UNITS
-from .render import add_sides_material, render_object
+from .render import add_sides_material, render_map
 from .sources import MeshSource, import_mesh
 
 
@@ -118,7 +118,6 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     # the colours are painted once at the end without keeping every measurement in memory.
     painter = np.zeros(result.n_vertices, dtype=np.int64)
     plus_side = np.zeros(result.n_vertices, dtype=bool)
-    view = np.zeros(3)
     last_report = start = time.perf_counter()
     for done, task in enumerate(tasks, start=1):
         try:
@@ -134,7 +133,6 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             result.rows.append((task.index, records.to_row(obj, item, stale=False, units=units)))
             painter[m.indices] = item.break_number
             plus_side[m.indices] = m.labels
-            view += m.mean_normal
             result.measured += 1
         now = time.perf_counter()
         if progress is not None and now - last_report >= 1.0:
@@ -159,12 +157,11 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         else:
             measuring.repaint(obj, geometry=geometry)
         add_sides_material(obj, colors.ATTRIBUTE_NAME)
+        colors.show_sides_once(obj)
 
     if options.get("render"):
-        path = Path(options["render"]) / f"{safe_file_name(obj.name)}.png"
         try:
-            render_object(obj, path, options, view.tolist())
-            result.render = str(path)
+            result.render = str(render_map(obj, Path(options["render"]), options))
         except Exception as error:  # a render problem must not lose the measurements
             result.render_error = f"{type(error).__name__}: {error}"
     return result
@@ -197,7 +194,3 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress):
         result = MeshResult(mesh=index, failed=len(tasks))
         result.rows = [(t.index, error_row(t, source.name, message, units)) for t in tasks]
         return result
-
-
-def safe_file_name(name: str) -> str:
-    return "".join(c if c.isalnum() or c in "-_.+" else "_" for c in name) or "mesh"

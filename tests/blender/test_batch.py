@@ -292,13 +292,27 @@ def test_a_crashing_worker_loses_only_its_mesh(two_meshes, meshes, tmp_path):
             assert row.angle == expected.angle and not row.error
 
 
-def test_render_writes_a_png_per_mesh(meshes, tmp_path):
+def test_render_writes_the_measurement_map_per_mesh(meshes, tmp_path):
     renders = tmp_path / "renders"
     result = ok(batch(meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS, "--out",
                       tmp_path / "out.csv", "--render", renders, "--render-size", 48, 32,
                       "--render-samples", 1))  # fmt: skip
-    assert png_size(renders / "w90.png") == (48, 32)
-    assert "wrote 1 render(s)" in result.stderr
+    views = ("front", "back", "right", "left", "top", "bottom")
+    for view in views:
+        assert png_size(renders / f"w90_map_{view}.png") == (48, 32)
+    assert png_size(renders / "w90_map.png") == (3 * 48, 2 * 32)  # the contact sheet
+    assert sorted(p.name for p in renders.iterdir()) == sorted(
+        ["w90_map.png", *(f"w90_map_{view}.png" for view in views)]
+    )
+    assert "wrote 1 measurement map(s)" in result.stderr
+
+
+def test_render_views_flake(meshes, tmp_path):
+    renders = tmp_path / "renders"
+    ok(batch(meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS, "--out",
+             tmp_path / "out.csv", "--render", renders, "--render-views", "flake",
+             "--render-size", 48, 32, "--render-samples", 1))  # fmt: skip
+    assert png_size(renders / "w90_map.png") == (2 * 48, 32)
 
 
 # --------------------------------------------------------------------------- against the extension
