@@ -24,14 +24,14 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from ..vg_addon import GoniometerError
-from ..vg_addon.workflow.labels import SIX_VIEWS, declutter, flake_views
+from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, place_labels
 from .colors import ATTRIBUTE_NAME
 from .label_data import labels_of
 from .mesh_data import read_positions, world_points
 
 MAP_VIEWS = ("SIX", "FLAKE")
 TEXT_FRACTION = 0.035  # label height, as a fraction of the picture's width
-SPACING_EM = 2.2  # minimum distance between two labels' centres, in label heights
+GLYPH_EM = 0.6  # the width of a label's character (at most, about), in label heights
 OUTLINE = 0.07  # the black ring around label text, in label heights
 MARGIN = 1.25  # the frame around the object, room for labels at its edges
 
@@ -228,21 +228,29 @@ class MapJob:
         return path
 
     def _visible(self, label, look) -> bool:
-        """Whether a ray along ``look`` from outside the object first meets it at ``label``."""
+        """Whether the camera looking along ``look`` sees ``label``'s centre: a ray along
+        ``look`` through the centre, or through one of four points a quarter radius around it
+        (a centre on a break edge is often right on the outline), first meets the object
+        within half a radius of the centre."""
         obj_eval = self.obj.evaluated_get(self.depsgraph)
         to_local = np.linalg.inv(np.array(self.obj.matrix_world, dtype=np.float64))
-        origin = label.position - np.asarray(look) * 2.0 * self._size
-        local_origin = to_local[:3, :3] @ origin + to_local[:3, 3]
-        local_direction = to_local[:3, :3] @ np.asarray(look, dtype=np.float64)
-        hit, location, _normal, _face = obj_eval.ray_cast(
-            Vector(local_origin), Vector(local_direction)
-        )
-        if not hit:
-            return False
-        world_hit = np.array(self.obj.matrix_world @ location, dtype=np.float64)
-        return float(np.linalg.norm(world_hit - label.position)) <= max(
-            0.5 * label.radius, self._size * 1e-3
-        )
+        look = np.asarray(look, dtype=np.float64)
+        side = np.cross(look, [0.0, 0.0, 1.0] if abs(look[2]) < 0.9 else [1.0, 0.0, 0.0])
+        side /= np.linalg.norm(side)
+        other = np.cross(look, side)
+        step = 0.25 * label.radius
+        local_direction = Vector(to_local[:3, :3] @ look)
+        reach = max(0.5 * label.radius, self._size * 1e-3)
+        for offset in (0.0 * side, step * side, -step * side, step * other, -step * other):
+            origin = label.position + offset - look * 2.0 * self._size
+            local_origin = Vector(to_local[:3, :3] @ origin + to_local[:3, 3])
+            hit, location, _normal, _face = obj_eval.ray_cast(local_origin, local_direction)
+            if not hit:
+                continue
+            world_hit = np.array(self.obj.matrix_world @ location, dtype=np.float64)
+            if float(np.linalg.norm(world_hit - label.position)) <= reach:
+                return True
+        return False
 
     def _place_labels(self, view_name, right, up, back, centre, front, scale, rotation) -> None:
         for block in self._label_objects:
@@ -264,12 +272,15 @@ class MapJob:
         ).reshape(-1, 2)
         priority = [(len(shown) if label.active else 0) + i for i, label in enumerate(shown)]
         plane = front + 0.05 * self._size  # in front of the mesh, behind the camera
-        for index in declutter(positions, priority, SPACING_EM * TEXT_FRACTION * width):
+        text_px = TEXT_FRACTION * width
+        widths = [GLYPH_EM * len(label.text) * text_px for label in shown]
+        gap = 0.45 * text_px
+        for index, side in place_labels(positions, widths, text_px, priority, gap=gap):
             label = shown[index]
             on_plane = label.position + back * (plane - label.position @ back)
             self._marker(on_plane, rotation, 0.22 * text_height)
-            at = on_plane + right * 0.45 * text_height
-            self._text(label.text, at, rotation, text_height)
+            at = on_plane + side * right * gap * pixel
+            self._text(label.text, at, rotation, text_height, "LEFT" if side > 0 else "RIGHT")
         # The caption: object and view, in the top-left corner.
         corner = centre + back * plane
         corner = (
@@ -279,9 +290,9 @@ class MapJob:
         )
         self._text(f"{self.obj.name} · {view_name}", corner, rotation, text_height)
 
-    def _text(self, text, at, rotation, height) -> None:
-        """White text ringed in black at ``at`` (its left middle), facing the camera: eight
-        black copies shifted around a white one, so it reads on light and dark alike."""
+    def _text(self, text, at, rotation, height, align="LEFT") -> None:
+        """White text ringed in black, its left (or right) middle at ``at``, facing the camera:
+        eight black copies shifted around a white one, so it reads on light and dark alike."""
         right, up, back = (np.array(rotation.col[i][:3]) for i in range(3))
         shift = OUTLINE * height
         copies = [
@@ -291,7 +302,7 @@ class MapJob:
         curve = self._keep(bpy.data.curves.new("VG Map label", "FONT"))
         curve.body = text
         curve.size = height
-        curve.align_x = "LEFT"
+        curve.align_x = align
         curve.align_y = "CENTER"
         curve.materials.append(self._black)
         white = self._keep(curve.copy())

@@ -3,8 +3,9 @@ its centre, white with a dark outline so they read on dark and light backgrounds
 
 A ``POST_PIXEL`` draw handler, added on register; it only reads the records (through
 ``bridge.label_data``) and the scene's label settings. The active object's measurements are
-labelled; with many, labels are decluttered by screen distance (the selected measurement and
-then the newest win), or limited to the current break.
+labelled; with many, a label goes to the left of its centre where the right is taken, and is
+left out where both are (the selected measurement, then the newest, are placed first); or the
+labels are limited to the current break.
 """
 
 from __future__ import annotations
@@ -15,14 +16,13 @@ import numpy as np
 from bpy_extras import view3d_utils
 
 from ..bridge.label_data import labels_of
-from ..vg_addon.workflow.labels import declutter
+from ..vg_addon.workflow.labels import place_labels
 
 FONT_ID = 0
 TEXT_COLOR = (1.0, 1.0, 1.0, 1.0)
 ACTIVE_COLOR = (1.0, 0.85, 0.2, 1.0)
 OUTLINE_COLOR = (0.0, 0.0, 0.0, 0.9)
 OUTLINE_OFFSETS = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
-SPACING_EM = 2.5  # minimum distance between two labels, in text heights
 
 _handle = {"draw": None}
 
@@ -51,10 +51,12 @@ def _draw() -> None:
     priority = [(2 * len(placed) if label.active else 0) + i for i, (label, _) in enumerate(placed)]
     positions = np.array([coord for _, coord in placed])
     blf.size(FONT_ID, size)
-    for index in declutter(positions, priority, SPACING_EM * size):
+    widths = [blf.dimensions(FONT_ID, label.text)[0] for label, _ in placed]
+    gap = 0.6 * size
+    for index, side in place_labels(positions, widths, size, priority, gap=gap):
         label, (x, y) = placed[index]
-        x, y = x + 0.6 * size, y + 0.3 * size  # beside the centre, not on it
-        _outlined(label.text, x, y, ACTIVE_COLOR if label.active else TEXT_COLOR)
+        x = x + gap if side > 0 else x - gap - widths[index]
+        _outlined(label.text, x, y - 0.35 * size, ACTIVE_COLOR if label.active else TEXT_COLOR)
 
 
 def _outlined(text: str, x: float, y: float, color) -> None:

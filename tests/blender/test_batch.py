@@ -430,6 +430,7 @@ def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
     assert rows[0].units.startswith("BU (1 BU = 0.001 m")
     assert len({r.break_number for r in rows}) == len(sites)  # one colour pair per site
     assert "true angle" in result.stdout and f"Output folder: {out}" in result.stdout
-    assert png_size(out / "bone_fragment.png") == (800, 600)
+    assert png_size(out / "bone_fragment_map_front.png") == (800, 600)
+    assert png_size(out / "bone_fragment_map.png") == (3 * 800, 2 * 600)  # the contact sheet
     assert (out / "bone_fragment.blend").stat().st_size > 0
     assert meshio.read_mesh(out / "bone_fragment.ply").n_vertices > 200_000

@@ -12,40 +12,74 @@ import numpy as np
 from ..errors import GoniometerError
 
 
-def declutter(positions, priority, min_distance: float) -> np.ndarray:
-    """Indices of the labels to show: greedily, by priority, each at least ``min_distance``
-    from every label kept before it.
+def label_box(anchor, width: float, height: float, side: int, gap: float) -> np.ndarray:
+    """``[left, bottom, right, top]`` of a label's text: to the right of its anchor
+    (``side=1``) or to the left (``side=-1``), ``gap`` away, vertically centred on it."""
+    x, y = float(anchor[0]), float(anchor[1])
+    near, far = x + side * gap, x + side * (gap + width)
+    return np.array([min(near, far), y - height / 2, max(near, far), y + height / 2])
+
+
+def _overlaps(boxes: np.ndarray, box: np.ndarray) -> bool:
+    return bool(
+        (
+            (boxes[:, 0] < box[2])
+            & (box[0] < boxes[:, 2])
+            & (boxes[:, 1] < box[3])
+            & (box[1] < boxes[:, 3])
+        ).any()
+    )
+
+
+def place_labels(anchors, widths, height: float, priority, *, gap: float | None = None) -> list:
+    """Which labels to show and on which side of their anchor, so that no two overlap.
+
+    Greedily, by priority: a label goes to the right of its anchor if its text box is clear of
+    every text and anchor kept before it, else to the left, else it is left out.
 
     Parameters
     ----------
-    positions : array_like, shape (n, 2)
-        Label anchors on the picture (pixels).
+    anchors : array_like, shape (n, 2)
+        Where each label points (pixels): the measurement's centre on the picture.
+    widths : array_like, shape (n,)
+        Each label's text width (pixels).
+    height : float
+        The text height (pixels); labels keep a quarter of it apart.
     priority : array_like, shape (n,)
-        Higher first (e.g. the active measurement, then the newest); ties keep input order.
-    min_distance : float
-        Pixels between any two kept anchors.
+        Higher first (e.g. the selected measurement, then the newest); ties keep input order.
+    gap : float, optional
+        Between anchor and text; default half the height.
 
     Returns
     -------
-    ndarray of int
-        Kept indices, in priority order. The first label is always kept.
+    list of (int, int)
+        ``(index, side)`` of each label shown, in priority order; side 1 is right, -1 left.
+        The first label is always shown.
     """
-    positions = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
+    anchors = np.asarray(anchors, dtype=np.float64).reshape(-1, 2)
+    widths = np.asarray(widths, dtype=np.float64).reshape(-1)
     priority = np.asarray(priority, dtype=np.float64).reshape(-1)
-    if positions.shape[0] != priority.shape[0]:
+    if not anchors.shape[0] == widths.shape[0] == priority.shape[0]:
         raise GoniometerError(
-            f"declutter: {positions.shape[0]} positions but {priority.shape[0]} priorities."
+            f"place_labels: {anchors.shape[0]} anchors, {widths.shape[0]} widths and "
+            f"{priority.shape[0]} priorities; give one of each per label."
         )
-    order = np.argsort(-priority, kind="stable")
-    kept: list[int] = []
-    limit = float(min_distance) ** 2
-    for index in order:  # labels shown at once: tens to a few hundred
-        if kept:
-            offsets = positions[kept] - positions[index]
-            if np.einsum("ij,ij->i", offsets, offsets).min() < limit:
-                continue
-        kept.append(int(index))
-    return np.array(kept, dtype=np.int64)
+    gap = 0.5 * height if gap is None else float(gap)
+    pad = 0.125 * height
+    dot = 0.25 * height
+    taken = np.empty((0, 4))
+    shown = []
+    for index in np.argsort(-priority, kind="stable"):
+        anchor = anchors[index]
+        mark = np.array([anchor[0] - dot, anchor[1] - dot, anchor[0] + dot, anchor[1] + dot])
+        for side in (1, -1):
+            box = label_box(anchor, widths[index], height, side, gap)
+            padded = box + np.array([-pad, -pad, pad, pad])
+            if not taken.size or not (_overlaps(taken, padded) or _overlaps(taken, mark)):
+                shown.append((int(index), side))
+                taken = np.vstack([taken, box, mark])
+                break
+    return shown
 
 
 #: The six orthographic views of a map: name, the direction the camera looks along, and the
