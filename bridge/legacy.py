@@ -35,7 +35,9 @@ def legacy_fingerprint(geometry: Geometry) -> str:
 
 def has_world_records(obj) -> bool:
     """Whether any measurement of ``obj`` is still recorded in world space."""
-    return any(records.space_of(item) == records.WORLD for item in obj.vg.measurements)
+    return any(
+        (numbers := exact_numbers(item)) and "space" not in numbers for item in obj.vg.measurements
+    )
 
 
 def migrate(obj, geometry: Geometry, surface) -> list[int]:

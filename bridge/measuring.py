@@ -212,6 +212,44 @@ def replicate_rows(
     GoniometerError
         Listing every row that names another mesh or cannot be measured; nothing is recorded.
     """
+    steps = replicate_steps(
+        obj,
+        rows,
+        ignore_mesh_names=ignore_mesh_names,
+        radius=radius,
+        lam=lam,
+        patch=patch,
+        depsgraph=depsgraph,
+        source=source,
+    )
+    try:
+        while True:
+            done, total = next(steps)
+            if progress is not None and progress(done, total) is False:
+                steps.close()
+                raise GoniometerError(
+                    f"Import of {source} cancelled after {done} of {total} rows: nothing was "
+                    "imported."
+                )
+    except StopIteration as finished:
+        return finished.value
+
+
+def replicate_steps(
+    obj,
+    rows,
+    *,
+    ignore_mesh_names=False,
+    radius=None,
+    lam=2.0,
+    patch="euclidean",
+    depsgraph=None,
+    source="the CSV",
+):
+    """:func:`replicate_rows` a row at a time: a generator that yields ``(done, total)`` before
+    each row is measured and returns the new measurements' numbers (``StopIteration.value``)
+    once all are recorded. Closing it before the end records nothing; so does a mesh that
+    changed between steps (a GoniometerError)."""
     check_measurable(obj)
     if not rows:
         raise GoniometerError(f"{source} has no measurement rows: nothing to import.")
@@ -222,11 +260,7 @@ def replicate_rows(
     scale = uniform_scale(geometry.matrix)
     results, failures = [], []
     for done, row in enumerate(rows):
-        if progress is not None and progress(done, len(rows)) is False:
-            raise GoniometerError(
-                f"Import of {source} cancelled after {done} of {len(rows)} rows: nothing was "
-                "imported."
-            )
+        yield done, len(rows)
         try:
             row_radius = radius if row.radius is None else row.radius
             if row_radius is None:
@@ -257,6 +291,11 @@ def replicate_rows(
             f"{len(failures)} of {len(rows)} rows of {source} could not be measured on "
             f"'{obj.name}'; nothing was imported.\n" + bounded_list(failures, lines=True)
         )
+    check_measurable(obj)
+    if evaluated_geometry(obj, depsgraph).fingerprint != geometry.fingerprint:
+        raise GoniometerError(
+            f"'{obj.name}' changed while {source} was being measured; nothing was imported."
+        )
     numbers = []
     for row, m in results:
         _remember(geometry.fingerprint, m)
@@ -269,11 +308,16 @@ def replicate_rows(
     return numbers
 
 
+def read_rows(path) -> tuple[list, str]:
+    """The replication rows of the CSV at ``path`` and how messages name it."""
+    return csvio.read_replication_csv(Path(path)), f"'{Path(path).name}'"
+
+
 def import_csv(obj, path, *, depsgraph=None, **options) -> list[int]:
     """Read a measurement CSV (ours, MeshLab's, the earlier add-on's or plain x, y, z points) and
     replicate it on ``obj``; ``options`` as for :func:`replicate_rows`."""
-    rows = csvio.read_replication_csv(Path(path))
-    return replicate_rows(obj, rows, depsgraph=depsgraph, source=f"'{Path(path).name}'", **options)
+    rows, source = read_rows(path)
+    return replicate_rows(obj, rows, depsgraph=depsgraph, source=source, **options)
 
 
 def export_rows(objects, scene, *, depsgraph=None) -> list:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import bpy
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
@@ -99,42 +101,115 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         description="Measure rows whose Mesh Name is not this object's on this object too",
         default=False,
     )
+    interactive: BoolProperty(
+        name="Interactive",
+        description="Started from the file browser: measure in steps, with progress, and let "
+        "Esc cancel (scripts measure in one go)",
+        default=False,
+        options={"HIDDEN", "SKIP_SAVE"},
+    )
+
+    # Rows measured per timer step: a step stays short enough for Esc to be noticed.
+    STEP_SECONDS = 0.1
 
     @classmethod
     def poll(cls, context):
         return poll_measurable(cls, context)
 
-    def execute(self, context):
+    def invoke(self, context, event):
+        self.interactive = True
+        return ImportHelper.invoke(self, context, event)
+
+    def _start(self, context):
+        """Read the file and prepare the steps; report and return None on a problem."""
         path = _path(self)
         obj = context.active_object
         try:
             check_measurable(obj)
             if not path:
                 raise GoniometerError("No file name given: choose the CSV to import.")
+            rows, source = measuring.read_rows(path)
             settings = context.scene.vg_settings
-            with Progress(context, f"Re-measuring {bpy.path.basename(path)}") as progress:
-                numbers = measuring.import_csv(
-                    obj,
-                    path,
-                    ignore_mesh_names=self.ignore_mesh_names,
-                    radius=typed_value(settings.radius),
-                    lam=typed_value(settings.seg_param),
-                    patch=settings.patch,
-                    depsgraph=context.evaluated_depsgraph_get(),
-                    progress=progress.step,
-                )
+            steps = measuring.replicate_steps(
+                obj,
+                rows,
+                ignore_mesh_names=self.ignore_mesh_names,
+                radius=typed_value(settings.radius),
+                lam=typed_value(settings.seg_param),
+                patch=settings.patch,
+                depsgraph=context.evaluated_depsgraph_get(),
+                source=source,
+            )
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return None
+        except OSError as error:
+            self.report({"ERROR"}, f"Could not read {path}: {error}")
+            return None
+        self._obj, self._path_name, self._steps = obj, bpy.path.basename(path), steps
+        return steps
+
+    def execute(self, context):
+        steps = self._start(context)
+        if steps is None:
+            return {"CANCELLED"}
+        if self.interactive and context.window is not None:
+            wm = context.window_manager
+            self._progress = Progress(context, f"Re-measuring {self._path_name} (Esc cancels)")
+            self._timer = wm.event_timer_add(0.01, window=context.window)
+            wm.modal_handler_add(self)
+            return {"RUNNING_MODAL"}
+        with Progress(context, f"Re-measuring {self._path_name}") as progress:
+            return self._advance(progress, until=None)
+
+    def _advance(self, progress, until):
+        """Measure rows until the time ``until`` (None: to the end); the operator's result, or
+        None to go on."""
+        try:
+            while True:
+                done, total = next(self._steps)
+                progress.step(done, total)
+                if until is not None and time.perf_counter() > until:
+                    return None
+        except StopIteration as finished:
+            numbers = finished.value
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        except OSError as error:
-            self.report({"ERROR"}, f"Could not read {path}: {error}")
-            return {"CANCELLED"}
         self.report(
             {"INFO"},
-            f"Re-measured {len(numbers)} row(s) of {bpy.path.basename(path)} on '{obj.name}' "
+            f"Re-measured {len(numbers)} row(s) of {self._path_name} on '{self._obj.name}' "
             f"(measurements {numbers[0]}–{numbers[-1]})",
         )
         return {"FINISHED"}
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self._finish(context)
+            self.report({"INFO"}, f"Import of {self._path_name} cancelled: nothing was imported.")
+            return {"CANCELLED"}
+        if event.type != "TIMER" or event.timer is not self._timer:
+            return {"RUNNING_MODAL"}
+        try:
+            result = self._advance(self._progress, until=time.perf_counter() + self.STEP_SECONDS)
+        except ReferenceError:  # the object was deleted meanwhile
+            result = {"CANCELLED"}
+            self.report({"ERROR"}, "The object was deleted: nothing was imported.")
+        if result is None:
+            return {"RUNNING_MODAL"}
+        self._finish(context)
+        return result
+
+    def cancel(self, context):
+        """Blender ends the operator (file load, window closed): nothing is imported."""
+        self._finish(context)
+
+    def _finish(self, context) -> None:
+        self._steps.close()
+        timer, self._timer = getattr(self, "_timer", None), None
+        if timer is not None:
+            context.window_manager.event_timer_remove(timer)
+        self._progress.__exit__(None, None, None)
 
 
 classes = (VG_OT_export_csv, VG_OT_import_csv)
