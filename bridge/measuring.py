@@ -322,9 +322,9 @@ def import_csv(obj, path, *, depsgraph=None, **options) -> list[int]:
 
 def export_rows(objects, scene, *, depsgraph=None) -> list:
     """CSV rows of every measurement of ``objects`` (stale ones flagged), in list order."""
-    units = records.units_label(scene)
     rows = []
     for obj in objects:
+        units = records.units_label(scene, obj)
         stale = stale_numbers(obj, depsgraph=depsgraph)
         rows.extend(
             records.to_row(obj, item, stale=item.number in stale, units=units)

@@ -14,6 +14,7 @@ import numpy as np
 from ..properties import exact_numbers
 from ..vg_addon import GoniometerError, palette
 from ..vg_addon.formats import csvio
+from .mesh_data import uniform_scale
 
 _MANIFEST = Path(__file__).resolve().parents[1] / "blender_manifest.toml"
 
@@ -138,12 +139,26 @@ def replay_args(item) -> dict:
     }
 
 
-def units_label(scene) -> str:
-    """What one coordinate unit is: Blender units, and their length in the scene's unit system."""
+def units_label(scene, obj=None) -> str:
+    """What one coordinate unit is: Blender units and their length in the scene's unit system,
+    for a mesh shown at its own size; for an object scaled by ``s``, one mesh unit is ``s``
+    Blender units in the scene, and the label says so."""
     units = scene.unit_settings
+    scale = None
+    if obj is not None:
+        scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
+        if scale is None:
+            return "mesh units (the object's scale is not uniform)"
     if units.system == "NONE":
-        return "BU"
-    return f"BU (1 BU = {units.scale_length:g} m, shown in {units.length_unit.lower()})"
+        base = "BU"
+        metres = None
+    else:
+        base = f"BU (1 BU = {units.scale_length:g} m, shown in {units.length_unit.lower()})"
+        metres = units.scale_length
+    if scale is None or scale == 1.0:
+        return base
+    shown = f"{scale:g} BU" if metres is None else f"{scale * metres:g} m"
+    return f"mesh units (1 unit = {shown} in the scene, object scale {scale:g})"
 
 
 def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:

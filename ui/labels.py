@@ -12,10 +12,13 @@ from __future__ import annotations
 
 import blf
 import bpy
+import gpu
 import numpy as np
 from bpy_extras import view3d_utils
+from gpu_extras.batch import batch_for_shader
 
 from ..bridge.label_data import labels_of
+from ..operators.drag_overlay import point_shader
 from ..vg_addon.workflow.labels import place_labels
 
 FONT_ID = 0
@@ -53,10 +56,31 @@ def _draw() -> None:
     blf.size(FONT_ID, size)
     widths = [blf.dimensions(FONT_ID, label.text)[0] for label, _ in placed]
     gap = 0.6 * size
-    for index, side in place_labels(positions, widths, size, priority, gap=gap):
+    shown = place_labels(positions, widths, size, priority, gap=gap)
+    _dots(positions[[index for index, _ in shown]], 0.5 * size)
+    for index, side in shown:
         label, (x, y) = placed[index]
         x = x + gap if side > 0 else x - gap - widths[index]
         _outlined(label.text, x, y - 0.35 * size, ACTIVE_COLOR if label.active else TEXT_COLOR)
+
+
+def _dots(positions: np.ndarray, diameter: float) -> None:
+    """A white dot ringed in black at each labelled centre (pixel coordinates)."""
+    shader, sized = point_shader()
+    coords = np.column_stack([positions, np.zeros(len(positions))]).astype(np.float32)
+    batch = batch_for_shader(shader, "POINTS", {"pos": coords})
+    shader.bind()
+    gpu.state.blend_set("ALPHA")
+    for color, size in ((OUTLINE_COLOR, diameter + 3.0), (TEXT_COLOR, diameter)):
+        if sized:
+            shader.uniform_float("size", size)
+        else:
+            gpu.state.point_size_set(size)
+        shader.uniform_float("color", color)
+        batch.draw(shader)
+    if not sized:
+        gpu.state.point_size_set(1.0)
+    gpu.state.blend_set("NONE")
 
 
 def _outlined(text: str, x: float, y: float, color) -> None:

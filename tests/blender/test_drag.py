@@ -165,6 +165,19 @@ def test_radius_is_measured_on_the_view_plane(drag, view):
         assert measured == pytest.approx(radius, abs=tolerance)
 
 
+def test_radius_is_in_mesh_units_on_a_scaled_object(drag, view):
+    view.obj.scale = (2.0, 2.0, 2.0)
+    bpy.context.view_layer.update()
+    matrix = np.array(view.obj.matrix_world, dtype=np.float64)
+    center = view.local[ridge_vertex(view)]
+    center_world = matrix[:3, :3] @ center + matrix[:3, 3]
+    x, y = pixel(view, center_world)
+    one_pixel = drag.view_plane_radius(view.region, view.rv3d, (x + 1.0, y), center, matrix)
+    coord = pixel(view, center_world + 0.8 * view.right)  # 0.8 in the world: 0.4 on the mesh
+    measured = drag.view_plane_radius(view.region, view.rv3d, coord, center, matrix)
+    assert measured == pytest.approx(0.4, abs=one_pixel)
+
+
 # -- the drag session, driven by translated events --------------------------------------------
 
 

@@ -149,6 +149,9 @@ def test_export_is_in_mesh_coordinates_and_replicates_on_the_file_with_the_core(
     assert not any(row.stale for row in rows)
     assert [[r.x, r.y, r.z] for r in rows] == mesh.points[picks].tolist()
     assert [r.radius for r in rows] == [0.3] * 3  # mesh units, not the object's 0.003
+    assert {r.units for r in rows} == {
+        "mesh units (1 unit = 0.01 m in the scene, object scale 0.01)"
+    }
     surface = Surface(mesh.points, mesh.triangles)  # the file, float64 as written
     for row, exported in zip(csvio.read_replication_csv(path), rows, strict=True):
         m = surface.measure((row.x, row.y, row.z), row.radius, row.lam, row.patch)
