@@ -75,8 +75,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     """Load (or find) one mesh, measure its tasks, record them on the object, colour it and
     optionally render it. Never raises for a problem of this mesh: it becomes the rows' error.
 
-    The numbers come from the extension's own pipeline: the object's evaluated mesh in world
-    space (``mesh_data.evaluated_geometry``), its cached ``Surface`` (``mesh_data.surface_for``)
+    The numbers come from the extension's own pipeline: the object's evaluated mesh in its own
+    coordinates (``mesh_data.evaluated_geometry``), its cached ``Surface`` (``mesh_data.surface_for``)
     and ``records.add_measurement``; ``measuring.measure_on_object`` does the same per click,
     re-evaluating the mesh and repainting each time, which a batch does once per mesh instead.
     """
@@ -121,7 +121,10 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     last_report = start = time.perf_counter()
     for done, task in enumerate(tasks, start=1):
         try:
-            m = surface.measure(task.center, task.radius, task.lam, task.patch)
+            center, radius = task.center, task.radius
+            if task.coordinates == records.WORLD:  # a row of an export of earlier versions
+                center, radius = measuring.from_world(center, radius, geometry.matrix)
+            m = surface.measure(center, radius, task.lam, task.patch)
         except GoniometerError as error:
             result.rows.append((task.index, error_row(task, obj.name, str(error), units)))
             result.failed += 1

@@ -166,6 +166,29 @@ def stale_numbers(obj, *, depsgraph=None) -> set[int]:
     return {item.number for item in obj.vg.measurements if item.fingerprint != current}
 
 
+def from_world(location, radius, matrix, *, scale_radius=True):
+    """A world-space centre and radius in mesh coordinates: ``(location, radius)``.
+
+    The radius is divided by the object's scale (when ``scale_radius``; a default radius given
+    in mesh units is kept).
+
+    Raises
+    ------
+    GoniometerError
+        The object's scale is not uniform: a world-space radius has no single length on the
+        mesh.
+    """
+    scale = uniform_scale(matrix)
+    if scale is None:
+        raise GoniometerError(
+            "its coordinates are in world space and the object's scale is not uniform, so its "
+            "radius has no single length on the mesh: re-export the CSV in mesh coordinates, or "
+            "set a uniform scale"
+        )
+    location = mesh_points(np.asarray(location, dtype=np.float64), matrix)
+    return location, (radius / scale if scale_radius and radius is not None else radius)
+
+
 def replicate_rows(
     obj,
     rows,
@@ -257,7 +280,6 @@ def replicate_steps(
         csvio.check_mesh_names(rows, (obj.name, obj.data.name), source=source)
     geometry = evaluated_geometry(obj, depsgraph)
     surface = surface_for(obj, geometry)
-    scale = uniform_scale(geometry.matrix)
     results, failures = [], []
     for done, row in enumerate(rows):
         yield done, len(rows)
@@ -267,15 +289,9 @@ def replicate_steps(
                 raise GoniometerError("no radius (the CSV has no Radius for this row)")
             location = (row.x, row.y, row.z)
             if row.coordinates == records.WORLD:
-                if scale is None:
-                    raise GoniometerError(
-                        "its coordinates are in world space and the object's scale is not "
-                        "uniform, so its radius has no single length on the mesh: re-export "
-                        "the CSV in mesh coordinates, or set a uniform scale"
-                    )
-                location = mesh_points(location, geometry.matrix)
-                if row.radius is not None:
-                    row_radius = row.radius / scale
+                location, row_radius = from_world(
+                    location, row_radius, geometry.matrix, scale_radius=row.radius is not None
+                )
             m = surface.measure(
                 location,
                 row_radius,

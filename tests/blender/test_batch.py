@@ -374,6 +374,32 @@ def test_blend_input_mesh_coordinates_and_saved_measurements(vg, tmp_path):
     np.testing.assert_array_equal(colours(stored), painted)
 
 
+def test_an_old_world_space_csv_on_a_moved_blend_object(vg, tmp_path):
+    """An export of a version that wrote world coordinates (no Coordinates column), re-measured
+    by the batch on the .blend object where it stands: the same vertex, the radius in mesh
+    units, the same angle as measuring there in mesh coordinates."""
+    shape = wedge(75.0, n=30, irregular=True, seed=5)
+    obj = mesh_object("Bone", shape.points, shape.triangles, location=(10.0, -2.0, 3.0),
+                      rotation=(0.3, -0.2, 1.1), scale=(2.0, 2.0, 2.0))  # fmt: skip
+    source = tmp_path / "study.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(source))
+    vertex = int(np.argmin(np.linalg.norm(shape.points - [0.1, 0.0, 0.0], axis=1)))
+    matrix = np.array(obj.matrix_world, dtype=np.float64)
+    local = np.float32(shape.points[vertex]).astype(np.float64)
+    centre = matrix[:3, :3] @ local + matrix[:3, 3]
+    header = [c for c in csvio.EXPORT_COLUMNS if c != "Coordinates"]
+    values = {"Mesh Name": "Bone", "Radius": "1.2", "SegParam": "2.0", "Patch Mode": "euclidean"}
+    values.update({axis: repr(float(v)) for axis, v in zip("xyz", centre, strict=True)})
+    old = tmp_path / "old.csv"
+    old.write_text(",".join(header) + "\n" + ",".join(values.get(c, "") for c in header) + "\n")
+    out = tmp_path / "out.csv"
+    ok(batch(source, "--object", "Bone", "--points", old, "--out", out))
+    row = rows_of(out)[0]
+    assert (row.x, row.y, row.z) == tuple(local) and row.radius == 0.6
+    bpy.ops.vg.measure_xyz(location=tuple(local), space="MESH", radius=0.6)
+    assert exact(obj.vg.measurements[0])["angle"] == row.angle
+
+
 def test_blend_input_errors_exit_2(tmp_path):
     bpy.ops.wm.read_homefile(use_empty=True)
     shape = wedge(75.0, n=8)
