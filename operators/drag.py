@@ -21,6 +21,7 @@ from ..bridge.mesh_data import (
     evaluated_geometry,
     mesh_points,
     surface_for,
+    uniform_scale,
     world_points,
 )
 from ..vg_addon import GoniometerError
@@ -279,7 +280,11 @@ class DragSession:
     def header_text(self, scene) -> str:
         """The header line: radius, vertex count, λ, the angle after a λ change, and any hint."""
         machine = self.machine
-        parts = [f"Goniometer radius {format_length(scene, machine.radius)}"]
+        if uniform_scale(self.matrix) == 1.0:
+            radius = format_length(scene, machine.radius)
+        else:  # the scene's units measure world lengths, not the scaled mesh's
+            radius = f"{machine.radius:.5g} mesh units"
+        parts = [f"Goniometer radius {radius}"]
         if machine.typed:
             parts[0] += f" (typed {machine.typed})"
         parts.append(f"{machine.n_vertices} vertices")
