@@ -136,3 +136,18 @@ def test_the_operator_refuses_a_relative_folder_of_an_unsaved_file(vg):
     measured_annulus(vg)
     with pytest.raises(RuntimeError, match="not saved yet"):
         bpy.ops.vg.render_map(directory="//maps")
+
+
+def test_the_operator_writes_the_map(vg, tmp_path):
+    obj = measured_annulus(vg)
+    folder = tmp_path / "maps"
+    result = bpy.ops.vg.render_map(
+        directory=str(folder), views="FLAKE", width=120, height=90, samples=1
+    )
+    assert result == {"FINISHED"}
+    assert sorted(p.name for p in folder.iterdir()) == [
+        f"{obj.name}_map.png",
+        f"{obj.name}_map_face_A.png",
+        f"{obj.name}_map_face_B.png",
+    ]
+    assert pixels_of(folder / f"{obj.name}_map.png").shape == (90, 240, 4)
