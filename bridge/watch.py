@@ -93,7 +93,22 @@ def on_load_post(*_args):
     clear_caches()
     for obj in bpy.data.objects:
         if obj.type == "MESH" and legacy.has_world_records(obj):
-            refresh(obj)
+            migrate(obj)
+
+
+def migrate(obj) -> list[int]:
+    """Bring ``obj``'s world-space records into mesh coordinates where they still match, and
+    repaint it if any were; returns their numbers. Objects that cannot be measured now are
+    left as they are."""
+    try:
+        check_measurable(obj)
+        geometry = evaluated_geometry(obj)
+    except GoniometerError:
+        return []
+    migrated = legacy.migrate(obj, geometry, mesh_data.surface_for(obj, geometry))
+    if migrated:
+        repaint(obj, geometry=geometry)
+    return migrated
 
 
 _HANDLERS = (

@@ -7,7 +7,7 @@ import json
 
 import bpy
 import numpy as np
-from bpy_helpers import exact, local_points, wedge_object, world
+from bpy_helpers import colours, exact, expected_colours, local_points, wedge_object, world
 
 from vg_addon import Surface
 from vg_addon.formats import csvio
@@ -71,6 +71,7 @@ def test_an_old_blend_file_is_migrated_on_load(vg, tmp_path):
     )
     origin = world(np.zeros((1, 3)), kept)[0] + 0.01
     old = old_record(kept, origin, 1.2)  # 0.4 mesh units at a scale of 3
+    kept.vg.measurements[0].stale = True  # flagged while it was elsewhere, now back in place
     moved = wedge_object(80.0, "Moved", location=(5.0, 0.0, 0.0))
     old_moved = old_record(moved, world(np.zeros((1, 3)), moved)[0], 0.4)
     moved.location.x += 1.0  # moved after measuring, as the old versions could not follow
@@ -95,6 +96,8 @@ def test_an_old_blend_file_is_migrated_on_load(vg, tmp_path):
         local_points(kept)[vertex].astype(np.float64), 1.2 / 3.0
     )
     assert (numbers["center"], numbers["angle"]) == (m.center.tolist(), m.angle)
+    painted = expected_colours(vg, len(kept.data.vertices), [(m.indices, m.labels, 1)])
+    np.testing.assert_array_equal(colours(kept), painted)  # and painted again
     # It now follows the object.
     kept.location.z += 4.0
     bpy.context.view_layer.update()
