@@ -110,6 +110,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         return fail_all(str(error))
     result.n_vertices = int(geometry.points.shape[0])
     result.prepare_seconds = time.perf_counter() - start
+    units = records.units_label(bpy.context.scene, obj)  # a .blend object may be scaled
 
     data = obj.vg
     base = data.next_number - 1  # measurements already on a .blend object keep their numbers

@@ -86,7 +86,11 @@ class MapJob:
         self._scene = None
         self._label_objects: list = []
         self.directory.mkdir(parents=True, exist_ok=True)
-        self._build_scene()
+        try:
+            self._build_scene()
+        except BaseException:
+            self.close()
+            raise
 
     @property
     def done(self) -> bool:
