@@ -30,6 +30,20 @@ from .vg_addon import palette
 
 # Paths may start with // (the .blend's folder); Blender 4.5 and later want that declared.
 BLEND_RELATIVE = {"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else set()
+RULE_ITEMS = (
+    (
+        "oriented",
+        "Oriented",
+        "Sign the position term by the edge's convexity: right on concave edges and on meshes "
+        "wound inward (the default)",
+    ),
+    (
+        "paper",
+        "Paper",
+        "Algorithm 1 as printed (MeshLab plugin, earlier add-on): misreads concave edges; for "
+        "replicating old measurements",
+    ),
+)
 
 PATCH_ITEMS = (
     ("euclidean", "Euclidean", "All vertices within the radius (a ball around the centre)"),
@@ -41,7 +55,9 @@ def exact_numbers(item) -> dict:
     """The float64 numbers of a measurement, decoded from its ``exact`` JSON text.
 
     Keys: ``angle``, ``fit``, ``fit_plus``, ``fit_minus``, ``radius``, ``lam``, ``snap_distance``
-    (floats) and ``center``, ``requested``, ``normal_plus``, ``normal_minus`` (lists of 3 floats).
+    (floats) and ``center``, ``requested``, ``normal_plus``, ``normal_minus`` (lists of 3 floats);
+    since the oriented rule also ``rule``, ``convexity``, ``correlation`` and ``stability`` (a
+    dict of its parts, or None). Records without ``rule`` were measured with the paper's rule.
     """
     try:
         return json.loads(item.exact) if item.exact else {}
@@ -75,6 +91,28 @@ def _world_centre(self):
     if matrix is None:
         return tuple(centre)
     return tuple(matrix @ Vector(centre))
+
+
+def _text_value(key, default=""):
+    def get(self):
+        return str(exact_numbers(self).get(key, default))
+
+    return get
+
+
+def _stability_text(self):
+    parts = exact_numbers(self).get("stability")
+    if not parts:
+        return "not computed"
+    spread = parts["spread"]
+    return f"± {spread:.2f}°" if spread < 0.1 else f"± {spread:.1f}°"
+
+
+def _stability_part(key):
+    def get(self):
+        return float((exact_numbers(self).get("stability") or {}).get(key, 0.0))
+
+    return get
 
 
 def _side_colour(side):
@@ -156,6 +194,29 @@ class VG_Measurement(PropertyGroup):
     normal_minus: FloatVectorProperty(
         name="Plane normal −", size=3, subtype="DIRECTION", get=_vector("normal_minus")
     )
+    rule: StringProperty(
+        name="Rule",
+        description="How the projection was signed: oriented, or paper (Algorithm 1 as printed); "
+        "measurements recorded before the rule existed used the paper's",
+        get=_text_value("rule", "paper"),
+    )
+    convexity: StringProperty(
+        name="Edge",
+        description="Convex, concave (the angle is then the open wedge's, 360° minus the solid's "
+        "interior angle) or unclear, relative to the mesh's normals",
+        get=_text_value("convexity", "not recorded"),
+    )
+    stability_text: StringProperty(
+        name="Stability",
+        description="The largest change of the angle with the centre moved two edge lengths, "
+        "the radius ±10%, λ from 1 to 3, and the vertices resampled",
+        get=_stability_text,
+    )
+    stability_center: FloatProperty(name="Centre moved (°)", get=_stability_part("center"))
+    stability_radius: FloatProperty(name="Radius ±10% (°)", get=_stability_part("radius"))
+    stability_lam: FloatProperty(name="λ 1 to 3 (°)", get=_stability_part("lam"))
+    stability_bootstrap: FloatProperty(name="Bootstrap 95% (°)", get=_stability_part("bootstrap"))
+    stability_orientation: FloatProperty(name="Other sign (°)", get=_stability_part("orientation"))
     color_plus: FloatVectorProperty(
         name="Colour +", size=3, subtype="COLOR_GAMMA", get=_side_colour(0)
     )
@@ -180,6 +241,11 @@ class VG_ObjectData(PropertyGroup):
         description="The viewports were switched to show the sides, on the first measurement",
         default=False,
         options={"HIDDEN"},
+    )
+    winding: StringProperty(
+        name="Winding",
+        description="Which way the measured mesh's faces are wound: outward, inward, mixed, or "
+        "open (cannot be decided); set when it is measured",
     )
 
 
@@ -208,6 +274,38 @@ class VG_SceneSettings(PropertyGroup):
     )
     patch: EnumProperty(
         name="Patch", items=PATCH_ITEMS, default="euclidean", description="How the patch is chosen"
+    )
+    rule: EnumProperty(
+        name="Rule",
+        items=RULE_ITEMS,
+        default="oriented",
+        description="How the projection is signed",
+    )
+    stability: BoolProperty(
+        name="Stability",
+        description="Also compute the stability figure (± degrees) of each measurement",
+        default=True,
+    )
+    sweep_start: FloatProperty(
+        name="From",
+        description="First radius of a radius sweep, scene units",
+        default=0.5,
+        min=0.0,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    sweep_stop: FloatProperty(
+        name="To",
+        description="Last radius of a radius sweep, scene units",
+        default=2.0,
+        min=0.0,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    sweep_count: IntProperty(
+        name="Radii", description="Number of radii in a sweep", default=16, min=2, max=1000
     )
     export_all_objects: BoolProperty(
         name="All objects",

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import argparse
 
+from ..vg_addon import GoniometerError
+from ..vg_addon.method.sweep import sweep_radii
+
 # --units: Blender's unit system, unit scale and length unit for what one coordinate unit is.
 UNITS = {
     "none": ("NONE", 1.0, None),
@@ -28,6 +31,16 @@ points:
   Blender add-on: each row is re-measured with its own radius and lambda and matched to its
   mesh by its mesh name (the file name without extension). --radius, --lambda and --patch are
   the defaults for rows that carry none.
+
+rule and checks:
+  --rule oriented (the default) reads concave edges and inward-wound meshes right; --rule paper
+  is Algorithm 1 as printed. Rows of MeshLab and earlier add-on CSVs, and extension exports
+  without a Rule column, are always re-measured with the paper's rule they were taken with.
+  --stability adds each measurement's stability figure (the Stability columns; it costs about
+  ten measurements). A closed mesh wound inward is named once in the output: its angles are
+  right, its convex/concave labels swapped.
+  --sweep R0 R1 N also measures every point at N radii from R0 to R1: rows in
+  <out>_sweep.csv, and a plot per point in the folder <out>_sweep/.
 
 output:
   --out CSV gets one row per requested point, in input order, in the extension's export
@@ -62,7 +75,8 @@ def build_parser() -> argparse.ArgumentParser:
         usage="blender -b [file.blend] --python vg_batch.py -- ARGS\n"
         "       python vg_batch.py ARGS\n\n"
         "ARGS:  MESH... [--object NAME] (--at X Y Z ... | --points CSV) [--radius R]\n"
-        "       [--lambda L] [--patch euclidean|geodesic] --out CSV [--save-blend PATH]\n"
+        "       [--lambda L] [--patch euclidean|geodesic] [--rule oriented|paper]\n"
+        "       [--stability] [--sweep R0 R1 N] --out CSV [--save-blend PATH]\n"
         "       [--render DIR] [--jobs N] [--shard K/N]\n"
         "   or: --demo [--out-dir DIR]",
         description="Measure break-edge angles (the Virtual Goniometer) on meshes and point "
@@ -114,6 +128,25 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("euclidean", "geodesic"),
         default="euclidean",
         help="patch shape: a ball (euclidean, default) or along mesh edges (geodesic)",
+    )
+    how.add_argument(
+        "--rule",
+        choices=("oriented", "paper"),
+        default="oriented",
+        help="how the projection is signed: oriented (default; right on concave edges) or paper "
+        "(Algorithm 1 as printed); rows of MeshLab/earlier add-on CSVs keep the paper's",
+    )
+    how.add_argument(
+        "--stability",
+        action="store_true",
+        help="also compute each measurement's stability figure (about ten measurements' cost)",
+    )
+    how.add_argument(
+        "--sweep",
+        nargs=3,
+        type=float,
+        metavar=("R0", "R1", "N"),
+        help="also measure each point at N radii from R0 to R1: <out>_sweep.csv and plots",
     )
     how.add_argument(
         "--units",
@@ -220,3 +253,11 @@ def check_args(args) -> None:
         raise UsageError(f"--jobs must be 1 or more (got {args.jobs}).")
     if min(args.render_size) < 16 or args.render_samples < 1:
         raise UsageError("--render-size must be at least 16 16 and --render-samples positive.")
+    if args.sweep:
+        start, stop, count = args.sweep
+        if count != int(count):
+            raise UsageError(f"--sweep R0 R1 N: N must be a whole number (got {count:g}).")
+        try:
+            sweep_radii(start, stop, int(count))
+        except GoniometerError as error:
+            raise UsageError(f"--sweep R0 R1 N: {error}") from None

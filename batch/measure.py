@@ -11,8 +11,10 @@ import bpy
 import numpy as np
 
 from ..bridge import colors, measuring, mesh_data, records
+from ..bridge.measurement_map import safe_file_name
 from ..vg_addon import GoniometerError
-from ..vg_addon.formats import csvio
+from ..vg_addon.formats import csvio, sweep_plot
+from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
 from .render import add_sides_material, render_map
 from .sources import MeshSource, import_mesh
@@ -35,6 +37,9 @@ class MeshResult:
     render: str = ""
     render_error: str = ""
     blend: str = ""  # a worker's one-object .blend, for --save-blend
+    winding: str = ""  # see vg_addon.method.winding.WINDINGS
+    sweep_rows: list = dataclasses.field(default_factory=list)  # [(task index, [cells])]
+    sweep_plots: int = 0
 
     def to_json(self) -> dict:
         out = dataclasses.asdict(self)
@@ -111,6 +116,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     result.n_vertices = int(geometry.points.shape[0])
     result.prepare_seconds = time.perf_counter() - start
     units = records.units_label(bpy.context.scene, obj)  # a .blend object may be scaled
+    result.winding = surface.winding
+    measuring.note_winding(obj, surface)
 
     data = obj.vg
     base = data.next_number - 1  # measurements already on a .blend object keep their numbers
@@ -125,7 +132,14 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             center, radius = task.center, task.radius
             if task.coordinates == records.WORLD:  # a row of an export of earlier versions
                 center, radius = measuring.from_world(center, radius, geometry.matrix)
-            m = surface.measure(center, radius, task.lam, task.patch)
+            m = surface.measure(
+                center,
+                radius,
+                task.lam,
+                task.patch,
+                rule=task.rule,
+                stability=bool(options.get("stability")),
+            )
         except GoniometerError as error:
             result.rows.append((task.index, error_row(task, obj.name, str(error), units)))
             result.failed += 1
@@ -143,6 +157,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             progress(done)
             last_report = now
     result.measure_seconds = time.perf_counter() - start
+    if options.get("sweep"):
+        sweep_sites(result, surface, obj.name, tasks, options, geometry.matrix)
     if len(data.measurements):
         data.next_number = max(item.number for item in data.measurements) + 1
 
@@ -169,6 +185,32 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         except Exception as error:  # a render problem must not lose the measurements
             result.render_error = f"{type(error).__name__}: {error}"
     return result
+
+
+def sweep_sites(result: MeshResult, surface, name: str, tasks, options, matrix) -> None:
+    """``--sweep``: each task's site at the sweep's radii, as CSV cells and a plot per site.
+    ``matrix`` is the object's ``matrix_world`` (for world-space rows of older exports)."""
+    start, stop, count = options["sweep"]
+    folder = Path(options["sweep_plots"])
+    for task in tasks:
+        try:
+            center = task.center
+            if task.coordinates == records.WORLD:
+                center, _ = measuring.from_world(center, None, matrix)
+            points = radius_sweep(
+                surface, center, start, stop, int(count), task.lam, task.patch, task.rule
+            )
+        except GoniometerError as error:
+            points = [
+                SweepPoint(float(r), None, str(error)) for r in sweep_radii(start, stop, count)
+            ]
+        else:
+            path = folder / f"{safe_file_name(name)}_{task.number}.png"
+            sweep_plot.write_sweep_png(path, points)
+            result.sweep_plots += 1
+        result.sweep_rows.extend(
+            (task.index, csvio.sweep_cells(name, task.number, point)) for point in points
+        )
 
 
 def set_units(scene, unit: str | None) -> None:

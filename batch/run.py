@@ -15,6 +15,7 @@ import bpy
 from ..bridge import records
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
+from ..vg_addon.method.winding import winding_message
 from ..vg_addon.workflow import batchplan
 from . import extension
 from .blend_file import append_objects, forget, save_blend
@@ -33,6 +34,7 @@ class Run:
         self.total_meshes = total_meshes
         self.jobs = 1  # processes measuring at once
         self.rows: dict[int, object] = {}
+        self.sweep_rows: list = []  # (task index, cells), --sweep
         self.results: list[MeshResult] = []
         self.bad_files: list[str] = []
         self.lock = threading.Lock()
@@ -72,6 +74,7 @@ class Run:
             self.results.append(result)
             for index, row in result.rows:
                 self.rows[index] = row
+            self.sweep_rows.extend(result.sweep_rows)
             if result.bad_file:
                 self.bad_files.append(result.bad_file)
             # Rewrite the CSV now and then (each write costs more as rows accumulate), so a run
@@ -89,6 +92,8 @@ class Run:
             )
         elif note:
             self.say(f"{source.name}{note}")
+        if message := winding_message(result.object_name or source.name, result.winding):
+            self.say(f"note: {message}")  # once per mesh, also with --quiet
 
     def write_csv(self) -> None:
         start = time.perf_counter()
@@ -105,6 +110,12 @@ class Run:
                 task, name, "not measured: the run stopped before this mesh", self.units
             )
         self.write_csv()
+        if self.args.sweep:
+            csv_path, plots = sweep_paths(self.args.out)
+            rows = [cells for _, cells in sorted(self.sweep_rows, key=lambda pair: pair[0])]
+            csvio.replace_atomically(str(csv_path), csvio.format_sweep_rows(rows).encode("utf-8"))
+            drawn = sum(r.sweep_plots for r in self.results)
+            self.say(f"wrote {csv_path} ({len(rows):,} sweep rows) and {drawn} plot(s) in {plots}")
         failed = [(i, row) for i, row in sorted(self.rows.items()) if row.error]
         measured = len(self.rows) - len(failed)
         elapsed = time.perf_counter() - self.started
@@ -135,6 +146,12 @@ class Run:
         return batchplan.exit_code(len(failed), len(self.bad_files))
 
 
+def sweep_paths(out) -> tuple[Path, Path]:
+    """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``."""
+    out = Path(out).resolve()
+    return out.with_name(out.stem + "_sweep.csv"), out.with_name(out.stem + "_sweep")
+
+
 def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     """Run a batch from parsed arguments; returns the exit status and the run's results.
 
@@ -159,7 +176,12 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     try:
         if args.at:
             tasks = bp.plan_points(
-                len(sources), args.at, radius=args.radius, lam=args.lam, patch=args.patch
+                len(sources),
+                args.at,
+                radius=args.radius,
+                lam=args.lam,
+                patch=args.patch,
+                rule=args.rule,
             )
         else:
             try:
@@ -174,6 +196,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                 patch=args.patch,
                 ignore_mesh_names=args.ignore_mesh_names,
                 source=f"'{Path(args.points).name}'",
+                rule=args.rule,
             )
         if args.shard:
             k, n = bp.parse_shard(args.shard)
@@ -193,7 +216,12 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "render_views": args.render_views.upper(),
         "save_blend": bool(args.save_blend),
         "units": units,
+        "stability": bool(args.stability),
+        "sweep": list(args.sweep) if args.sweep else None,
+        "sweep_plots": str(sweep_paths(args.out)[1]) if args.sweep else "",
     }
+    if args.sweep:
+        sweep_paths(args.out)[1].mkdir(parents=True, exist_ok=True)
     run = Run(args, sources, tasks, len(groups))
     if args.shard and not args.quiet:
         run.say(f"shard {args.shard}: {len(tasks):,} point(s) on {len(groups)} mesh(es)")

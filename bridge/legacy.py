@@ -5,7 +5,8 @@ Such a record has no ``"space"`` in its exact numbers, and its fingerprint hashe
 transform with the mesh. When that fingerprint still matches the object (the mesh and the
 transform are as they were when it was measured) and the transform is a similarity (a move, a
 rotation, a mirror and a uniform scale, which keep angles), the record is re-measured at the same
-vertex, with the radius divided by the scale, the same λ and patch mode, and its numbers are
+vertex, with the radius divided by the scale, the same λ, patch mode and rule (the paper's for
+records from before the rule existed), and its numbers are
 replaced by the new measurement's: the one it replays to from then on. The world-space numbers
 are kept in the record (``"world_record"``) so the change stays traceable. The angle is the same
 up to the rounding the world-space coordinates carried (a similarity changes no angle; a few
@@ -97,8 +98,14 @@ def _remeasure(geometry: Geometry, surface, numbers: dict, patch: str, scale: fl
     vertex = int(hits[0])
     radius = float(numbers["radius"]) / scale
     requested = mesh_points(np.array(numbers["requested"], dtype=np.float64), geometry.matrix)
-    m = surface.measure(requested, radius, float(numbers["lam"]), patch)
+    options = {
+        "rule": numbers.get("rule", "paper"),  # records from before the rule used the paper's
+        "stability": bool(numbers.get("stability")),
+    }
+    m = surface.measure(requested, radius, float(numbers["lam"]), patch, **options)
     if not np.array_equal(m.center, geometry.points[vertex]):
         # Rounding moved the snap to an equally near vertex: measure at the recorded one.
-        m = surface.measure(geometry.points[vertex], radius, float(numbers["lam"]), patch)
+        m = surface.measure(
+            geometry.points[vertex], radius, float(numbers["lam"]), patch, **options
+        )
     return m

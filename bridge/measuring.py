@@ -15,6 +15,7 @@ import numpy as np
 from ..vg_addon import GoniometerError, Measurement
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
+from ..vg_addon.method.sweep import radius_sweep
 from . import colors, legacy, records
 from .mesh_data import (
     Geometry,
@@ -32,12 +33,12 @@ _SIDES_CACHE_VERTICES = 5_000_000  # patch vertices kept in all: bounds the memo
 _sides: OrderedDict[tuple, Measurement] = OrderedDict()
 
 
-def _key(fingerprint: str, center, radius: float, lam: float, patch: str) -> tuple:
-    return (fingerprint, np.asarray(center, dtype=np.float64).tobytes(), radius, lam, patch)
+def _key(fingerprint: str, center, radius: float, lam: float, patch: str, rule: str) -> tuple:
+    return (fingerprint, np.asarray(center, dtype=np.float64).tobytes(), radius, lam, patch, rule)
 
 
 def _remember(fingerprint: str, m: Measurement) -> None:
-    _sides[_key(fingerprint, m.center, m.radius, m.lam, m.patch)] = m
+    _sides[_key(fingerprint, m.center, m.radius, m.lam, m.patch, m.rule)] = m
     while len(_sides) > 1 and (
         len(_sides) > _SIDES_CACHE_SIZE
         or sum(kept.n_vertices for kept in _sides.values()) > _SIDES_CACHE_VERTICES
@@ -47,7 +48,14 @@ def _remember(fingerprint: str, m: Measurement) -> None:
 
 def _replay(obj, geometry: Geometry, item) -> Measurement:
     args = records.replay_args(item)
-    key = _key(geometry.fingerprint, args["center"], args["radius"], args["lam"], args["patch"])
+    key = _key(
+        geometry.fingerprint,
+        args["center"],
+        args["radius"],
+        args["lam"],
+        args["patch"],
+        args["rule"],
+    )
     m = _sides.get(key)
     if m is None:
         m = surface_for(obj, geometry).measure(**args)
@@ -55,7 +63,18 @@ def _replay(obj, geometry: Geometry, item) -> Measurement:
     return m
 
 
-def measure(obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None, space="mesh"):
+def measure(
+    obj,
+    location,
+    radius,
+    lam=2.0,
+    patch="euclidean",
+    *,
+    depsgraph=None,
+    rule="oriented",
+    stability=False,
+    space="mesh",
+):
     """Measure ``obj`` without recording anything: ``(Measurement, Geometry)``.
 
     The building block for previews (e.g. a drag tool) and for :func:`measure_on_object`;
@@ -67,13 +86,57 @@ def measure(obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None
         location = mesh_points(location, geometry.matrix)
     elif space != "mesh":
         raise GoniometerError(f"Unknown coordinate space {space!r}: use 'mesh' or 'world'.")
-    m = surface_for(obj, geometry).measure(location, radius, lam, patch)
+    surface = surface_for(obj, geometry)
+    m = surface.measure(location, radius, lam, patch, rule=rule, stability=stability)
     _remember(geometry.fingerprint, m)
+    note_winding(obj, surface)
     return m, geometry
 
 
+def note_winding(obj, surface) -> None:
+    """Keep the surface's winding on the object, for the panel to say once if it is inward."""
+    if obj.vg.winding != surface.winding:
+        obj.vg.winding = surface.winding
+
+
+def sweep(
+    obj,
+    location,
+    start,
+    stop,
+    count,
+    lam=2.0,
+    patch="euclidean",
+    *,
+    depsgraph=None,
+    rule="oriented",
+    space="mesh",
+):
+    """A radius sweep at ``location`` on ``obj`` (nothing is recorded): ``SweepPoint`` list.
+
+    ``location`` is in mesh coordinates, or world space with ``space="world"``; the radii are
+    in mesh units."""
+    check_measurable(obj)
+    geometry = evaluated_geometry(obj, depsgraph)
+    if space == "world":
+        location = mesh_points(location, geometry.matrix)
+    surface = surface_for(obj, geometry)
+    note_winding(obj, surface)
+    return radius_sweep(surface, location, start, stop, count, lam, patch, rule)
+
+
 def measure_on_object(
-    obj, location, radius, lam=2.0, patch="euclidean", *, depsgraph=None, note="", space="mesh"
+    obj,
+    location,
+    radius,
+    lam=2.0,
+    patch="euclidean",
+    *,
+    depsgraph=None,
+    note="",
+    rule="oriented",
+    stability=False,
+    space="mesh",
 ):
     """Measure the active mesh at ``location``, record the measurement and repaint the sides.
 
@@ -98,6 +161,10 @@ def measure_on_object(
         Free text stored with the measurement (the CSV's User Data).
     space : {"mesh", "world"}
         The coordinates ``location`` is given in.
+    rule : {"oriented", "paper"}
+        How the projection is signed (``vg_addon.method.algorithm.RULES``).
+    stability : bool
+        Also compute and record the stability figure.
 
     Returns
     -------
@@ -111,7 +178,17 @@ def measure_on_object(
         No object, not a mesh, linked data, Edit Mode, an empty mesh, a location farther than
         ``radius`` from the surface, too few vertices, ...; nothing is changed then.
     """
-    m, geometry = measure(obj, location, radius, lam, patch, depsgraph=depsgraph, space=space)
+    m, geometry = measure(
+        obj,
+        location,
+        radius,
+        lam,
+        patch,
+        depsgraph=depsgraph,
+        rule=rule,
+        stability=stability,
+        space=space,
+    )
     records.add_measurement(obj, m, geometry.fingerprint, note=note)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
     colors.show_sides_once(obj)
@@ -199,6 +276,8 @@ def replicate_rows(
     patch="euclidean",
     depsgraph=None,
     source="the CSV",
+    rule="oriented",
+    stability=False,
     progress=None,
 ):
     """Re-measure every replication row on ``obj`` and record them all, or nothing.
@@ -208,9 +287,12 @@ def replicate_rows(
     rows : list of csvio.ReplicationRow
     ignore_mesh_names : bool
         Accept rows whose mesh name is neither this object's nor its mesh's.
-    radius, lam, patch
+    radius, lam, patch, rule
         Used for rows that do not give their own (a plain points CSV); a row without a radius
-        is an error when ``radius`` is None.
+        is an error when ``radius`` is None. Rows of MeshLab and earlier add-on files carry the
+        paper's rule (see ``csvio.ReplicationRow.rule``).
+    stability : bool
+        Also compute and record each measurement's stability figure.
     source : str
         How to name the rows' origin in messages (e.g. the file name).
     progress : callable, optional
@@ -244,6 +326,8 @@ def replicate_rows(
         patch=patch,
         depsgraph=depsgraph,
         source=source,
+        rule=rule,
+        stability=stability,
     )
     try:
         while True:
@@ -268,6 +352,8 @@ def replicate_steps(
     patch="euclidean",
     depsgraph=None,
     source="the CSV",
+    rule="oriented",
+    stability=False,
 ):
     """:func:`replicate_rows` a row at a time: a generator that yields ``(done, total)`` before
     each row is measured and returns the new measurements' numbers (``StopIteration.value``)
@@ -280,6 +366,7 @@ def replicate_steps(
         csvio.check_mesh_names(rows, (obj.name, obj.data.name), source=source)
     geometry = evaluated_geometry(obj, depsgraph)
     surface = surface_for(obj, geometry)
+    note_winding(obj, surface)
     results, failures = [], []
     for done, row in enumerate(rows):
         yield done, len(rows)
@@ -297,6 +384,8 @@ def replicate_steps(
                 row_radius,
                 lam if row.lam is None else row.lam,
                 row.patch or patch,
+                rule=row.rule or rule,
+                stability=stability,
             )
         except GoniometerError as error:
             failures.append(f"row {row.row_number}: {error}")

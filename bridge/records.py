@@ -39,6 +39,19 @@ def _floats(vector) -> list[float]:
     return [float(v) for v in np.asarray(vector, dtype=np.float64)]
 
 
+def _stability(stability) -> dict:
+    return {
+        "spread": float(stability.spread),
+        "center": float(stability.center),
+        "radius": float(stability.radius),
+        "lam": float(stability.lam),
+        "bootstrap": float(stability.bootstrap),
+        "orientation": float(stability.orientation),
+        "runs": int(stability.n_runs),
+        "refused": int(stability.n_failed),
+    }
+
+
 def exact_record(m) -> dict:
     """The exact numbers stored for measurement ``m`` (taken in mesh coordinates)."""
     return {
@@ -53,6 +66,10 @@ def exact_record(m) -> dict:
         "requested": _floats(m.requested_center),
         "normal_plus": _floats(m.normal_plus),
         "normal_minus": _floats(m.normal_minus),
+        "rule": m.rule,
+        "convexity": m.convexity,
+        "correlation": float(m.correlation),
+        "stability": None if m.stability is None else _stability(m.stability),
         "space": MESH,
     }
 
@@ -129,13 +146,15 @@ def space_of(item) -> str:
 
 
 def replay_args(item) -> dict:
-    """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``."""
+    """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``,
+    ``rule`` (``"paper"`` for records from before the rule existed: that is what they used)."""
     numbers = numbers_of(item)
     return {
         "center": np.array(numbers["center"], dtype=np.float64),
         "radius": float(numbers["radius"]),
         "lam": float(numbers["lam"]),
         "patch": item.patch,
+        "rule": numbers.get("rule", "paper"),
     }
 
 
@@ -165,6 +184,7 @@ def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
     """The CSV row of ``item``, measured on ``obj``."""
     numbers = numbers_of(item)
     x, y, z = numbers["center"]
+    stability = numbers.get("stability") or {}
     return csvio.MeasurementRow(
         mesh_name=obj.name,
         date=item.date,
@@ -194,5 +214,16 @@ def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
         stale=stale,
         extension_version=extension_version(),
         blender_version=bpy.app.version_string,
+        rule=numbers.get("rule", "paper"),
+        convexity=numbers.get("convexity", ""),
+        correlation=numbers.get("correlation"),
+        stability=stability.get("spread"),
+        stability_center=stability.get("center"),
+        stability_radius=stability.get("radius"),
+        stability_lam=stability.get("lam"),
+        stability_bootstrap=stability.get("bootstrap"),
+        stability_orientation=stability.get("orientation"),
+        stability_runs=stability.get("runs"),
+        stability_refused=stability.get("refused"),
         error="",
     )

@@ -88,7 +88,8 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
 class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
     """Re-measure every row of a measurement CSV on the active mesh (the paper's xyz method).
     Reads this extension's CSVs, the MeshLab plugin's, the earlier Blender add-on's and plain
-    x, y, z point lists (rows without radius, λ or patch mode take the panel's)"""
+    x, y, z point lists (rows without radius, λ or patch mode take the panel's; MeshLab and
+    earlier add-on rows are re-measured with the paper's rule they were taken with)"""
 
     bl_idname = "vg.import_csv"
     bl_label = "Import Measurements CSV"
@@ -139,6 +140,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                 patch=settings.patch,
                 depsgraph=context.evaluated_depsgraph_get(),
                 source=source,
+                rule=settings.rule,
+                stability=settings.stability,
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))

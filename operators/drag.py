@@ -169,13 +169,14 @@ class DragSession:
     call repeatedly) removes the drawing and the header and status texts on every way out.
     """
 
-    def __init__(self, obj, surface, patch: str, lam: float, matrix=None):
+    def __init__(self, obj, surface, patch: str, lam: float, rule: str = "oriented", matrix=None):
         self.obj = obj
         self.surface = surface
         self.matrix = np.eye(4) if matrix is None else np.asarray(matrix, dtype=np.float64)
         self.patch = patch
+        self.rule = rule
         self.machine = DragMachine(
-            **surface_callbacks(surface, patch), lam=lam, quantize=typed_value
+            **surface_callbacks(surface, patch, rule), lam=lam, quantize=typed_value
         )
         self.overlay = DragOverlay()
         self._area = None
@@ -208,7 +209,12 @@ class DragSession:
         geometry = evaluated_geometry(obj, depsgraph)
         surface = surface_for(obj, geometry)
         session = cls(
-            obj, surface, settings.patch, typed_value(settings.seg_param), geometry.matrix
+            obj,
+            surface,
+            settings.patch,
+            typed_value(settings.seg_param),
+            settings.rule,
+            matrix=geometry.matrix,
         )
         hit = ray_cast_object(obj, depsgraph, region, region_data, coord)
         if not session.machine.press(hit):
@@ -324,6 +330,7 @@ def record_properties(session: DragSession) -> dict | None:
         "radius": record.radius,
         "seg_param": record.lam,
         "patch": session.patch,
+        "rule": session.rule,
     }
 
 

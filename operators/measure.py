@@ -4,11 +4,18 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, StringProperty
+from bpy.props import (
+    BoolProperty,
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    IntProperty,
+    StringProperty,
+)
 
 from ..bridge import measuring
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, uniform_scale
-from ..properties import PATCH_ITEMS
+from ..properties import PATCH_ITEMS, RULE_ITEMS
 from ..vg_addon import GoniometerError
 
 
@@ -99,6 +106,10 @@ class MeasureProperties:
         name="λ (SegParam)", description="Segmentation parameter; default: the panel's", min=0.0
     )
     patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
+    rule: EnumProperty(name="Rule", items=RULE_ITEMS, description="Default: the panel's")
+    stability: BoolProperty(
+        name="Stability", description="Compute the stability figure; default: the panel's"
+    )
     note: StringProperty(name="Note", description="Free text stored with the measurement")
 
 
@@ -125,6 +136,10 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
             self.seg_param = settings.seg_param
         if not given("patch"):
             self.patch = settings.patch
+        if not given("rule"):
+            self.rule = settings.rule
+        if not given("stability"):
+            self.stability = settings.stability
         obj = context.active_object
         try:
             item = measuring.measure_on_object(
@@ -136,14 +151,18 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
                 depsgraph=context.evaluated_depsgraph_get(),
                 note=self.note,
                 space=self.space.lower(),
+                rule=self.rule,
+                stability=self.stability,
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
+        spread = f" {item.stability_text}" if self.stability else ""
         self.report(
             {"INFO"},
             f"Measurement {item.number} (break {item.break_number}) on '{obj.name}': "
-            f"{item.angle:.2f}° (fit error {item.fit_error:.3g}, {item.n_vertices} vertices)",
+            f"{item.angle:.2f}°{spread}, {item.convexity} edge (fit error {item.fit_error:.3g}, "
+            f"{item.n_vertices} vertices)",
         )
         for warning in (_stale_warning(obj), non_uniform_scale_note(obj)):
             if warning:

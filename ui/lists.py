@@ -4,7 +4,8 @@ import bpy
 
 
 class VG_UL_measurements(bpy.types.UIList):
-    """One row per measurement: number, break, angle, fit error, radius, vertices, colours."""
+    """One row per measurement: number, break, angle (and concave/unclear), fit error, radius,
+    vertices, colours."""
 
     def draw_item(self, context, layout, data, item, icon, active_data, active_property, index):
         if self.layout_type == "GRID":
@@ -14,7 +15,9 @@ class VG_UL_measurements(bpy.types.UIList):
         row = layout.row(align=True)
         row.label(text=f"#{item.number}", icon="ERROR" if item.stale else "NONE")
         row.label(text=f"B{item.break_number}")
-        row.label(text=f"{item.angle:.2f}°")
+        # A concave or unclear edge is named: its angle is not the solid's interior angle.
+        kind = "" if item.convexity in ("convex", "not recorded") else f" {item.convexity}"
+        row.label(text=f"{item.angle:.2f}°{kind}")
         row.label(text=f"fit {item.fit_error:.2g}")
         row.label(text=f"r {item.radius:.3g}")
         row.label(text=f"{item.n_vertices} v")

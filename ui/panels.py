@@ -1,8 +1,18 @@
 """The "Goniometer" tab of the 3D viewport sidebar (panels only draw; operators do the work)."""
 
+import textwrap
+
 import bpy
 
 from ..operators.measure import non_uniform_scale_note
+from ..vg_addon.method.winding import winding_message
+
+# What the angle of a measurement is, by its convexity label.
+ANGLE_MEANING = {
+    "convex": "Interior angle of the solid",
+    "concave": "Open wedge: 360° minus the solid's angle",
+    "unclear": "Convex or concave unclear here",
+}
 
 CATEGORY = "Goniometer"
 
@@ -32,6 +42,8 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
         column.prop(settings, "radius")
         column.prop(settings, "seg_param")
         column.prop(settings, "patch")
+        column.prop(settings, "rule")
+        column.prop(settings, "stability")
 
         obj = _active_mesh(context)
         if obj is None:
@@ -42,6 +54,10 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
             box.label(text="Non-uniform scale: not measured", icon="INFO")
             box.label(text="Angles are those of the mesh as stored;")
             box.label(text="apply the scale (Ctrl A) to change its shape")
+        if message := winding_message(obj.name, obj.vg.winding):
+            box = layout.box()
+            for number, line in enumerate(textwrap.wrap(message, 42)):
+                box.label(text=line, icon="ERROR" if number == 0 else "BLANK1")
         layout.operator("vg.measure_xyz", text="Measure at 3D Cursor", icon="PIVOT_CURSOR")
         drag = layout.operator("wm.tool_set_by_id", text="Drag to Measure", icon="MOUSE_LMB_DRAG")
         drag.name = "vg.measure_drag_tool"
@@ -91,7 +107,20 @@ class VIEW3D_PT_vg_selected(_GoniometerPanel, bpy.types.Panel):
         column.use_property_split = True
         column.use_property_decorate = False
         _text(column, "Measurement", f"{item.number}, break {item.break_number}")
-        for name in ("angle", "fit_error", "fit_error_plus", "fit_error_minus"):
+        column.prop(item, "angle")
+        _text(column, "Edge", f"{item.convexity}: {ANGLE_MEANING.get(item.convexity, '')}")
+        _text(column, "Stability", item.stability_text)
+        if item.stability_text != "not computed":
+            for name in (
+                "stability_center",
+                "stability_radius",
+                "stability_lam",
+                "stability_bootstrap",
+                "stability_orientation",
+            ):
+                column.prop(item, name)
+        _text(column, "Rule", item.rule)
+        for name in ("fit_error", "fit_error_plus", "fit_error_minus"):
             column.prop(item, name)
         column.prop(item, "radius")
         column.prop(item, "seg_param")
@@ -141,6 +170,25 @@ class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
         row.prop(settings, "ignore_mesh_names", text="Ignore Names")
 
 
+class VIEW3D_PT_vg_sweep(_GoniometerPanel, bpy.types.Panel):
+    """Angle and fit error over a range of radii at the 3D cursor, written as a CSV and a plot."""
+
+    bl_label = "Radius Sweep"
+    bl_parent_id = "VIEW3D_PT_vg_measure"
+    bl_options = {"DEFAULT_CLOSED"}  # noqa: RUF012 (Blender wants a set)
+
+    def draw(self, context):
+        settings = context.scene.vg_settings
+        layout = self.layout
+        column = layout.column(align=True)
+        column.use_property_split = True
+        column.use_property_decorate = False
+        column.prop(settings, "sweep_start")
+        column.prop(settings, "sweep_stop")
+        column.prop(settings, "sweep_count")
+        layout.operator("vg.radius_sweep", text="Sweep at 3D Cursor", icon="GRAPH")
+
+
 class VIEW3D_PT_vg_map(_GoniometerPanel, bpy.types.Panel):
     """Render the measurement map: the coloured sides with numbered labels, from chosen views."""
 
@@ -158,4 +206,10 @@ class VIEW3D_PT_vg_map(_GoniometerPanel, bpy.types.Panel):
         op.directory = settings.map_directory
 
 
-classes = (VIEW3D_PT_vg_measure, VIEW3D_PT_vg_selected, VIEW3D_PT_vg_csv, VIEW3D_PT_vg_map)
+classes = (
+    VIEW3D_PT_vg_measure,
+    VIEW3D_PT_vg_selected,
+    VIEW3D_PT_vg_csv,
+    VIEW3D_PT_vg_sweep,
+    VIEW3D_PT_vg_map,
+)

@@ -26,6 +26,7 @@ __all__ = [
     "BoneFragment",
     "BreakSite",
     "SynthMesh",
+    "bevelled_wedge",
     "bone_fragment",
     "wedge",
 ]
@@ -92,6 +93,7 @@ def wedge(
     irregular: bool = False,
     seed: int = 0,
     imbalance: float = 1.0,
+    concave: bool = False,
 ) -> SynthMesh:
     """Two planar faces meeting at a straight crease with interior angle ``angle_deg``.
 
@@ -121,6 +123,11 @@ def wedge(
     imbalance : float
         Extent of face -1 relative to face +1 (same grid spacing), so a ball centred on the
         crease can hold unequal vertex counts per side.
+    concave : bool
+        Mirror the wedge in the plane ``z = 0``: the faces rise from the crease (a valley) and the
+        solid lies below them, so the edge is concave and ``angle_deg`` is the angle of the open
+        wedge above it (the solid's interior angle is ``360 - angle_deg``). Normals stay outward
+        (upward).
 
     Returns
     -------
@@ -197,13 +204,103 @@ def wedge(
             tris = tris[:, [0, 2, 1]]  # e_x x u points into the solid on face -1
         triangles.append(tris)
 
+    normal_plus, normal_minus = np.array([0.0, c, s]), np.array([0.0, -c, s])
+    if concave:  # a reflection also turns the winding, so the same triangles stay outward
+        points[:, 2] = -points[:, 2]
+        normal_plus, normal_minus = normal_minus, normal_plus
     return SynthMesh(
         points=points,
         triangles=np.vstack(triangles).astype(np.int64),
         angle=angle,
         side=side,
-        normal_plus=np.array([0.0, c, s]),
-        normal_minus=np.array([0.0, -c, s]),
+        normal_plus=normal_plus,
+        normal_minus=normal_minus,
+    )
+
+
+def bevelled_wedge(
+    angle_deg: float,
+    fillet: float,
+    *,
+    half_width: float = 1.0,
+    depth: float = 1.0,
+    spacing: float = 0.02,
+    concave: bool = False,
+) -> SynthMesh:
+    """A wedge whose crease is rounded by a circular fillet (a worn or bevelled edge).
+
+    The two planar faces are those of :func:`wedge` (same angle, orientation and normals); near
+    the crease they are joined by a circular arc of radius ``fillet``, tangent to both, so the
+    angle between the faces is still exactly ``angle_deg``. The mesh is a regular grid: rows
+    ``spacing`` apart along the profile (the arc gets at least two segments), columns ``spacing``
+    apart along the crease (the x axis).
+
+    Parameters
+    ----------
+    angle_deg : float
+        Angle between the faces, ``0 < angle_deg < 180``.
+    fillet : float
+        Radius of the rounding (0: a sharp crease).
+    half_width, depth : float
+        Half the crease length; extent of each face beyond the fillet's tangent line.
+    spacing : float
+        Grid spacing.
+    concave : bool
+        Mirror in ``z = 0`` as :func:`wedge` does: a rounded valley, normals still outward.
+
+    Returns
+    -------
+    SynthMesh
+        ``side`` is +1/-1 on the planar parts, 0 on the fillet.
+    """
+    angle = float(angle_deg)
+    if not 0.0 < angle < 180.0:
+        raise GoniometerError(f"The wedge angle must be between 0 and 180 degrees, got {angle}.")
+    fillet = float(fillet)
+    if not (math.isfinite(fillet) and fillet >= 0):
+        raise GoniometerError(f"The fillet radius must be 0 or more, got {fillet}.")
+    half_width, depth = _positive("half_width", half_width), _positive("depth", depth)
+    spacing = _positive("spacing", spacing)
+    half = math.radians(angle) / 2.0
+    s, c = math.sin(half), math.cos(half)
+    tangent_length = fillet / math.tan(half)  # crease to the fillet's tangent points
+    centre = np.array([0.0, -fillet / s])  # (y, z) of the fillet's centre, on the bisector
+    # The tangent points sit at centre + fillet * (outward normal of their face): at the angles
+    # pi - half (face -1) and half (face +1); the arc runs over the top between them.
+    start, stop = math.pi - half, half
+    n_arc = max(2, math.ceil(fillet * abs(stop - start) / spacing)) if fillet > 0 else 0
+    arc_angles = np.linspace(start, stop, n_arc + 1) if fillet > 0 else np.zeros(1)
+    arc = centre + fillet * np.column_stack([np.cos(arc_angles), np.sin(arc_angles)])
+    if fillet == 0:
+        arc = np.zeros((1, 2))
+    steps = np.arange(1, math.floor(depth / spacing) + 1) * spacing
+    plus = (tangent_length + steps)[:, None] * np.array([s, -c])
+    minus = (tangent_length + steps[::-1])[:, None] * np.array([-s, -c])
+    profile = np.vstack([minus, arc, plus])
+    x = np.linspace(-half_width, half_width, max(2, round(2 * half_width / spacing)) + 1)
+    points = np.column_stack(
+        [np.repeat(x, len(profile)), np.tile(profile[:, 0], x.size), np.tile(profile[:, 1], x.size)]
+    )
+    side = np.tile(
+        np.concatenate([-np.ones(len(minus)), np.zeros(len(arc)), np.ones(len(plus))]), x.size
+    ).astype(np.int8)
+    ids = np.arange(points.shape[0]).reshape(x.size, len(profile))
+    a, b = ids[:-1, :-1].ravel(), ids[1:, :-1].ravel()
+    cc, d = ids[1:, 1:].ravel(), ids[:-1, 1:].ravel()
+    # Along the profile the points run from face -1 to face +1, i.e. towards +y; (e_x, +y)
+    # counter-clockwise has its normal up (outward).
+    triangles = np.vstack([np.column_stack([a, b, cc]), np.column_stack([a, cc, d])])
+    normal_plus, normal_minus = np.array([0.0, c, s]), np.array([0.0, -c, s])
+    if concave:
+        points[:, 2] = -points[:, 2]
+        normal_plus, normal_minus = normal_minus, normal_plus
+    return SynthMesh(
+        points=points,
+        triangles=triangles.astype(np.int64),
+        angle=angle,
+        side=side,
+        normal_plus=normal_plus,
+        normal_minus=normal_minus,
     )
 
 

@@ -18,6 +18,7 @@ OPERATORS = (
     "export_csv",
     "import_csv",
     "render_map",
+    "radius_sweep",
 )
 
 

@@ -41,6 +41,17 @@ OUR_EXTRA_COLUMNS = [
     "Stale",
     "Extension Version",
     "Blender Version",
+    "Rule",
+    "Convexity",
+    "Convexity Correlation",
+    "Stability",
+    "Stability Centre",
+    "Stability Radius",
+    "Stability SegParam",
+    "Stability Bootstrap",
+    "Stability Orientation",
+    "Stability Runs",
+    "Stability Refused",
     "error",
 ]
 
@@ -78,6 +89,17 @@ def good_row(**changes) -> MeasurementRow:
         stale=False,
         extension_version="0.1.0",
         blender_version="5.0.1",
+        rule="oriented",
+        convexity="concave",
+        correlation=-0.8660254037844386,
+        stability=0.4123,
+        stability_center=0.4123,
+        stability_radius=0.1,
+        stability_lam=0.05,
+        stability_bootstrap=0.2,
+        stability_orientation=0.0,
+        stability_runs=21,
+        stability_refused=1,
         error="",
     )
     values.update(changes)
@@ -368,6 +390,7 @@ def test_meshlab_file_parses():
             number=1,
             break_number=1,
             source_format="meshlab",
+            rule="paper",
         ),
         ReplicationRow(
             row_number=3,
@@ -382,6 +405,7 @@ def test_meshlab_file_parses():
             number=2.05,
             break_number=2,
             source_format="meshlab",
+            rule="paper",
         ),
     ]
 
@@ -652,3 +676,41 @@ def test_format_colors():
     for bad in [("orange",), ("orange", "mauve"), ((256, 0, 0), (0, 0, 0)), ((1, 2), "blue")]:
         with pytest.raises(GoniometerError):
             csvio.format_colors(bad)
+
+
+# --------------------------------------------------------------------------- the rule column
+
+
+def test_rule_and_stability_columns_round_trip():
+    text = csvio.format_measurements_csv([good_row(), good_row(rule="paper", stability=None)])
+    back = csvio.parse_measurements_csv(text)
+    assert back[0] == good_row()
+    assert back[1].rule == "paper" and back[1].stability is None
+    by_column = dict(zip(csvio.EXPORT_COLUMNS, cells(text)[1], strict=True))
+    assert by_column["Rule"] == "oriented"
+    assert by_column["Convexity"] == "concave"
+    assert by_column["Stability"] == "0.4123"
+
+
+def test_replication_keeps_the_rule_each_row_was_taken_with():
+    text = csvio.format_measurements_csv([good_row(rule="paper"), good_row(rule="oriented")])
+    assert [row.rule for row in csvio.read_replication_csv(text)] == ["paper", "oriented"]
+
+
+def test_files_from_before_the_rule_replicate_with_the_papers_rule():
+    assert {r.rule for r in csvio.read_replication_csv(MESHLAB_FILE)} == {"paper"}
+    assert {r.rule for r in csvio.read_replication_csv(OLD_ADDON_FILE)} == {"paper"}
+    old_columns = [c for c in csvio.EXPORT_COLUMNS if c not in csvio.RULE_COLUMNS]
+    full = cells(csvio.format_measurements_csv([good_row()]))
+    keep = [csvio.EXPORT_COLUMNS.index(c) for c in old_columns]
+    old_export = "\n".join(",".join(f'"{row[i]}"' for i in keep) for row in full) + "\n"
+    rows = csvio.read_replication_csv(old_export)
+    assert rows[0].source_format == "extension" and rows[0].rule == "paper"
+    assert csvio.parse_measurements_csv(old_export)[0].rule == ""
+
+
+def test_points_files_take_the_default_rule_or_their_own():
+    assert csvio.read_replication_csv("x,y,z\n1,2,3\n")[0].rule is None
+    rows = csvio.read_replication_csv("x,y,z,rule\n1,2,3,Paper\n1,2,3,\n")
+    assert [r.rule for r in rows] == ["paper", None]
+    raises_with("x,y,z,rule\n1,2,3,literal\n", "row 2", "unknown rule 'literal'")

@@ -38,6 +38,7 @@ from datetime import datetime
 from pathlib import Path
 
 from ..errors import GoniometerError, bounded_list
+from ..method.algorithm import RULES
 from ..method.surface import PATCH_MODES
 from ..palette import OKABE_ITO
 
@@ -90,7 +91,34 @@ _SCHEMA = (
     ("stale", "bool", ("Stale",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
+    ("rule", "text", ("Rule",)),
+    ("convexity", "text", ("Convexity",)),
+    ("correlation", "float", ("Convexity Correlation",)),
+    ("stability", "float", ("Stability",)),
+    ("stability_center", "float", ("Stability Centre",)),
+    ("stability_radius", "float", ("Stability Radius",)),
+    ("stability_lam", "float", ("Stability SegParam",)),
+    ("stability_bootstrap", "float", ("Stability Bootstrap",)),
+    ("stability_orientation", "float", ("Stability Orientation",)),
+    ("stability_runs", "int", ("Stability Runs",)),
+    ("stability_refused", "int", ("Stability Refused",)),
     ("error", "text", ("error",)),
+)
+
+#: Columns added with the oriented rule (issue 8). Exports written before lack them; such a file
+#: still reads, and its rows replicate with the paper's rule, the only one there was then.
+RULE_COLUMNS = (
+    "Rule",
+    "Convexity",
+    "Convexity Correlation",
+    "Stability",
+    "Stability Centre",
+    "Stability Radius",
+    "Stability SegParam",
+    "Stability Bootstrap",
+    "Stability Orientation",
+    "Stability Runs",
+    "Stability Refused",
 )
 
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
@@ -192,6 +220,19 @@ class MeasurementRow:
     stale : bool
         The mesh changed since the measurement was taken.
     extension_version, blender_version : str
+    rule : str
+        ``"oriented"`` or ``"paper"``: how the projection was signed (see ``vg_addon.method``).
+    convexity : str
+        ``"convex"``, ``"concave"`` (the angle is then the open wedge's) or ``"unclear"``.
+    correlation : float or None
+        The correlation whose sign gives the convexity (its size: how clearly).
+    stability : float or None
+        The stability figure, degrees (the "±"); empty when it was not computed.
+    stability_center, stability_radius, stability_lam, stability_bootstrap, stability_orientation : float or None
+        Its parts: the largest change of the angle with the centre moved, the radius ±10%, λ from
+        1 to 3, the bootstrap's 95% half-width, and the other sign's reading where unclear.
+    stability_runs, stability_refused : int or None
+        Perturbed measurements tried, and how many of them were refused.
     error : str
         Empty for a good row; why it failed otherwise.
     """
@@ -224,6 +265,17 @@ class MeasurementRow:
     stale: bool = False
     extension_version: str = ""
     blender_version: str = ""
+    rule: str = ""
+    convexity: str = ""
+    correlation: float | None = None
+    stability: float | None = None
+    stability_center: float | None = None
+    stability_radius: float | None = None
+    stability_lam: float | None = None
+    stability_bootstrap: float | None = None
+    stability_orientation: float | None = None
+    stability_runs: int | None = None
+    stability_refused: int | None = None
     error: str = ""
 
 
@@ -261,6 +313,11 @@ class ReplicationRow:
         ``"mesh"`` (the mesh's own coordinates: MeshLab's files, points files, exports with
         ``Coordinates`` = mesh) or ``"world"`` (Blender world space: exports of this extension
         written before the ``Coordinates`` column existed, or with ``Coordinates`` = world).
+    rule : str or None
+        The rule to replicate with: the ``Rule`` cell of an export; ``"paper"`` for MeshLab and
+        earlier add-on files and for exports written before the ``Rule`` column existed (they
+        were all measured with the paper's rule); a points file's ``rule`` column, else ``None``
+        (the current default).
     """
 
     row_number: int
@@ -276,6 +333,7 @@ class ReplicationRow:
     break_number: int | None = None
     source_format: str = "points"
     coordinates: str = MESH_COORDINATES
+    rule: str | None = None
 
 
 # --------------------------------------------------------------------------- small helpers
@@ -498,7 +556,9 @@ def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
     return "".join(lines)
 
 
-def _replace_atomically(path: str, data: bytes) -> None:
+def replace_atomically(path: str, data: bytes) -> None:
+    """Write ``data`` to a temporary file beside ``path`` and move it over ``path`` in one step:
+    ``path`` holds its old content or the new one, never part of it."""
     folder = os.path.dirname(os.path.abspath(path)) or "."
     if not os.path.isdir(folder):
         raise GoniometerError(
@@ -554,7 +614,7 @@ def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
         Other file-system errors (disk full, no permission to create the file, ...).
     """
     data = format_measurements_csv(rows).encode("utf-8")
-    _replace_atomically(os.fspath(path), data)
+    replace_atomically(os.fspath(path), data)
 
 
 # --------------------------------------------------------------------------- reading
@@ -674,6 +734,7 @@ _REPLICATION_ALIASES = {
     "number": ("measurement #", "measurement number", "measurement", "number"),
     "break_number": ("break #", "break number", "break"),
     "coordinates": ("coordinates", "coordinate space"),
+    "rule": ("rule",),
     "error": ("error",),
 }
 _REQUIRED = ("x", "y", "z")
@@ -816,6 +877,15 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 f"row {number}: unknown coordinates {cell('coordinates').strip()!r} "
                 f"(use {' or '.join(COORDINATE_SPACES)})"
             )
+        rule = _parse_optional_text(cell("rule"))
+        if rule is not None:
+            rule = rule.casefold()
+            if rule not in RULES:
+                problems.append(
+                    f"row {number}: unknown rule {cell('rule').strip()!r} (use {' or '.join(RULES)})"
+                )
+        elif fmt != "points":
+            rule = "paper"  # MeshLab, the earlier add-on, exports from before the Rule column
         if problems:
             continue  # nothing is returned anyway; keep collecting
         break_number = _lenient_number(cell("break_number"))
@@ -834,6 +904,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 break_number=break_number if isinstance(break_number, int) else None,
                 source_format=fmt,
                 coordinates=coordinates,
+                rule=rule,
             )
         )
     if problems:
@@ -868,10 +939,12 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
     aliases: ``Mesh Name``/``Mesh``/``Object``; ``x``/``Center x``; ``Radius``/``r``;
     ``SegParam``/``Seg Param``/``lambda``/``λ``/``Segmentation Parameter``;
     ``Patch Mode``/``patch``; ``label``/``User Data``/``note`` (``label`` wins over
-    ``User Data``); ``Measurement #``; ``Break #``; ``Coordinates`` (``mesh`` or ``world``;
-    absent or blank: ``world`` in an export of this extension, which wrote world coordinates
-    before it had the column, ``mesh`` in every other file); ``error``. Only x, y and z are
-    required.
+    ``User Data``); ``Measurement #``; ``Break #``; ``Rule`` (``oriented`` or ``paper``);
+    ``Coordinates`` (``mesh`` or ``world``; absent or blank: ``world`` in an export of this
+    extension, which wrote world coordinates before it had the column, ``mesh`` in every other
+    file); ``error``. Only x, y and z are required. Rows of MeshLab and earlier add-on files, and
+    of exports without a ``Rule`` column, replicate with the paper's rule (see
+    :attr:`ReplicationRow.rule`).
     A UTF-8 byte-order mark is ignored; cells are read without surrounding whitespace, and the
     apostrophe the writer puts before formula-like text is removed.
 
@@ -923,7 +996,7 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     missing = [
         column
         for column in EXPORT_COLUMNS
-        if column not in columns and column not in _LEGACY_DEFAULTS
+        if column not in columns and column not in RULE_COLUMNS and column not in _LEGACY_DEFAULTS
     ]
     if missing:
         problems.insert(
@@ -942,7 +1015,7 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
         def cell(column: str, cells=cells) -> str:
             index = columns.get(column)
             if index is None:
-                return _LEGACY_DEFAULTS[column]
+                return _LEGACY_DEFAULTS.get(column, "")
             return cells[index] if index < len(cells) else ""
 
         def number_of(column: str, number=number) -> float | None:
@@ -991,3 +1064,72 @@ def read_measurements_csv(path_or_text) -> list[MeasurementRow]:
     """
     text, source = _load(path_or_text)
     return parse_measurements_csv(text, source)
+
+
+# --------------------------------------------------------------------------- radius sweeps
+
+#: The columns of a radius-sweep CSV: one row per radius, refused radii with their message.
+SWEEP_COLUMNS = (
+    "Mesh Name",
+    "Measurement #",
+    "Radius",
+    "Angle",
+    "fit",
+    "Number of Vertices",
+    "Vertices +",
+    "Vertices -",
+    "Convexity",
+    "x",
+    "y",
+    "z",
+    "Requested x",
+    "Requested y",
+    "Requested z",
+    "SegParam",
+    "Patch Mode",
+    "Rule",
+    "error",
+)
+
+
+def sweep_cells(mesh_name: str, number: int | None, point) -> list[str]:
+    """The cells of one :data:`SWEEP_COLUMNS` row for a ``vg_addon.method.sweep.SweepPoint``.
+
+    A refused radius keeps its radius and message; its measured cells are empty.
+    """
+    m = point.measurement
+
+    def cell(value, column):
+        return _float_cell(value, 0, point, column)
+
+    cells = [_escape_text(str(mesh_name)), "" if number is None else str(int(number))]
+    cells.append(cell(point.radius, "Radius"))
+    if m is None:
+        cells += [""] * (len(SWEEP_COLUMNS) - 4)
+    else:
+        cells += [
+            cell(m.angle, "Angle"),
+            cell(m.fit_error, "fit"),
+            str(int(m.n_vertices)),
+            str(int(m.n_plus)),
+            str(int(m.n_minus)),
+            m.convexity,
+            *(cell(v, "x") for v in m.center),
+            *(cell(v, "Requested x") for v in m.requested_center),
+            cell(m.lam, "SegParam"),
+            m.patch,
+            m.rule,
+        ]
+    cells.append(_escape_text(point.error))
+    return cells
+
+
+def format_sweep_rows(rows: Iterable[Sequence[str]]) -> str:
+    """A sweep CSV's text: the :data:`SWEEP_COLUMNS` header, then rows from :func:`sweep_cells`."""
+    return _csv_line(SWEEP_COLUMNS) + "".join(_csv_line(cells) for cells in rows)
+
+
+def write_sweep_csv(path, mesh_name: str, points, number: int | None = None) -> None:
+    """Write one site's sweep to ``path`` atomically (as :func:`write_measurements_csv`)."""
+    text = format_sweep_rows(sweep_cells(mesh_name, number, point) for point in points)
+    replace_atomically(os.fspath(path), text.encode("utf-8"))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..errors import GoniometerError
@@ -13,12 +15,15 @@ from .algorithm import (
     as_points,
     as_radius,
     canonical_order,
+    check_rule,
     measure_patch,
 )
 from .geodesic import EdgeGraph
 from .normals import pca_normals, vertex_normals
 from .result import Measurement
 from .spatial import GridIndex
+from .stability import estimate_stability
+from .winding import mesh_winding
 
 PATCH_MODES = ("euclidean", "geodesic")
 
@@ -75,6 +80,7 @@ class Surface:
         if self.triangles is not None and self.triangles.shape[0] == 0:
             self.triangles = None
         self._graph = None
+        self._winding = None
         full_index = None
         if normals is not None:
             self.normals = as_normals(normals, n)
@@ -99,6 +105,14 @@ class Surface:
     def n_points(self) -> int:
         """Number of vertices (including any without a normal)."""
         return self.points.shape[0]
+
+    @property
+    def winding(self) -> str:
+        """``"outward"``, ``"inward"``, ``"mixed"`` or ``"open"`` (see ``winding.WINDINGS``);
+        computed on first use. On an ``"inward"`` surface convex edges are labelled concave."""
+        if self._winding is None:
+            self._winding = mesh_winding(self.points, self.triangles)
+        return self._winding
 
     def snap(self, center, radius: float) -> tuple[int, float]:
         """Index of the vertex nearest ``center`` and its distance; an error if farther than ``radius``."""
@@ -141,7 +155,13 @@ class Surface:
         return indices
 
     def measure(
-        self, center, radius: float, lam: float = 2.0, patch: str = "euclidean"
+        self,
+        center,
+        radius: float,
+        lam: float = 2.0,
+        patch: str = "euclidean",
+        rule: str = "oriented",
+        stability: bool = False,
     ) -> Measurement:
         """Measure the break angle at ``center`` (Algorithm 1 on the patch around it).
 
@@ -155,6 +175,12 @@ class Surface:
             Segmentation parameter λ ≥ 0 (default 2).
         patch : {"euclidean", "geodesic"}, optional
             How the patch is chosen (default ``"euclidean"``).
+        rule : {"oriented", "paper"}, optional
+            How the projection's position term is signed (default ``"oriented"``; ``"paper"`` is
+            Algorithm 1 as printed, for replicating old measurements).
+        stability : bool, optional
+            Also compute :attr:`Measurement.stability` (about as costly as a dozen measurements,
+            batched; default ``False``).
 
         Returns
         -------
@@ -170,6 +196,7 @@ class Surface:
         radius = as_radius(radius)
         lam = as_lambda(lam)
         mode = check_patch_mode(patch)
+        rule = check_rule(rule)
         center_index, snap_distance = self.snap(requested, radius)
         indices = self.patch(center_index, radius, mode)
         if indices.size < 2 * MIN_SIDE_VERTICES:
@@ -181,9 +208,9 @@ class Surface:
         order = canonical_order(points, normals)
         indices = indices[order]
         fields = measure_patch(
-            points[order], normals[order], self.points[center_index], radius, lam
+            points[order], normals[order], self.points[center_index], radius, lam, rule
         )
-        return Measurement(
+        measurement = Measurement(
             **fields,
             indices=indices,
             center=self.points[center_index].copy(),
@@ -194,6 +221,9 @@ class Surface:
             lam=lam,
             patch=mode,
         )
+        if stability:
+            measurement = replace(measurement, stability=estimate_stability(self, measurement))
+        return measurement
 
 
 def check_patch_mode(patch) -> str:

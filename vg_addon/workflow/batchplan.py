@@ -60,6 +60,9 @@ class Task:
         ``"mesh"``: ``center`` and ``radius`` are in the mesh's own coordinates (every input
         but a world-space row, see :attr:`ReplicationRow.coordinates`); ``"world"``: in Blender
         world space, to be converted by the object's transform.
+    rule : str
+        ``"oriented"`` or ``"paper"``: a CSV row's own rule (MeshLab and earlier add-on rows
+        carry the paper's), else the run's.
     """
 
     index: int
@@ -75,6 +78,7 @@ class Task:
     mesh_name: str = ""
     error: str = ""
     coordinates: str = "mesh"
+    rule: str = "oriented"
 
 
 # --------------------------------------------------------------------------- command line values
@@ -180,7 +184,13 @@ def mesh_names(files: Sequence[str | os.PathLike]) -> list[str]:
 
 
 def plan_points(
-    n_meshes: int, points: Sequence[Sequence[float]], *, radius, lam: float, patch: str
+    n_meshes: int,
+    points: Sequence[Sequence[float]],
+    *,
+    radius,
+    lam: float,
+    patch: str,
+    rule: str = "oriented",
 ) -> list[Task]:
     """Tasks for ``--at`` points: every point on every mesh (mesh by mesh, points in order).
 
@@ -204,6 +214,7 @@ def plan_points(
                     lam=lam,
                     patch=patch,
                     number=number,
+                    rule=rule,
                 )
             )
     return tasks
@@ -218,6 +229,7 @@ def plan_rows(
     patch: str = "euclidean",
     ignore_mesh_names: bool = False,
     source: str = "the points CSV",
+    rule: str = "oriented",
 ) -> list[Task]:
     """Tasks for the rows of a points or measurements CSV, in file order.
 
@@ -227,8 +239,9 @@ def plan_rows(
         Per mesh, the names it is known by (its primary name first, e.g. the file name without
         extension; for a Blender object also its mesh data name).
     rows : sequence of csvio.ReplicationRow
-    radius, lam, patch
-        Defaults for rows that carry none (``radius=None``: every row must carry one).
+    radius, lam, patch, rule
+        Defaults for rows that carry none (``radius=None``: every row must carry one); rows
+        from MeshLab and earlier add-on files carry the paper's rule.
     ignore_mesh_names : bool
         With a single mesh, measure every row on it whatever mesh the row names.
     source : str
@@ -291,6 +304,7 @@ def plan_rows(
                 mesh_name=row.mesh_name or "",
                 error=error,
                 coordinates=row.coordinates,
+                rule=row.rule or rule,
             )
         )
     return tasks
