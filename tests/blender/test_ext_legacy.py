@@ -36,7 +36,10 @@ def old_record(obj, requested_world, radius_world, lam=2.0):
     triangles = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
     mesh.loop_triangles.foreach_get("vertices", triangles)
     m = Surface(world(local_points(obj), obj), triangles.reshape(-1, 3).astype(np.int64)).measure(
-        requested_world, radius_world, lam
+        requested_world,
+        radius_world,
+        lam,
+        rule="paper",  # the only rule there was then
     )
     data = obj.vg
     item = data.measurements.add()
@@ -93,8 +96,9 @@ def test_an_old_blend_file_is_migrated_on_load(vg, tmp_path):
     # The migrated record is what the core measures in mesh coordinates at the same vertex.
     vertex = int(np.argmin(np.linalg.norm(world(local_points(kept), kept) - old["center"], axis=1)))
     m = Surface(local_points(kept).astype(np.float64), _triangles(kept)).measure(
-        local_points(kept)[vertex].astype(np.float64), 1.2 / 3.0
+        local_points(kept)[vertex].astype(np.float64), 1.2 / 3.0, rule="paper"
     )
+    assert numbers["rule"] == "paper"
     assert (numbers["center"], numbers["angle"]) == (m.center.tolist(), m.angle)
     painted = expected_colours(vg, len(kept.data.vertices), [(m.indices, m.labels, 1)])
     np.testing.assert_array_equal(colours(kept), painted)  # and painted again
