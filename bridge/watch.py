@@ -108,6 +108,8 @@ def migrate(obj) -> list[int]:
     migrated = legacy.migrate(obj, geometry, mesh_data.surface_for(obj, geometry))
     if migrated:
         repaint(obj, geometry=geometry)
+    else:
+        refresh(obj)  # the flags of records that stay in world space
     return migrated
 
 

@@ -110,6 +110,7 @@ def test_an_old_blend_file_is_migrated_on_load(vg, tmp_path):
 
     stale = moved.vg.measurements[0]
     assert exact(stale) == old_moved  # left exactly as it was: world space
+    assert stale.stale  # flagged on load
     bpy.context.view_layer.objects.active = moved
     bpy.ops.vg.repaint()
     assert stale.stale
