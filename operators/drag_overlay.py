@@ -38,7 +38,7 @@ def point_shader():
     fallback UNIFORM_COLOR (sized by ``gpu.state.point_size_set``)."""
     try:
         return gpu.shader.from_builtin("POINT_UNIFORM_COLOR"), True
-    except ValueError:
+    except (ValueError, TypeError):  # 4.2: not one of its built-in shaders
         return gpu.shader.from_builtin("UNIFORM_COLOR"), False
 
 
