@@ -76,7 +76,7 @@ class VG_OT_render_map(bpy.types.Operator):
                     progress.step(len(job.written), len(job.views))
                     job.render_next()
             job.finish()
-        except (GoniometerError, OSError, RuntimeError) as error:
+        except (GoniometerError, OSError, RuntimeError, ReferenceError) as error:
             return self._stop(context, f"The map failed: {error}")
         return self._done(context)
 
@@ -107,7 +107,7 @@ class VG_OT_render_map(bpy.types.Operator):
                 self._show_progress(context)
                 return {"RUNNING_MODAL"}
             self._job.finish()
-        except (GoniometerError, OSError, RuntimeError) as error:
+        except (GoniometerError, OSError, RuntimeError, ReferenceError) as error:
             return self._stop(context, f"The map failed: {error}")
         return self._done(context)
 
