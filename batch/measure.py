@@ -12,10 +12,11 @@ import numpy as np
 
 from ..bridge import colors, measuring, mesh_data, records
 from ..bridge.measurement_map import safe_file_name
-from ..vg_addon import GoniometerError
+from ..vg_addon import GoniometerError, Surface
 from ..vg_addon.formats import csvio, sweep_plot
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
+from .edges import failed_edge_row, measure_edges, spec_applies
 from .render import add_sides_material, render_map
 from .sources import MeshSource, import_mesh
 
@@ -26,6 +27,8 @@ class MeshResult:
 
     mesh: int
     rows: list = dataclasses.field(default_factory=list)  # [(task index, MeasurementRow)]
+    station_rows: list = dataclasses.field(default_factory=list)  # --edge stations (in-process)
+    edge_rows: list = dataclasses.field(default_factory=list)  # --edge summaries (in-process)
     object_name: str = ""
     bad_file: str = ""  # why the mesh file could not be read
     n_vertices: int = 0
@@ -81,9 +84,12 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     optionally render it. Never raises for a problem of this mesh: it becomes the rows' error.
 
     The numbers come from the extension's own pipeline: the object's evaluated mesh in its own
-    coordinates (``mesh_data.evaluated_geometry``), its cached ``Surface`` (``mesh_data.surface_for``)
-    and ``records.add_measurement``; ``measuring.measure_on_object`` does the same per click,
-    re-evaluating the mesh and repainting each time, which a batch does once per mesh instead.
+    coordinates (``mesh_data.evaluated_geometry``), its cached ``Surface``
+    (``mesh_data.surface_for``) and ``records.add_measurement``; a mesh file whose float64
+    coordinates float32 would round is measured at the file's coordinates instead
+    (:func:`exact_surface`, ``Precision`` float64 in the CSV). The colours are painted once per
+    mesh at the end by ``measuring.repaint``, the extension's own painter, from the sides kept
+    while measuring.
     """
     result = MeshResult(mesh=index)
     units = records.units_label(bpy.context.scene)
@@ -92,11 +98,20 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         name = result.object_name or source.name
         result.rows = [(t.index, error_row(t, name, message, units)) for t in tasks]
         result.failed = len(tasks)
+        applying = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
+        result.station_rows = [
+            failed_edge_row(number, spec, name, message, units)
+            for number, spec in enumerate(applying, start=1)
+        ]
         return result
 
     start = time.perf_counter()
+    exact_points = None
     try:
-        obj = import_mesh(source) if source.path else bpy.data.objects[source.name]
+        if source.path:
+            obj, exact_points = import_mesh(source)
+        else:
+            obj = bpy.data.objects[source.name]
     except GoniometerError as error:
         result.bad_file = str(error)
         return fail_all(f"could not read the mesh: {error}")
@@ -110,7 +125,10 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     try:
         mesh_data.check_measurable(obj)
         geometry = mesh_data.evaluated_geometry(obj)
-        surface = mesh_data.surface_for(obj, geometry)
+        if exact_points is None:
+            surface, precision = mesh_data.surface_for(obj, geometry), "float32"
+        else:
+            surface, precision = exact_surface(source, exact_points, geometry), "float64"
     except GoniometerError as error:
         return fail_all(str(error))
     result.n_vertices = int(geometry.points.shape[0])
@@ -121,11 +139,6 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
 
     data = obj.vg
     base = data.next_number - 1  # measurements already on a .blend object keep their numbers
-    fresh = len(data.measurements) == 0
-    # Per vertex, the break number and side of the last measurement covering it (0: none), so
-    # the colours are painted once at the end without keeping every measurement in memory.
-    painter = np.zeros(result.n_vertices, dtype=np.int64)
-    plus_side = np.zeros(result.n_vertices, dtype=bool)
     last_report = start = time.perf_counter()
     for done, task in enumerate(tasks, start=1):
         try:
@@ -148,9 +161,9 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             item = records.add_measurement(
                 obj, m, geometry.fingerprint, note=task.label, break_number=task.break_number
             )
-            result.rows.append((task.index, records.to_row(obj, item, stale=False, units=units)))
-            painter[m.indices] = item.break_number
-            plus_side[m.indices] = m.labels
+            row = records.to_row(obj, item, stale=False, units=units, precision=precision)
+            result.rows.append((task.index, row))
+            measuring.keep_sides(obj, geometry, item, m)
             result.measured += 1
         now = time.perf_counter()
         if progress is not None and now - last_report >= 1.0:
@@ -161,23 +174,17 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         sweep_sites(result, surface, obj.name, tasks, options, geometry.matrix)
     if len(data.measurements):
         data.next_number = max(item.number for item in data.measurements) + 1
+        records.continue_after_recorded_breaks(obj)
 
     if result.measured:
-        if fresh and len(obj.data.vertices) == result.n_vertices:
-            # Every measurement is this run's, on these vertices: paint them as repaint() would
-            # (later over earlier), without measuring each one again.
-            painted = np.flatnonzero(painter)
-            sides = [
-                (vertices, plus_side[vertices], int(number))
-                for number in np.unique(painter[painted])
-                for vertices in [painted[painter[painted] == number]]
-            ]
-            rgba = colors.side_colours(result.n_vertices, sides)
-            colors.write_attribute(obj.data, rgba)
-        else:
-            measuring.repaint(obj, geometry=geometry)
+        measuring.repaint(obj, geometry=geometry)
         add_sides_material(obj, colors.ATTRIBUTE_NAME)
         colors.show_sides_once(obj)
+
+    if options.get("edges"):
+        result.station_rows, result.edge_rows = measure_edges(
+            obj, source, options, units, safe_file_name(obj.name)
+        )
 
     if options.get("render"):
         try:
@@ -211,6 +218,24 @@ def sweep_sites(result: MeshResult, surface, name: str, tasks, options, matrix) 
         result.sweep_rows.extend(
             (task.index, csvio.sweep_cells(name, task.number, point)) for point in points
         )
+
+
+def exact_surface(source: MeshSource, points: np.ndarray, geometry) -> Surface:
+    """The surface of a mesh file at its own float64 coordinates, with the faces Blender kept.
+
+    The imported object is untransformed, and measurements are taken in mesh coordinates, so the
+    file's coordinates are the ones measured in; Blender's float32 copy would round them (by up to a few
+    thousandths of a unit at a thousand units from the origin, which tilts small patches).
+    """
+    if points.shape != geometry.points.shape:
+        raise GoniometerError(
+            f"'{source.path}' has float64 coordinates that Blender's float32 mesh rounds, and "
+            f"Blender's import changed its vertices ({points.shape[0]} in the file, "
+            f"{geometry.points.shape[0]} in Blender), so it cannot be measured at the file's "
+            "precision. Move the mesh near the origin (subtract an offset) and measure again."
+        )
+    triangles = geometry.triangles if geometry.triangles.size else None
+    return Surface(points, triangles)
 
 
 def set_units(scene, unit: str | None) -> None:

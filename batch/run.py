@@ -20,7 +20,9 @@ from ..vg_addon.workflow import batchplan
 from . import extension
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
+from .edges import edge_specs, spec_applies
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
+from .outputs import check_outputs, make_folders
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
 from .workers import run_workers
@@ -35,6 +37,8 @@ class Run:
         self.jobs = 1  # processes measuring at once
         self.rows: dict[int, object] = {}
         self.sweep_rows: list = []  # (task index, cells), --sweep
+        self.station_rows: list = []  # edge profiles' stations (and failed edges), after the rows
+        self.edge_rows: list = []  # one summary per edge profile, for OUT_edges.csv
         self.results: list[MeshResult] = []
         self.bad_files: list[str] = []
         self.lock = threading.Lock()
@@ -44,6 +48,10 @@ class Run:
         self.write_seconds = 0.0  # how long that took
         self.in_flight: dict[int, int] = {}  # mesh -> points done so far (running meshes)
         self.units = records.units_label(bpy.context.scene)
+        # A pipe or standard output gets the CSV once, at the end; a file is rewritten as the
+        # meshes finish, so a run that is stopped keeps what it measured.
+        self.stream = csvio.output_target(args.out) == "stream"
+        self.failed_outputs: list[str] = []  # .blend or pictures that could not be written
         for task in tasks:
             if task.mesh < 0:
                 self.rows[task.index] = error_row(task, task.mesh_name, task.error, self.units)
@@ -75,11 +83,18 @@ class Run:
             for index, row in result.rows:
                 self.rows[index] = row
             self.sweep_rows.extend(result.sweep_rows)
+            self.station_rows.extend(result.station_rows)
+            self.edge_rows.extend(result.edge_rows)
             if result.bad_file:
                 self.bad_files.append(result.bad_file)
+            if result.render_error:
+                name = self.sources[result.mesh].name
+                self.failed_outputs.append(f"render of {name}: {result.render_error}")
             # Rewrite the CSV now and then (each write costs more as rows accumulate), so a run
             # that is killed keeps what it measured; finish() always writes.
-            if time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds):
+            if not self.stream and (
+                time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds)
+            ):
                 self.write_csv()
         source = self.sources[result.mesh]
         rate = result.measured / result.measure_seconds if result.measure_seconds > 0 else 0
@@ -97,8 +112,10 @@ class Run:
 
     def write_csv(self) -> None:
         start = time.perf_counter()
-        rows = [self.rows[i] for i in sorted(self.rows)]
+        rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
         csvio.write_measurements_csv(self.args.out, rows)
+        if self.args.edge or self.args.edges_csv:
+            csvio.write_edges_csv(csvio.edges_path_for(self.args.out), self.edge_rows)
         self.last_write = time.perf_counter()
         self.write_seconds = self.last_write - start
 
@@ -109,7 +126,12 @@ class Run:
             self.rows[task.index] = error_row(
                 task, name, "not measured: the run stopped before this mesh", self.units
             )
-        self.write_csv()
+        try:
+            self.write_csv()
+        except (OSError, GoniometerError) as error:
+            where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+            self.say(f"could not write the CSV to {where}: {error}")
+            return 2
         if self.args.sweep:
             csv_path, plots = sweep_paths(self.args.out)
             rows = [cells for _, cells in sorted(self.sweep_rows, key=lambda pair: pair[0])]
@@ -117,6 +139,7 @@ class Run:
             drawn = sum(r.sweep_plots for r in self.results)
             self.say(f"wrote {csv_path} ({len(rows):,} sweep rows) and {drawn} plot(s) in {plots}")
         failed = [(i, row) for i, row in sorted(self.rows.items()) if row.error]
+        failed_edges = [row for row in self.station_rows if row.error]
         measured = len(self.rows) - len(failed)
         elapsed = time.perf_counter() - self.started
         load = sum(r.load_seconds for r in self.results)
@@ -140,10 +163,26 @@ class Run:
             self.say(f"  failed: {where} on {row.mesh_name!r}: {row.error}")
         if len(failed) > 10:
             self.say(f"  ... and {len(failed) - 10} more failed rows (see the error column)")
+        for edge in self.edge_rows:
+            self.say(
+                f"edge {edge.edge_number} on {edge.mesh_name!r}: {edge.n_stations} stations every "
+                f"{edge.spacing:g} over {edge.length:.4g}: mean {edge.mean:.2f}° ± {edge.std:.2f}° "
+                f"(min {edge.min:.2f}°, max {edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°"
+                + (
+                    f"; the path crosses no ridge at arc lengths {edge.flat_spans}"
+                    if edge.flat_spans
+                    else ""
+                )
+            )
+        for row in failed_edges:
+            self.say(f"  failed: edge {row.edge_number} on {row.mesh_name!r}: {row.error}")
+        if self.edge_rows or failed_edges:
+            self.say(f"wrote {csvio.edges_path_for(self.args.out)}")
         for message in self.bad_files:
             self.say(f"  unreadable mesh: {message}")
-        self.say(f"wrote {self.args.out}")
-        return batchplan.exit_code(len(failed), len(self.bad_files))
+        where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+        self.say(f"wrote the CSV to {where}")
+        return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
 
 
 def sweep_paths(out) -> tuple[Path, Path]:
@@ -158,6 +197,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     ``file_ready``: the caller has already opened the file to measure in (and activated the
     extension), as the demo does; otherwise the .blend among the inputs is opened here.
     """
+    check_outputs(args)  # before anything is read or written
     blend = ""
     if file_ready:
         inputs = list(args.inputs)
@@ -183,6 +223,8 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                 patch=args.patch,
                 rule=args.rule,
             )
+        elif not args.points:
+            tasks = []  # edges only
         else:
             try:
                 rows = csvio.read_replication_csv(args.points)
@@ -203,12 +245,17 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             tasks = bp.shard(tasks, k, n)
     except GoniometerError as error:
         raise UsageError(str(error)) from None
+    edges = edge_specs(args, sources)
     groups = {mesh: ts for mesh, ts in bp.by_mesh(tasks).items() if mesh >= 0}
+    if edges:  # every mesh with edges is measured, whether or not it has points
+        groups = {
+            mesh: groups.get(mesh, [])
+            for mesh in range(len(sources))
+            if mesh in groups or any(spec_applies(spec, sources[mesh]) for spec in edges)
+        }
     units = args.units or ("none" if not blend else None)
     set_units(bpy.context.scene, units)
-    for path in (args.out, args.save_blend):
-        if path:
-            Path(path).resolve().parent.mkdir(parents=True, exist_ok=True)
+    make_folders(args)
     options = {
         "render": str(Path(args.render).resolve()) if args.render else "",
         "render_size": list(args.render_size),
@@ -219,16 +266,19 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "stability": bool(args.stability),
         "sweep": list(args.sweep) if args.sweep else None,
         "sweep_plots": str(sweep_paths(args.out)[1]) if args.sweep else "",
+        "edges": edges,
+        "plots": str(Path(args.out).resolve().parent / Path(args.out).stem) if edges else "",
     }
     if args.sweep:
         sweep_paths(args.out)[1].mkdir(parents=True, exist_ok=True)
     run = Run(args, sources, tasks, len(groups))
     if args.shard and not args.quiet:
         run.say(f"shard {args.shard}: {len(tasks):,} point(s) on {len(groups)} mesh(es)")
-    try:
-        run.write_csv()
-    except (OSError, GoniometerError) as error:
-        raise UsageError(f"cannot write {args.out}: {error}") from None
+    if not run.stream:
+        try:
+            run.write_csv()  # the header now: a place that cannot be written fails here
+        except (OSError, GoniometerError) as error:
+            raise UsageError(f"cannot write {args.out}: {error}") from None
 
     parallel = args.jobs > 1 and len(groups) > 1 and not blend
     if args.jobs > 1 and blend and not args.quiet:
@@ -240,6 +290,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             if parallel:
                 plan = {
                     "folder": folder,
+                    "parent_session": bpy.app.tempdir,  # removed by the workers if this dies
                     "sources": [dataclasses.asdict(s) for s in sources],
                     "tasks": {
                         str(m): [dataclasses.asdict(t) for t in ts] for m, ts in groups.items()
@@ -264,13 +315,20 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                 objects = append_objects(run.results)
             else:
                 objects = [bpy.data.objects.get(name) for name in kept if name]
-            save_blend(args.save_blend, objects)
+            try:
+                save_blend(args.save_blend, objects)
+            except (RuntimeError, OSError) as error:
+                run.failed_outputs.append(f".blend {args.save_blend}: {str(error).strip()}")
+            else:
+                run.say(f"wrote {args.save_blend}")
     finally:
         if folder:
             shutil.rmtree(folder, ignore_errors=True)
-    if args.save_blend:
-        run.say(f"wrote {args.save_blend}")
     if args.render:
         rendered = sum(1 for r in run.results if r.render)
         run.say(f"wrote {rendered} measurement map(s) to {args.render}")
+    for message in run.failed_outputs:
+        run.say(f"  could not write the {message}")
+    if run.failed_outputs:
+        code = max(code, 2)  # the CSV is complete, but an output asked for is missing
     return code, run

@@ -100,22 +100,54 @@ def file_sources(inputs: list[str]) -> list[MeshSource]:
 
 def import_mesh(source: MeshSource):
     """A new mesh object made from ``source``'s file (float32 coordinates, as Blender stores
-    them), linked to the scene at the world origin."""
+    them), linked to the scene at the world origin.
+
+    Returns
+    -------
+    obj : bpy.types.Object
+    exact_points : ndarray of float64, shape (n, 3), or None
+        The file's own coordinates when they are float64 values that float32 rounds (e.g. a
+        scan far from the origin), to be measured at the file's precision; ``None`` when
+        Blender's float32 mesh holds them exactly.
+    """
     data = meshio.read_mesh(source.path)
     points = np.ascontiguousarray(data.points, dtype=np.float32)
+    rounded = not np.array_equal(points.astype(np.float64), data.points)
+    exact_points = data.points if rounded else None
     mesh = bpy.data.meshes.new(source.name)
     mesh.vertices.add(points.shape[0])
-    mesh.vertices.foreach_set("co", points.ravel())
+    # The attribute arrays take plain copies: much faster than the per-vertex properties.
+    mesh.attributes["position"].data.foreach_set("vector", points.ravel())
     if data.triangles is not None:
         triangles = np.ascontiguousarray(data.triangles, dtype=np.int32)
         mesh.loops.add(triangles.size)
-        mesh.loops.foreach_set("vertex_index", triangles.ravel())
+        mesh.attributes[".corner_vert"].data.foreach_set("value", triangles.ravel())
         mesh.polygons.add(triangles.shape[0])
         mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
     mesh.update(calc_edges=True)
-    # Drop degenerate and duplicate faces as Blender's own importers do, so the object is the
-    # one File > Import would make from the same file.
-    mesh.validate(verbose=False)
+    if data.triangles is not None and needs_validation(data.triangles):
+        # Drop degenerate and duplicate faces as Blender's own importers do, so the object is
+        # the one File > Import would make from the same file. (Indices are in range: the
+        # reader checked them; so a list with neither has nothing for validate() to change.)
+        mesh.validate(verbose=False)
     obj = bpy.data.objects.new(source.name, mesh)
     bpy.context.scene.collection.objects.link(obj)
-    return obj
+    return obj, exact_points
+
+
+def needs_validation(triangles: np.ndarray) -> bool:
+    """Whether a triangle list has a degenerate face (a vertex twice) or the same face twice
+    (the same three vertices, in any order)."""
+    a, b, c = (np.ascontiguousarray(triangles[:, k], dtype=np.int64) for k in range(3))
+    if ((a == b) | (b == c) | (a == c)).any():
+        return True
+    low = np.minimum(np.minimum(a, b), c)
+    high = np.maximum(np.maximum(a, b), c)
+    middle = a + b + c - low - high
+    n = int(high.max()) + 1
+    if n < 1 << 21:  # the three indices packed into one int64 key
+        keys = np.sort((low << 42) | (middle << 21) | high)
+        return bool((keys[1:] == keys[:-1]).any())
+    order = np.lexsort((high, low * n + middle))
+    first, second = (low * n + middle)[order], high[order]
+    return bool(((first[1:] == first[:-1]) & (second[1:] == second[:-1])).any())

@@ -26,12 +26,7 @@ import numpy as np
 from ..properties import exact_numbers
 from ..vg_addon import GoniometerError
 from . import records
-from .mesh_data import Geometry, fingerprint, mesh_points, uniform_scale, world_points
-
-
-def legacy_fingerprint(geometry: Geometry) -> str:
-    """The fingerprint the world-space versions gave this geometry (mesh and transform)."""
-    return fingerprint(geometry.local, geometry.triangles.astype(np.int32), geometry.matrix)
+from .mesh_data import Geometry, mesh_points, uniform_scale, world_points
 
 
 def has_world_records(obj) -> bool:
@@ -58,21 +53,26 @@ def migrate(obj, geometry: Geometry, surface) -> list[int]:
         Numbers of the records migrated (the others are left exactly as they were).
     """
     scale = uniform_scale(geometry.matrix)
-    old_key = None
     migrated = []
     for item in obj.vg.measurements:
         numbers = exact_numbers(item)
         if not numbers or "space" in numbers:
             continue
-        if old_key is None:
-            old_key = legacy_fingerprint(geometry)
-        if item.fingerprint != old_key or scale is None:
+        if item.fingerprint not in geometry.world_fingerprints or scale is None:
             continue
         try:
             m = _remeasure(geometry, surface, numbers, item.patch, scale)
         except (GoniometerError, KeyError, ValueError, TypeError):
             continue
-        new = records.exact_record(m)
+        station = None
+        if "arc_length" in numbers:  # an edge station: its lengths in mesh units too
+            station = (
+                0,
+                float(numbers["arc_length"]) / scale,
+                float(numbers["spacing"]) / scale,
+                bool(numbers.get("plus_left", True)),
+            )
+        new = records.exact_record(m, station)
         new["world_record"] = numbers
         item.exact = json.dumps(new)
         item.n_vertices, item.n_plus, item.n_minus = (

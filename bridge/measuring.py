@@ -7,7 +7,6 @@ raises :class:`GoniometerError` for bad input before changing anything.
 
 from __future__ import annotations
 
-from collections import OrderedDict
 from pathlib import Path
 
 import numpy as np
@@ -16,51 +15,48 @@ from ..vg_addon import GoniometerError, Measurement
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
 from ..vg_addon.method.sweep import radius_sweep
-from . import colors, legacy, records
+from . import colors, legacy, painting, records
 from .mesh_data import (
     Geometry,
     check_measurable,
     evaluated_geometry,
     mesh_points,
+    own_write,
     surface_for,
     uniform_scale,
 )
 
-# Measurements are deterministic, so a repaint can reuse the sides of a measurement it has
-# already computed for the same geometry and inputs.
-_SIDES_CACHE_SIZE = 256
-_SIDES_CACHE_VERTICES = 5_000_000  # patch vertices kept in all: bounds the memory, not the count
-_sides: OrderedDict[tuple, Measurement] = OrderedDict()
+
+def _sides_key(obj, geometry: Geometry, item) -> tuple:
+    """What a measurement's painted sides depend on: the geometry, its exact inputs and break
+    (and the object's own mesh, when modifiers change the vertex count)."""
+    mapped = None if len(obj.data.vertices) == geometry.points.shape[0] else obj.data.session_uid
+    return (geometry.fingerprint, item.exact, item.patch, item.break_number, mapped)
 
 
-def _key(fingerprint: str, center, radius: float, lam: float, patch: str, rule: str) -> tuple:
-    return (fingerprint, np.asarray(center, dtype=np.float64).tobytes(), radius, lam, patch, rule)
-
-
-def _remember(fingerprint: str, m: Measurement) -> None:
-    _sides[_key(fingerprint, m.center, m.radius, m.lam, m.patch, m.rule)] = m
-    while len(_sides) > 1 and (
-        len(_sides) > _SIDES_CACHE_SIZE
-        or sum(kept.n_vertices for kept in _sides.values()) > _SIDES_CACHE_VERTICES
-    ):
-        _sides.popitem(last=False)
-
-
-def _replay(obj, geometry: Geometry, item) -> Measurement:
-    args = records.replay_args(item)
-    key = _key(
-        geometry.fingerprint,
-        args["center"],
-        args["radius"],
-        args["lam"],
-        args["patch"],
-        args["rule"],
+def _sides(obj, geometry: Geometry, m: Measurement, item) -> painting.Sides:
+    vertices, plus = colors.original_sides(obj, geometry, m)
+    if not records.plus_on_pair_side(item):  # an edge station, painted edge-wise
+        plus = ~plus
+    return painting.Sides(
+        vertices.astype(np.int32), plus, int(item.break_number), m.center.copy(), float(m.radius)
     )
-    m = _sides.get(key)
-    if m is None:
-        m = surface_for(obj, geometry).measure(**args)
-        _remember(geometry.fingerprint, m)
-    return m
+
+
+def keep_sides(obj, geometry: Geometry, item, m: Measurement) -> None:
+    """Keep the sides of ``m``, just recorded as ``item``, so that painting it measures
+    nothing again."""
+    painting.keep(_sides_key(obj, geometry, item), _sides(obj, geometry, m, item))
+
+
+def _sides_of_item(obj, geometry: Geometry, item, key: tuple) -> painting.Sides:
+    sides = painting.kept_sides(key)
+    if sides is None:
+        # Deterministic: re-measuring at the exact stored inputs gives the sides it had.
+        m = surface_for(obj, geometry).measure(**records.replay_args(item))
+        sides = _sides(obj, geometry, m, item)
+        painting.keep(key, sides)
+    return sides
 
 
 def measure(
@@ -88,7 +84,6 @@ def measure(
         raise GoniometerError(f"Unknown coordinate space {space!r}: use 'mesh' or 'world'.")
     surface = surface_for(obj, geometry)
     m = surface.measure(location, radius, lam, patch, rule=rule, stability=stability)
-    _remember(geometry.fingerprint, m)
     note_winding(obj, surface)
     return m, geometry
 
@@ -189,21 +184,49 @@ def measure_on_object(
         stability=stability,
         space=space,
     )
-    records.add_measurement(obj, m, geometry.fingerprint, note=note)
+    item = records.add_measurement(obj, m, geometry.fingerprint, note=note)
+    keep_sides(obj, geometry, item, m)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
     colors.show_sides_once(obj)
     return obj.vg.measurements[obj.vg.active_index]
 
 
-def repaint(obj, *, depsgraph=None, geometry: Geometry | None = None) -> list[int]:
+# Per measurement, what changes whenever it is replaced by another one; read for the whole list
+# at once (foreach_get) to recognise the measurements already painted without reading them.
+_SIGNATURE = ("number", "break_number", "n_vertices", "n_plus", "n_minus")
+
+
+def _signatures(items) -> list[tuple]:
+    columns = []
+    for name in _SIGNATURE:
+        values = np.empty(len(items), dtype=np.int64)
+        items.foreach_get(name, values)
+        columns.append(values.tolist())
+    stale = np.empty(len(items), dtype=bool)
+    items.foreach_get("stale", stale)
+    columns.append(stale.tolist())
+    return list(zip(*columns, strict=True))
+
+
+def repaint(
+    obj, *, depsgraph=None, geometry: Geometry | None = None, verify: bool = False
+) -> list[int]:
     """Update the stale flags and repaint the "VG Sides" colours of ``obj`` from its records.
 
-    Every measurement whose geometry fingerprint still matches the evaluated mesh is re-measured
-    at its exact stored centre, radius, λ and patch mode (deterministic, so its sides are the
-    ones it had) and painted, later measurements over earlier ones. The others are flagged
-    stale and left unpainted. Records from versions that measured in world space are first
-    brought into mesh coordinates where they still match (see ``legacy``). The viewports'
-    shading is left as the user set it.
+    Every measurement whose geometry fingerprint still matches the evaluated mesh is painted,
+    later measurements over earlier ones, with the sides it has at its exact stored centre,
+    radius, λ and patch mode (kept from when it was measured, or measured again once). The
+    others are flagged stale and left unpainted. Only what changed since the last painting of
+    this object is repainted (see ``painting``). Records from versions that measured in world
+    space are first brought into mesh coordinates where they still match (see ``legacy``). The
+    viewports' shading is left as the user set it.
+
+    Parameters
+    ----------
+    verify : bool
+        Read every record again, instead of recognising the ones painted last time (on the
+        same geometry, with no undo or file load since) by their number, break and vertex
+        counts. For records changed by other means than this module's functions.
 
     Returns
     -------
@@ -213,22 +236,65 @@ def repaint(obj, *, depsgraph=None, geometry: Geometry | None = None) -> list[in
     check_measurable(obj)
     if geometry is None:
         geometry = evaluated_geometry(obj, depsgraph)
-    if legacy.has_world_records(obj):
+    mesh = obj.data
+    n = len(mesh.vertices)
+    items = obj.vg.measurements
+    state = painting.state_for(obj)
+    usable = (
+        state is not None
+        and state.fingerprint == geometry.fingerprint
+        and state.colours.shape[0] == n
+        and colors.has_attribute(mesh)
+    )
+    trusted = usable and not verify and state.generation == painting.generation()
+    if not trusted and legacy.has_world_records(obj):
+        # Only a file load or an undo brings world-space records, and neither is trusted.
         legacy.migrate(obj, geometry, surface_for(obj, geometry))
-    measured, stale = [], []
-    for item in obj.vg.measurements:
-        is_stale = item.fingerprint != geometry.fingerprint
-        if not is_stale:
-            try:
-                measured.append((_replay(obj, geometry, item), item.break_number))
-            except GoniometerError:
-                is_stale = True
-        if item.stale != is_stale:
-            item.stale = is_stale
-        if is_stale:
-            stale.append(item.number)
-    colors.write_attribute(obj.data, colors.original_vertex_colours(obj, geometry, measured))
+    known = state.known if trusted else {}
+    keys, sides, stale, remembered = [], {}, [], {}
+    for position, signature in enumerate(_signatures(items)):
+        entry = known.get(signature)
+        if entry is None:
+            item = items[position]
+            is_stale, key = not geometry.matches(item.fingerprint), None
+            if not is_stale:
+                key = _sides_key(obj, geometry, item)
+                try:
+                    sides[key] = _sides_of_item(obj, geometry, item, key)
+                except GoniometerError:
+                    is_stale, key = True, None
+            if item.stale != is_stale:
+                item.stale = is_stale
+            signature = (*signature[:-1], is_stale)
+            entry = (key, sides.get(key))
+        remembered[signature] = entry
+        key, kept = entry
+        if key is None:
+            stale.append(signature[0])
+        else:
+            keys.append(key)
+            sides[key] = kept
+    if not usable or not state.update_to(keys, sides.__getitem__):
+        state = painting.PaintState.blank(geometry.fingerprint, n)
+        for key in keys:
+            state.add(key, sides[key])
+        painting.set_state(obj, state)
+    state.known, state.generation = remembered, painting.generation()
+    with own_write(mesh, depsgraph):
+        colors.write_attribute(mesh, state.colours)
     return stale
+
+
+def migrate_fingerprints(obj, geometry: Geometry) -> int:
+    """Rewrite in the current format the fingerprints of ``obj``'s measurements that an earlier
+    version wrote and that match ``geometry``; returns how many. Ones that do not match are
+    left as they are (their measurements are stale either way)."""
+    migrated = 0
+    for item in obj.vg.measurements:
+        if item.fingerprint != geometry.fingerprint and geometry.matches(item.fingerprint):
+            item.fingerprint = geometry.fingerprint
+            migrated += 1
+    return migrated
 
 
 def stale_numbers(obj, *, depsgraph=None) -> set[int]:
@@ -237,10 +303,14 @@ def stale_numbers(obj, *, depsgraph=None) -> set[int]:
     if not len(obj.vg.measurements):
         return set()
     try:
-        current = evaluated_geometry(obj, depsgraph).fingerprint
+        current = evaluated_geometry(obj, depsgraph)
     except GoniometerError:  # e.g. every vertex deleted since
         current = None
-    return {item.number for item in obj.vg.measurements if item.fingerprint != current}
+    return {
+        item.number
+        for item in obj.vg.measurements
+        if current is None or not current.matches(item.fingerprint)
+    }
 
 
 def from_world(location, radius, matrix, *, scale_radius=True):
@@ -305,7 +375,9 @@ def replicate_rows(
     divided by its scale; that needs a transform that scales every direction alike.
 
     Each new measurement keeps the row's break number when it has one (else the object's
-    current break) and takes the row's label or User Data as its note.
+    current break) and takes the row's label or User Data as its note. Rows that are stations
+    of an edge profile (an ``Edge #``) are grouped back into one edge per edge number, with a
+    new edge record whose summary is recomputed from the re-measured stations.
 
     Returns
     -------
@@ -372,6 +444,12 @@ def replicate_steps(
         yield done, len(rows)
         try:
             row_radius = radius if row.radius is None else row.radius
+            if row.break_number is not None and not (
+                1 <= row.break_number <= csvio.MAX_BREAK_NUMBER
+            ):
+                raise GoniometerError(
+                    f"Break # {row.break_number} is not from 1 to {csvio.MAX_BREAK_NUMBER}"
+                )
             if row_radius is None:
                 raise GoniometerError("no radius (the CSV has no Radius for this row)")
             location = (row.x, row.y, row.z)
@@ -402,12 +480,38 @@ def replicate_steps(
             f"'{obj.name}' changed while {source} was being measured; nothing was imported."
         )
     numbers = []
+    stations: dict[int, list] = {}
     for row, m in results:
-        _remember(geometry.fingerprint, m)
+        station = None
+        if row.edge_number is not None:  # numbered and oriented when its edge is rebuilt
+            station = (0, row.arc_length or 0.0, row.spacing or 0.0, True)
         item = records.add_measurement(
-            obj, m, geometry.fingerprint, note=row.label or "", break_number=row.break_number
+            obj,
+            m,
+            geometry.fingerprint,
+            note=row.label or "",
+            break_number=row.break_number,
+            station=station,
         )
+        keep_sides(obj, geometry, item, m)
         numbers.append(item.number)
+        if station is not None:
+            stations.setdefault(row.edge_number, []).append(
+                (item.number, m, station[1], station[2])
+            )
+    if stations:
+        from . import edges  # edges records through this module: imported when needed
+
+        by_number = {item.number: item for item in obj.vg.measurements}
+        edges.edges_from_stations(
+            obj,
+            {
+                key: [(by_number[entry[0]], *entry[1:]) for entry in group]
+                for key, group in stations.items()
+            },
+            geometry,
+        )
+    records.continue_after_recorded_breaks(obj)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
     colors.show_sides_once(obj)
     return numbers
@@ -438,6 +542,17 @@ def export_rows(objects, scene, *, depsgraph=None) -> list:
     return rows
 
 
+def forget_paint() -> None:
+    """Forget what was painted and the kept sides (file load, unregister)."""
+    painting.forget()
+
+
+def export_edge_rows(objects, scene) -> list:
+    """Edge summary CSV rows of every edge profile of ``objects``, in list order."""
+    units = records.units_label(scene)
+    return [records.edge_row(obj, edge, units=units) for obj in objects for edge in obj.vg.edges]
+
+
 def clear_cache() -> None:
-    """Forget the remembered sides (called on unregister)."""
-    _sides.clear()
+    """Forget the kept sides and paint states (called on unregister)."""
+    painting.forget()

@@ -1,20 +1,22 @@
-"""Keep stale flags and colours in step with the mesh while the user edits it.
+"""Keep the geometry caches, stale flags and colours in step with the mesh while the user edits it.
 
-After an edit of the mesh or its modifiers of an object that has measurements, and once the
-edits pause, the object's measurements are checked against its geometry; if a stale flag no
-longer matches, the object is repainted, so the colours never show sides of a mesh that has
-changed. Moving, rotating or scaling the object changes no measurement (they are in mesh
-coordinates) and triggers nothing. The check runs from a timer, not inside the depsgraph
-handler (writing data there would re-trigger it), and not in Edit Mode (leaving Edit Mode
-triggers it again).
+Every depsgraph update of an object's geometry drops its kept geometry
+(``mesh_data.invalidate``), except the update our own colour write causes
+(``mesh_data.own_write``). After an edit of the mesh or its modifiers of an object that has
+measurements, and once the edits pause, the object's measurements are checked against its
+geometry; if a stale flag no longer matches, the object is repainted, so the colours never show
+sides of a mesh that has changed. Moving, rotating or scaling the object changes no measurement
+(they are in mesh coordinates) and triggers nothing. The check runs from a timer, not inside the
+depsgraph handler (writing data there would re-trigger it), and not in Edit Mode (leaving Edit
+Mode triggers it again). Undo and redo drop every kept geometry.
 
 The timer writes only what follows from the mesh the user edited (the stale flags and the "VG
 Sides" colours), never the viewport shading or the active colour attribute: undoing the edit
 brings the mesh back, and the next check brings the flags and colours back with it, so there is
 nothing of the timer's own for the user to undo. Its writes join the edit's undo step.
 
-On file load (``on_load_post``) the caches are emptied and measurements recorded in world space
-by earlier versions are brought into mesh coordinates (see ``legacy``).
+On file load (``on_load``) the caches are emptied and measurements recorded in world space by
+earlier versions are brought into mesh coordinates (see ``legacy``).
 """
 
 from __future__ import annotations
@@ -23,8 +25,8 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..vg_addon import GoniometerError
-from . import legacy, measuring, mesh_data
-from .measuring import repaint
+from . import legacy, mesh_data, painting
+from .measuring import forget_paint, migrate_fingerprints, repaint
 from .mesh_data import check_measurable, evaluated_geometry
 
 _DELAY = 0.5  # seconds of quiet after the last edit before checking
@@ -35,7 +37,8 @@ def refresh(obj, depsgraph=None) -> bool:
     """Repaint ``obj`` if its stale flags disagree with its current geometry.
 
     Returns True if it was repainted. Objects that cannot be measured now (Edit Mode, linked,
-    emptied) are left as they are.
+    emptied) are left as they are. Fingerprints written by earlier versions that match are
+    rewritten in the current format.
     """
     if obj is None or obj.type != "MESH" or not len(obj.vg.measurements):
         return False
@@ -44,11 +47,12 @@ def refresh(obj, depsgraph=None) -> bool:
         geometry = evaluated_geometry(obj, depsgraph)
     except GoniometerError:
         return False
+    migrate_fingerprints(obj, geometry)
     if all(
         (item.fingerprint != geometry.fingerprint) == item.stale for item in obj.vg.measurements
     ):
         return False
-    repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    repaint(obj, depsgraph=depsgraph, geometry=geometry, verify=True)
     return True
 
 
@@ -62,34 +66,48 @@ def _check_pending():
 
 @persistent
 def on_depsgraph_update(scene, depsgraph):
-    """Note the measured objects whose evaluated geometry changed; check them soon."""
+    """Drop the kept geometry of objects whose geometry changed (not a mere move); note the
+    measured ones, to check them soon."""
     for update in depsgraph.updates:
         if not update.is_updated_geometry:
             continue
         obj = update.id.original
-        if isinstance(obj, bpy.types.Object) and obj.type == "MESH":
-            vg = getattr(obj, "vg", None)
-            if vg is not None and len(vg.measurements):
-                _pending.add(obj.name)
+        if not isinstance(obj, bpy.types.Object) or obj.type != "MESH":
+            continue
+        if mesh_data.is_own_write(obj):
+            continue
+        mesh_data.invalidate(obj)
+        vg = getattr(obj, "vg", None)
+        if vg is not None and len(vg.measurements):
+            _pending.add(obj.name)
     if _pending:
         if bpy.app.timers.is_registered(_check_pending):
             bpy.app.timers.unregister(_check_pending)
         bpy.app.timers.register(_check_pending, first_interval=_DELAY)
 
 
+@persistent
+def on_undo_or_redo(*_args):
+    """Undo and redo may restore any geometry and any records: read them again before
+    trusting what was kept."""
+    mesh_data.invalidate_all()
+    painting.new_generation()
+
+
 def clear_caches() -> None:
-    """Forget every cached surface and measurement, and every pending check."""
+    """Forget every kept geometry, surface, paint state and measurement, and every pending
+    check."""
     mesh_data.clear_cache()
-    measuring.clear_cache()
+    forget_paint()
     _pending.clear()
     if bpy.app.timers.is_registered(_check_pending):
         bpy.app.timers.unregister(_check_pending)
 
 
 @persistent
-def on_load_post(*_args):
-    """A file was opened: empty the caches (they describe the previous file's meshes) and bring
-    world-space measurements of earlier versions into mesh coordinates."""
+def on_load(*_args):
+    """Another file: forget everything kept for the previous one, and bring world-space
+    measurements of earlier versions into mesh coordinates."""
     clear_caches()
     for obj in bpy.data.objects:
         if obj.type == "MESH" and legacy.has_world_records(obj):
@@ -107,26 +125,32 @@ def migrate(obj) -> list[int]:
         return []
     migrated = legacy.migrate(obj, geometry, mesh_data.surface_for(obj, geometry))
     if migrated:
-        repaint(obj, geometry=geometry)
+        repaint(obj, geometry=geometry, verify=True)
     else:
         refresh(obj)  # the flags of records that stay in world space
     return migrated
 
 
 _HANDLERS = (
-    (bpy.app.handlers.depsgraph_update_post, on_depsgraph_update),
-    (bpy.app.handlers.load_post, on_load_post),
+    ("depsgraph_update_post", on_depsgraph_update),
+    ("undo_post", on_undo_or_redo),
+    ("redo_post", on_undo_or_redo),
+    ("load_post", on_load),
 )
 
 
 def register() -> None:
-    for handlers, handler in _HANDLERS:
+    for name, handler in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
         if handler not in handlers:
             handlers.append(handler)
+    mesh_data.set_watching(True)
 
 
 def unregister() -> None:
-    for handlers, handler in _HANDLERS:
+    mesh_data.set_watching(False)
+    for name, handler in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
         if handler in handlers:
             handlers.remove(handler)
     if bpy.app.timers.is_registered(_check_pending):

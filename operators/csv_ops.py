@@ -8,7 +8,7 @@ import bpy
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from ..bridge import measuring
+from ..bridge import edges, measuring
 from ..bridge.mesh_data import check_measurable
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
@@ -17,7 +17,21 @@ from .progress import Progress
 
 
 def _path(operator) -> str:
-    return bpy.path.abspath(operator.filepath) if operator.filepath else ""
+    """The operator's file path made absolute; ``""`` when none was given.
+
+    Raises
+    ------
+    GoniometerError
+        A path relative to the .blend file (``//``) while the file has never been saved: it
+        would silently mean the process's working folder.
+    """
+    path = operator.filepath
+    if path.startswith("//") and not bpy.data.filepath:
+        raise GoniometerError(
+            f"{path!r} is relative to the .blend file ('//'), but this file has not been saved "
+            "yet: save the .blend file first, or choose a full path."
+        )
+    return bpy.path.abspath(path) if path else ""
 
 
 class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
@@ -43,7 +57,11 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
         return False
 
     def execute(self, context):
-        path = _path(self)
+        try:
+            path = _path(self)
+        except GoniometerError as error:
+            self.report({"ERROR"}, f"{error} Nothing was written.")
+            return {"CANCELLED"}
         if not path:
             self.report({"ERROR"}, "No file name given: choose where to write the CSV.")
             return {"CANCELLED"}
@@ -73,6 +91,9 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
                 objects, context.scene, depsgraph=context.evaluated_depsgraph_get()
             )
             csvio.write_measurements_csv(path, rows)
+            edge_rows = measuring.export_edge_rows(objects, context.scene)
+            if edge_rows:
+                csvio.write_edges_csv(csvio.edges_path_for(path), edge_rows)
         except OSError as error:
             self.report({"ERROR"}, f"Could not write {path}: {error}")
             return {"CANCELLED"}
@@ -81,7 +102,11 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
             return {"CANCELLED"}
         stale = sum(row.stale for row in rows)
         note = f" ({stale} stale)" if stale else ""
-        self.report({"INFO"}, f"Wrote {len(rows)} measurement(s){note} to {path}")
+        edges = f" and {len(edge_rows)} edge profile(s) to {csvio.edges_path_for(path)}"
+        self.report(
+            {"INFO"},
+            f"Wrote {len(rows)} measurement(s){note} to {path}" + (edges if edge_rows else ""),
+        )
         return {"FINISHED"}
 
 
@@ -89,7 +114,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
     """Re-measure every row of a measurement CSV on the active mesh (the paper's xyz method).
     Reads this extension's CSVs, the MeshLab plugin's, the earlier Blender add-on's and plain
     x, y, z point lists (rows without radius, λ or patch mode take the panel's; MeshLab and
-    earlier add-on rows are re-measured with the paper's rule they were taken with)"""
+    earlier add-on rows are re-measured with the paper's rule they were taken with); an edge
+    summary file (NAME_edges.csv) has each of its edges traced and measured again"""
 
     bl_idname = "vg.import_csv"
     bl_label = "Import Measurements CSV"
@@ -122,15 +148,32 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         return ImportHelper.invoke(self, context, event)
 
     def _start(self, context):
-        """Read the file and prepare the steps; report and return None on a problem."""
-        path = _path(self)
+        """Read the file and prepare the steps; report and return None on a problem (an edge
+        summary file is imported at once: the operator's result)."""
+        path = self.filepath
         obj = context.active_object
         try:
+            path = _path(self)
             check_measurable(obj)
             if not path:
                 raise GoniometerError("No file name given: choose the CSV to import.")
-            rows, source = measuring.read_rows(path)
             settings = context.scene.vg_settings
+            if csvio.is_edges_csv(path):  # an edge summary file: re-trace its edges
+                edge_numbers = edges.import_edges_csv(
+                    obj,
+                    path,
+                    ignore_mesh_names=self.ignore_mesh_names,
+                    lam=typed_value(settings.seg_param),
+                    patch=settings.patch,
+                    depsgraph=context.evaluated_depsgraph_get(),
+                )
+                self.report(
+                    {"INFO"},
+                    f"Re-measured {len(edge_numbers)} edge profile(s) of "
+                    f"{bpy.path.basename(path)} on '{obj.name}'",
+                )
+                return {"FINISHED"}
+            rows, source = measuring.read_rows(path)
             steps = measuring.replicate_steps(
                 obj,
                 rows,
@@ -156,6 +199,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         steps = self._start(context)
         if steps is None:
             return {"CANCELLED"}
+        if isinstance(steps, set):  # an edge summary file, imported at once
+            return steps
         if self.interactive and context.window is not None:
             wm = context.window_manager
             self._progress = Progress(context, f"Re-measuring {self._path_name} (Esc cancels)")

@@ -158,8 +158,26 @@ def object_alive(context, obj) -> bool:
     return context.scene.objects.get(name) == obj
 
 
-def in_region(region, coord) -> bool:
-    return 0 <= coord[0] < region.width and 0 <= coord[1] < region.height
+def _contains(region, x, y) -> bool:
+    return region.x <= x < region.x + region.width and region.y <= y < region.y + region.height
+
+
+def pointer_in_view(area, region, coord) -> bool:
+    """Whether region pixel ``coord`` of the 3D view's WINDOW ``region`` is on the view itself.
+
+    A modal operator gets every pointer position relative to the region it started in, and with
+    Region Overlap (Blender's default) that region spans the whole area: the sidebar, the toolbar,
+    the header and the tool settings are drawn over it. So a pixel inside ``region`` is on the view
+    only if no other shown region of ``area`` covers it. Hidden regions are 1 pixel or less and
+    are ignored.
+    """
+    if coord is None or not (0 <= coord[0] < region.width and 0 <= coord[1] < region.height):
+        return False
+    x, y = region.x + coord[0], region.y + coord[1]  # window pixels, like every region's x, y
+    return not any(
+        other.type != "WINDOW" and other.width > 1 and other.height > 1 and _contains(other, x, y)
+        for other in area.regions
+    )
 
 
 class DragSession:
@@ -231,7 +249,9 @@ class DragSession:
     def handle(self, context, action: str, argument=None, coord=None) -> str:
         """Apply one translated event; returns ``"running"``, ``"pass"`` or ``"done"``.
 
-        ``coord`` is the mouse position relative to the region (needed for ``"move"``).
+        ``coord`` is the pointer position relative to the region (needed for ``"move"`` and
+        ``"release"``): a move or release off the view (outside the region, or over the sidebar,
+        toolbar or header drawn over it) cancels the drag, so it records nothing.
         """
         machine = self.machine
         if not object_alive(context, self.obj):
@@ -243,10 +263,10 @@ class DragSession:
             return DONE
         if action == "pass":
             return PASS
+        if action in ("move", "release") and not pointer_in_view(self._area, region, coord):
+            machine.cancel("Left the 3D view: nothing was recorded.")
+            return DONE
         if action == "move":
-            if not in_region(region, coord):
-                machine.cancel("Left the 3D view: nothing was recorded.")
-                return DONE
             machine.move(view_plane_radius(region, region_data, coord, machine.center, self.matrix))
         elif action == "type":
             machine.type_character(argument)

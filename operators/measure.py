@@ -13,7 +13,7 @@ from bpy.props import (
     StringProperty,
 )
 
-from ..bridge import measuring
+from ..bridge import measuring, records
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, uniform_scale
 from ..properties import PATCH_ITEMS, RULE_ITEMS
 from ..vg_addon import GoniometerError
@@ -97,13 +97,15 @@ class MeasureProperties:
     radius: FloatProperty(
         name="Radius",
         description="Patch radius, in the mesh's own units; default: the panel's radius",
-        min=0.0,
+        soft_min=0.0,  # not min: a negative radius is refused, not quietly made 0
         precision=4,
         subtype="DISTANCE",
         unit="LENGTH",
     )
     seg_param: FloatProperty(
-        name="λ (SegParam)", description="Segmentation parameter; default: the panel's", min=0.0
+        name="λ (SegParam)",
+        description="Segmentation parameter; default: the panel's",
+        soft_min=0.0,  # not min: a negative λ is refused, as in a CSV, not quietly made 0
     )
     patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
     rule: EnumProperty(name="Rule", items=RULE_ITEMS, description="Default: the panel's")
@@ -195,7 +197,8 @@ def _active_geometry(operator, context):
 
 
 class VG_OT_next_break(bpy.types.Operator):
-    """Start a new break: the next measurements get the next break number and colour pair"""
+    """Start a new break: the next measurements get a break number no measurement has yet, and
+    its colour pair"""
 
     bl_idname = "vg.next_break"
     bl_label = "Next Break"
@@ -209,7 +212,7 @@ class VG_OT_next_break(bpy.types.Operator):
         obj = _active_measurable(self, context)
         if obj is None:
             return {"CANCELLED"}
-        obj.vg.break_number += 1
+        obj.vg.break_number = records.next_free_break(obj)
         self.report({"INFO"}, f"Break {obj.vg.break_number} on '{obj.name}'")
         return {"FINISHED"}
 
@@ -249,7 +252,7 @@ class VG_OT_delete_measurement(bpy.types.Operator):
 
 
 class VG_OT_clear_measurements(bpy.types.Operator):
-    """Delete every measurement of the active object and paint it grey"""
+    """Delete every measurement and edge profile of the active object and paint it grey"""
 
     bl_idname = "vg.clear_measurements"
     bl_label = "Clear Measurements"
@@ -267,6 +270,13 @@ class VG_OT_clear_measurements(bpy.types.Operator):
         if obj is None:
             return {"CANCELLED"}
         count = len(obj.vg.measurements)
+        for edge in obj.vg.edges:  # the edge profiles go with their stations
+            image = bpy.data.images.get(edge.plot)
+            if image is not None:
+                bpy.data.images.remove(image)
+        obj.vg.edges.clear()
+        obj.vg.active_edge_index = 0
+        obj.vg.next_edge_number = 1
         obj.vg.measurements.clear()
         obj.vg.active_index = 0
         obj.vg.next_number = 1
@@ -292,7 +302,7 @@ class VG_OT_repaint(bpy.types.Operator):
         if obj is None:
             return {"CANCELLED"}
         try:
-            measuring.repaint(obj, depsgraph=context.evaluated_depsgraph_get())
+            measuring.repaint(obj, depsgraph=context.evaluated_depsgraph_get(), verify=True)
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

@@ -100,7 +100,7 @@ def test_an_old_blend_file_is_migrated_on_load(vg, tmp_path):
     )
     assert numbers["rule"] == "paper"
     assert (numbers["center"], numbers["angle"]) == (m.center.tolist(), m.angle)
-    painted = expected_colours(vg, len(kept.data.vertices), [(m.indices, m.labels, 1)])
+    painted = expected_colours(len(kept.data.vertices), [(m.indices, m.labels, 1)])
     np.testing.assert_array_equal(colours(kept), painted)  # and painted again
     # It now follows the object.
     kept.location.z += 4.0
@@ -133,9 +133,11 @@ def _triangles(obj):
 def test_file_load_clears_the_caches(vg, tmp_path):
     wedge_object(90.0)
     bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
-    assert vg.bridge.mesh_data._surfaces and vg.bridge.measuring._sides
+    painting = vg.bridge.painting
+    assert vg.bridge.mesh_data._surfaces and painting._kept and painting._states
     path = tmp_path / "plain.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.open_mainfile(filepath=str(path))
-    assert not vg.bridge.mesh_data._surfaces and not vg.bridge.measuring._sides
+    assert not vg.bridge.mesh_data._surfaces and not vg.bridge.mesh_data._geometries
+    assert not painting._kept and not painting._states
     assert len(bpy.data.objects["Wedge"].vg.measurements) == 1

@@ -39,6 +39,13 @@ faces."""
 
 _RANK_TOLERANCE = 1e-10
 
+MAX_MAGNITUDE = 1e150
+"""Largest coordinate and radius, in any unit: squares of larger values, and sums of them over
+many points, overflow float64 (from about 1e154). A scan in any real unit is far below this."""
+
+MIN_RADIUS = 1e-152
+"""Smallest patch radius: squared distances below about 1e-154 lose precision (subnormal)."""
+
 
 def canonical_order(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """Order that sorts a patch by coordinates (then normals), independent of vertex numbering.
@@ -269,6 +276,12 @@ def as_points(name: str, values, *, allow_empty: bool = False) -> np.ndarray:
     if not allow_empty and array.shape[0] == 0:
         raise GoniometerError(f"There are no {name}: the mesh or patch is empty.")
     _check_finite(name, array)
+    largest = float(np.abs(array).max()) if array.size else 0.0
+    if largest > MAX_MAGNITUDE:
+        raise GoniometerError(
+            f"The {name} reach {largest:.3g}, beyond ±{MAX_MAGNITUDE:g}, where squared distances "
+            "overflow: scale the mesh to a real unit (e.g. millimetres) before measuring."
+        )
     return array
 
 
@@ -280,6 +293,11 @@ def as_radius(radius) -> float:
         raise GoniometerError(f"The radius must be a number; got {radius!r}.") from None
     if not np.isfinite(value) or value <= 0:
         raise GoniometerError(f"The radius must be a finite number greater than 0; got {value!r}.")
+    if not MIN_RADIUS <= value <= MAX_MAGNITUDE:
+        raise GoniometerError(
+            f"The radius must be from {MIN_RADIUS:g} to {MAX_MAGNITUDE:g}, where squared "
+            f"distances stay representable; got {value!r}. Scale the mesh to a real unit."
+        )
     return value
 
 
