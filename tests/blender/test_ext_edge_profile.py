@@ -1,6 +1,7 @@
 """vg.measure_edge against the core: one break of stations, bit-identical to Surface.measure_along
 and replayable with vg.measure_xyz; its record, plot, CSV rows, re-import, undo and delete."""
 
+import csv
 import json
 
 import bpy
@@ -187,13 +188,14 @@ def test_edge_session_event_translation(vg):
     assert points.tolist() == (np.array(POINTS) / 3.0).tolist()
 
 
-def test_local_points_are_measured_in_world_space(vg):
-    obj, _ = ramp_object(scale=(2.0, 2.0, 2.0))
+def test_world_points_on_a_scaled_object_are_measured_in_mesh_coordinates(vg):
+    obj, _ = ramp_object(location=(1.0, 0.0, 0.0), scale=(2.0, 2.0, 2.0))
     points = world(np.array(POINTS), obj)
-    measure_edge(points=points.tolist(), spacing=1.0, radius=0.6)
-    assert all(
-        exact(i)["center"] in world(local_points(obj), obj).tolist() for i in obj.vg.measurements
-    )
+    measure_edge(points=points.tolist(), spacing=0.5, radius=0.3)  # mesh units
+    local = local_points(obj).astype(np.float64).tolist()
+    assert all(exact(i)["center"] in local for i in obj.vg.measurements)
+    assert {exact(i)["radius"] for i in obj.vg.measurements} == {0.3}
+    np.testing.assert_allclose(exact(obj.vg.edges[0])["points"], POINTS, atol=1e-12)
 
 
 def test_each_side_of_a_curved_edge_is_painted_in_one_colour(vg):
@@ -249,6 +251,26 @@ def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):
         (b["angle"], b["arc_length"]) for b in before
     ]
     assert [exact(e)["points"] for e in copy.vg.edges] == [exact(e)["points"] for e in obj.vg.edges]
+    # An edge file of an earlier version: world-space points, no Coordinates column. Read as
+    # world space and brought onto the moved object's mesh: the same stations.
+    moved, _ = ramp_object("Moved", location=(1.0, 2.0, 3.0), rotation=(0.2, 0.0, 0.3))
+    with open(edge_file, newline="", encoding="utf-8") as handle:
+        table = list(csv.DictReader(handle))
+    for row in table:
+        row.pop("Coordinates")
+        # Cells starting with "-" are written behind an apostrophe, which the reader removes.
+        clicks = world(np.array(csvio.parse_points(row["Points"].removeprefix("'"))), moved)
+        text = csvio.format_points(clicks)
+        row["Points"] = "'" + text if text.startswith("-") else text
+    old_file = tmp_path / "old_edges.csv"
+    with open(old_file, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(table[0]))
+        writer.writeheader()
+        writer.writerows(table)
+    assert bpy.ops.vg.import_csv(filepath=str(old_file), ignore_mesh_names=True) == {"FINISHED"}
+    assert [(exact(a)["angle"], exact(a)["center"]) for a in moved.vg.measurements] == [
+        (b["angle"], b["center"]) for b in before
+    ]
     # Another object's name without Ignore Names: refused, nothing recorded.
     other, _ = ramp_object("Other")
     with pytest.raises(RuntimeError, match="names the mesh 'Ramp'"):
