@@ -28,8 +28,10 @@ if numpy_import_error is None:
         properties.register_properties()
         operators.drag.register_tool()
         watch.register()
+        ui.labels.register()
 
     def unregister():
+        ui.labels.unregister()
         operators.drag.unregister_tool()
         watch.unregister()
         properties.unregister_properties()

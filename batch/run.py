@@ -254,6 +254,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "render": str(Path(args.render).resolve()) if args.render else "",
         "render_size": list(args.render_size),
         "render_samples": args.render_samples,
+        "render_views": args.render_views.upper(),
         "save_blend": bool(args.save_blend),
         "units": units,
         "stability": bool(args.stability),
@@ -319,7 +320,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             shutil.rmtree(folder, ignore_errors=True)
     if args.render:
         rendered = sum(1 for r in run.results if r.render)
-        run.say(f"wrote {rendered} render(s) to {args.render}")
+        run.say(f"wrote {rendered} measurement map(s) to {args.render}")
     for message in run.failed_outputs:
         run.say(f"  could not write the {message}")
     if run.failed_outputs:

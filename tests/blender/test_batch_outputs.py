@@ -132,7 +132,8 @@ def test_out_into_a_folder_that_is_a_file_is_refused(scan, tmp_path):
 
 def test_a_render_that_fails_late_gives_a_nonzero_exit_and_keeps_the_csv(scan, tmp_path):
     renders, out = tmp_path / "renders", tmp_path / "o.csv"
-    (renders / "scan.png").mkdir(parents=True)  # Cycles cannot write its picture there
+    # The map cannot write its contact sheet there.
+    (renders / "scan_map.png").mkdir(parents=True)
     result = batch(scan, *AT, "--out", out, "--render", renders, "--render-size", 16, 16,
                    "--render-samples", 1)  # fmt: skip
     assert result.returncode == 2, result.stderr

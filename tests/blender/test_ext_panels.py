@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import bpy
+import numpy as np
 import pytest
 from bpy_helpers import exact, wedge_object
 from conftest import ROOT
@@ -32,7 +33,11 @@ def measured(obj=None, at=OFFSET):
 
 
 def mark_stale(obj):
-    obj.location.x += 1.0
+    """Edit the mesh (a move would not do: measurements are in mesh coordinates)."""
+    co = np.empty(len(obj.data.vertices) * 3, dtype=np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    obj.data.vertices.foreach_set("co", co * np.float32(1.01))
+    obj.data.update()
     bpy.context.view_layer.update()
     bpy.ops.vg.repaint()
     assert all(item.stale for item in obj.vg.measurements)
