@@ -104,7 +104,9 @@ if __name__ == "__main__":
         status = 2
     sys.stdout.flush()
     sys.stderr.flush()
-    if IN_BLENDER:
-        # Blender would otherwise carry on and exit with 0; end the process with our status.
+    if "bpy" in sys.modules:
+        # Everything is written and closed. Blender would otherwise carry on and exit with 0, and
+        # the bpy 4.x modules fail at interpreter exit (4.2 can crash; 4.5 hangs for ever once a
+        # .blend was written or read: a static destructor waits on its file-closing thread).
         os._exit(status)
     sys.exit(status)
