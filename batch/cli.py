@@ -42,6 +42,17 @@ rule and checks:
   --sweep R0 R1 N also measures every point at N radii from R0 to R1: rows in
   <out>_sweep.csv, and a plot per point in the folder <out>_sweep/.
 
+edges:
+  --edge X1 Y1 Z1 X2 Y2 Z2 (repeatable) measures a whole break edge on every mesh given: the
+  path from the first point to the second is traced along the ridge (through the --via X Y Z
+  points that follow that --edge, in order) and measured at stations every --spacing D of arc
+  length, each with --radius, --lambda and --patch. Its stations are rows of --out (after the
+  points, with Edge #, Arc Length and Spacing), its summary a row of OUT_edges.csv, and its
+  profile plot OUT_<mesh>_edge<N>.png beside --out. --edges CSV re-measures the edges of an
+  edge summary file (an export's NAME_edges.csv): each row's Points with its own Spacing,
+  Radius, SegParam and Patch Mode, on the mesh its Mesh Name names. Edges run in this process
+  (not with --jobs or --shard).
+
 output:
   --out CSV gets one row per requested point, in input order, in the extension's export
   schema (MeshLab's 14 columns first). A row that cannot be measured has its message in the
@@ -68,8 +79,29 @@ examples:
   python vg_batch.py scans/ --points sites.csv --radius 2 --jobs 2 --out angles.csv
   python vg_batch.py scan.ply --points old_meshlab.csv --out replicated.csv --save-blend s.blend
   blender -b study.blend --python vg_batch.py -- --object Bone_12 --points p.csv --out a.csv
+  python vg_batch.py scan.ply --edge 0 0 0 10 2 0 --via 5 1.5 0.2 --spacing 1 --radius 2 \
+      --out edge.csv
   python vg_batch.py --demo
 """
+
+
+class EdgeAction(argparse.Action):
+    """``--edge X1 Y1 Z1 X2 Y2 Z2``: a new edge ``{"start", "end", "via"}`` on ``args.edge``."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        edges = list(getattr(namespace, self.dest) or [])
+        edges.append({"start": list(values[:3]), "end": list(values[3:]), "via": []})
+        setattr(namespace, self.dest, edges)
+
+
+class ViaAction(argparse.Action):
+    """``--via X Y Z``: a via point of the last ``--edge`` given before it."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        edges = getattr(namespace, "edge", None)
+        if not edges:
+            parser.error("--via X Y Z must follow the --edge it belongs to.")
+        edges[-1]["via"].append(list(values))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -78,6 +110,7 @@ def build_parser() -> argparse.ArgumentParser:
         usage="blender -b [file.blend] --python vg_batch.py -- ARGS\n"
         "       python vg_batch.py ARGS\n\n"
         "ARGS:  MESH... [--object NAME] (--at X Y Z ... | --points CSV) [--radius R]\n"
+        "       [--edge X1 Y1 Z1 X2 Y2 Z2 [--via X Y Z]... --spacing D]... [--edges CSV]\n"
         "       [--lambda L] [--patch euclidean|geodesic] [--rule oriented|paper]\n"
         "       [--stability] [--sweep R0 R1 N] --out CSV [--save-blend PATH]\n"
         "       [--render DIR] [--jobs N] [--shard K/N]\n"
@@ -111,6 +144,37 @@ def build_parser() -> argparse.ArgumentParser:
         help="a point to measure at (repeatable); it snaps to the nearest vertex",
     )
     where.add_argument("--points", metavar="CSV", help="a points or measurements CSV")
+    edges = parser.add_argument_group("edges (with or without points)")
+    edges.add_argument(
+        "--edge",
+        nargs=6,
+        type=float,
+        action=EdgeAction,
+        default=[],
+        metavar=("X1", "Y1", "Z1", "X2", "Y2", "Z2"),
+        help="a whole break edge from the first point to the second, traced along the ridge "
+        "(repeatable)",
+    )
+    edges.add_argument(
+        "--via",
+        nargs=3,
+        type=float,
+        action=ViaAction,
+        metavar=("X", "Y", "Z"),
+        help="a point the path of the preceding --edge passes through (repeatable, in order)",
+    )
+    edges.add_argument(
+        "--edges",
+        dest="edges_csv",
+        metavar="CSV",
+        help="an edge summary CSV (NAME_edges.csv): re-measure each of its edges on its mesh",
+    )
+    edges.add_argument(
+        "--spacing",
+        type=float,
+        metavar="D",
+        help="arc length between the stations of every --edge (needed with --edge)",
+    )
     how = parser.add_argument_group("measuring")
     how.add_argument(
         "--radius",
@@ -231,6 +295,8 @@ def check_args(args) -> None:
                 ("--object", args.object),
                 ("--at", args.at),
                 ("--points", args.points),
+                ("--edge", args.edge),
+                ("--edges", args.edges_csv),
                 ("--out", args.out),
                 ("--shard", args.shard),
             )
@@ -241,8 +307,19 @@ def check_args(args) -> None:
         return
     if args.out_dir:
         raise UsageError("--out-dir is for --demo; use --out CSV for a batch run.")
-    if bool(args.at) == bool(args.points):
-        raise UsageError("give the points to measure: --at X Y Z (repeatable) or --points CSV.")
+    if args.at and args.points:
+        raise UsageError(
+            "give the points to measure with --at X Y Z (repeatable) or --points CSV, not both."
+        )
+    if not (args.at or args.points or args.edge or args.edges_csv):
+        raise UsageError(
+            "give what to measure: --at X Y Z (repeatable), --points CSV, --edge "
+            "X1 Y1 Z1 X2 Y2 Z2 (repeatable) or --edges CSV."
+        )
+    if args.edge and (args.spacing is None or args.radius is None):
+        raise UsageError("--edge needs --spacing D and --radius R (in the mesh's units).")
+    if (args.edge or args.edges_csv) and (args.jobs > 1 or args.shard):
+        raise UsageError("edges are measured in this process: drop --jobs and --shard.")
     if not args.out:
         raise UsageError("--out CSV is required: the measurements CSV to write.")
     if args.jobs < 1:

@@ -15,6 +15,7 @@ from ..vg_addon import GoniometerError, Surface
 from ..vg_addon.formats import csvio, sweep_plot
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
+from .edges import failed_edge_row, measure_edges, spec_applies
 from .render import add_sides_material, render_object
 from .sources import MeshSource, import_mesh
 
@@ -25,6 +26,8 @@ class MeshResult:
 
     mesh: int
     rows: list = dataclasses.field(default_factory=list)  # [(task index, MeasurementRow)]
+    station_rows: list = dataclasses.field(default_factory=list)  # --edge stations (in-process)
+    edge_rows: list = dataclasses.field(default_factory=list)  # --edge summaries (in-process)
     object_name: str = ""
     bad_file: str = ""  # why the mesh file could not be read
     n_vertices: int = 0
@@ -93,6 +96,11 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         name = result.object_name or source.name
         result.rows = [(t.index, error_row(t, name, message, units)) for t in tasks]
         result.failed = len(tasks)
+        applying = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
+        result.station_rows = [
+            failed_edge_row(number, spec, name, message, units)
+            for number, spec in enumerate(applying, start=1)
+        ]
         return result
 
     start = time.perf_counter()
@@ -167,6 +175,11 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     if result.measured:
         measuring.repaint(obj, geometry=geometry)
         add_sides_material(obj, colors.ATTRIBUTE_NAME)
+
+    if options.get("edges"):
+        result.station_rows, result.edge_rows = measure_edges(
+            obj, source, options, units, safe_file_name(obj.name)
+        )
 
     if options.get("render"):
         path = Path(options["render"]) / f"{safe_file_name(obj.name)}.png"

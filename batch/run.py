@@ -20,8 +20,9 @@ from ..vg_addon.workflow import batchplan
 from . import extension
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
+from .edges import edge_specs, spec_applies
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
-from .outputs import check_outputs, make_folders
+from .outputs import check_outputs, make_folders, sweep_paths
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
 from .workers import run_workers
@@ -36,6 +37,8 @@ class Run:
         self.jobs = 1  # processes measuring at once
         self.rows: dict[int, object] = {}
         self.sweep_rows: list = []  # (task index, cells), --sweep
+        self.station_rows: list = []  # edge profiles' stations (and failed edges), after the rows
+        self.edge_rows: list = []  # one summary per edge profile, for OUT_edges.csv
         self.results: list[MeshResult] = []
         self.bad_files: list[str] = []
         self.lock = threading.Lock()
@@ -80,6 +83,8 @@ class Run:
             for index, row in result.rows:
                 self.rows[index] = row
             self.sweep_rows.extend(result.sweep_rows)
+            self.station_rows.extend(result.station_rows)
+            self.edge_rows.extend(result.edge_rows)
             if result.bad_file:
                 self.bad_files.append(result.bad_file)
             if result.render_error:
@@ -107,8 +112,10 @@ class Run:
 
     def write_csv(self) -> None:
         start = time.perf_counter()
-        rows = [self.rows[i] for i in sorted(self.rows)]
+        rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
         csvio.write_measurements_csv(self.args.out, rows)
+        if self.args.edge or self.args.edges_csv:
+            csvio.write_edges_csv(csvio.edges_path_for(self.args.out), self.edge_rows)
         self.last_write = time.perf_counter()
         self.write_seconds = self.last_write - start
 
@@ -132,6 +139,7 @@ class Run:
             drawn = sum(r.sweep_plots for r in self.results)
             self.say(f"wrote {csv_path} ({len(rows):,} sweep rows) and {drawn} plot(s) in {plots}")
         failed = [(i, row) for i, row in sorted(self.rows.items()) if row.error]
+        failed_edges = [row for row in self.station_rows if row.error]
         measured = len(self.rows) - len(failed)
         elapsed = time.perf_counter() - self.started
         load = sum(r.load_seconds for r in self.results)
@@ -155,17 +163,26 @@ class Run:
             self.say(f"  failed: {where} on {row.mesh_name!r}: {row.error}")
         if len(failed) > 10:
             self.say(f"  ... and {len(failed) - 10} more failed rows (see the error column)")
+        for edge in self.edge_rows:
+            self.say(
+                f"edge {edge.edge_number} on {edge.mesh_name!r}: {edge.n_stations} stations every "
+                f"{edge.spacing:g} over {edge.length:.4g}: mean {edge.mean:.2f}° ± {edge.std:.2f}° "
+                f"(min {edge.min:.2f}°, max {edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°"
+                + (
+                    f"; the path crosses no ridge at arc lengths {edge.flat_spans}"
+                    if edge.flat_spans
+                    else ""
+                )
+            )
+        for row in failed_edges:
+            self.say(f"  failed: edge {row.edge_number} on {row.mesh_name!r}: {row.error}")
+        if self.edge_rows or failed_edges:
+            self.say(f"wrote {csvio.edges_path_for(self.args.out)}")
         for message in self.bad_files:
             self.say(f"  unreadable mesh: {message}")
         where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
         self.say(f"wrote the CSV to {where}")
-        return batchplan.exit_code(len(failed), len(self.bad_files))
-
-
-def sweep_paths(out) -> tuple[Path, Path]:
-    """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``."""
-    out = Path(out).resolve()
-    return out.with_name(out.stem + "_sweep.csv"), out.with_name(out.stem + "_sweep")
+        return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
 
 
 def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
@@ -200,6 +217,8 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                 patch=args.patch,
                 rule=args.rule,
             )
+        elif not args.points:
+            tasks = []  # edges only
         else:
             try:
                 rows = csvio.read_replication_csv(args.points)
@@ -220,7 +239,14 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             tasks = bp.shard(tasks, k, n)
     except GoniometerError as error:
         raise UsageError(str(error)) from None
+    edges = edge_specs(args, sources)
     groups = {mesh: ts for mesh, ts in bp.by_mesh(tasks).items() if mesh >= 0}
+    if edges:  # every mesh with edges is measured, whether or not it has points
+        groups = {
+            mesh: groups.get(mesh, [])
+            for mesh in range(len(sources))
+            if mesh in groups or any(spec_applies(spec, sources[mesh]) for spec in edges)
+        }
     units = args.units or ("none" if not blend else None)
     set_units(bpy.context.scene, units)
     make_folders(args)
@@ -233,6 +259,8 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "stability": bool(args.stability),
         "sweep": list(args.sweep) if args.sweep else None,
         "sweep_plots": str(sweep_paths(args.out)[1]) if args.sweep else "",
+        "edges": edges,
+        "plots": str(Path(args.out).resolve().parent / Path(args.out).stem) if edges else "",
     }
     if args.sweep:
         sweep_paths(args.out)[1].mkdir(parents=True, exist_ok=True)

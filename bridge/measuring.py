@@ -26,17 +26,19 @@ def _sides_key(obj, geometry: Geometry, item) -> tuple:
     return (geometry.fingerprint, item.exact, item.patch, item.break_number, mapped)
 
 
-def _sides(obj, geometry: Geometry, m: Measurement, break_number: int) -> painting.Sides:
+def _sides(obj, geometry: Geometry, m: Measurement, item) -> painting.Sides:
     vertices, plus = colors.original_sides(obj, geometry, m)
+    if not records.plus_on_pair_side(item):  # an edge station, painted edge-wise
+        plus = ~plus
     return painting.Sides(
-        vertices.astype(np.int32), plus, int(break_number), m.center.copy(), float(m.radius)
+        vertices.astype(np.int32), plus, int(item.break_number), m.center.copy(), float(m.radius)
     )
 
 
 def keep_sides(obj, geometry: Geometry, item, m: Measurement) -> None:
     """Keep the sides of ``m``, just recorded as ``item``, so that painting it measures
     nothing again."""
-    painting.keep(_sides_key(obj, geometry, item), _sides(obj, geometry, m, item.break_number))
+    painting.keep(_sides_key(obj, geometry, item), _sides(obj, geometry, m, item))
 
 
 def _sides_of_item(obj, geometry: Geometry, item, key: tuple) -> painting.Sides:
@@ -44,7 +46,7 @@ def _sides_of_item(obj, geometry: Geometry, item, key: tuple) -> painting.Sides:
     if sides is None:
         # Deterministic: re-measuring at the exact stored inputs gives the sides it had.
         m = surface_for(obj, geometry).measure(**records.replay_args(item))
-        sides = _sides(obj, geometry, m, item.break_number)
+        sides = _sides(obj, geometry, m, item)
         painting.keep(key, sides)
     return sides
 
@@ -300,7 +302,9 @@ def replicate_rows(
         How to name the rows' origin in messages (e.g. the file name).
 
     Each new measurement keeps the row's break number when it has one (else the object's
-    current break) and takes the row's label or User Data as its note.
+    current break) and takes the row's label or User Data as its note. Rows that are stations
+    of an edge profile (an ``Edge #``) are grouped back into one edge per edge number, with a
+    new edge record whose summary is recomputed from the re-measured stations.
 
     Returns
     -------
@@ -350,12 +354,37 @@ def replicate_rows(
             f"'{obj.name}'; nothing was imported.\n" + bounded_list(failures, lines=True)
         )
     numbers = []
+    stations: dict[int, list] = {}
     for row, m in results:
+        station = None
+        if row.edge_number is not None:  # numbered and oriented when its edge is rebuilt
+            station = (0, row.arc_length or 0.0, row.spacing or 0.0, True)
         item = records.add_measurement(
-            obj, m, geometry.fingerprint, note=row.label or "", break_number=row.break_number
+            obj,
+            m,
+            geometry.fingerprint,
+            note=row.label or "",
+            break_number=row.break_number,
+            station=station,
         )
         keep_sides(obj, geometry, item, m)
         numbers.append(item.number)
+        if station is not None:
+            stations.setdefault(row.edge_number, []).append(
+                (item.number, m, station[1], station[2])
+            )
+    if stations:
+        from . import edges  # edges records through this module: imported when needed
+
+        by_number = {item.number: item for item in obj.vg.measurements}
+        edges.edges_from_stations(
+            obj,
+            {
+                key: [(by_number[entry[0]], *entry[1:]) for entry in group]
+                for key, group in stations.items()
+            },
+            geometry,
+        )
     records.continue_after_recorded_breaks(obj)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
     return numbers
@@ -384,6 +413,12 @@ def export_rows(objects, scene, *, depsgraph=None) -> list:
 def forget_paint() -> None:
     """Forget what was painted and the kept sides (file load, unregister)."""
     painting.forget()
+
+
+def export_edge_rows(objects, scene) -> list:
+    """Edge summary CSV rows of every edge profile of ``objects``, in list order."""
+    units = records.units_label(scene)
+    return [records.edge_row(obj, edge, units=units) for obj in objects for edge in obj.vg.edges]
 
 
 def clear_cache() -> None:

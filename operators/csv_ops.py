@@ -6,7 +6,7 @@ import bpy
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from ..bridge import measuring
+from ..bridge import edges, measuring
 from ..bridge.mesh_data import check_measurable
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
@@ -81,6 +81,9 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
                 objects, context.scene, depsgraph=context.evaluated_depsgraph_get()
             )
             csvio.write_measurements_csv(path, rows)
+            edge_rows = measuring.export_edge_rows(objects, context.scene)
+            if edge_rows:
+                csvio.write_edges_csv(csvio.edges_path_for(path), edge_rows)
         except OSError as error:
             self.report({"ERROR"}, f"Could not write {path}: {error}")
             return {"CANCELLED"}
@@ -89,7 +92,11 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
             return {"CANCELLED"}
         stale = sum(row.stale for row in rows)
         note = f" ({stale} stale)" if stale else ""
-        self.report({"INFO"}, f"Wrote {len(rows)} measurement(s){note} to {path}")
+        edges = f" and {len(edge_rows)} edge profile(s) to {csvio.edges_path_for(path)}"
+        self.report(
+            {"INFO"},
+            f"Wrote {len(rows)} measurement(s){note} to {path}" + (edges if edge_rows else ""),
+        )
         return {"FINISHED"}
 
 
@@ -97,7 +104,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
     """Re-measure every row of a measurement CSV on the active mesh (the paper's xyz method).
     Reads this extension's CSVs, the MeshLab plugin's, the earlier Blender add-on's and plain
     x, y, z point lists (rows without radius, λ or patch mode take the panel's; MeshLab and
-    earlier add-on rows are re-measured with the paper's rule they were taken with)"""
+    earlier add-on rows are re-measured with the paper's rule they were taken with); an edge
+    summary file (NAME_edges.csv) has each of its edges traced and measured again"""
 
     bl_idname = "vg.import_csv"
     bl_label = "Import Measurements CSV"
@@ -120,6 +128,21 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             if not path:
                 raise GoniometerError("No file name given: choose the CSV to import.")
             settings = context.scene.vg_settings
+            if csvio.is_edges_csv(path):  # an edge summary file: re-trace its edges
+                edge_numbers = edges.import_edges_csv(
+                    obj,
+                    path,
+                    ignore_mesh_names=self.ignore_mesh_names,
+                    lam=typed_value(settings.seg_param),
+                    patch=settings.patch,
+                    depsgraph=context.evaluated_depsgraph_get(),
+                )
+                self.report(
+                    {"INFO"},
+                    f"Re-measured {len(edge_numbers)} edge profile(s) of "
+                    f"{bpy.path.basename(path)} on '{obj.name}'",
+                )
+                return {"FINISHED"}
             numbers = measuring.import_csv(
                 obj,
                 path,

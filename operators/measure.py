@@ -194,7 +194,7 @@ class VG_OT_delete_measurement(bpy.types.Operator):
 
 
 class VG_OT_clear_measurements(bpy.types.Operator):
-    """Delete every measurement of the active object and paint it grey"""
+    """Delete every measurement and edge profile of the active object and paint it grey"""
 
     bl_idname = "vg.clear_measurements"
     bl_label = "Clear Measurements"
@@ -208,6 +208,13 @@ class VG_OT_clear_measurements(bpy.types.Operator):
         if obj is None:
             return {"CANCELLED"}
         count = len(obj.vg.measurements)
+        for edge in obj.vg.edges:  # the edge profiles go with their stations
+            image = bpy.data.images.get(edge.plot)
+            if image is not None:
+                bpy.data.images.remove(image)
+        obj.vg.edges.clear()
+        obj.vg.active_edge_index = 0
+        obj.vg.next_edge_number = 1
         obj.vg.measurements.clear()
         obj.vg.active_index = 0
         obj.vg.next_number = 1

@@ -120,6 +120,12 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
 
     rows = [
         ("Measurement", f"{item.number}, break {item.break_number}"),
+    ]
+    if item.edge_number:
+        rows.append(
+            ("Station of edge", f"{item.edge_number}, at arc length {number('arc_length')}")
+        )
+    rows += [
         ("Angle", number("angle", "°")),
         ("Edge", f"{item.convexity}: {ANGLE_MEANING.get(item.convexity, '')}"),
         ("Rule", item.rule),
@@ -168,6 +174,55 @@ def _text(layout, label, value):
     split.label(text=value)
 
 
+class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
+    """Whole edges: spacing, the Edge Profile button, the list, and the selected one's plot."""
+
+    bl_label = "Edge Profiles"
+    bl_parent_id = "VIEW3D_PT_vg_measure"
+
+    @classmethod
+    def poll(cls, context):
+        return _active_mesh(context) is not None
+
+    def draw(self, context):
+        obj = _active_mesh(context)
+        settings = context.scene.vg_settings
+        layout = self.layout
+        column = layout.column(align=True)
+        column.use_property_split = True
+        column.use_property_decorate = False
+        column.prop(settings, "edge_spacing")
+        column.prop(settings, "radius", text="Radius")
+        layout.operator("vg.measure_edge", text="Edge Profile", icon="CURVE_PATH")
+        layout.label(text="Click start, via points, end; Enter measures")
+        if not len(obj.vg.edges):
+            return
+        row = layout.row()
+        row.template_list("VG_UL_edges", "", obj.vg, "edges", obj.vg, "active_edge_index", rows=3)
+        row.column(align=True).operator("vg.delete_edge", text="", icon="REMOVE")
+        if not 0 <= obj.vg.active_edge_index < len(obj.vg.edges):
+            return
+        edge = obj.vg.edges[obj.vg.active_edge_index]
+        stations = [m for m in obj.vg.measurements if m.edge_number == edge.number]
+        if any(m.stale for m in stations) or len(stations) != edge.n_stations:
+            box = layout.box()
+            box.label(text="Stations stale or deleted since measured", icon="ERROR")
+            box.label(text="The summary is kept as it was recorded")
+        column = layout.column(align=True)
+        _text(column, "Edge", f"{edge.number}, break {edge.break_number}")
+        _text(
+            column, "Stations", f"{edge.n_stations} every {edge.spacing:.4g} over {edge.length:.4g}"
+        )
+        _text(column, "Mean ± SD", f"{edge.mean:.2f}° ± {edge.std:.2f}°")
+        _text(column, "Min, max", f"{edge.min:.2f}°, {edge.max:.2f}°")
+        _text(column, "Pooled", f"{edge.pooled_angle:.2f}°")
+        image = bpy.data.images.get(edge.plot)
+        if image is not None:  # the image's preview icon, made on demand by layout.icon
+            layout.template_icon(icon_value=layout.icon(image), scale=10.0)
+            layout.label(text="Angle (°) against arc length")
+        layout.prop(edge, "note")
+
+
 class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
     """Export the measurements, or replicate a CSV's measurements on this mesh."""
 
@@ -207,4 +262,10 @@ class VIEW3D_PT_vg_sweep(_GoniometerPanel, bpy.types.Panel):
         layout.operator("vg.radius_sweep", text="Sweep at 3D Cursor", icon="GRAPH")
 
 
-classes = (VIEW3D_PT_vg_measure, VIEW3D_PT_vg_selected, VIEW3D_PT_vg_csv, VIEW3D_PT_vg_sweep)
+classes = (
+    VIEW3D_PT_vg_measure,
+    VIEW3D_PT_vg_selected,
+    VIEW3D_PT_vg_edges,
+    VIEW3D_PT_vg_csv,
+    VIEW3D_PT_vg_sweep,
+)

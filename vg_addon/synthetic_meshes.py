@@ -1,6 +1,8 @@
 """Synthetic shapes with known angles, for tests and demonstrations.
 
 * :func:`wedge`: two planar faces meeting at a straight crease of a given interior angle.
+* :func:`varying_wedge`: a crease whose interior angle changes linearly along it.
+* :func:`lens`: two intersecting spheres, whose circular rim has one exact angle all round.
 * :func:`bone_fragment`: a watertight long-bone shaft fragment (hollow tube) with a transverse
   and an oblique fracture face, and :class:`BreakSite` points on its rims whose true angles
   follow exactly from the geometry.
@@ -28,6 +30,8 @@ __all__ = [
     "SynthMesh",
     "bevelled_wedge",
     "bone_fragment",
+    "lens",
+    "varying_wedge",
     "wedge",
 ]
 
@@ -301,6 +305,140 @@ def bevelled_wedge(
         side=side,
         normal_plus=normal_plus,
         normal_minus=normal_minus,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class EdgeShape:
+    """A synthetic mesh with one break edge whose exact angle is known everywhere along it.
+
+    Attributes
+    ----------
+    points, triangles : numpy.ndarray
+        Vertices (float64) and outward-wound triangles (int64).
+    edge : numpy.ndarray
+        Indices of the vertices on the break edge, in order along it.
+    angle_at : callable
+        ``angle_at(xyz)`` gives the exact interior angle (degrees) at points of the edge,
+        ``(k, 3) -> (k,)``.
+    """
+
+    points: np.ndarray
+    triangles: np.ndarray
+    edge: np.ndarray
+    angle_at: object
+
+
+def _grid_triangles(ids: np.ndarray, flip: bool) -> np.ndarray:
+    """Two triangles per cell of a grid of vertex ids, counter-clockwise unless ``flip``."""
+    a, b = ids[:-1, :-1].ravel(), ids[:-1, 1:].ravel()
+    c, d = ids[1:, 1:].ravel(), ids[1:, :-1].ravel()
+    tris = np.stack([np.column_stack([a, b, c]), np.column_stack([a, c, d])], axis=1).reshape(-1, 3)
+    return tris[:, [0, 2, 1]] if flip else tris
+
+
+def varying_wedge(
+    angle_start: float,
+    angle_end: float,
+    *,
+    half_width: float = 4.0,
+    depth: float = 1.0,
+    n: int = 30,
+) -> EdgeShape:
+    """A wedge whose interior angle changes linearly from ``angle_start`` at ``x = -half_width``
+    to ``angle_end`` at ``x = half_width``.
+
+    The crease is the x axis; the cross-section at ``x`` is an exact wedge of angle ``a(x)``:
+    its faces are the ruled surfaces ``(x, ±t sin(a(x)/2), -t cos(a(x)/2))``, ``0 <= t <= depth``,
+    so the local angle at crease point ``x`` is exactly ``a(x)``. ``n`` vertices per unit length.
+    """
+    for value in (angle_start, angle_end):
+        if not 0.0 < float(value) < 180.0:
+            raise GoniometerError(
+                f"The wedge angles must be between 0 and 180 degrees, got {value}."
+            )
+    half_width, depth = _positive("half_width", half_width), _positive("depth", depth)
+    n = _count("n", n, 2)
+    x = np.linspace(-half_width, half_width, round(2 * half_width * n) + 1)
+    t = np.linspace(0.0, depth, round(depth * n) + 1)[1:]
+    half = (
+        np.radians(angle_start + (angle_end - angle_start) * (x + half_width) / (2 * half_width))
+        / 2
+    )
+    nx, nt = x.size, t.size
+    points = [np.column_stack([x, np.zeros(nx), np.zeros(nx)])]
+    for sign in (1.0, -1.0):
+        grid_x = np.broadcast_to(x, (nt, nx))
+        grid_y = sign * t[:, None] * np.sin(half)[None, :]
+        grid_z = -t[:, None] * np.cos(half)[None, :]
+        points.append(np.column_stack([grid_x.ravel(), grid_y.ravel(), grid_z.ravel()]))
+    crease = np.arange(nx)
+    plus = np.vstack([crease, nx + np.arange(nt * nx).reshape(nt, nx)])
+    minus = np.vstack([crease, nx + nt * nx + np.arange(nt * nx).reshape(nt, nx)])
+    triangles = np.vstack([_grid_triangles(plus, False), _grid_triangles(minus, True)])
+
+    def angle_at(xyz):
+        xs = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)[:, 0]
+        return angle_start + (angle_end - angle_start) * (xs + half_width) / (2 * half_width)
+
+    return EdgeShape(np.vstack(points), triangles.astype(np.int64), crease, angle_at)
+
+
+def lens(angle_deg: float = 70.53, *, radius: float = 1.0, n_around: int = 240) -> EdgeShape:
+    """The lens where two spheres of equal ``radius`` overlap; its rim has interior angle
+    ``angle_deg`` all round.
+
+    The spheres' centres are ``(0, 0, ±d)``; the rim is the circle ``z = 0`` of radius
+    ``rho = sqrt(radius^2 - d^2)``. At the rim the outward normals are ``(rho, 0, ±d) / radius``,
+    so the interior angle is ``180° - arccos((rho^2 - d^2) / radius^2)``: ``d`` is chosen from it.
+    The caps are polar grids of ``n_around`` vertices per ring, the rim ring shared by both.
+    """
+    angle = float(angle_deg)
+    if not 0.0 < angle < 180.0:
+        raise GoniometerError(f"The lens angle must be between 0 and 180 degrees, got {angle}.")
+    radius = _positive("radius", radius)
+    n_around = _count("n_around", n_around, 8)
+    # (rho^2 - d^2) / R^2 = cos(180° - angle) and rho^2 + d^2 = R^2.
+    cosine = math.cos(math.radians(180.0 - angle))
+    d = radius * math.sqrt((1.0 - cosine) / 2.0)
+    rho = math.sqrt(radius**2 - d**2)
+    polar = math.acos(d / radius)  # the cap's half-angle seen from its sphere's centre
+    rings = max(2, round(polar * radius / (2 * math.pi * rho / n_around)))
+    phi = 2 * math.pi * np.arange(n_around) / n_around
+    theta = polar * np.arange(1, rings + 1) / rings  # ring 'rings' is the rim
+    sin_t, cos_t = np.sin(theta)[:, None], np.cos(theta)[:, None]
+    rim = np.column_stack([rho * np.cos(phi), rho * np.sin(phi), np.zeros(n_around)])
+    points, triangles = [rim], []
+    offset = n_around
+    for sign in (1.0, -1.0):  # the cap above z = 0 belongs to the sphere centred below
+        ring_xyz = np.stack(
+            [
+                radius * sin_t * np.cos(phi),
+                radius * sin_t * np.sin(phi),
+                sign * (radius * cos_t - d) + 0 * phi,
+            ],
+            axis=-1,
+        )[:-1]  # the last ring is the rim
+        pole = offset
+        points.append(np.array([[0.0, 0.0, sign * (radius - d)]]))
+        ids = np.vstack(
+            [
+                offset + 1 + np.arange((rings - 1) * n_around).reshape(rings - 1, n_around),
+                np.arange(n_around),
+            ]
+        )
+        points.append(ring_xyz.reshape(-1, 3))
+        offset += 1 + (rings - 1) * n_around
+        wrap = np.hstack([ids, ids[:, :1]])
+        cap = _grid_triangles(wrap, sign > 0)
+        fan = np.column_stack([np.full(n_around, pole), wrap[0, :-1], wrap[0, 1:]])
+        triangles += [cap, fan if sign > 0 else fan[:, [0, 2, 1]]]
+
+    def angle_at(xyz):
+        return np.full(np.asarray(xyz).reshape(-1, 3).shape[0], angle)
+
+    return EdgeShape(
+        np.vstack(points), np.vstack(triangles).astype(np.int64), np.arange(n_around), angle_at
     )
 
 

@@ -87,12 +87,19 @@ def png_size(path) -> tuple[int, int]:
     return struct.unpack(">II", data[16:24])
 
 
+def exact_in_float32(shape):
+    return dataclasses.replace(shape, points=shape.points.astype(np.float32).astype(np.float64))
+
+
 @pytest.fixture(scope="module")
 def meshes(tmp_path_factory) -> dict:
     """Wedges of 90° (as PLY, OBJ and STL) and 60° (PLY), with their true angles."""
     folder = tmp_path_factory.mktemp("meshes")
-    w90 = wedge(90.0, n=24, irregular=True, seed=3)
-    w60 = wedge(60.0, n=24, irregular=True, seed=4)
+    # Coordinates that float32 holds exactly: every format then gives Blender the same mesh,
+    # and the batch measures it as the extension does (float64 files that float32 would round
+    # are measured at the file's precision: test_batch_precision.py).
+    w90 = exact_in_float32(wedge(90.0, n=24, irregular=True, seed=3))
+    w60 = exact_in_float32(wedge(60.0, n=24, irregular=True, seed=4))
     return {
         "ply": meshio.write_ply(folder / "w90.ply", w90.points, w90.triangles),
         "obj": write_obj(folder / "w90_obj.obj", w90.points, w90.triangles),
@@ -145,15 +152,11 @@ def test_points_given_with_at_on_ply_obj_and_stl(meshes, tmp_path):
         assert abs(r.angle - 90.0) < 0.01
         assert (r.radius, r.seg_param, r.patch) == (RADIUS, 2.0, "euclidean")
         assert r.units == "BU" and r.extension_version and r.blender_version
-    # The same surface in three file formats. PLY and OBJ carry the float64 coordinates, which
-    # float32 would round: both are measured at the file's precision, bit for bit alike. STL
-    # holds float32 coordinates: measured as Blender stores them, so equal to rounding only.
-    assert {r.precision for r in rows} == {r.precision for r in results["obj"]} == {"float64"}
-    assert [r.angle for r in results["obj"]] == [r.angle for r in rows]
-    assert [r.normal_plus for r in results["obj"]] == [r.normal_plus for r in rows]
-    assert {r.precision for r in results["stl"]} == {"float32"}
-    for stl, ply in zip(results["stl"], rows, strict=True):
-        assert abs(stl.angle - ply.angle) < 1e-6
+    # The same surface in three file formats: the same float32 vertices and faces in Blender,
+    # hence the same numbers, bit for bit.
+    for kind in ("obj", "stl"):
+        assert [r.angle for r in results[kind]] == [r.angle for r in rows]
+        assert [r.normal_plus for r in results[kind]] == [r.normal_plus for r in rows]
 
 
 def test_points_csv_plain_our_export_and_meshlab_replicate_the_same_angles(meshes, tmp_path):
@@ -404,7 +407,8 @@ def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
     out = tmp_path / "demo"
     result = ok(batch("--demo", "--out-dir", out))
     sites = bone_fragment().sites
-    rows = rows_of(out / "measurements.csv")
+    every_row = rows_of(out / "measurements.csv")
+    rows = [row for row in every_row if row.edge_number is None]
     assert len(rows) == len(sites)
     for site, row in zip(sites, rows, strict=True):
         assert not row.error
@@ -416,6 +420,21 @@ def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
     assert "true angle" in result.stdout and f"Output folder: {out}" in result.stdout
     assert png_size(out / "bone_fragment.png") == (800, 600)
     assert (out / "bone_fragment.blend").stat().st_size > 0
+    # The whole oblique outer rim, profiled: every station within 1° of the exact local angle
+    # (180° minus the angle between the cylinder's and the oblique plane's outward normals).
+    stations = [row for row in every_row if row.edge_number == 1]
+    assert len(stations) > 15 and not any(row.error for row in stations)
+    tilt = np.radians(35.0)
+    plane = np.array([-np.tan(tilt), 0.0, 1.0]) / np.hypot(np.tan(tilt), 1.0)
+    for row in stations:
+        radial = np.array([row.x, row.y]) / np.hypot(row.x, row.y)
+        exact = 180.0 - np.degrees(np.arccos(radial @ plane[:2]))
+        assert abs(row.angle - exact) < 1.0, (row.arc_length, row.angle, exact)
+    (edge,) = csvio.read_edges_csv(out / "measurements_edges.csv")
+    assert edge.n_stations == len(stations)
+    assert edge.mean == pytest.approx(np.mean([row.angle for row in stations]), abs=1e-12)
+    assert "Whole edge" in result.stdout and f"pooled {edge.pooled_angle:.2f}°" in result.stdout
+    assert png_size(out / "measurements_bone_fragment_edge1.png") == (480, 240)
     assert meshio.read_mesh(out / "bone_fragment.ply").n_vertices > 200_000
 
 
@@ -483,3 +502,84 @@ def test_needs_validation_agrees_with_brute_force(vg):
                 flawed |= len(set(row)) < 3 or frozenset(row) in seen
                 seen.add(frozenset(row))
             assert sources.needs_validation(triangles) == flawed, triangles
+
+
+# --------------------------------------------------------------------------- whole edges
+
+
+def test_edges_write_station_rows_summaries_and_plots_equal_to_the_core(tmp_path):
+    from vg_addon import Surface
+    from vg_addon.synthetic_meshes import varying_wedge
+
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+    mesh = tmp_path / "ramp.ply"
+    meshio.write_ply(mesh, shape.points, shape.triangles)
+    out = tmp_path / "out.csv"
+    result = ok(
+        batch(
+            mesh, "--at", 0, 0, 0,
+            "--edge", -1.5, 0.01, 0, 1.5, 0, 0, "--via", 0, -0.01, 0,
+            "--edge", -1, 0, 0, 1, 0, 0,
+            "--spacing", 0.5, "--radius", 0.3, "--out", out,
+        )
+    )  # fmt: skip
+    rows = rows_of(out)
+    assert rows[0].edge_number is None and rows[0].number == 1
+    # Blender keeps coordinates in float32: the core measures the same numbers.
+    surface = Surface(meshio.read_mesh(mesh).points.astype(np.float32), shape.triangles)
+    edges = csvio.read_edges_csv(out.with_name("out_edges.csv"))
+    clicks = [[[-1.5, 0.01, 0], [0, -0.01, 0], [1.5, 0, 0]], [[-1, 0, 0], [1, 0, 0]]]
+    for number, (edge, points) in enumerate(zip(edges, clicks, strict=True), start=1):
+        profile = surface.measure_along(points, 0.5, 0.3)
+        stations = [row for row in rows if row.edge_number == number]
+        assert [r.angle for r in stations] == profile.angles.tolist()
+        assert [r.arc_length for r in stations] == profile.arc_lengths.tolist()
+        assert [(r.x, r.y, r.z) for r in stations] == [tuple(m.center) for m in profile.stations]
+        assert (edge.mean, edge.pooled_angle) == (profile.mean, profile.pooled_angle)
+        assert len({r.break_number for r in stations}) == 1
+        assert (
+            np.abs(
+                np.array([r.angle for r in stations])
+                - shape.angle_at(np.array([(r.x, r.y, r.z) for r in stations]))
+            ).max()
+            < 1.0
+        )
+        assert png_size(tmp_path / f"out_ramp_edge{number}.png") == (480, 240)
+        assert f"edge {number} on 'ramp'" in result.stderr + result.stdout
+
+    # The edge file replicates: --edges re-measures every edge with its own settings.
+    again = tmp_path / "again.csv"
+    ok(batch(mesh, "--edges", out.with_name("out_edges.csv"), "--out", again))
+    replayed = rows_of(again)
+    stations = [row for row in rows if row.edge_number is not None]
+    assert [(r.edge_number, r.angle, r.arc_length) for r in replayed] == [
+        (r.edge_number, r.angle, r.arc_length) for r in stations
+    ]
+    result = ok(batch(mesh, "--edges", out, "--out", again), 2)  # not an edge file
+    assert "missing the column(s)" in result.stderr
+
+
+def test_a_failed_edge_is_an_error_row_and_exit_1(tmp_path):
+    shape = wedge(90.0, n=20)
+    mesh = tmp_path / "w.ply"
+    meshio.write_ply(mesh, shape.points, shape.triangles)
+    out = tmp_path / "out.csv"
+    ok(batch(mesh, "--edge", -0.5, 0, 0, 0.5, 0, 0, "--spacing", 0.2, "--radius", 1e-4,
+             "--out", out), 1)  # fmt: skip
+    (row,) = rows_of(out)
+    assert row.edge_number == 1 and "edge not measured" in row.error and "radius" in row.error
+
+
+def test_edge_arguments_are_checked(tmp_path):
+    out = tmp_path / "out.csv"
+    result = ok(batch("x.ply", "--edge", 0, 0, 0, 1, 0, 0, "--radius", 1, "--out", out), 2)
+    assert "--edge needs --spacing D and --radius R" in result.stderr
+    result = ok(batch("x.ply", "--via", 0, 0, 0, "--out", out), 2)
+    assert "--via X Y Z must follow the --edge" in result.stderr
+    result = ok(
+        batch("x.ply", "--edge", 0, 0, 0, 1, 0, 0, "--spacing", 1, "--radius", 1, "--jobs", 2,
+              "--out", out), 2
+    )  # fmt: skip
+    assert "drop --jobs and --shard" in result.stderr
+    result = ok(batch("--demo", "--edge", 0, 0, 0, 1, 0, 0), 2)
+    assert "--demo takes no --edge" in result.stderr

@@ -36,6 +36,9 @@ OUR_EXTRA_COLUMNS = [
     "Requested y",
     "Requested z",
     "Snap Distance",
+    "Edge #",
+    "Arc Length",
+    "Spacing",
     "Units",
     "Precision",
     "Stale",
@@ -719,3 +722,72 @@ def test_an_export_written_before_the_precision_column_still_reads_back():
     )
     (read,) = csvio.read_measurements_csv(stream.getvalue())
     assert read.precision == "" and read.angle == good_row().angle
+
+
+# --------------------------------------------------------------------------- edge profiles
+
+
+def test_station_rows_carry_their_edge_and_replicate_with_it(tmp_path):
+    station = good_row(edge_number=3, arc_length=1.2345678901234567, spacing=0.5)
+    single = good_row(number=2)
+    path = tmp_path / "m.csv"
+    csvio.write_measurements_csv(path, [station, single])
+    back = csvio.read_measurements_csv(path)
+    assert (back[0].edge_number, back[0].arc_length, back[0].spacing) == (
+        3,
+        station.arc_length,
+        0.5,
+    )
+    assert (back[1].edge_number, back[1].arc_length, back[1].spacing) == (None, None, None)
+    rows = csvio.read_replication_csv(path)
+    assert (rows[0].edge_number, rows[0].arc_length, rows[0].spacing) == (
+        3,
+        station.arc_length,
+        0.5,
+    )
+    assert rows[1].edge_number is None
+
+
+def test_an_export_from_before_the_edge_columns_still_reads():
+    old_columns = [c for c in csvio.EXPORT_COLUMNS if c not in csvio.LATER_COLUMNS]
+    written = cells(csvio.format_measurements_csv([good_row()]))
+    keep = [i for i, c in enumerate(written[0]) if c in old_columns]
+    text = "\n".join(",".join(f'"{line[i]}"' for i in keep) for line in written) + "\n"
+    (row,) = csvio.read_measurements_csv(text)
+    assert row.angle == good_row().angle and row.edge_number is None
+
+
+def test_edge_summary_file_round_trips_beside_the_export(tmp_path):
+    points = [(0.1, -2.0, 1e-17), (3.0, 4.0, 5.123456789012345)]
+    edge = csvio.EdgeRow(
+        mesh_name="bone_12",
+        date="2024-05-01T14:03:11+02:00",
+        edge_number=1,
+        break_number=4,
+        colors="#E69F00/#0072B2",
+        n_stations=12,
+        spacing=0.5,
+        radius=3.0,
+        seg_param=2.0,
+        patch="euclidean",
+        length=5.75,
+        mean=101.25,
+        std=0.3,
+        min=100.5,
+        max=102.0,
+        pooled_angle=101.2,
+        pooled_fit=0.004,
+        points=csvio.format_points(points),
+        units="BU",
+    )
+    path = csvio.edges_path_for(tmp_path / "m.csv")
+    assert path.name == "m_edges.csv"
+    csvio.write_edges_csv(path, [edge])
+    (back,) = csvio.read_edges_csv(path)
+    assert back == edge
+    assert csvio.parse_points(back.points) == points
+    assert path.read_text().split("\n")[0] == ",".join(csvio.EDGE_COLUMNS)
+    assert csvio.is_edges_csv(path)
+    assert not csvio.is_edges_csv(csvio.format_measurements_csv([good_row()]))
+    with pytest.raises(GoniometerError, match="three numbers"):
+        csvio.parse_points("1 2")

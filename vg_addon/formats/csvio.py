@@ -86,6 +86,9 @@ _SCHEMA = (
     ("normal_minus", "vec3", ("Normal - x", "Normal - y", "Normal - z")),
     ("requested", "vec3", ("Requested x", "Requested y", "Requested z")),
     ("snap_distance", "float", ("Snap Distance",)),
+    ("edge_number", "int", ("Edge #",)),
+    ("arc_length", "float", ("Arc Length",)),
+    ("spacing", "float", ("Spacing",)),
     ("units", "text", ("Units",)),
     ("precision", "text", ("Precision",)),
     ("stale", "bool", ("Stale",)),
@@ -124,9 +127,39 @@ RULE_COLUMNS = (
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
 EXPORT_COLUMNS = tuple(column for _, _, columns in _SCHEMA for column in columns)
 
-# Columns added after the first release: an export written before them still reads back
-# (their cells read as empty).
-_LATER_COLUMNS = frozenset(["Precision", *RULE_COLUMNS])
+#: Columns added after the first exports: a file without them still reads (their cells empty).
+LATER_COLUMNS = ("Precision", *RULE_COLUMNS, "Edge #", "Arc Length", "Spacing")
+
+# The edge summary file: one row per measured edge profile (see EdgeRow).
+_EDGE_SCHEMA = (
+    ("mesh_name", "text", ("Mesh Name",)),
+    ("date", "text", ("Date",)),
+    ("edge_number", "int", ("Edge #",)),
+    ("break_number", "int", ("Break #",)),
+    ("colors", "text", ("Colors",)),
+    ("user_data", "text", ("User Data",)),
+    ("n_stations", "int", ("Stations",)),
+    ("spacing", "float", ("Spacing",)),
+    ("radius", "float", ("Radius",)),
+    ("seg_param", "float", ("SegParam",)),
+    ("patch", "text", ("Patch Mode",)),
+    ("length", "float", ("Length",)),
+    ("mean", "float", ("Mean Angle",)),
+    ("std", "float", ("SD Angle",)),
+    ("min", "float", ("Min Angle",)),
+    ("max", "float", ("Max Angle",)),
+    ("pooled_angle", "float", ("Pooled Angle",)),
+    ("pooled_fit", "float", ("Pooled Fit",)),
+    ("points", "text", ("Points",)),
+    ("flat_spans", "text", ("Flat Spans",)),
+    ("units", "text", ("Units",)),
+    ("extension_version", "text", ("Extension Version",)),
+    ("blender_version", "text", ("Blender Version",)),
+    ("error", "text", ("error",)),
+)
+
+#: Every column of an edge summary file.
+EDGE_COLUMNS = tuple(column for _, _, columns in _EDGE_SCHEMA for column in columns)
 
 #: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
 SOURCE_FORMATS = ("extension", "meshlab", "points")
@@ -207,6 +240,12 @@ class MeasurementRow:
         The centre that was asked for, before snapping.
     snap_distance : float or None
         Distance from ``requested`` to ``(x, y, z)``.
+    edge_number : int or None
+        The edge profile the row is a station of (``None`` for a single measurement).
+    arc_length : float or None
+        The station's arc length along its edge's traced path.
+    spacing : float or None
+        The edge's station spacing.
     units : str
         What one coordinate unit is.
     precision : str
@@ -256,6 +295,9 @@ class MeasurementRow:
     normal_minus: tuple[float, float, float] | None = None
     requested: tuple[float, float, float] | None = None
     snap_distance: float | None = None
+    edge_number: int | None = None
+    arc_length: float | None = None
+    spacing: float | None = None
     units: str = ""
     precision: str = ""
     stale: bool = False
@@ -273,6 +315,76 @@ class MeasurementRow:
     stability_runs: int | None = None
     stability_refused: int | None = None
     error: str = ""
+
+
+@dataclass
+class EdgeRow:
+    """One row of an edge summary file: what the stations of one edge profile say together.
+
+    Attributes
+    ----------
+    mesh_name, date, colors, user_data, units, extension_version, blender_version, error : str
+        As in :class:`MeasurementRow`.
+    edge_number, break_number : int or None
+        The edge (its stations carry the same ``Edge #``) and its break.
+    n_stations : int or None
+    spacing, radius, seg_param : float or None
+        The settings every station was measured with; ``patch`` the patch mode.
+    length : float or None
+        Arc length of the traced path.
+    mean, std, min, max : float or None
+        Of the stations' angles (degrees); ``std`` is the sample standard deviation.
+    pooled_angle, pooled_fit : float or None
+        One plane pair fitted to all stations' sides (the whole-edge angle), and its fit error.
+    points : str
+        The clicked points that define the path, ``"x y z; x y z; ..."`` (start, via, end).
+    flat_spans : str
+        Arc-length intervals where the path crossed no ridge, ``"a-b; ..."``; empty if none.
+    """
+
+    mesh_name: str = ""
+    date: str = ""
+    edge_number: int | None = None
+    break_number: int | None = None
+    colors: str = ""
+    user_data: str = ""
+    n_stations: int | None = None
+    spacing: float | None = None
+    radius: float | None = None
+    seg_param: float | None = None
+    patch: str = ""
+    length: float | None = None
+    mean: float | None = None
+    std: float | None = None
+    min: float | None = None
+    max: float | None = None
+    pooled_angle: float | None = None
+    pooled_fit: float | None = None
+    points: str = ""
+    flat_spans: str = ""
+    units: str = ""
+    extension_version: str = ""
+    blender_version: str = ""
+    error: str = ""
+
+
+def format_points(points) -> str:
+    """The ``Points`` cell of an edge row: ``"x y z; x y z"`` with every float in full."""
+    return "; ".join(" ".join(repr(float(v)) for v in point) for point in points)
+
+
+def parse_points(text: str) -> list[tuple[float, float, float]]:
+    """The points of a ``Points`` cell (see :func:`format_points`)."""
+    points = []
+    for part in text.split(";"):
+        values = part.split()
+        if len(values) != 3:
+            raise GoniometerError(f"A point of the edge must be three numbers x y z; got {part!r}.")
+        try:
+            points.append(tuple(float(v) for v in values))
+        except ValueError:
+            raise GoniometerError(f"A point of the edge is not three numbers: {part!r}.") from None
+    return points
 
 
 @dataclass(frozen=True)
@@ -301,6 +413,10 @@ class ReplicationRow:
         ``None`` when absent, blank or not a number.
     break_number : int or None
         The original ``Break #`` (1 to :data:`MAX_BREAK_NUMBER`); ``None`` when absent or blank.
+    edge_number : int or None
+        The ``Edge #`` of an edge profile's station; ``None`` for a single measurement.
+    arc_length, spacing : float or None
+        A station's ``Arc Length`` and its edge's ``Spacing`` (kept with the re-measured station).
     source_format : str
         ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
         columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
@@ -323,6 +439,9 @@ class ReplicationRow:
     label: str | None = None
     number: int | float | None = None
     break_number: int | None = None
+    edge_number: int | None = None
+    arc_length: float | None = None
+    spacing: float | None = None
     source_format: str = "points"
     rule: str | None = None
 
@@ -483,9 +602,9 @@ def _float_cell(value, index, row, column) -> str:
     return repr(number)
 
 
-def _row_cells(index: int, row: MeasurementRow) -> list[str]:
+def _row_cells(index: int, row, schema=_SCHEMA) -> list[str]:
     cells = []
-    for field, kind, columns in _SCHEMA:
+    for field, kind, columns in schema:
         value = getattr(row, field)
         if kind == "text":
             cells.append(_escape_text("" if value is None else str(value)))
@@ -549,6 +668,14 @@ def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
 
 #: The path that means standard output.
 STDOUT = "-"
+
+
+def format_edges_csv(rows: Iterable[EdgeRow]) -> str:
+    """The text of an edge summary file: the :data:`EDGE_COLUMNS` header and one line per edge,
+    written like :func:`format_measurements_csv`."""
+    lines = [_csv_line(EDGE_COLUMNS)]
+    lines.extend(_csv_line(_row_cells(index, row, _EDGE_SCHEMA)) for index, row in enumerate(rows))
+    return "".join(lines)
 
 
 def _replace_atomically(path: str, data: bytes) -> None:
@@ -718,6 +845,17 @@ def replace_atomically(path, data: bytes) -> None:
         _replace_atomically(os.path.realpath(path), data)
 
 
+def edges_path_for(path) -> Path:
+    """Where the edge summary of the export ``path`` goes: ``name_edges.csv`` beside it."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}_edges{path.suffix or '.csv'}")
+
+
+def write_edges_csv(path, rows: Iterable[EdgeRow]) -> None:
+    """Write an edge summary file to ``path``, atomically, like :func:`write_measurements_csv`."""
+    replace_atomically(path, format_edges_csv(rows).encode("utf-8"))
+
+
 # --------------------------------------------------------------------------- reading
 
 
@@ -835,6 +973,9 @@ _REPLICATION_ALIASES = {
     "number": ("measurement #", "measurement number", "measurement", "number"),
     "break_number": ("break #", "break number", "break"),
     "rule": ("rule",),
+    "edge_number": ("edge #", "edge number", "edge"),
+    "arc_length": ("arc length", "arc"),
+    "spacing": ("spacing",),
     "error": ("error",),
 }
 _REQUIRED = ("x", "y", "z")
@@ -952,7 +1093,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
             skipped += 1
             continue
         values: dict[str, float | None] = {}
-        for field in ("x", "y", "z", "radius", "lam"):
+        for field in ("x", "y", "z", "radius", "lam", "arc_length", "spacing"):
             raw = cell(field)
             if not raw.strip():
                 values[field] = None
@@ -994,6 +1135,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
             rule = "paper"  # MeshLab, the earlier add-on, exports from before the Rule column
         if problems:
             continue  # nothing is returned anyway; keep collecting
+        edge_number = _lenient_number(cell("edge_number"))
         rows.append(
             ReplicationRow(
                 row_number=number,
@@ -1007,6 +1149,9 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 label=_parse_optional_text(cell("label")),
                 number=_lenient_number(cell("number")),
                 break_number=break_number,
+                edge_number=edge_number if isinstance(edge_number, int) else None,
+                arc_length=values["arc_length"],
+                spacing=values["spacing"],
                 source_format=fmt,
                 rule=rule,
             )
@@ -1083,29 +1228,52 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     """Parse an export written by :func:`format_measurements_csv` back into rows.
 
     Every column of :data:`EXPORT_COLUMNS` must be present (in any order; names are matched
-    case-insensitively), except ``Precision`` (added later: empty when absent); text cells are kept as written (only the formula-guard apostrophe is
-    removed), numbers read back bit-identical. Blank lines are skipped.
+    case-insensitively), except the :data:`LATER_COLUMNS`, which older exports lack; text cells
+    are kept as written (only the formula-guard apostrophe is removed), numbers read back
+    bit-identical. Blank lines are skipped.
 
     Raises
     ------
     GoniometerError
         Listing every missing column and every cell that does not parse, with row numbers.
     """
+    return _parse_table(text, source, _SCHEMA, MeasurementRow, LATER_COLUMNS, "an export")
+
+
+def parse_edges_csv(text: str, source: str = "The CSV text") -> list[EdgeRow]:
+    """Parse an edge summary file written by :func:`format_edges_csv` back into rows."""
+    return _parse_table(text, source, _EDGE_SCHEMA, EdgeRow, (), "an edge summary file")
+
+
+def is_edges_csv(path_or_text) -> bool:
+    """Whether a CSV file (or text) is an edge summary file: its header has ``Edge #``,
+    ``Points`` and ``Spacing``."""
+    text, source = _load(path_or_text)
+    _, header = _header(_records(text, source), source)
+    names = {_normalise(name) for name in header}
+    return {"edge #", "points", "spacing"} <= names
+
+
+def read_edges_csv(path_or_text) -> list[EdgeRow]:
+    """Read an edge summary file (see :func:`parse_edges_csv`); arguments as for
+    :func:`read_replication_csv`."""
+    text, source = _load(path_or_text)
+    return parse_edges_csv(text, source)
+
+
+def _parse_table(text, source, schema, row_type, optional, what):
     records = _records(text, source)
     header_at, header = _header(records, source)
     problems: list[str] = []
-    aliases = {column: (_normalise(column),) for column in EXPORT_COLUMNS}
+    all_columns = [column for _, _, names in schema for column in names]
+    aliases = {column: (_normalise(column),) for column in all_columns}
     columns = _resolve_columns(header, aliases, problems)
-    missing = [
-        column
-        for column in EXPORT_COLUMNS
-        if column not in columns and column not in _LATER_COLUMNS
-    ]
+    missing = [c for c in all_columns if c not in columns and c not in optional]
     if missing:
         problems.insert(
             0,
             f"header: missing the column(s) {', '.join(missing)}; this reader needs a complete "
-            "export of this extension (use read_replication_csv for other files)",
+            f"{what} of this extension (use read_replication_csv for other files)",
         )
     if problems:
         raise _problems_error(source, problems)
@@ -1129,7 +1297,7 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
             return value
 
         values = {}
-        for field, kind, names in _SCHEMA:
+        for field, kind, names in schema:
             if kind == "text":
                 values[field] = _unescape_text(cell(names[0]))
             elif kind == "float":
@@ -1151,7 +1319,7 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
                     problems.append(
                         f"row {number}: {', '.join(names)} must be all filled or all empty"
                     )
-        rows.append(MeasurementRow(**values))
+        rows.append(row_type(**values))
     if problems:
         raise _problems_error(source, problems)
     return rows

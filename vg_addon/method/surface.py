@@ -98,6 +98,8 @@ class Surface:
             )
         if full_index is not None and self.valid_ids.size == n:
             self.index = full_index  # the same points: the normals' index serves the queries
+        elif self.valid_ids.size == n:
+            self.index = GridIndex(self.points)  # every vertex: no copy of the points needed
         else:
             self.index = GridIndex(self.points[self.valid_ids], ids=self.valid_ids)
         self.ranks = canonical_ranks(self.points, self.normals)
@@ -233,6 +235,20 @@ class Surface:
         if stability:
             measurement = replace(measurement, stability=estimate_stability(self, measurement))
         return measurement
+
+    def trace_edge(self, start, end, via=()):
+        """The break edge from ``start`` through ``via`` to ``end``, as an ``EdgePath`` of mesh
+        vertices following the ridge; see :func:`vg_addon.method.edge_profile.trace_edge`."""
+        from .edge_profile import trace_edge
+
+        return trace_edge(self, start, end, via)
+
+    def measure_along(self, path, spacing, radius, lam=2.0, patch="euclidean"):
+        """Measure stations every ``spacing`` along ``path``: an ``EdgeProfile``; see
+        :func:`vg_addon.method.edge_profile.measure_along`."""
+        from .edge_profile import measure_along
+
+        return measure_along(self, path, spacing, radius, lam, patch)
 
 
 def _too_far(center: np.ndarray, radius: float) -> GoniometerError:
