@@ -12,6 +12,7 @@ does it (see docs/BATCH.md).
 
 import importlib.util
 import os
+import shutil
 import sys
 import traceback
 from pathlib import Path
@@ -29,6 +30,13 @@ def script_argv() -> list[str]:
     if IN_BLENDER:
         return sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
     return sys.argv[1:]
+
+
+def remove_session_folder(folder: str) -> None:
+    """Remove Blender's per-process temporary folder (``bpy.app.tempdir``, ``blender_XXXXXX``)."""
+    path = Path(folder) if folder else None
+    if path is not None and path.name.startswith("blender_") and path.is_dir():
+        shutil.rmtree(path, ignore_errors=True)
 
 
 def import_bpy() -> None:
@@ -104,7 +112,11 @@ if __name__ == "__main__":
         status = 2
     sys.stdout.flush()
     sys.stderr.flush()
-    if IN_BLENDER:
-        # Blender would otherwise carry on and exit with 0; end the process with our status.
+    if "bpy" in sys.modules:
+        # Everything is written and closed. Blender would otherwise carry on and exit with 0, and
+        # the bpy 4.x modules fail at interpreter exit (4.2 can crash; 4.5 hangs for ever once a
+        # .blend was written or read: a static destructor waits on its file-closing thread). So
+        # end here, removing Blender's session folder as its own exit would.
+        remove_session_folder(sys.modules["bpy"].app.tempdir)
         os._exit(status)
     sys.exit(status)
