@@ -32,13 +32,6 @@ def script_argv() -> list[str]:
     return sys.argv[1:]
 
 
-def remove_session_folder(folder: str) -> None:
-    """Remove Blender's per-process temporary folder (``bpy.app.tempdir``, ``blender_XXXXXX``)."""
-    path = Path(folder) if folder else None
-    if path is not None and path.name.startswith("blender_") and path.is_dir():
-        shutil.rmtree(path, ignore_errors=True)
-
-
 def import_bpy() -> None:
     """Import the bpy module with what it prints while starting sent to stderr: bpy 5.x logs on
     stdout (e.g. "Using OCIO=..." where the OCIO variable is set, as it is in any child of a
@@ -91,9 +84,9 @@ def main() -> int:
         return 2
     import_bpy()
     package = extension_package()
-    if package.numpy_import_error is not None:
-        message = package.numpy_missing.message(str(package.numpy_import_error))
-        print(f"vg_batch: error: {message}", file=sys.stderr)
+    if package.numpy_import_error is not None:  # a distribution's Blender without NumPy
+        error = package.numpy_missing.message(str(package.numpy_import_error))
+        print(f"vg_batch: error: {error}", file=sys.stderr)
         return 2
     importlib.import_module(f"{package.__name__}.batch")
     try:
@@ -113,10 +106,11 @@ if __name__ == "__main__":
     sys.stdout.flush()
     sys.stderr.flush()
     if "bpy" in sys.modules:
-        # Everything is written and closed. Blender would otherwise carry on and exit with 0, and
-        # the bpy 4.x modules fail at interpreter exit (4.2 can crash; 4.5 hangs for ever once a
-        # .blend was written or read: a static destructor waits on its file-closing thread). So
-        # end here, removing Blender's session folder as its own exit would.
-        remove_session_folder(sys.modules["bpy"].app.tempdir)
+        # All written and closed. Blender would carry on and exit with 0, and the bpy 4.x modules
+        # fail at exit (4.2 can crash; 4.5 hangs once a .blend was read or written): end here,
+        # removing Blender's session folder (blender_XXXXXX) as its own exit would.
+        session = Path(sys.modules["bpy"].app.tempdir or ".").resolve()
+        if session.name.startswith("blender_"):
+            shutil.rmtree(session, ignore_errors=True)
         os._exit(status)
     sys.exit(status)

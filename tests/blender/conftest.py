@@ -99,8 +99,11 @@ def pytest_unconfigure(config):
     and pytest has printed its summary: 4.2 crashes (SIGSEGV), 4.5 hangs for ever (a static
     destructor waits on the thread that closes files read in the background, once a .blend has
     been read). End the process with pytest's own status instead; the 5.x lines exit cleanly and
-    are left alone."""
+    are left alone. Blender's session folder is removed first, as Blender's own exit would."""
     if bpy.app.version < (5, 0, 0):
+        session = Path(bpy.app.tempdir or ".").resolve()
+        if session.name.startswith("blender_"):
+            shutil.rmtree(session, ignore_errors=True)
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(_exit_status["code"])
