@@ -97,7 +97,7 @@ def test_labels_follow_the_object_and_skip_stale_ones(vg):
 def test_csv_import_reports_progress_and_can_be_cancelled(vg, tmp_path):
     obj = wedge_object(100.0)
     path = tmp_path / "points.csv"
-    rows = [f"{x!r},0.0,0.0" for x in np.linspace(-0.3, 0.3, 25)]
+    rows = [f"{x!r},0.0,0.0" for x in np.linspace(-0.3, 0.3, 25).tolist()]
     path.write_text("x,y,z\n" + "\n".join(rows) + "\n", encoding="utf-8")
     seen = []
 
