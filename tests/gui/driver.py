@@ -23,7 +23,7 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[2]
 ROOT_SCRIPT = REPO / "scripts" / "blender_root.sh"
-SCREEN = (1280, 800)
+SCREEN = (1280, 1440)  # tall: the whole sidebar shows without scrolling
 GUEST_REPO, GUEST_TMP = "/vg/repo", "/vg/tmp"
 END = "__vg_end__"
 
@@ -35,8 +35,20 @@ class RootShell:
         loop = f'while IFS= read -r line; do eval "$line" </dev/null 2>&1; echo "{END} $?"; done'
         self._log = open(log, "ab")  # noqa: SIM115 (closed in close())
         self.process = subprocess.Popen(
-            [str(ROOT_SCRIPT), suite, "--ro-bind", str(REPO), GUEST_REPO]
-            + ["--bind", str(host_tmp), GUEST_TMP, "--", "bash", "-c", loop],
+            [
+                str(ROOT_SCRIPT),
+                suite,
+                "--ro-bind",
+                str(REPO),
+                GUEST_REPO,
+                "--bind",
+                str(host_tmp),
+                GUEST_TMP,
+                "--",
+                "bash",
+                "-c",
+                loop,
+            ],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=self._log,
@@ -213,14 +225,16 @@ class GuiBlender:
         self.settle()
 
     def find_button(
-        self, region: str, copied: str, step: int = 8, key: str = "ctrl+c"
+        self, region: str, copied: str, step: int = 8, key: str = "ctrl+c", upward: bool = False
     ) -> tuple[float, float]:
         """Screen position of the button in ``region`` whose copy to the clipboard contains
         ``copied``: Ctrl+C over an operator button copies its Python call, Ctrl+Shift+C over a
-        property its data path. Buttons are hovered top to bottom, as a user would."""
+        property its data path. Buttons are hovered top to bottom (or bottom to top), as a user
+        would."""
         left, top, width, height = self.state()["regions"][region]
+        rows = range(top + 4, top + height - 4, step)
         for x in (left + width // 2, left + width // 4, left + 3 * width // 4):
-            for y in range(top + 4, top + height - 4, step):
+            for y in reversed(rows) if upward else rows:
                 self.move((x, y))
                 seq = self.state()["seq"]
                 self.xdotool("key", key)
@@ -233,8 +247,25 @@ class GuiBlender:
     def screenshot(self, name: str = "shot") -> np.ndarray:
         """The whole X screen as an (height, width, 3) uint8 array (also kept as ``name``.ppm)."""
         path = f"{GUEST_TMP}/{name}.ppm"
-        self.shell.check(f"xwd -root -silent -display {self.display} | xwdtopnm >{path} 2>/dev/null")
+        self.shell.check(
+            f"xwd -root -silent -display {self.display} | xwdtopnm >{path} 2>/dev/null"
+        )
         return read_ppm(self.tmp / f"{name}.ppm")
+
+    def wait_for_change(self, before: np.ndarray, box, timeout: float, what: str) -> None:
+        """Wait until a fifth of the pixels in ``box`` (left, top, width, height) differ from
+        the screenshot ``before`` (e.g. a popup opened there)."""
+        left, top, width, height = (int(v) for v in box)
+        deadline = time.monotonic() + timeout
+        while True:
+            now = self.screenshot("change")
+            cut = (slice(max(top, 0), top + height), slice(max(left, 0), left + width))
+            changed = np.any(now[cut] != before[cut], axis=2).mean()
+            if changed > 0.2:
+                return
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"waited {timeout} s for {what} to show")
+            time.sleep(0.2)
 
     def save_png(self, name: str, destination: Path, crop=None) -> None:
         """Screenshot as PNG (optionally cropped to ``(left, top, width, height)``)."""
