@@ -95,8 +95,11 @@ class RootShell:
 class GuiBlender:
     """One real Blender window under Xvfb, with the extension installed from ``zip_path``."""
 
-    def __init__(self, suite: str, zip_path: Path, points: dict[str, list[float]]):
+    def __init__(
+        self, suite: str, zip_path: Path, points: dict[str, list[float]], scene: str = "wedge"
+    ):
         self.suite = suite
+        self.scene = scene
         self.tmp = Path(tempfile.mkdtemp(prefix=f"vg-gui-{suite}-"))
         os.chmod(self.tmp, 0o755)
         shutil.copy(zip_path, self.tmp / "extension.zip")
@@ -140,7 +143,7 @@ class GuiBlender:
             time.sleep(0.1)
         self.display = ":" + display.read_text().strip()
         run(
-            f"DISPLAY={self.display} VG_GUI_STATE={GUEST_TMP}/state.json "
+            f"DISPLAY={self.display} VG_GUI_SCENE={self.scene} VG_GUI_STATE={GUEST_TMP}/state.json "
             f"VG_GUI_POINTS={GUEST_TMP}/points.json blender -p 0 0 {width} {height} "
             f"--python {GUEST_REPO}/tests/gui/harness_startup.py "
             f">{GUEST_TMP}/blender.log 2>&1 & echo $! >{GUEST_TMP}/blender.pid"

@@ -1,7 +1,8 @@
 """Startup script of the GUI Blender in the GUI test lane (``blender --python`` this file).
 
 It only sets the scene up and reports; the test drives Blender with real X events (xdotool).
-On its first timer tick it builds the wedge scene (:mod:`scene`); then, ten times a second, it
+On its first timer tick it builds the wedge scene (:mod:`scene`; ``VG_GUI_SCENE=fragment``: the
+bone fragment of the README's pictures, its break sites written to ``$VG_GUI_POINTS``); then, ten times a second, it
 writes what the test needs to read to ``$VG_GUI_STATE`` (JSON, replaced atomically): the
 measurements of every mesh object with their exact numbers, the active tool, the 3D view's
 regions in X screen pixels, the sidebar's tab, the 3D cursor, the running drag (found by
@@ -117,8 +118,14 @@ def _objects(scene_) -> dict:
 def _setup(window) -> None:
     area = _view3d(window)
     with bpy.context.temp_override(window=window, area=area):
-        scene.build_wedge()
-        scene.frame_view(area.spaces.active)
+        if os.environ.get("VG_GUI_SCENE") == "fragment":
+            _obj, sites = scene.build_fragment()
+            scene.frame_fragment(area.spaces.active)
+            with open(POINTS, "w") as handle:
+                json.dump({site.label: list(site.point) for site in sites}, handle)
+        else:
+            scene.build_wedge()
+            scene.frame_view(area.spaces.active)
 
 
 def _tick():

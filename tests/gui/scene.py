@@ -67,3 +67,53 @@ def frame_view(space) -> None:
     space.overlay.show_floor = False
     space.overlay.show_axis_x = False
     space.overlay.show_axis_y = False
+
+
+FRAGMENT_NAME = "BoneFragment"
+
+
+def build_fragment():
+    """A synthetic long-bone fragment (mm), for the README's pictures; return it and its sites."""
+    synthetic = importlib.import_module(EXTENSION + ".vg_addon.synthetic_meshes")
+    fragment = synthetic.bone_fragment(spacing=0.5, roughness=0.08, seed=2)
+    for obj in list(bpy.data.objects):
+        if obj.type == "MESH":
+            bpy.data.objects.remove(obj)
+    points = np.asarray(fragment.points, dtype=np.float32)
+    triangles = np.asarray(fragment.triangles, dtype=np.int32)
+    mesh = bpy.data.meshes.new(FRAGMENT_NAME)
+    mesh.vertices.add(points.shape[0])
+    mesh.vertices.foreach_set("co", points.ravel())
+    mesh.loops.add(triangles.size)
+    mesh.loops.foreach_set("vertex_index", triangles.ravel())
+    mesh.polygons.add(triangles.shape[0])
+    mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
+    mesh.update(calc_edges=True)
+    obj = bpy.data.objects.new(FRAGMENT_NAME, mesh)
+    scene = bpy.context.scene
+    scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    scene.unit_settings.system = "METRIC"
+    scene.unit_settings.scale_length = 0.001
+    scene.unit_settings.length_unit = "MILLIMETERS"
+    scene.vg_settings.radius = 1.5
+    bpy.context.view_layer.update()
+    return obj, fragment.sites
+
+
+def frame_fragment(space) -> None:
+    """Look at the fragment's oblique break from the side, the sidebar open."""
+    from mathutils import Euler, Vector
+
+    region_3d = space.region_3d
+    region_3d.view_perspective = "PERSP"
+    region_3d.view_rotation = Euler((math.radians(62.0), 0.0, math.radians(35.0))).to_quaternion()
+    region_3d.view_location = Vector((0.0, 0.0, 45.0))
+    region_3d.view_distance = 70.0
+    space.clip_end = 10000.0
+    space.show_region_ui = True
+    space.show_region_toolbar = True
+    space.overlay.show_floor = False
+    space.overlay.show_axis_x = False
+    space.overlay.show_axis_y = False

@@ -1,0 +1,99 @@
+"""Make the README's pictures from the real Blender GUI (Debian's Blender in a provisioned root).
+
+    .venv/bin/python scripts/make_pictures.py            # -> docs/images/*.png
+    .venv/bin/python scripts/make_pictures.py --suite trixie --out-dir /tmp/pictures
+
+Needs root (scripts/provision_blender.sh makes the root on first use). The extension zip is built,
+installed into a fresh Blender user folder, and a synthetic bone fragment (mm) is measured by
+real drags with the Goniometer tool at three of its break sites, as a user would, driven with
+xdotool (the same driver as the GUI test lane, tests/gui/driver.py). Pictures:
+
+- ``panel.png``: the Goniometer sidebar with the list of measurements and the selected one;
+- ``drag.png``: a drag in progress (the patch, its sides and the radius circle);
+- ``sides.png``: the coloured sides of the measured patches on the fragment.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "gui"))
+
+from driver import GuiBlender  # noqa: E402 (the GUI lane's driver)
+
+SITES = ("oblique/outer acute", "oblique/outer right", "transverse/outer")
+TOOL = "vg.measure_drag_tool"
+
+
+def build_zip(out: Path) -> Path:
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "scripts" / "build_extension.py"), "--output-dir", str(out)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    return Path(result.stdout.strip().splitlines()[-1])
+
+
+def drag(gui: GuiBlender, site: str, pixels: float, *, hold: bool = False) -> None:
+    """Press on a break site, drag ``pixels`` to the right; release unless ``hold``."""
+    start = gui.state()["points"][site]
+    gui.move(start)
+    gui.xdotool("mousedown", "1")
+    gui.wait_for(lambda s: s["drag"] is not None, 30, "the drag to start")
+    for i in range(1, 7):
+        gui.move((start[0] + pixels * i / 6, start[1]))
+    gui.settle(5)
+    if not hold:
+        gui.xdotool("mouseup", "1")
+        gui.wait_for(lambda s: s["drag"] is None, 30, "the drag to end")
+        gui.settle(5)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--suite", default="unstable", help="Debian suite of the Blender root")
+    parser.add_argument("--out-dir", type=Path, default=ROOT / "docs" / "images")
+    args = parser.parse_args(argv)
+    subprocess.run(["bash", str(ROOT / "scripts" / "provision_blender.sh"), args.suite], check=True)
+    args.out_dir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as dist:
+        gui = GuiBlender(args.suite, build_zip(Path(dist)), {}, scene="fragment")
+    try:
+        state = gui.state()
+        left, top, width, height = state["regions"]["UI"]
+        gui.click((left + width // 2, top + height - 15))  # the swallowed first click
+        for y in range(top + 10, top + height - 10, 12):  # the Goniometer tab
+            gui.click((left + width - 12, y))
+            if gui.state()["sidebar_category"] == "Goniometer":
+                break
+        gui.click(gui.find_button("TOOLS", TOOL, step=12))
+        gui.wait_for(lambda s: s["tool"] == TOOL, 10, "the Goniometer tool")
+        gui.settle(5)
+        for site in SITES[:2]:
+            drag(gui, site, 22)
+        drag(gui, SITES[2], 22, hold=True)
+        window = gui.state()["regions"]["WINDOW"]
+        view = (window[0], window[1], left - window[0], min(window[3], 900))
+        gui.save_png("drag", args.out_dir / "drag.png", crop=view)
+        gui.xdotool("mouseup", "1")
+        gui.wait_for(lambda s: s["drag"] is None, 30, "the drag to end")
+        gui.settle(10)
+        gui.save_png("sides", args.out_dir / "sides.png", crop=view)
+        gui.save_png("panel", args.out_dir / "panel.png", crop=(left, top, width, 900))
+        items = gui.state()["objects"]["BoneFragment"]["measurements"]
+        for item in items:
+            print(f"measurement {item['number']}: {item['exact']['angle']:.4f}°")
+    finally:
+        gui.close()
+    print(f"pictures in {args.out_dir}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
