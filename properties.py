@@ -27,6 +27,21 @@ from bpy.types import PropertyGroup
 
 from .vg_addon import palette
 
+RULE_ITEMS = (
+    (
+        "oriented",
+        "Oriented",
+        "Sign the position term by the edge's convexity: right on concave edges and on meshes "
+        "wound inward (the default)",
+    ),
+    (
+        "paper",
+        "Paper",
+        "Algorithm 1 as printed (MeshLab plugin, earlier add-on): misreads concave edges; for "
+        "replicating old measurements",
+    ),
+)
+
 PATCH_ITEMS = (
     ("euclidean", "Euclidean", "All vertices within the radius (a ball around the centre)"),
     ("geodesic", "Geodesic", "Vertices reachable along mesh edges within the radius"),
@@ -34,10 +49,15 @@ PATCH_ITEMS = (
 
 
 def exact_numbers(item) -> dict:
-    """The float64 numbers of a measurement, decoded from its ``exact`` JSON text.
+    """The float64 numbers of a measurement (or an edge profile), decoded from its ``exact`` JSON
+    text.
 
     Keys: ``angle``, ``fit``, ``fit_plus``, ``fit_minus``, ``radius``, ``lam``, ``snap_distance``
-    (floats) and ``center``, ``requested``, ``normal_plus``, ``normal_minus`` (lists of 3 floats).
+    (floats) and ``center``, ``requested``, ``normal_plus``, ``normal_minus`` (lists of 3 floats);
+    since the oriented rule also ``rule``, ``convexity``, ``correlation`` and ``stability`` (a
+    dict of its parts, or None). Records without ``rule`` were measured with the paper's rule.
+    A station of an edge profile adds ``arc_length``, ``spacing`` and ``plus_left``. Keys of
+    an edge profile: see ``bridge.edges``.
     """
     try:
         return json.loads(item.exact) if item.exact else {}
@@ -56,6 +76,28 @@ def _vector(key):
     def get(self):
         value = exact_numbers(self).get(key)
         return tuple(value) if value else (0.0, 0.0, 0.0)
+
+    return get
+
+
+def _text_value(key, default=""):
+    def get(self):
+        return str(exact_numbers(self).get(key, default))
+
+    return get
+
+
+def _stability_text(self):
+    parts = exact_numbers(self).get("stability")
+    if not parts:
+        return "not computed"
+    spread = parts["spread"]
+    return f"± {spread:.2f}°" if spread < 0.1 else f"± {spread:.1f}°"
+
+
+def _stability_part(key):
+    def get(self):
+        return float((exact_numbers(self).get("stability") or {}).get(key, 0.0))
 
     return get
 
@@ -98,8 +140,18 @@ class VG_Measurement(PropertyGroup):
         description="The mesh or its transform changed since this measurement was taken: its "
         "numbers are kept as recorded, but it is no longer painted",
     )
+    edge_number: IntProperty(
+        name="Edge #", description="The edge profile this measurement is a station of (0: none)"
+    )
 
     # Read-only views of the exact numbers, for drawing.
+    arc_length: FloatProperty(
+        name="Arc length",
+        description="Where this station lies along its edge's traced path",
+        subtype="DISTANCE",
+        unit="LENGTH",
+        get=_number("arc_length"),
+    )
     angle: FloatProperty(name="Angle (°)", get=_number("angle"), precision=2)
     fit_error: FloatProperty(name="Fit error", get=_number("fit"), precision=6)
     fit_error_plus: FloatProperty(name="Fit error +", get=_number("fit_plus"), precision=6)
@@ -121,6 +173,29 @@ class VG_Measurement(PropertyGroup):
     normal_minus: FloatVectorProperty(
         name="Plane normal −", size=3, subtype="DIRECTION", get=_vector("normal_minus")
     )
+    rule: StringProperty(
+        name="Rule",
+        description="How the projection was signed: oriented, or paper (Algorithm 1 as printed); "
+        "measurements recorded before the rule existed used the paper's",
+        get=_text_value("rule", "paper"),
+    )
+    convexity: StringProperty(
+        name="Edge",
+        description="Convex, concave (the angle is then the open wedge's, 360° minus the solid's "
+        "interior angle) or unclear, relative to the mesh's normals",
+        get=_text_value("convexity", "not recorded"),
+    )
+    stability_text: StringProperty(
+        name="Stability",
+        description="The largest change of the angle with the centre moved two edge lengths, "
+        "the radius ±10%, λ from 1 to 3, and the vertices resampled",
+        get=_stability_text,
+    )
+    stability_center: FloatProperty(name="Centre moved (°)", get=_stability_part("center"))
+    stability_radius: FloatProperty(name="Radius ±10% (°)", get=_stability_part("radius"))
+    stability_lam: FloatProperty(name="λ 1 to 3 (°)", get=_stability_part("lam"))
+    stability_bootstrap: FloatProperty(name="Bootstrap 95% (°)", get=_stability_part("bootstrap"))
+    stability_orientation: FloatProperty(name="Other sign (°)", get=_stability_part("orientation"))
     color_plus: FloatVectorProperty(
         name="Colour +", size=3, subtype="COLOR_GAMMA", get=_side_colour(0)
     )
@@ -129,16 +204,66 @@ class VG_Measurement(PropertyGroup):
     )
 
 
+class VG_EdgeProfile(PropertyGroup):
+    """One whole break edge measured at stations: its clicks, path and summary.
+
+    The stations are the object's measurements with this ``number`` as their ``edge_number``.
+    """
+
+    number: IntProperty(name="Edge #", description="Edge profile number on this object")
+    break_number: IntProperty(name="Break #", description="Break the stations belong to")
+    exact: StringProperty(
+        name="Exact numbers",
+        description="The profile's float64 numbers (JSON): clicks, path, settings and summary",
+        options={"HIDDEN"},
+    )
+    patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="How the patches were chosen")
+    n_stations: IntProperty(name="Stations", description="Number of stations measured")
+    date: StringProperty(name="Date", description="When the edge was measured (ISO 8601)")
+    note: StringProperty(name="Note", description="Free text, exported with the edge")
+    colors: StringProperty(name="Colours", description="Palette colours of the + and − sides")
+    fingerprint: StringProperty(
+        name="Geometry fingerprint",
+        description="Hash of the evaluated mesh and transform the edge was measured on",
+        options={"HIDDEN"},
+    )
+    plot: StringProperty(
+        name="Plot image", description="Name of the image holding the profile's plot"
+    )
+
+    # Read-only views of the exact numbers, for drawing.
+    mean: FloatProperty(name="Mean (°)", get=_number("mean"), precision=2)
+    std: FloatProperty(name="SD (°)", get=_number("std"), precision=2)
+    min: FloatProperty(name="Min (°)", get=_number("min"), precision=2)
+    max: FloatProperty(name="Max (°)", get=_number("max"), precision=2)
+    pooled_angle: FloatProperty(name="Pooled (°)", get=_number("pooled_angle"), precision=2)
+    length: FloatProperty(name="Length", subtype="DISTANCE", unit="LENGTH", get=_number("length"))
+    spacing: FloatProperty(
+        name="Spacing", subtype="DISTANCE", unit="LENGTH", get=_number("spacing")
+    )
+    radius: FloatProperty(name="Radius", subtype="DISTANCE", unit="LENGTH", get=_number("radius"))
+
+
 class VG_ObjectData(PropertyGroup):
     """An object's measurements (``Object.vg``)."""
 
     measurements: CollectionProperty(type=VG_Measurement)
     active_index: IntProperty(name="Active measurement", default=0, min=0)
+    edges: CollectionProperty(type=VG_EdgeProfile)
+    active_edge_index: IntProperty(name="Active edge", default=0, min=0)
+    next_edge_number: IntProperty(
+        name="Next edge #", description="Number the next edge profile gets", default=1, min=1
+    )
     break_number: IntProperty(
         name="Break #", description="Break the next measurement belongs to", default=1, min=1
     )
     next_number: IntProperty(
         name="Next measurement #", description="Number the next measurement gets", default=1, min=1
+    )
+    winding: StringProperty(
+        name="Winding",
+        description="Which way the measured mesh's faces are wound: outward, inward, mixed, or "
+        "open (cannot be decided); set when it is measured",
     )
 
 
@@ -167,6 +292,48 @@ class VG_SceneSettings(PropertyGroup):
     patch: EnumProperty(
         name="Patch", items=PATCH_ITEMS, default="euclidean", description="How the patch is chosen"
     )
+    rule: EnumProperty(
+        name="Rule",
+        items=RULE_ITEMS,
+        default="oriented",
+        description="How the projection is signed",
+    )
+    stability: BoolProperty(
+        name="Stability",
+        description="Also compute the stability figure (± degrees) of each measurement",
+        default=True,
+    )
+    sweep_start: FloatProperty(
+        name="From",
+        description="First radius of a radius sweep, scene units",
+        default=0.5,
+        min=0.0,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    edge_spacing: FloatProperty(
+        name="Spacing",
+        description="Arc length between the stations of an edge profile, in scene units",
+        default=1.0,
+        min=0.0,
+        soft_min=1e-4,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    sweep_stop: FloatProperty(
+        name="To",
+        description="Last radius of a radius sweep, scene units",
+        default=2.0,
+        min=0.0,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    sweep_count: IntProperty(
+        name="Radii", description="Number of radii in a sweep", default=16, min=2, max=1000
+    )
     export_all_objects: BoolProperty(
         name="All objects",
         description="Export the measurements of every object in the scene, not only the active one",
@@ -179,7 +346,7 @@ class VG_SceneSettings(PropertyGroup):
     )
 
 
-classes = (VG_Measurement, VG_ObjectData, VG_SceneSettings)
+classes = (VG_Measurement, VG_EdgeProfile, VG_ObjectData, VG_SceneSettings)
 
 
 def register_properties() -> None:

@@ -9,32 +9,12 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-from ..vg_addon import palette
 from .mesh_data import read_positions, world_points
 
 ATTRIBUTE_NAME = "VG Sides"
 
 # Rows of candidate vertices matched against a patch at once (bounds the temporary matrix).
 _CHUNK = 1024
-
-
-def side_colours(n: int, sides) -> np.ndarray:
-    """RGBA (scene-linear float32, shape (n, 4)) of ``n`` vertices painted by ``sides``.
-
-    Parameters
-    ----------
-    n : int
-        Number of vertices.
-    sides : iterable of (indices, labels, break_number)
-        Per measurement, in painting order (later over earlier): the patch vertex indices, their
-        side labels (True = "+") and the break number that picks the colour pair.
-    """
-    colours = np.tile(palette.neutral_linear(), (n, 1))
-    for indices, labels, break_number in sides:
-        plus, minus = palette.pair_linear(break_number)
-        colours[indices[labels]] = plus
-        colours[indices[~labels]] = minus
-    return colours.astype(np.float32)
 
 
 def _nearest_labels(candidates: np.ndarray, patch_points: np.ndarray, labels: np.ndarray):
@@ -48,52 +28,59 @@ def _nearest_labels(candidates: np.ndarray, patch_points: np.ndarray, labels: np
     return out
 
 
-def original_vertex_colours(obj, geometry, measured) -> np.ndarray:
-    """RGBA for the vertices of ``obj.data`` (the original mesh) from measurements on the
-    evaluated mesh.
-
-    Parameters
-    ----------
-    obj : bpy.types.Object
-    geometry : mesh_data.Geometry
-        The evaluated geometry the measurements were taken on.
-    measured : list of (Measurement, break_number)
-        In painting order.
+def original_sides(obj, geometry, m) -> tuple[np.ndarray, np.ndarray]:
+    """The vertices of ``obj.data`` (the original mesh) that measurement ``m``, taken on the
+    evaluated ``geometry``, paints, and their side labels (True = "+").
 
     Notes
     -----
     When the modifiers keep the vertex count (no modifier, or deforming ones), evaluated vertex
     ``i`` is original vertex ``i``. When they change it (e.g. Subdivision Surface), each original
-    vertex within a patch's radius takes the side of the nearest evaluated patch vertex: the
+    vertex within the patch's radius takes the side of the nearest evaluated patch vertex: the
     colours then approximate the measured sides, the numbers are unaffected.
     """
     mesh = obj.data
-    n_original = len(mesh.vertices)
-    n_evaluated = geometry.points.shape[0]
-    if n_original == n_evaluated:
-        return side_colours(n_original, [(m.indices, m.labels, b) for m, b in measured])
+    if len(mesh.vertices) == geometry.points.shape[0]:
+        return m.indices, m.labels
     original = world_points(read_positions(mesh), geometry.matrix)
-    sides = []
-    for m, break_number in measured:
-        offsets = original - m.center
-        inside = np.flatnonzero(np.einsum("ij,ij->i", offsets, offsets) <= m.radius * m.radius)
-        labels = _nearest_labels(original[inside], geometry.points[m.indices], m.labels)
-        sides.append((inside, labels, break_number))
-    return side_colours(n_original, sides)
+    offsets = original - m.center
+    inside = np.flatnonzero(np.einsum("ij,ij->i", offsets, offsets) <= m.radius * m.radius)
+    return inside, _nearest_labels(original[inside], geometry.points[m.indices], m.labels)
+
+
+def _ours(mesh):
+    """The "VG Sides" attribute if it is a point FLOAT_COLOR one, else None.
+
+    Looked up among the colour attributes: looking up ``mesh.attributes`` makes every attribute
+    array of the mesh writable, which copies them all after an undo step (milliseconds at 1M).
+    """
+    attribute = mesh.color_attributes.get(ATTRIBUTE_NAME)
+    if (
+        attribute is not None
+        and attribute.domain == "POINT"
+        and attribute.data_type == "FLOAT_COLOR"
+    ):
+        return attribute
+    return None
 
 
 def write_attribute(mesh, rgba: np.ndarray) -> None:
     """Write ``rgba`` into the mesh's "VG Sides" point colour attribute and make it active."""
-    existing = mesh.attributes.get(ATTRIBUTE_NAME)
-    if existing is not None and (existing.domain != "POINT" or existing.data_type != "FLOAT_COLOR"):
-        mesh.attributes.remove(existing)
-        existing = None
-    if existing is None:
-        mesh.color_attributes.new(ATTRIBUTE_NAME, "FLOAT_COLOR", "POINT")
-    attribute = mesh.color_attributes[ATTRIBUTE_NAME]
+    attribute = _ours(mesh)
+    if attribute is None:
+        existing = mesh.attributes.get(ATTRIBUTE_NAME)  # of another domain or type
+        if existing is not None:
+            mesh.attributes.remove(existing)
+        attribute = mesh.color_attributes.new(ATTRIBUTE_NAME, "FLOAT_COLOR", "POINT")
     attribute.data.foreach_set("color", np.ascontiguousarray(rgba, dtype=np.float32).ravel())
-    mesh.color_attributes.active_color = mesh.color_attributes[ATTRIBUTE_NAME]
+    if mesh.color_attributes.active_color_name != ATTRIBUTE_NAME:
+        mesh.color_attributes.active_color = attribute
     mesh.update()
+
+
+def has_attribute(mesh) -> bool:
+    """Whether the mesh has the "VG Sides" attribute as :func:`write_attribute` makes it."""
+    return _ours(mesh) is not None
 
 
 def read_attribute(mesh) -> np.ndarray | None:

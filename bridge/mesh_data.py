@@ -1,11 +1,18 @@
 """From a Blender mesh object to NumPy: world-space float64 vertices, triangles, a fingerprint,
-and a cache of prepared :class:`~vg_addon.Surface` objects."""
+and caches of each object's evaluated geometry and prepared :class:`~vg_addon.Surface`.
+
+The geometry of an object is read once and kept until a depsgraph update says its geometry or
+transform changed (``watch`` calls :func:`invalidate`), so a click reads nothing it already has.
+After an invalidation the mesh is read again; if its fingerprint is unchanged (e.g. an undo
+step that only restored colours) the kept geometry and Surface are reused.
+"""
 
 from __future__ import annotations
 
 import hashlib
 from collections import OrderedDict
 from dataclasses import dataclass
+from functools import cached_property
 
 import bpy
 import numpy as np
@@ -14,7 +21,20 @@ from ..vg_addon import GoniometerError, Surface
 
 # A Surface of a million-vertex scan takes a few hundred MB; keep only the latest few.
 _CACHE_SIZE = 3
-_surfaces: OrderedDict[tuple[str, str], Surface] = OrderedDict()
+_surfaces: OrderedDict[str, Surface] = OrderedDict()
+
+FINGERPRINT_PREFIX = "2-"
+"""Fingerprints written since issue 10 (SHA-256 of positions, face corners and face offsets);
+older files hold 32-hex-digit BLAKE2b fingerprints of positions and loop triangles."""
+
+# Per object (its session_uid): the geometry last read, and whether it is still current, i.e. no
+# depsgraph update has touched the object's geometry or transform since. Only trusted while the
+# watcher's depsgraph handler is registered (``watching``).
+_geometries: OrderedDict[int, Geometry] = OrderedDict()
+_current: set[int] = set()
+_watching = False
+# Meshes whose colours we are writing: the depsgraph update that follows is ours, not an edit.
+_own_writes: set[int] = set()
 
 
 @dataclass(frozen=True)
@@ -42,6 +62,22 @@ class Geometry:
     points: np.ndarray
     fingerprint: str
 
+    @cached_property
+    def legacy_fingerprint(self) -> str:
+        """The fingerprint files written before issue 10 hold for this geometry (BLAKE2b of the
+        positions, the loop triangles as Blender gives them and the matrix)."""
+        triangles = self.triangles
+        if np.linalg.det(self.matrix[:3, :3]) < 0.0:
+            triangles = triangles[:, ::-1]
+        return legacy_fingerprint(self.local, triangles.astype(np.int32), self.matrix)
+
+    def matches(self, stored: str) -> bool:
+        """Whether a measurement recorded with fingerprint ``stored`` was taken on this
+        geometry (a fingerprint of either format)."""
+        if stored == self.fingerprint:
+            return True
+        return is_legacy(stored) and stored == self.legacy_fingerprint
+
 
 def world_points(local: np.ndarray, matrix: np.ndarray) -> np.ndarray:
     """World-space float64 coordinates ``M[:3, :3] @ p + M[:3, 3]`` of object-space points.
@@ -53,14 +89,49 @@ def world_points(local: np.ndarray, matrix: np.ndarray) -> np.ndarray:
     return local @ matrix[:3, :3].T + matrix[:3, 3]
 
 
-def fingerprint(local: np.ndarray, triangles: np.ndarray, matrix: np.ndarray) -> str:
-    """A short hex digest of the geometry a measurement depends on."""
-    digest = hashlib.blake2b(digest_size=16)
-    for array in (local, triangles, matrix):
+def _digest(digest, arrays) -> None:
+    for array in arrays:
         array = np.ascontiguousarray(array)
         digest.update(f"{array.dtype.str}{array.shape}".encode())
-        digest.update(memoryview(array).cast("B"))
+        # Flat, because a memoryview with a zero in its shape (no faces) cannot be cast; the
+        # bytes, and so the digests of recorded measurements, are the same.
+        digest.update(memoryview(array.reshape(-1)).cast("B"))
+
+
+def fingerprint(local: np.ndarray, corners: np.ndarray, faces, matrix: np.ndarray) -> str:
+    """A short digest of the geometry a measurement depends on.
+
+    Parameters
+    ----------
+    local : ndarray of float32, shape (n, 3)
+        Vertex positions, object space.
+    corners : ndarray of int32
+        The vertex of each face corner, face after face.
+    faces : ndarray of int32 or None
+        Each face's first corner; None when every face is a triangle (implied by ``corners``).
+    matrix : ndarray of float64, shape (4, 4)
+
+    Notes
+    -----
+    Blender's triangulation of quads and n-gons follows from these, so they fix the triangles
+    without reading them. SHA-256: the fastest hashlib digest on CPUs with SHA instructions
+    (about 2.5x BLAKE2b here), and collisions are out of reach.
+    """
+    digest = hashlib.sha256()
+    _digest(digest, (local, corners, np.zeros(0, np.int32) if faces is None else faces, matrix))
+    return FINGERPRINT_PREFIX + digest.hexdigest()[:32]
+
+
+def legacy_fingerprint(local: np.ndarray, triangles: np.ndarray, matrix: np.ndarray) -> str:
+    """The fingerprint of files written before issue 10 (kept to migrate them)."""
+    digest = hashlib.blake2b(digest_size=16)
+    _digest(digest, (local, triangles, matrix))
     return digest.hexdigest()
+
+
+def is_legacy(stored: str) -> bool:
+    """Whether ``stored`` is a fingerprint of the format before issue 10."""
+    return len(stored) == 32 and not stored.startswith(FINGERPRINT_PREFIX)
 
 
 def read_positions(mesh) -> np.ndarray:
@@ -74,17 +145,34 @@ def read_positions(mesh) -> np.ndarray:
     return co.reshape(-1, 3)
 
 
-def read_triangles(mesh) -> np.ndarray:
-    """Triangles of a bpy mesh, int32 ``(m, 3)``: its own triangles, or Blender's
-    triangulation of its quads and n-gons (``loop_triangles``)."""
+def read_corners(mesh) -> tuple[np.ndarray, np.ndarray | None]:
+    """The vertex of every face corner (int32), and each face's first corner (int32), or None
+    when every face is a triangle."""
     n_faces, n_corners = len(mesh.polygons), len(mesh.loops)
+    corners = np.empty(n_corners, dtype=np.int32)
     corner_vert = mesh.attributes.get(".corner_vert")
-    if n_corners == 3 * n_faces and corner_vert is not None and corner_vert.data_type == "INT":
-        # Every face is a triangle (each has at least 3 corners), and faces own consecutive
-        # corners in order: the corner-vertex array is the triangle list. Reading it is ~100x
-        # faster than reading loop_triangles, and gives the same triangles.
-        corners = np.empty(n_corners, dtype=np.int32)
+    if corner_vert is not None and corner_vert.data_type == "INT":
         corner_vert.data.foreach_get("value", corners)
+    else:
+        mesh.loops.foreach_get("vertex_index", corners)
+    if n_corners == 3 * n_faces:
+        return corners, None  # every face has at least 3 corners, so exactly 3
+    faces = np.empty(n_faces, dtype=np.int32)
+    mesh.polygons.foreach_get("loop_start", faces)
+    return corners, faces
+
+
+def read_triangles(mesh, corners: np.ndarray | None = None, faces=0) -> np.ndarray:
+    """Triangles of a bpy mesh, int32 ``(m, 3)``: its own triangles, or Blender's
+    triangulation of its quads and n-gons (``loop_triangles``).
+
+    ``corners`` and ``faces``: what :func:`read_corners` gave, if already read.
+    """
+    if corners is None:
+        corners, faces = read_corners(mesh)
+    if faces is None:
+        # Every face is a triangle, and faces own consecutive corners in order: the corner
+        # array is the triangle list. ~100x faster than reading loop_triangles, same triangles.
         return corners.reshape(-1, 3)
     mesh.calc_loop_triangles()
     triangles = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
@@ -119,6 +207,9 @@ def check_measurable(obj) -> None:
 def evaluated_geometry(obj, depsgraph=None) -> Geometry:
     """The evaluated mesh of ``obj`` (modifiers applied) in world space.
 
+    Read once and kept until a depsgraph update touches the object's geometry or transform
+    (see the module notes); the kept geometry is returned without reading the mesh.
+
     Parameters
     ----------
     obj : bpy.types.Object
@@ -129,16 +220,40 @@ def evaluated_geometry(obj, depsgraph=None) -> Geometry:
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
     obj_eval = obj.evaluated_get(depsgraph)
+    key = obj.session_uid
+    kept = _geometries.get(key)
+    if (
+        _watching
+        and kept is not None
+        and key in _current
+        # Belt and braces: a transform is 16 numbers to compare.
+        and np.array_equal(np.array(obj_eval.matrix_world, dtype=np.float64), kept.matrix)
+    ):
+        _geometries.move_to_end(key)
+        return kept
+    geometry = _read_geometry(obj, obj_eval, kept)
+    _geometries[key] = geometry
+    _geometries.move_to_end(key)
+    _current.add(key)
+    while len(_geometries) > _CACHE_SIZE:
+        _current.discard(_geometries.popitem(last=False)[0])
+    return geometry
+
+
+def _read_geometry(obj, obj_eval, kept: Geometry | None) -> Geometry:
     mesh = obj_eval.to_mesh()
     try:
         local = read_positions(mesh)
-        triangles = read_triangles(mesh)
+        if local.shape[0] == 0:
+            raise GoniometerError(f"'{obj.name}' has no vertices: there is nothing to measure.")
+        corners, faces = read_corners(mesh)
+        matrix = np.array(obj_eval.matrix_world, dtype=np.float64)
+        key = fingerprint(local, corners, faces, matrix)
+        if kept is not None and kept.fingerprint == key:
+            return kept
+        triangles = read_triangles(mesh, corners, faces)
     finally:
         obj_eval.to_mesh_clear()
-    if local.shape[0] == 0:
-        raise GoniometerError(f"'{obj.name}' has no vertices: there is nothing to measure.")
-    matrix = np.array(obj_eval.matrix_world, dtype=np.float64)
-    key = fingerprint(local, triangles, matrix)
     triangles = triangles.astype(np.int64)
     if np.linalg.det(matrix[:3, :3]) < 0.0:
         # A mirroring transform turns the faces inside out in world space: flip the winding so
@@ -153,9 +268,68 @@ def evaluated_geometry(obj, depsgraph=None) -> Geometry:
     return Geometry(local, triangles, matrix, points, key)
 
 
+def invalidate(obj) -> None:
+    """Note that ``obj``'s geometry or transform may have changed: the next
+    :func:`evaluated_geometry` reads it again."""
+    _current.discard(obj.session_uid)
+
+
+def invalidate_all() -> None:
+    """Note that any object may have changed (file load, undo)."""
+    _current.clear()
+
+
+def is_own_write(obj) -> bool:
+    """Whether a depsgraph update of ``obj`` comes from our own colour write (see
+    :func:`own_write`), not from a change of its geometry."""
+    data = obj.data
+    return data is not None and data.session_uid in _own_writes
+
+
+class own_write:
+    """Write into ``mesh``'s attributes with ``with own_write(mesh): ...``.
+
+    Pending depsgraph updates are evaluated first (they are the user's and invalidate as they
+    should); then, after the body, the depsgraph is evaluated again while the updates of
+    ``mesh`` are marked as ours, so writing colours neither drops the kept geometry nor wakes
+    the staleness watcher.
+    """
+
+    def __init__(self, mesh, depsgraph=None):
+        self.mesh = mesh
+        self.depsgraph = depsgraph
+
+    def _evaluate(self) -> None:
+        if self.depsgraph is not None:
+            self.depsgraph.update()
+        else:
+            bpy.context.evaluated_depsgraph_get()
+
+    def __enter__(self):
+        self._evaluate()
+        return self.mesh
+
+    def __exit__(self, *exc) -> None:
+        key = self.mesh.session_uid
+        _own_writes.add(key)
+        try:
+            self._evaluate()
+        finally:
+            _own_writes.discard(key)
+
+
+def set_watching(watching: bool) -> None:
+    """Whether depsgraph updates reach :func:`invalidate` (the watcher is registered); kept
+    geometry is only trusted while they do."""
+    global _watching
+    _watching = watching
+    _current.clear()
+
+
 def surface_for(obj, geometry: Geometry) -> Surface:
-    """The prepared :class:`Surface` of ``geometry``, built once per object and fingerprint."""
-    key = (obj.name, geometry.fingerprint)
+    """The prepared :class:`Surface` of ``geometry``, built once per fingerprint (objects with
+    equal geometry and transform share it)."""
+    key = geometry.fingerprint
     surface = _surfaces.get(key)
     if surface is None:
         triangles = geometry.triangles if geometry.triangles.size else None
@@ -169,5 +343,8 @@ def surface_for(obj, geometry: Geometry) -> Surface:
 
 
 def clear_cache() -> None:
-    """Forget every cached Surface (frees memory; called on unregister and file load)."""
+    """Forget every cached Surface and geometry (frees memory; called on unregister and file
+    load)."""
     _surfaces.clear()
+    _geometries.clear()
+    _current.clear()

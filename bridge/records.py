@@ -32,7 +32,22 @@ def _floats(vector) -> list[float]:
     return [float(v) for v in np.asarray(vector, dtype=np.float64)]
 
 
-def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_number=None):
+def _stability(stability) -> dict:
+    return {
+        "spread": float(stability.spread),
+        "center": float(stability.center),
+        "radius": float(stability.radius),
+        "lam": float(stability.lam),
+        "bootstrap": float(stability.bootstrap),
+        "orientation": float(stability.orientation),
+        "runs": int(stability.n_runs),
+        "refused": int(stability.n_failed),
+    }
+
+
+def add_measurement(
+    obj, m, geometry_fingerprint: str, *, note: str = "", break_number=None, station=None
+):
     """Append measurement ``m`` to ``obj.vg.measurements`` and make it the active one.
 
     Parameters
@@ -45,19 +60,41 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
     note : str
         Free text (the CSV's User Data).
     break_number : int, optional
-        Default: the object's current break.
+        1 to ``csvio.MAX_BREAK_NUMBER``. Default: the object's current break.
+    station : tuple (edge_number, arc_length, spacing, plus_left), optional
+        For a station of an edge profile: its edge, its arc length along the path, the edge's
+        spacing, and whether its "+" side lies left of the path (if not, its colours are
+        recorded the other way round, so that one side of the whole edge has one colour).
 
     Returns
     -------
     The new ``VG_Measurement`` item (valid until the collection changes again).
+
+    Raises
+    ------
+    GoniometerError
+        A break number out of range; nothing is added then.
     """
     data = obj.vg
-    item = data.measurements.add()
-    item.number = data.next_number
-    data.next_number += 1
-    item.break_number = data.break_number if break_number is None else int(break_number)
-    item.exact = json.dumps(
+    break_number = data.break_number if break_number is None else break_number
+    if not (
+        isinstance(break_number, int | np.integer) and 1 <= break_number <= csvio.MAX_BREAK_NUMBER
+    ):
+        raise GoniometerError(
+            f"Break # must be a whole number from 1 to {csvio.MAX_BREAK_NUMBER}; got "
+            f"{break_number!r}. Nothing was recorded."
+        )
+    numbers = {}
+    if station is not None:
+        _, arc_length, spacing, plus_left = station
+        numbers = {
+            "arc_length": float(arc_length),
+            "spacing": float(spacing),
+            "plus_left": bool(plus_left),
+        }
+    exact = json.dumps(
         {
+            **numbers,
             "angle": float(m.angle),
             "fit": float(m.fit_error),
             "fit_plus": float(m.fit_error_plus),
@@ -69,19 +106,58 @@ def add_measurement(obj, m, geometry_fingerprint: str, *, note: str = "", break_
             "requested": _floats(m.requested_center),
             "normal_plus": _floats(m.normal_plus),
             "normal_minus": _floats(m.normal_minus),
+            "rule": m.rule,
+            "convexity": m.convexity,
+            "correlation": float(m.correlation),
+            "stability": None if m.stability is None else _stability(m.stability),
         }
     )
+    # Everything that can fail is done: from here on the item is written whole.
+    item = data.measurements.add()
+    item.number = data.next_number
+    data.next_number += 1
+    item.break_number = int(break_number)
+    item.exact = exact
+    if station is not None:
+        item.edge_number = int(station[0])
     item.patch = m.patch
     item.n_vertices = int(m.n_vertices)
     item.n_plus = int(m.n_plus)
     item.n_minus = int(m.n_minus)
     item.date = csvio.now_iso()
     item.note = note
-    item.colors = "/".join(palette.pair_names(item.break_number))
+    item.colors = "/".join(station_colours(item.break_number, numbers.get("plus_left", True)))
     item.fingerprint = geometry_fingerprint
     item.stale = False
     data.active_index = len(data.measurements) - 1
     return item
+
+
+def next_free_break(obj) -> int:
+    """The break after the current one: one past the highest the object uses or is on."""
+    data = obj.vg
+    return max([data.break_number, *(item.break_number for item in data.measurements)]) + 1
+
+
+def continue_after_recorded_breaks(obj) -> None:
+    """After recording many measurements at once (a batch run, a CSV import): make the current
+    break one past the highest in use, so the next click starts a break of its own instead of
+    joining a recorded one (and its colours)."""
+    data = obj.vg
+    highest = max((item.break_number for item in data.measurements), default=0)
+    data.break_number = max(data.break_number, highest + 1)
+
+
+def station_colours(break_number: int, plus_left: bool = True) -> tuple[str, str]:
+    """The "+"/"-" colour names of a measurement: its break's pair, swapped for an edge station
+    whose "+" side lies right of the path (the edge's left side always gets the first colour)."""
+    names = tuple(palette.pair_names(break_number))
+    return names if plus_left else names[::-1]
+
+
+def plus_on_pair_side(item) -> bool:
+    """Whether ``item``'s "+" side is painted in the first colour of its break's pair."""
+    return bool(exact_numbers(item).get("plus_left", True))
 
 
 _KEYS = (
@@ -112,13 +188,15 @@ def numbers_of(item) -> dict:
 
 
 def replay_args(item) -> dict:
-    """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``."""
+    """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``,
+    ``rule`` (``"paper"`` for records from before the rule existed: that is what they used)."""
     numbers = numbers_of(item)
     return {
         "center": np.array(numbers["center"], dtype=np.float64),
         "radius": float(numbers["radius"]),
         "lam": float(numbers["lam"]),
         "patch": item.patch,
+        "rule": numbers.get("rule", "paper"),
     }
 
 
@@ -130,10 +208,15 @@ def units_label(scene) -> str:
     return f"BU (1 BU = {units.scale_length:g} m, shown in {units.length_unit.lower()})"
 
 
-def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
-    """The CSV row of ``item``, measured on ``obj``."""
+def to_row(
+    obj, item, *, stale: bool, units: str, precision: str = "float32"
+) -> csvio.MeasurementRow:
+    """The CSV row of ``item``, measured on ``obj``; ``precision``: the coordinates measured
+    (``"float32"``, Blender's mesh, unless a batch run measured a file's float64 ones)."""
     numbers = numbers_of(item)
     x, y, z = numbers["center"]
+    stability = numbers.get("stability") or {}
+    station = item.edge_number > 0
     return csvio.MeasurementRow(
         mesh_name=obj.name,
         date=item.date,
@@ -158,9 +241,125 @@ def to_row(obj, item, *, stale: bool, units: str) -> csvio.MeasurementRow:
         normal_minus=tuple(numbers["normal_minus"]),
         requested=tuple(numbers["requested"]),
         snap_distance=numbers["snap_distance"],
+        edge_number=item.edge_number if station else None,
+        arc_length=numbers.get("arc_length") if station else None,
+        spacing=numbers.get("spacing") if station else None,
         units=units,
+        precision=precision,
         stale=stale,
         extension_version=extension_version(),
         blender_version=bpy.app.version_string,
+        rule=numbers.get("rule", "paper"),
+        convexity=numbers.get("convexity", ""),
+        correlation=numbers.get("correlation"),
+        stability=stability.get("spread"),
+        stability_center=stability.get("center"),
+        stability_radius=stability.get("radius"),
+        stability_lam=stability.get("lam"),
+        stability_bootstrap=stability.get("bootstrap"),
+        stability_orientation=stability.get("orientation"),
+        stability_runs=stability.get("runs"),
+        stability_refused=stability.get("refused"),
         error="",
+    )
+
+
+def add_edge(obj, profile, clicks, geometry_fingerprint: str, *, break_number: int, note: str = ""):
+    """Append an edge profile record to ``obj.vg.edges`` and make it the active one.
+
+    Parameters
+    ----------
+    profile : vg_addon.EdgeProfile
+        The measured profile.
+    clicks : sequence of array_like, shape (3,)
+        The points that define the path (start, via points, end).
+    break_number : int
+        The break its stations were recorded in.
+
+    Returns
+    -------
+    The new ``VG_EdgeProfile`` item; its ``number`` is the stations' ``edge_number``.
+    """
+    numbers = edge_numbers(profile, clicks)
+    return _add_edge(
+        obj, numbers, profile.patch, geometry_fingerprint, break_number=break_number, note=note
+    )
+
+
+def edge_numbers(profile, clicks) -> dict:
+    """The exact numbers an edge record stores (JSON-ready) for ``profile`` and its ``clicks``."""
+    figures = profile.figures
+    spans = profile.path.flat_spans
+    return {
+        "points": [_floats(p) for p in clicks],
+        "path": [_floats(p) for p in profile.path.points],
+        "spacing": float(profile.spacing),
+        "radius": float(profile.radius),
+        "lam": float(profile.lam),
+        "length": float(profile.path.length),
+        "arc_lengths": [float(a) for a in profile.arc_lengths],
+        "angles": [float(a) for a in profile.angles],
+        "mean": float(figures.mean),
+        "std": float(figures.std),
+        "min": float(figures.min),
+        "max": float(figures.max),
+        "pooled_angle": float(figures.pooled_angle),
+        "pooled_fit": float(figures.pooled_fit_error),
+        "flat_spans": [[float(a), float(b)] for a, b in spans],
+    }
+
+
+def _add_edge(obj, numbers: dict, patch: str, fingerprint: str, *, break_number: int, note=""):
+    data = obj.vg
+    edge = data.edges.add()
+    edge.number = data.next_edge_number
+    data.next_edge_number += 1
+    edge.break_number = int(break_number)
+    edge.exact = json.dumps(numbers)
+    edge.patch = patch
+    edge.n_stations = len(numbers["angles"])
+    edge.date = csvio.now_iso()
+    edge.note = note
+    edge.colors = "/".join(palette.pair_names(edge.break_number))
+    edge.fingerprint = fingerprint
+    data.active_edge_index = len(data.edges) - 1
+    return edge
+
+
+def add_edge_from_numbers(
+    obj, numbers: dict, patch: str, fingerprint: str, *, break_number, note=""
+):
+    """Append an edge record from ready numbers (see :func:`edge_numbers`); used when an edge is
+    rebuilt from re-measured stations."""
+    return _add_edge(obj, numbers, patch, fingerprint, break_number=break_number, note=note)
+
+
+def edge_row(obj, edge, *, units: str) -> csvio.EdgeRow:
+    """The edge summary CSV row of ``edge``, measured on ``obj``."""
+    numbers = exact_numbers(edge)
+    spans = numbers.get("flat_spans", [])
+    return csvio.EdgeRow(
+        mesh_name=obj.name,
+        date=edge.date,
+        edge_number=edge.number,
+        break_number=edge.break_number,
+        colors=csvio.format_colors(tuple(edge.colors.split("/"))),
+        user_data=edge.note,
+        n_stations=edge.n_stations,
+        spacing=numbers.get("spacing"),
+        radius=numbers.get("radius"),
+        seg_param=numbers.get("lam"),
+        patch=edge.patch,
+        length=numbers.get("length"),
+        mean=numbers.get("mean"),
+        std=numbers.get("std"),
+        min=numbers.get("min"),
+        max=numbers.get("max"),
+        pooled_angle=numbers.get("pooled_angle"),
+        pooled_fit=numbers.get("pooled_fit"),
+        points=csvio.format_points(numbers.get("points", [])),
+        flat_spans="; ".join(f"{a!r}-{b!r}" for a, b in spans),
+        units=units,
+        extension_version=extension_version(),
+        blender_version=bpy.app.version_string,
     )

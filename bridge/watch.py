@@ -1,10 +1,13 @@
-"""Keep stale flags and colours in step with the mesh while the user edits it.
+"""Keep the geometry caches, stale flags and colours in step with the mesh while the user edits it.
 
-After an edit (or a move) of an object that has measurements, and once the edits pause, the
-object's measurements are checked against its geometry; if a stale flag no longer matches, the
-object is repainted, so the colours never show sides of a mesh that has changed. The check runs
-from a timer, not inside the depsgraph handler (writing data there would re-trigger it), and not
-in Edit Mode (leaving Edit Mode triggers it again).
+Every depsgraph update of an object's geometry or transform drops its kept geometry
+(``mesh_data.invalidate``), except the update our own colour write causes
+(``mesh_data.own_write``). After an edit (or a move) of an object that has measurements, and
+once the edits pause, the object's measurements are checked against its geometry; if a stale flag
+no longer matches, the object is repainted, so the colours never show sides of a mesh that has
+changed. The check runs from a timer, not inside the depsgraph handler (writing data there would
+re-trigger it), and not in Edit Mode (leaving Edit Mode triggers it again). Undo, redo and file
+loads drop every kept geometry.
 """
 
 from __future__ import annotations
@@ -13,7 +16,8 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..vg_addon import GoniometerError
-from .measuring import repaint
+from . import mesh_data, painting
+from .measuring import forget_paint, migrate_fingerprints, repaint
 from .mesh_data import check_measurable, evaluated_geometry
 
 _DELAY = 0.5  # seconds of quiet after the last edit before checking
@@ -24,7 +28,8 @@ def refresh(obj, depsgraph=None) -> bool:
     """Repaint ``obj`` if its stale flags disagree with its current geometry.
 
     Returns True if it was repainted. Objects that cannot be measured now (Edit Mode, linked,
-    emptied) are left as they are.
+    emptied) are left as they are. Fingerprints written by earlier versions that match are
+    rewritten in the current format.
     """
     if obj is None or obj.type != "MESH" or not len(obj.vg.measurements):
         return False
@@ -33,11 +38,12 @@ def refresh(obj, depsgraph=None) -> bool:
         geometry = evaluated_geometry(obj, depsgraph)
     except GoniometerError:
         return False
+    migrate_fingerprints(obj, geometry)
     if all(
         (item.fingerprint != geometry.fingerprint) == item.stale for item in obj.vg.measurements
     ):
         return False
-    repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    repaint(obj, depsgraph=depsgraph, geometry=geometry, verify=True)
     return True
 
 
@@ -51,29 +57,63 @@ def _check_pending():
 
 @persistent
 def on_depsgraph_update(scene, depsgraph):
-    """Note the measured objects whose geometry or transform changed; check them soon."""
+    """Drop the kept geometry of objects whose geometry or transform changed; note the measured
+    ones, to check them soon."""
     for update in depsgraph.updates:
         if not (update.is_updated_geometry or update.is_updated_transform):
             continue
         obj = update.id.original
-        if isinstance(obj, bpy.types.Object) and obj.type == "MESH":
-            vg = getattr(obj, "vg", None)
-            if vg is not None and len(vg.measurements):
-                _pending.add(obj.name)
+        if not isinstance(obj, bpy.types.Object) or obj.type != "MESH":
+            continue
+        if mesh_data.is_own_write(obj):
+            continue
+        mesh_data.invalidate(obj)
+        vg = getattr(obj, "vg", None)
+        if vg is not None and len(vg.measurements):
+            _pending.add(obj.name)
     if _pending:
         if bpy.app.timers.is_registered(_check_pending):
             bpy.app.timers.unregister(_check_pending)
         bpy.app.timers.register(_check_pending, first_interval=_DELAY)
 
 
+@persistent
+def on_undo_or_redo(*_args):
+    """Undo and redo may restore any geometry and any records: read them again before
+    trusting what was kept."""
+    mesh_data.invalidate_all()
+    painting.new_generation()
+
+
+@persistent
+def on_load(*_args):
+    """Another file: forget everything kept for the previous one."""
+    mesh_data.clear_cache()
+    forget_paint()
+
+
+_HANDLERS = (
+    ("depsgraph_update_post", on_depsgraph_update),
+    ("undo_post", on_undo_or_redo),
+    ("redo_post", on_undo_or_redo),
+    ("load_post", on_load),
+)
+
+
 def register() -> None:
-    if on_depsgraph_update not in bpy.app.handlers.depsgraph_update_post:
-        bpy.app.handlers.depsgraph_update_post.append(on_depsgraph_update)
+    for name, handler in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if handler not in handlers:
+            handlers.append(handler)
+    mesh_data.set_watching(True)
 
 
 def unregister() -> None:
-    if on_depsgraph_update in bpy.app.handlers.depsgraph_update_post:
-        bpy.app.handlers.depsgraph_update_post.remove(on_depsgraph_update)
+    mesh_data.set_watching(False)
+    for name, handler in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if handler in handlers:
+            handlers.remove(handler)
     if bpy.app.timers.is_registered(_check_pending):
         bpy.app.timers.unregister(_check_pending)
     _pending.clear()

@@ -6,7 +6,7 @@ import bpy
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from ..bridge import measuring
+from ..bridge import edges, measuring
 from ..bridge.mesh_data import check_measurable
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
@@ -14,7 +14,21 @@ from .measure import typed_value
 
 
 def _path(operator) -> str:
-    return bpy.path.abspath(operator.filepath) if operator.filepath else ""
+    """The operator's file path made absolute; ``""`` when none was given.
+
+    Raises
+    ------
+    GoniometerError
+        A path relative to the .blend file (``//``) while the file has never been saved: it
+        would silently mean the process's working folder.
+    """
+    path = operator.filepath
+    if path.startswith("//") and not bpy.data.filepath:
+        raise GoniometerError(
+            f"{path!r} is relative to the .blend file ('//'), but this file has not been saved "
+            "yet: save the .blend file first, or choose a full path."
+        )
+    return bpy.path.abspath(path) if path else ""
 
 
 class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
@@ -33,7 +47,11 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
     )
 
     def execute(self, context):
-        path = _path(self)
+        try:
+            path = _path(self)
+        except GoniometerError as error:
+            self.report({"ERROR"}, f"{error} Nothing was written.")
+            return {"CANCELLED"}
         if not path:
             self.report({"ERROR"}, "No file name given: choose where to write the CSV.")
             return {"CANCELLED"}
@@ -63,6 +81,9 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
                 objects, context.scene, depsgraph=context.evaluated_depsgraph_get()
             )
             csvio.write_measurements_csv(path, rows)
+            edge_rows = measuring.export_edge_rows(objects, context.scene)
+            if edge_rows:
+                csvio.write_edges_csv(csvio.edges_path_for(path), edge_rows)
         except OSError as error:
             self.report({"ERROR"}, f"Could not write {path}: {error}")
             return {"CANCELLED"}
@@ -71,14 +92,20 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
             return {"CANCELLED"}
         stale = sum(row.stale for row in rows)
         note = f" ({stale} stale)" if stale else ""
-        self.report({"INFO"}, f"Wrote {len(rows)} measurement(s){note} to {path}")
+        edges = f" and {len(edge_rows)} edge profile(s) to {csvio.edges_path_for(path)}"
+        self.report(
+            {"INFO"},
+            f"Wrote {len(rows)} measurement(s){note} to {path}" + (edges if edge_rows else ""),
+        )
         return {"FINISHED"}
 
 
 class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
     """Re-measure every row of a measurement CSV on the active mesh (the paper's xyz method).
     Reads this extension's CSVs, the MeshLab plugin's, the earlier Blender add-on's and plain
-    x, y, z point lists (rows without radius, λ or patch mode take the panel's)"""
+    x, y, z point lists (rows without radius, λ or patch mode take the panel's; MeshLab and
+    earlier add-on rows are re-measured with the paper's rule they were taken with); an edge
+    summary file (NAME_edges.csv) has each of its edges traced and measured again"""
 
     bl_idname = "vg.import_csv"
     bl_label = "Import Measurements CSV"
@@ -93,13 +120,29 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
     )
 
     def execute(self, context):
-        path = _path(self)
+        path = self.filepath
         obj = context.active_object
         try:
+            path = _path(self)
             check_measurable(obj)
             if not path:
                 raise GoniometerError("No file name given: choose the CSV to import.")
             settings = context.scene.vg_settings
+            if csvio.is_edges_csv(path):  # an edge summary file: re-trace its edges
+                edge_numbers = edges.import_edges_csv(
+                    obj,
+                    path,
+                    ignore_mesh_names=self.ignore_mesh_names,
+                    lam=typed_value(settings.seg_param),
+                    patch=settings.patch,
+                    depsgraph=context.evaluated_depsgraph_get(),
+                )
+                self.report(
+                    {"INFO"},
+                    f"Re-measured {len(edge_numbers)} edge profile(s) of "
+                    f"{bpy.path.basename(path)} on '{obj.name}'",
+                )
+                return {"FINISHED"}
             numbers = measuring.import_csv(
                 obj,
                 path,
@@ -108,6 +151,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                 lam=typed_value(settings.seg_param),
                 patch=settings.patch,
                 depsgraph=context.evaluated_depsgraph_get(),
+                rule=settings.rule,
+                stability=settings.stability,
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))

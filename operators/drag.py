@@ -146,8 +146,26 @@ def object_alive(context, obj) -> bool:
     return context.scene.objects.get(name) == obj
 
 
-def in_region(region, coord) -> bool:
-    return 0 <= coord[0] < region.width and 0 <= coord[1] < region.height
+def _contains(region, x, y) -> bool:
+    return region.x <= x < region.x + region.width and region.y <= y < region.y + region.height
+
+
+def pointer_in_view(area, region, coord) -> bool:
+    """Whether region pixel ``coord`` of the 3D view's WINDOW ``region`` is on the view itself.
+
+    A modal operator gets every pointer position relative to the region it started in, and with
+    Region Overlap (Blender's default) that region spans the whole area: the sidebar, the toolbar,
+    the header and the tool settings are drawn over it. So a pixel inside ``region`` is on the view
+    only if no other shown region of ``area`` covers it. Hidden regions are 1 pixel or less and
+    are ignored.
+    """
+    if coord is None or not (0 <= coord[0] < region.width and 0 <= coord[1] < region.height):
+        return False
+    x, y = region.x + coord[0], region.y + coord[1]  # window pixels, like every region's x, y
+    return not any(
+        other.type != "WINDOW" and other.width > 1 and other.height > 1 and _contains(other, x, y)
+        for other in area.regions
+    )
 
 
 class DragSession:
@@ -157,12 +175,13 @@ class DragSession:
     call repeatedly) removes the drawing and the header and status texts on every way out.
     """
 
-    def __init__(self, obj, surface, patch: str, lam: float):
+    def __init__(self, obj, surface, patch: str, lam: float, rule: str = "oriented"):
         self.obj = obj
         self.surface = surface
         self.patch = patch
+        self.rule = rule
         self.machine = DragMachine(
-            **surface_callbacks(surface, patch), lam=lam, quantize=typed_value
+            **surface_callbacks(surface, patch, rule), lam=lam, quantize=typed_value
         )
         self.overlay = DragOverlay()
         self._area = None
@@ -193,7 +212,7 @@ class DragSession:
         settings = context.scene.vg_settings
         depsgraph = context.evaluated_depsgraph_get()
         surface = surface_for(obj, evaluated_geometry(obj, depsgraph))
-        session = cls(obj, surface, settings.patch, typed_value(settings.seg_param))
+        session = cls(obj, surface, settings.patch, typed_value(settings.seg_param), settings.rule)
         hit = ray_cast_object(obj, depsgraph, region, region_data, coord)
         if not session.machine.press(hit):
             raise GoniometerError(session.machine.message)
@@ -209,7 +228,9 @@ class DragSession:
     def handle(self, context, action: str, argument=None, coord=None) -> str:
         """Apply one translated event; returns ``"running"``, ``"pass"`` or ``"done"``.
 
-        ``coord`` is the mouse position relative to the region (needed for ``"move"``).
+        ``coord`` is the pointer position relative to the region (needed for ``"move"`` and
+        ``"release"``): a move or release off the view (outside the region, or over the sidebar,
+        toolbar or header drawn over it) cancels the drag, so it records nothing.
         """
         machine = self.machine
         if not object_alive(context, self.obj):
@@ -221,10 +242,10 @@ class DragSession:
             return DONE
         if action == "pass":
             return PASS
+        if action in ("move", "release") and not pointer_in_view(self._area, region, coord):
+            machine.cancel("Left the 3D view: nothing was recorded.")
+            return DONE
         if action == "move":
-            if not in_region(region, coord):
-                machine.cancel("Left the 3D view: nothing was recorded.")
-                return DONE
             machine.move(view_plane_radius(region, region_data, coord, machine.center))
         elif action == "type":
             machine.type_character(argument)
@@ -303,6 +324,7 @@ def record_properties(session: DragSession) -> dict | None:
         "radius": record.radius,
         "seg_param": record.lam,
         "patch": session.patch,
+        "rule": session.rule,
     }
 
 

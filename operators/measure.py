@@ -4,11 +4,18 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, StringProperty
+from bpy.props import (
+    BoolProperty,
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    IntProperty,
+    StringProperty,
+)
 
-from ..bridge import measuring
+from ..bridge import measuring, records
 from ..bridge.mesh_data import check_measurable, evaluated_geometry
-from ..properties import PATCH_ITEMS
+from ..properties import PATCH_ITEMS, RULE_ITEMS
 from ..vg_addon import GoniometerError
 
 
@@ -46,15 +53,21 @@ class MeasureProperties:
     radius: FloatProperty(
         name="Radius",
         description="Patch radius, world space; default: the panel's radius",
-        min=0.0,
+        soft_min=0.0,  # not min: a negative radius is refused, not quietly made 0
         precision=4,
         subtype="DISTANCE",
         unit="LENGTH",
     )
     seg_param: FloatProperty(
-        name="λ (SegParam)", description="Segmentation parameter; default: the panel's", min=0.0
+        name="λ (SegParam)",
+        description="Segmentation parameter; default: the panel's",
+        soft_min=0.0,  # not min: a negative λ is refused, as in a CSV, not quietly made 0
     )
     patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
+    rule: EnumProperty(name="Rule", items=RULE_ITEMS, description="Default: the panel's")
+    stability: BoolProperty(
+        name="Stability", description="Compute the stability figure; default: the panel's"
+    )
     note: StringProperty(name="Note", description="Free text stored with the measurement")
 
 
@@ -76,6 +89,10 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
             self.seg_param = settings.seg_param
         if not given("patch"):
             self.patch = settings.patch
+        if not given("rule"):
+            self.rule = settings.rule
+        if not given("stability"):
+            self.stability = settings.stability
         obj = context.active_object
         try:
             item = measuring.measure_on_object(
@@ -86,15 +103,20 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
                 self.patch,
                 depsgraph=context.evaluated_depsgraph_get(),
                 note=self.note,
+                rule=self.rule,
+                stability=self.stability,
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
+        spread = f" {item.stability_text}" if self.stability else ""
         self.report(
             {"INFO"},
             f"Measurement {item.number} (break {item.break_number}) on '{obj.name}': "
-            f"{item.angle:.2f}° (fit error {item.fit_error:.3g}, {item.n_vertices} vertices)",
+            f"{item.angle:.2f}°{spread}, {item.convexity} edge (fit error {item.fit_error:.3g}, "
+            f"{item.n_vertices} vertices)",
         )
+
         if warning := _stale_warning(obj):
             self.report({"WARNING"}, warning)
         return {"FINISHED"}
@@ -125,7 +147,8 @@ def _active_geometry(operator, context):
 
 
 class VG_OT_next_break(bpy.types.Operator):
-    """Start a new break: the next measurements get the next break number and colour pair"""
+    """Start a new break: the next measurements get a break number no measurement has yet, and
+    its colour pair"""
 
     bl_idname = "vg.next_break"
     bl_label = "Next Break"
@@ -135,7 +158,7 @@ class VG_OT_next_break(bpy.types.Operator):
         obj = _active_measurable(self, context)
         if obj is None:
             return {"CANCELLED"}
-        obj.vg.break_number += 1
+        obj.vg.break_number = records.next_free_break(obj)
         self.report({"INFO"}, f"Break {obj.vg.break_number} on '{obj.name}'")
         return {"FINISHED"}
 
@@ -171,7 +194,7 @@ class VG_OT_delete_measurement(bpy.types.Operator):
 
 
 class VG_OT_clear_measurements(bpy.types.Operator):
-    """Delete every measurement of the active object and paint it grey"""
+    """Delete every measurement and edge profile of the active object and paint it grey"""
 
     bl_idname = "vg.clear_measurements"
     bl_label = "Clear Measurements"
@@ -185,6 +208,13 @@ class VG_OT_clear_measurements(bpy.types.Operator):
         if obj is None:
             return {"CANCELLED"}
         count = len(obj.vg.measurements)
+        for edge in obj.vg.edges:  # the edge profiles go with their stations
+            image = bpy.data.images.get(edge.plot)
+            if image is not None:
+                bpy.data.images.remove(image)
+        obj.vg.edges.clear()
+        obj.vg.active_edge_index = 0
+        obj.vg.next_edge_number = 1
         obj.vg.measurements.clear()
         obj.vg.active_index = 0
         obj.vg.next_number = 1
@@ -206,7 +236,7 @@ class VG_OT_repaint(bpy.types.Operator):
         if obj is None:
             return {"CANCELLED"}
         try:
-            measuring.repaint(obj, depsgraph=context.evaluated_depsgraph_get())
+            measuring.repaint(obj, depsgraph=context.evaluated_depsgraph_get(), verify=True)
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

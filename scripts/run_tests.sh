@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Set everything up and run every check: lint, the core on NumPy 1.26 and 2, the extension on
-# bpy 5.0 and on bpy 4.2 LTS. Extra arguments go to every pytest run (e.g. -x, -k name).
+# Set everything up and run every check: lint, the core on NumPy 2 and on NumPy 1.26, the extension
+# on every Blender line (bpy 5.2 LTS, 5.3, 4.5 LTS, 4.2 LTS). Extra arguments go to every pytest run
+# (e.g. -x, -k name).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh all
@@ -16,7 +17,8 @@ run() {  # run LABEL PYTHON PYTEST-ARGS...
     echo "== $label" >&2
     "$python" -m pytest -p no:cacheprovider "$@" || status=1
 }
-run "core, NumPy 2" .venv-numpy2/bin/python tests/core "$@"
-run "core and extension, bpy 5.0 (NumPy 1.26)" .venv/bin/python tests "$@"
-run "extension, bpy 4.2 LTS" .venv-bpy42/bin/python tests/blender "$@"
+run "core and extension, bpy 5.2 LTS (Python 3.13, NumPy 2)" .venv/bin/python tests "$@"
+run "core and extension, bpy 4.2 LTS (Python 3.11, NumPy 1.26)" .venv-bpy42/bin/python tests "$@"
+run "extension, bpy 4.5 LTS (Python 3.11, NumPy 1.26)" .venv-bpy45/bin/python tests/blender "$@"
+run "extension, bpy 5.3 (Python 3.13, NumPy 2)" .venv-bpy53/bin/python tests/blender "$@"
 exit $status

@@ -1,6 +1,9 @@
 """Shared test setup: the repository root on sys.path, and the reference data folder."""
 
+import os
+import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -11,6 +14,8 @@ SHARED_DATA = ROOT.parent / "shared" / "data"
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+import unprivileged  # noqa: E402  (tests/ is on sys.path once this file is imported)
+
 
 @pytest.fixture(scope="session")
 def shared_data() -> Path:
@@ -20,3 +25,15 @@ def shared_data() -> Path:
             f"reference meshes not found at {SHARED_DATA} (../shared is not beside the clone)"
         )
     return SHARED_DATA
+
+
+@pytest.fixture
+def user_folder():
+    """An empty folder the unprivileged user owns, where it can reach it (pytest's own
+    temporary folders are private to root)."""
+    folder = Path(tempfile.mkdtemp(prefix="vg-user-test-"))
+    if os.geteuid() == 0:
+        os.chown(folder, unprivileged.NOBODY, unprivileged.NOBODY)
+    folder.chmod(0o755)
+    yield folder
+    shutil.rmtree(folder, ignore_errors=True)

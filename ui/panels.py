@@ -1,6 +1,18 @@
 """The "Goniometer" tab of the 3D viewport sidebar (panels only draw; operators do the work)."""
 
+import textwrap
+
 import bpy
+
+from ..properties import exact_numbers
+from ..vg_addon.method.winding import winding_message
+
+# What the angle of a measurement is, by its convexity label.
+ANGLE_MEANING = {
+    "convex": "Interior angle of the solid",
+    "concave": "Open wedge: 360° minus the solid's angle",
+    "unclear": "Convex or concave unclear here",
+}
 
 CATEGORY = "Goniometer"
 
@@ -30,11 +42,17 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
         column.prop(settings, "radius")
         column.prop(settings, "seg_param")
         column.prop(settings, "patch")
+        column.prop(settings, "rule")
+        column.prop(settings, "stability")
 
         obj = _active_mesh(context)
         if obj is None:
             layout.label(text="Select a mesh object to measure", icon="INFO")
             return
+        if message := winding_message(obj.name, obj.vg.winding):
+            box = layout.box()
+            for number, line in enumerate(textwrap.wrap(message, 42)):
+                box.label(text=line, icon="ERROR" if number == 0 else "BLANK1")
         layout.operator("vg.measure_xyz", text="Measure at 3D Cursor", icon="PIVOT_CURSOR")
         drag = layout.operator("wm.tool_set_by_id", text="Drag to Measure", icon="MOUSE_LMB_DRAG")
         drag.name = "vg.measure_drag_tool"
@@ -73,33 +91,136 @@ class VIEW3D_PT_vg_selected(_GoniometerPanel, bpy.types.Panel):
             box = layout.box()
             box.label(text="Stale: the mesh changed since this measurement", icon="ERROR")
             box.label(text="Numbers kept as recorded; not painted")
-        # Recorded values are shown, not edited (only the note is the user's): the computed
-        # views are read-only properties, the stored ones are drawn as text.
+        # Recorded values are shown as text, exactly as stored, not as (rounded, editable)
+        # fields; only the note is the user's.
         column = layout.column(align=True)
-        column.use_property_split = True
-        column.use_property_decorate = False
-        _text(column, "Measurement", f"{item.number}, break {item.break_number}")
-        for name in ("angle", "fit_error", "fit_error_plus", "fit_error_minus"):
-            column.prop(item, name)
-        column.prop(item, "radius")
-        column.prop(item, "seg_param")
-        _text(column, "Patch", item.patch.capitalize())
-        _text(column, "Vertices", f"{item.n_vertices} ({item.n_plus} +, {item.n_minus} −)")
-        for name in ("center", "requested_center", "snap_distance", "normal_plus", "normal_minus"):
-            column.prop(item, name)
+        for label, value in selected_rows(item, context.scene):
+            _text(column, label, value)
         row = column.row(align=True)
         row.prop(item, "color_plus")
         row.prop(item, "color_minus", text="")
-        _text(column, "Date", item.date)
         layout.prop(item, "note")
 
 
+def exact_text(value: float) -> str:
+    """A float64 as the shortest text that reads back to exactly it (how the .blend stores it)."""
+    return repr(float(value))
+
+
+def selected_rows(item, scene) -> list[tuple[str, str]]:
+    """The Selected Measurement panel's rows ``(label, text)``: every recorded number exactly.
+
+    Angles in degrees; lengths and coordinates in Blender units (BU), as stored and exported;
+    vectors one component a row.
+    """
+    numbers = exact_numbers(item)
+
+    def number(key, suffix=""):
+        return exact_text(numbers[key]) + suffix if key in numbers else "missing"
+
+    rows = [
+        ("Measurement", f"{item.number}, break {item.break_number}"),
+    ]
+    if item.edge_number:
+        rows.append(
+            ("Station of edge", f"{item.edge_number}, at arc length {number('arc_length')}")
+        )
+    rows += [
+        ("Angle", number("angle", "°")),
+        ("Edge", f"{item.convexity}: {ANGLE_MEANING.get(item.convexity, '')}"),
+        ("Rule", item.rule),
+        ("Stability", item.stability_text),
+        ("Fit error", number("fit")),
+        ("Fit error +", number("fit_plus")),
+        ("Fit error −", number("fit_minus")),
+        ("Radius", number("radius")),
+        ("λ (SegParam)", number("lam")),
+        ("Patch", item.patch.capitalize()),
+        ("Vertices", f"{item.n_vertices} ({item.n_plus} +, {item.n_minus} −)"),
+    ]
+    for label, key in (
+        ("Centre", "center"),
+        ("Requested", "requested"),
+        ("Normal +", "normal_plus"),
+        ("Normal −", "normal_minus"),
+    ):
+        vector = numbers.get(key) or [None] * 3
+        for axis, value in zip("XYZ", vector, strict=True):
+            text = "missing" if value is None else exact_text(value)
+            rows.append((label if axis == "X" else "", f"{axis}  {text}"))
+    rows.append(("Snap distance", number("snap_distance")))
+    stability = numbers.get("stability") or {}
+    for label, key in (
+        ("± centre", "center"),
+        ("± radius", "radius"),
+        ("± λ", "lam"),
+        ("± bootstrap", "bootstrap"),
+        ("± orientation", "orientation"),
+    ):
+        if key in stability:
+            rows.append((label, exact_text(stability[key]) + "°"))
+    units = scene.unit_settings
+    scale = "" if units.system == "NONE" else f" (1 BU = {units.scale_length:g} m)"
+    rows.append(("Lengths in", "BU" + scale))
+    rows.append(("Date", item.date))
+    return rows
+
+
 def _text(layout, label, value):
-    split = layout.split(factor=0.4, align=True)
+    split = layout.split(factor=0.33, align=True)
     left = split.row()
     left.alignment = "RIGHT"
     left.label(text=label)
     split.label(text=value)
+
+
+class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
+    """Whole edges: spacing, the Edge Profile button, the list, and the selected one's plot."""
+
+    bl_label = "Edge Profiles"
+    bl_parent_id = "VIEW3D_PT_vg_measure"
+
+    @classmethod
+    def poll(cls, context):
+        return _active_mesh(context) is not None
+
+    def draw(self, context):
+        obj = _active_mesh(context)
+        settings = context.scene.vg_settings
+        layout = self.layout
+        column = layout.column(align=True)
+        column.use_property_split = True
+        column.use_property_decorate = False
+        column.prop(settings, "edge_spacing")
+        column.prop(settings, "radius", text="Radius")
+        layout.operator("vg.measure_edge", text="Edge Profile", icon="CURVE_PATH")
+        layout.label(text="Click start, via points, end; Enter measures")
+        if not len(obj.vg.edges):
+            return
+        row = layout.row()
+        row.template_list("VG_UL_edges", "", obj.vg, "edges", obj.vg, "active_edge_index", rows=3)
+        row.column(align=True).operator("vg.delete_edge", text="", icon="REMOVE")
+        if not 0 <= obj.vg.active_edge_index < len(obj.vg.edges):
+            return
+        edge = obj.vg.edges[obj.vg.active_edge_index]
+        stations = [m for m in obj.vg.measurements if m.edge_number == edge.number]
+        if any(m.stale for m in stations) or len(stations) != edge.n_stations:
+            box = layout.box()
+            box.label(text="Stations stale or deleted since measured", icon="ERROR")
+            box.label(text="The summary is kept as it was recorded")
+        column = layout.column(align=True)
+        _text(column, "Edge", f"{edge.number}, break {edge.break_number}")
+        _text(
+            column, "Stations", f"{edge.n_stations} every {edge.spacing:.4g} over {edge.length:.4g}"
+        )
+        _text(column, "Mean ± SD", f"{edge.mean:.2f}° ± {edge.std:.2f}°")
+        _text(column, "Min, max", f"{edge.min:.2f}°, {edge.max:.2f}°")
+        _text(column, "Pooled", f"{edge.pooled_angle:.2f}°")
+        image = bpy.data.images.get(edge.plot)
+        if image is not None:  # the image's preview icon, made on demand by layout.icon
+            layout.template_icon(icon_value=layout.icon(image), scale=10.0)
+            layout.label(text="Angle (°) against arc length")
+        layout.prop(edge, "note")
 
 
 class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
@@ -122,4 +243,29 @@ class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
         row.prop(settings, "ignore_mesh_names", text="Ignore Names")
 
 
-classes = (VIEW3D_PT_vg_measure, VIEW3D_PT_vg_selected, VIEW3D_PT_vg_csv)
+class VIEW3D_PT_vg_sweep(_GoniometerPanel, bpy.types.Panel):
+    """Angle and fit error over a range of radii at the 3D cursor, written as a CSV and a plot."""
+
+    bl_label = "Radius Sweep"
+    bl_parent_id = "VIEW3D_PT_vg_measure"
+    bl_options = {"DEFAULT_CLOSED"}  # noqa: RUF012 (Blender wants a set)
+
+    def draw(self, context):
+        settings = context.scene.vg_settings
+        layout = self.layout
+        column = layout.column(align=True)
+        column.use_property_split = True
+        column.use_property_decorate = False
+        column.prop(settings, "sweep_start")
+        column.prop(settings, "sweep_stop")
+        column.prop(settings, "sweep_count")
+        layout.operator("vg.radius_sweep", text="Sweep at 3D Cursor", icon="GRAPH")
+
+
+classes = (
+    VIEW3D_PT_vg_measure,
+    VIEW3D_PT_vg_selected,
+    VIEW3D_PT_vg_edges,
+    VIEW3D_PT_vg_csv,
+    VIEW3D_PT_vg_sweep,
+)

@@ -1,6 +1,8 @@
 """Synthetic shapes with known angles, for tests and demonstrations.
 
 * :func:`wedge`: two planar faces meeting at a straight crease of a given interior angle.
+* :func:`varying_wedge`: a crease whose interior angle changes linearly along it.
+* :func:`lens`: two intersecting spheres, whose circular rim has one exact angle all round.
 * :func:`bone_fragment`: a watertight long-bone shaft fragment (hollow tube) with a transverse
   and an oblique fracture face, and :class:`BreakSite` points on its rims whose true angles
   follow exactly from the geometry.
@@ -26,7 +28,10 @@ __all__ = [
     "BoneFragment",
     "BreakSite",
     "SynthMesh",
+    "bevelled_wedge",
     "bone_fragment",
+    "lens",
+    "varying_wedge",
     "wedge",
 ]
 
@@ -92,6 +97,7 @@ def wedge(
     irregular: bool = False,
     seed: int = 0,
     imbalance: float = 1.0,
+    concave: bool = False,
 ) -> SynthMesh:
     """Two planar faces meeting at a straight crease with interior angle ``angle_deg``.
 
@@ -121,6 +127,11 @@ def wedge(
     imbalance : float
         Extent of face -1 relative to face +1 (same grid spacing), so a ball centred on the
         crease can hold unequal vertex counts per side.
+    concave : bool
+        Mirror the wedge in the plane ``z = 0``: the faces rise from the crease (a valley) and the
+        solid lies below them, so the edge is concave and ``angle_deg`` is the angle of the open
+        wedge above it (the solid's interior angle is ``360 - angle_deg``). Normals stay outward
+        (upward).
 
     Returns
     -------
@@ -197,13 +208,237 @@ def wedge(
             tris = tris[:, [0, 2, 1]]  # e_x x u points into the solid on face -1
         triangles.append(tris)
 
+    normal_plus, normal_minus = np.array([0.0, c, s]), np.array([0.0, -c, s])
+    if concave:  # a reflection also turns the winding, so the same triangles stay outward
+        points[:, 2] = -points[:, 2]
+        normal_plus, normal_minus = normal_minus, normal_plus
     return SynthMesh(
         points=points,
         triangles=np.vstack(triangles).astype(np.int64),
         angle=angle,
         side=side,
-        normal_plus=np.array([0.0, c, s]),
-        normal_minus=np.array([0.0, -c, s]),
+        normal_plus=normal_plus,
+        normal_minus=normal_minus,
+    )
+
+
+def bevelled_wedge(
+    angle_deg: float,
+    fillet: float,
+    *,
+    half_width: float = 1.0,
+    depth: float = 1.0,
+    spacing: float = 0.02,
+    concave: bool = False,
+) -> SynthMesh:
+    """A wedge whose crease is rounded by a circular fillet (a worn or bevelled edge).
+
+    The two planar faces are those of :func:`wedge` (same angle, orientation and normals); near
+    the crease they are joined by a circular arc of radius ``fillet``, tangent to both, so the
+    angle between the faces is still exactly ``angle_deg``. The mesh is a regular grid: rows
+    ``spacing`` apart along the profile (the arc gets at least two segments), columns ``spacing``
+    apart along the crease (the x axis).
+
+    Parameters
+    ----------
+    angle_deg : float
+        Angle between the faces, ``0 < angle_deg < 180``.
+    fillet : float
+        Radius of the rounding (0: a sharp crease).
+    half_width, depth : float
+        Half the crease length; extent of each face beyond the fillet's tangent line.
+    spacing : float
+        Grid spacing.
+    concave : bool
+        Mirror in ``z = 0`` as :func:`wedge` does: a rounded valley, normals still outward.
+
+    Returns
+    -------
+    SynthMesh
+        ``side`` is +1/-1 on the planar parts, 0 on the fillet.
+    """
+    angle = float(angle_deg)
+    if not 0.0 < angle < 180.0:
+        raise GoniometerError(f"The wedge angle must be between 0 and 180 degrees, got {angle}.")
+    fillet = float(fillet)
+    if not (math.isfinite(fillet) and fillet >= 0):
+        raise GoniometerError(f"The fillet radius must be 0 or more, got {fillet}.")
+    half_width, depth = _positive("half_width", half_width), _positive("depth", depth)
+    spacing = _positive("spacing", spacing)
+    half = math.radians(angle) / 2.0
+    s, c = math.sin(half), math.cos(half)
+    tangent_length = fillet / math.tan(half)  # crease to the fillet's tangent points
+    centre = np.array([0.0, -fillet / s])  # (y, z) of the fillet's centre, on the bisector
+    # The tangent points sit at centre + fillet * (outward normal of their face): at the angles
+    # pi - half (face -1) and half (face +1); the arc runs over the top between them.
+    start, stop = math.pi - half, half
+    n_arc = max(2, math.ceil(fillet * abs(stop - start) / spacing)) if fillet > 0 else 0
+    arc_angles = np.linspace(start, stop, n_arc + 1) if fillet > 0 else np.zeros(1)
+    arc = centre + fillet * np.column_stack([np.cos(arc_angles), np.sin(arc_angles)])
+    if fillet == 0:
+        arc = np.zeros((1, 2))
+    steps = np.arange(1, math.floor(depth / spacing) + 1) * spacing
+    plus = (tangent_length + steps)[:, None] * np.array([s, -c])
+    minus = (tangent_length + steps[::-1])[:, None] * np.array([-s, -c])
+    profile = np.vstack([minus, arc, plus])
+    x = np.linspace(-half_width, half_width, max(2, round(2 * half_width / spacing)) + 1)
+    points = np.column_stack(
+        [np.repeat(x, len(profile)), np.tile(profile[:, 0], x.size), np.tile(profile[:, 1], x.size)]
+    )
+    side = np.tile(
+        np.concatenate([-np.ones(len(minus)), np.zeros(len(arc)), np.ones(len(plus))]), x.size
+    ).astype(np.int8)
+    ids = np.arange(points.shape[0]).reshape(x.size, len(profile))
+    a, b = ids[:-1, :-1].ravel(), ids[1:, :-1].ravel()
+    cc, d = ids[1:, 1:].ravel(), ids[:-1, 1:].ravel()
+    # Along the profile the points run from face -1 to face +1, i.e. towards +y; (e_x, +y)
+    # counter-clockwise has its normal up (outward).
+    triangles = np.vstack([np.column_stack([a, b, cc]), np.column_stack([a, cc, d])])
+    normal_plus, normal_minus = np.array([0.0, c, s]), np.array([0.0, -c, s])
+    if concave:
+        points[:, 2] = -points[:, 2]
+        normal_plus, normal_minus = normal_minus, normal_plus
+    return SynthMesh(
+        points=points,
+        triangles=triangles.astype(np.int64),
+        angle=angle,
+        side=side,
+        normal_plus=normal_plus,
+        normal_minus=normal_minus,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class EdgeShape:
+    """A synthetic mesh with one break edge whose exact angle is known everywhere along it.
+
+    Attributes
+    ----------
+    points, triangles : numpy.ndarray
+        Vertices (float64) and outward-wound triangles (int64).
+    edge : numpy.ndarray
+        Indices of the vertices on the break edge, in order along it.
+    angle_at : callable
+        ``angle_at(xyz)`` gives the exact interior angle (degrees) at points of the edge,
+        ``(k, 3) -> (k,)``.
+    """
+
+    points: np.ndarray
+    triangles: np.ndarray
+    edge: np.ndarray
+    angle_at: object
+
+
+def _grid_triangles(ids: np.ndarray, flip: bool) -> np.ndarray:
+    """Two triangles per cell of a grid of vertex ids, counter-clockwise unless ``flip``."""
+    a, b = ids[:-1, :-1].ravel(), ids[:-1, 1:].ravel()
+    c, d = ids[1:, 1:].ravel(), ids[1:, :-1].ravel()
+    tris = np.stack([np.column_stack([a, b, c]), np.column_stack([a, c, d])], axis=1).reshape(-1, 3)
+    return tris[:, [0, 2, 1]] if flip else tris
+
+
+def varying_wedge(
+    angle_start: float,
+    angle_end: float,
+    *,
+    half_width: float = 4.0,
+    depth: float = 1.0,
+    n: int = 30,
+) -> EdgeShape:
+    """A wedge whose interior angle changes linearly from ``angle_start`` at ``x = -half_width``
+    to ``angle_end`` at ``x = half_width``.
+
+    The crease is the x axis; the cross-section at ``x`` is an exact wedge of angle ``a(x)``:
+    its faces are the ruled surfaces ``(x, ±t sin(a(x)/2), -t cos(a(x)/2))``, ``0 <= t <= depth``,
+    so the local angle at crease point ``x`` is exactly ``a(x)``. ``n`` vertices per unit length.
+    """
+    for value in (angle_start, angle_end):
+        if not 0.0 < float(value) < 180.0:
+            raise GoniometerError(
+                f"The wedge angles must be between 0 and 180 degrees, got {value}."
+            )
+    half_width, depth = _positive("half_width", half_width), _positive("depth", depth)
+    n = _count("n", n, 2)
+    x = np.linspace(-half_width, half_width, round(2 * half_width * n) + 1)
+    t = np.linspace(0.0, depth, round(depth * n) + 1)[1:]
+    half = (
+        np.radians(angle_start + (angle_end - angle_start) * (x + half_width) / (2 * half_width))
+        / 2
+    )
+    nx, nt = x.size, t.size
+    points = [np.column_stack([x, np.zeros(nx), np.zeros(nx)])]
+    for sign in (1.0, -1.0):
+        grid_x = np.broadcast_to(x, (nt, nx))
+        grid_y = sign * t[:, None] * np.sin(half)[None, :]
+        grid_z = -t[:, None] * np.cos(half)[None, :]
+        points.append(np.column_stack([grid_x.ravel(), grid_y.ravel(), grid_z.ravel()]))
+    crease = np.arange(nx)
+    plus = np.vstack([crease, nx + np.arange(nt * nx).reshape(nt, nx)])
+    minus = np.vstack([crease, nx + nt * nx + np.arange(nt * nx).reshape(nt, nx)])
+    triangles = np.vstack([_grid_triangles(plus, False), _grid_triangles(minus, True)])
+
+    def angle_at(xyz):
+        xs = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)[:, 0]
+        return angle_start + (angle_end - angle_start) * (xs + half_width) / (2 * half_width)
+
+    return EdgeShape(np.vstack(points), triangles.astype(np.int64), crease, angle_at)
+
+
+def lens(angle_deg: float = 70.53, *, radius: float = 1.0, n_around: int = 240) -> EdgeShape:
+    """The lens where two spheres of equal ``radius`` overlap; its rim has interior angle
+    ``angle_deg`` all round.
+
+    The spheres' centres are ``(0, 0, ±d)``; the rim is the circle ``z = 0`` of radius
+    ``rho = sqrt(radius^2 - d^2)``. At the rim the outward normals are ``(rho, 0, ±d) / radius``,
+    so the interior angle is ``180° - arccos((rho^2 - d^2) / radius^2)``: ``d`` is chosen from it.
+    The caps are polar grids of ``n_around`` vertices per ring, the rim ring shared by both.
+    """
+    angle = float(angle_deg)
+    if not 0.0 < angle < 180.0:
+        raise GoniometerError(f"The lens angle must be between 0 and 180 degrees, got {angle}.")
+    radius = _positive("radius", radius)
+    n_around = _count("n_around", n_around, 8)
+    # (rho^2 - d^2) / R^2 = cos(180° - angle) and rho^2 + d^2 = R^2.
+    cosine = math.cos(math.radians(180.0 - angle))
+    d = radius * math.sqrt((1.0 - cosine) / 2.0)
+    rho = math.sqrt(radius**2 - d**2)
+    polar = math.acos(d / radius)  # the cap's half-angle seen from its sphere's centre
+    rings = max(2, round(polar * radius / (2 * math.pi * rho / n_around)))
+    phi = 2 * math.pi * np.arange(n_around) / n_around
+    theta = polar * np.arange(1, rings + 1) / rings  # ring 'rings' is the rim
+    sin_t, cos_t = np.sin(theta)[:, None], np.cos(theta)[:, None]
+    rim = np.column_stack([rho * np.cos(phi), rho * np.sin(phi), np.zeros(n_around)])
+    points, triangles = [rim], []
+    offset = n_around
+    for sign in (1.0, -1.0):  # the cap above z = 0 belongs to the sphere centred below
+        ring_xyz = np.stack(
+            [
+                radius * sin_t * np.cos(phi),
+                radius * sin_t * np.sin(phi),
+                sign * (radius * cos_t - d) + 0 * phi,
+            ],
+            axis=-1,
+        )[:-1]  # the last ring is the rim
+        pole = offset
+        points.append(np.array([[0.0, 0.0, sign * (radius - d)]]))
+        ids = np.vstack(
+            [
+                offset + 1 + np.arange((rings - 1) * n_around).reshape(rings - 1, n_around),
+                np.arange(n_around),
+            ]
+        )
+        points.append(ring_xyz.reshape(-1, 3))
+        offset += 1 + (rings - 1) * n_around
+        wrap = np.hstack([ids, ids[:, :1]])
+        cap = _grid_triangles(wrap, sign > 0)
+        fan = np.column_stack([np.full(n_around, pole), wrap[0, :-1], wrap[0, 1:]])
+        triangles += [cap, fan if sign > 0 else fan[:, [0, 2, 1]]]
+
+    def angle_at(xyz):
+        return np.full(np.asarray(xyz).reshape(-1, 3).shape[0], angle)
+
+    return EdgeShape(
+        np.vstack(points), np.vstack(triangles).astype(np.int64), np.arange(n_around), angle_at
     )
 
 

@@ -96,14 +96,42 @@ def snapshot(obj) -> dict:
     }
 
 
-def expected_colours(vg_module, n, sides) -> np.ndarray:
-    """Colours the extension should paint: grey, then each (indices, labels, break) in order."""
-    palette = vg_module.vg_addon.palette
-    rgba = np.tile(palette.neutral_linear(), (n, 1))
+# The colours as documented, not as the extension computes them: the Okabe-Ito palette as
+# published (Okabe & Ito 2008, "Color Universal Design"), the break pairs in the rotation
+# docs/USER_GUIDE.md lists, and a mid grey for everything else, all 8-bit sRGB.
+OKABE_ITO_HEX = {
+    "orange": "#E69F00",
+    "sky blue": "#56B4E9",
+    "bluish green": "#009E73",
+    "yellow": "#F0E442",
+    "blue": "#0072B2",
+    "vermillion": "#D55E00",
+    "reddish purple": "#CC79A7",
+}
+BREAK_PAIRS = [
+    ("orange", "blue"),
+    ("vermillion", "sky blue"),
+    ("reddish purple", "bluish green"),
+    ("yellow", "blue"),
+]
+GREY_HEX = "#808080"
+
+
+def linear_rgba(hex_colour: str) -> np.ndarray:
+    """Scene-linear RGBA of an sRGB hex colour, by the sRGB transfer function (IEC 61966-2-1)."""
+    srgb = np.array([int(hex_colour[i : i + 2], 16) for i in (1, 3, 5)]) / 255.0
+    linear = np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
+    return np.append(linear, 1.0)
+
+
+def expected_colours(n, sides) -> np.ndarray:
+    """Colours the extension should paint: grey, then each (indices, labels, break) in order,
+    "+" side first, from the documented palette (never from the extension's own code)."""
+    rgba = np.tile(linear_rgba(GREY_HEX), (n, 1))
     for indices, labels, break_number in sides:
-        plus, minus = palette.pair_linear(break_number)
-        rgba[indices[labels]] = plus
-        rgba[indices[~labels]] = minus
+        plus, minus = BREAK_PAIRS[(break_number - 1) % len(BREAK_PAIRS)]
+        rgba[indices[labels]] = linear_rgba(OKABE_ITO_HEX[plus])
+        rgba[indices[~labels]] = linear_rgba(OKABE_ITO_HEX[minus])
     return rgba.astype(np.float32)
 
 

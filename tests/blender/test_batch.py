@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import importlib
 import os
 import struct
 import subprocess
@@ -15,8 +16,9 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import colours, exact, mesh_object
+from bpy_helpers import colours, exact, expected_colours, mesh_object
 
+from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
 from vg_addon.synthetic_meshes import bone_fragment, wedge
 
@@ -143,11 +145,15 @@ def test_points_given_with_at_on_ply_obj_and_stl(meshes, tmp_path):
         assert abs(r.angle - 90.0) < 0.01
         assert (r.radius, r.seg_param, r.patch) == (RADIUS, 2.0, "euclidean")
         assert r.units == "BU" and r.extension_version and r.blender_version
-    # The same surface in three file formats: the same float32 vertices and faces in Blender,
-    # hence the same numbers, bit for bit.
-    for kind in ("obj", "stl"):
-        assert [r.angle for r in results[kind]] == [r.angle for r in rows]
-        assert [r.normal_plus for r in results[kind]] == [r.normal_plus for r in rows]
+    # The same surface in three file formats. PLY and OBJ carry the float64 coordinates, which
+    # float32 would round: both are measured at the file's precision, bit for bit alike. STL
+    # holds float32 coordinates: measured as Blender stores them, so equal to rounding only.
+    assert {r.precision for r in rows} == {r.precision for r in results["obj"]} == {"float64"}
+    assert [r.angle for r in results["obj"]] == [r.angle for r in rows]
+    assert [r.normal_plus for r in results["obj"]] == [r.normal_plus for r in rows]
+    assert {r.precision for r in results["stl"]} == {"float32"}
+    for stl, ply in zip(results["stl"], rows, strict=True):
+        assert abs(stl.angle - ply.angle) < 1e-6
 
 
 def test_points_csv_plain_our_export_and_meshlab_replicate_the_same_angles(meshes, tmp_path):
@@ -279,19 +285,6 @@ def test_an_unreadable_mesh_fails_alone_with_exit_2(meshes, tmp_path):
     assert "unreadable mesh" in result.stderr
 
 
-def test_a_crashing_worker_loses_only_its_mesh(two_meshes, meshes, tmp_path):
-    out = tmp_path / "out.csv"
-    ok(batch(meshes["ply"], meshes["ply60"], "--points", two_meshes["points"], "--radius", RADIUS,
-             "--jobs", "2", "--out", out, env={"VG_BATCH_ABORT_ON_MESH": "w60"}), 1)  # fmt: skip
-    rows = rows_of(out)
-    whole = two_meshes["rows"]
-    for row, expected in zip(rows, whole, strict=True):
-        if row.mesh_name == "w60":
-            assert "worker process measuring this mesh stopped" in row.error
-        else:
-            assert row.angle == expected.angle and not row.error
-
-
 def test_render_writes_a_png_per_mesh(meshes, tmp_path):
     renders = tmp_path / "renders"
     result = ok(batch(meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS, "--out",
@@ -304,13 +297,18 @@ def test_render_writes_a_png_per_mesh(meshes, tmp_path):
 # --------------------------------------------------------------------------- against the extension
 
 
-def test_batch_angle_equals_measure_xyz_on_blenders_own_ply_import(vg, meshes, tmp_path):
+def test_batch_angle_equals_measure_xyz_on_blenders_own_ply_import(vg, tmp_path):
+    # Coordinates float32 holds exactly: Blender's mesh is then the file (a float64 file that
+    # float32 rounds is measured at the file's precision by the batch, not by Blender).
+    shape = wedge(90.0, n=24, irregular=True, seed=3)
+    ply = meshio.write_ply(tmp_path / "w90.ply", shape.points.astype(np.float32), shape.triangles)
     out = tmp_path / "out.csv"
-    ok(batch(meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS, "--lambda", "1.5",
+    ok(batch(ply, *("--at", *CREASE[1]), "--radius", RADIUS, "--lambda", "1.5",
              "--out", out))  # fmt: skip
     row = rows_of(out)[0]
+    assert row.precision == "float32"
 
-    bpy.ops.wm.ply_import(filepath=str(meshes["ply"]))
+    bpy.ops.wm.ply_import(filepath=str(ply))
     obj = bpy.data.objects["w90"]
     bpy.context.view_layer.objects.active = obj
     location = tuple(float(v) for v in CREASE[1])
@@ -406,7 +404,8 @@ def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
     out = tmp_path / "demo"
     result = ok(batch("--demo", "--out-dir", out))
     sites = bone_fragment().sites
-    rows = rows_of(out / "measurements.csv")
+    every_row = rows_of(out / "measurements.csv")
+    rows = [row for row in every_row if row.edge_number is None]
     assert len(rows) == len(sites)
     for site, row in zip(sites, rows, strict=True):
         assert not row.error
@@ -418,4 +417,166 @@ def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
     assert "true angle" in result.stdout and f"Output folder: {out}" in result.stdout
     assert png_size(out / "bone_fragment.png") == (800, 600)
     assert (out / "bone_fragment.blend").stat().st_size > 0
+    # The whole oblique outer rim, profiled: every station within 1° of the exact local angle
+    # (180° minus the angle between the cylinder's and the oblique plane's outward normals).
+    stations = [row for row in every_row if row.edge_number == 1]
+    assert len(stations) > 15 and not any(row.error for row in stations)
+    tilt = np.radians(35.0)
+    plane = np.array([-np.tan(tilt), 0.0, 1.0]) / np.hypot(np.tan(tilt), 1.0)
+    for row in stations:
+        radial = np.array([row.x, row.y]) / np.hypot(row.x, row.y)
+        exact = 180.0 - np.degrees(np.arccos(radial @ plane[:2]))
+        assert abs(row.angle - exact) < 1.0, (row.arc_length, row.angle, exact)
+    (edge,) = csvio.read_edges_csv(out / "measurements_edges.csv")
+    assert edge.n_stations == len(stations)
+    assert edge.mean == pytest.approx(np.mean([row.angle for row in stations]), abs=1e-12)
+    assert "Whole edge" in result.stdout and f"pooled {edge.pooled_angle:.2f}°" in result.stdout
+    assert png_size(out / "measurements_bone_fragment_edge1.png") == (480, 240)
     assert meshio.read_mesh(out / "bone_fragment.ply").n_vertices > 200_000
+
+
+def test_batch_paints_as_the_extension_does(vg, meshes, tmp_path):
+    """The batch paints through the extension's own painter: every measured row is painted,
+    later over earlier (break 0, which the batch's former painter skipped, is now refused on
+    input: a break number is 1 or more)."""
+    points = write_csv(
+        tmp_path / "points.csv",
+        ["x", "y", "z", "break", "label"],
+        [["-0.3", "0", "0", "1", "a"], ["-0.1", "0", "0", "2", "b"], ["0.05", "0", "0", "1", "c"]],
+    )
+    out, saved = tmp_path / "out.csv", tmp_path / "saved.blend"
+    ok(batch(meshes["ply"], "--points", points, "--radius", RADIUS, "--out", out,
+             "--save-blend", saved))  # fmt: skip
+    bpy.ops.wm.open_mainfile(filepath=str(saved))
+    obj = bpy.data.objects["w90"]
+    assert [i.break_number for i in obj.vg.measurements] == [1, 2, 1]
+    co = np.empty(len(obj.data.vertices) * 3, dtype=np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    mesh = meshio.read_mesh(meshes["ply"])
+    surface = Surface(co.reshape(-1, 3).astype(np.float64), mesh.triangles)
+    sides = []
+    for item in obj.vg.measurements:
+        m = surface.measure(exact(item)["center"], RADIUS)
+        sides.append((m.indices, m.labels, item.break_number))
+    np.testing.assert_array_equal(colours(obj), expected_colours(len(obj.data.vertices), sides))
+
+
+@pytest.mark.parametrize("flaw", ["none", "degenerate", "duplicate"])
+def test_imported_mesh_is_blenders_own_ply_import(vg, tmp_path, flaw):
+    """The batch's import gives the mesh File > Import > PLY gives (Blender's C++ importer),
+    for a clean triangle list and for ones Blender has to repair."""
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    shape = wedge(70.0, n=12, irregular=True, seed=1)
+    triangles = shape.triangles.copy()
+    if flaw == "degenerate":
+        triangles = np.vstack([triangles, [[3, 3, 7]]])
+    elif flaw == "duplicate":
+        triangles = np.vstack([triangles, triangles[5][[1, 2, 0]]])
+    path = meshio.write_ply(tmp_path / f"{flaw}.ply", shape.points, triangles)
+    ours, _ = sources.import_mesh(sources.MeshSource("ours", str(path)))
+    assert bpy.ops.wm.ply_import(filepath=str(path)) == {"FINISHED"}
+    blenders = bpy.context.selected_objects[0]
+    assert blenders != ours
+    for attribute, kind, width in (("position", "vector", 3), (".corner_vert", "value", 1)):
+        got, want = (
+            np.empty(len(o.data.attributes[attribute].data) * width) for o in (ours, blenders)
+        )
+        ours.data.attributes[attribute].data.foreach_get(kind, got)
+        blenders.data.attributes[attribute].data.foreach_get(kind, want)
+        np.testing.assert_array_equal(got, want, attribute)
+    assert len(ours.data.polygons) == len(shape.triangles)  # the flaw is gone
+
+
+def test_needs_validation_agrees_with_brute_force(vg):
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    rng = np.random.default_rng(0)
+    for n in (6, 40, 3_000_000):  # the last packs no key into 63 bits
+        for _ in range(30):
+            triangles = rng.integers(0, min(n, 40), size=(int(rng.integers(1, 12)), 3))
+            triangles[0, 0] = n - 1  # fixes the largest index
+            seen, flawed = set(), False
+            for row in triangles.tolist():
+                flawed |= len(set(row)) < 3 or frozenset(row) in seen
+                seen.add(frozenset(row))
+            assert sources.needs_validation(triangles) == flawed, triangles
+
+
+# --------------------------------------------------------------------------- whole edges
+
+
+def test_edges_write_station_rows_summaries_and_plots_equal_to_the_core(tmp_path):
+    from vg_addon import Surface
+    from vg_addon.synthetic_meshes import varying_wedge
+
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+    mesh = tmp_path / "ramp.ply"
+    meshio.write_ply(mesh, shape.points, shape.triangles)
+    out = tmp_path / "out.csv"
+    result = ok(
+        batch(
+            mesh, "--at", 0, 0, 0,
+            "--edge", -1.5, 0.01, 0, 1.5, 0, 0, "--via", 0, -0.01, 0,
+            "--edge", -1, 0, 0, 1, 0, 0,
+            "--spacing", 0.5, "--radius", 0.3, "--out", out,
+        )
+    )  # fmt: skip
+    rows = rows_of(out)
+    assert rows[0].edge_number is None and rows[0].number == 1
+    # Blender keeps coordinates in float32: the core measures the same numbers.
+    surface = Surface(meshio.read_mesh(mesh).points.astype(np.float32), shape.triangles)
+    edges = csvio.read_edges_csv(out.with_name("out_edges.csv"))
+    clicks = [[[-1.5, 0.01, 0], [0, -0.01, 0], [1.5, 0, 0]], [[-1, 0, 0], [1, 0, 0]]]
+    for number, (edge, points) in enumerate(zip(edges, clicks, strict=True), start=1):
+        profile = surface.measure_along(points, 0.5, 0.3)
+        stations = [row for row in rows if row.edge_number == number]
+        assert [r.angle for r in stations] == profile.angles.tolist()
+        assert [r.arc_length for r in stations] == profile.arc_lengths.tolist()
+        assert [(r.x, r.y, r.z) for r in stations] == [tuple(m.center) for m in profile.stations]
+        assert (edge.mean, edge.pooled_angle) == (profile.mean, profile.pooled_angle)
+        assert len({r.break_number for r in stations}) == 1
+        assert (
+            np.abs(
+                np.array([r.angle for r in stations])
+                - shape.angle_at(np.array([(r.x, r.y, r.z) for r in stations]))
+            ).max()
+            < 1.0
+        )
+        assert png_size(tmp_path / f"out_ramp_edge{number}.png") == (480, 240)
+        assert f"edge {number} on 'ramp'" in result.stderr + result.stdout
+
+    # The edge file replicates: --edges re-measures every edge with its own settings.
+    again = tmp_path / "again.csv"
+    ok(batch(mesh, "--edges", out.with_name("out_edges.csv"), "--out", again))
+    replayed = rows_of(again)
+    stations = [row for row in rows if row.edge_number is not None]
+    assert [(r.edge_number, r.angle, r.arc_length) for r in replayed] == [
+        (r.edge_number, r.angle, r.arc_length) for r in stations
+    ]
+    result = ok(batch(mesh, "--edges", out, "--out", again), 2)  # not an edge file
+    assert "missing the column(s)" in result.stderr
+
+
+def test_a_failed_edge_is_an_error_row_and_exit_1(tmp_path):
+    shape = wedge(90.0, n=20)
+    mesh = tmp_path / "w.ply"
+    meshio.write_ply(mesh, shape.points, shape.triangles)
+    out = tmp_path / "out.csv"
+    ok(batch(mesh, "--edge", -0.5, 0, 0, 0.5, 0, 0, "--spacing", 0.2, "--radius", 1e-4,
+             "--out", out), 1)  # fmt: skip
+    (row,) = rows_of(out)
+    assert row.edge_number == 1 and "edge not measured" in row.error and "radius" in row.error
+
+
+def test_edge_arguments_are_checked(tmp_path):
+    out = tmp_path / "out.csv"
+    result = ok(batch("x.ply", "--edge", 0, 0, 0, 1, 0, 0, "--radius", 1, "--out", out), 2)
+    assert "--edge needs --spacing D and --radius R" in result.stderr
+    result = ok(batch("x.ply", "--via", 0, 0, 0, "--out", out), 2)
+    assert "--via X Y Z must follow the --edge" in result.stderr
+    result = ok(
+        batch("x.ply", "--edge", 0, 0, 0, 1, 0, 0, "--spacing", 1, "--radius", 1, "--jobs", 2,
+              "--out", out), 2
+    )  # fmt: skip
+    assert "drop --jobs and --shard" in result.stderr
+    result = ok(batch("--demo", "--edge", 0, 0, 0, 1, 0, 0), 2)
+    assert "--demo takes no --edge" in result.stderr

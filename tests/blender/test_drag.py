@@ -1,7 +1,7 @@
 """The drag tool in real bpy: ray cast through a real 3D-view region, the drag session driven by
 translated events, EXEC_DEFAULT equal to vg.measure_xyz, and clean exits.
 
-Headless limits (see the README, "Measuring by click and drag"): ``INVOKE_DEFAULT`` cannot run without an event loop,
+Headless limits (see docs/ARCHITECTURE.md, "Tests"): ``INVOKE_DEFAULT`` cannot run without an event loop,
 so ``invoke``/``modal`` themselves are not called; they only forward to ``DragSession`` and
 ``translate_event``, which are tested here. The view matrices cannot be recomputed in background
 mode, so the test mesh is placed in front of the startup file's saved perspective view.
@@ -284,6 +284,59 @@ def test_leaving_the_region_ends_cleanly(drag, view):
     session.finish(bpy.context)
     assert session.machine.phase == "cancelled" and "Left the 3D view" in session.machine.message
     assert handler_removed(handle) and snapshot(view.obj) == before
+
+
+def shown_regions_over_the_view(view):
+    """The area's other shown regions (toolbar, header, ...) whose rectangle meets the view's."""
+    view_box = (view.region.x, view.region.y, view.region.width, view.region.height)
+    regions = []
+    for other in view.area.regions:
+        if other.type == "WINDOW" or other.width <= 1 or other.height <= 1:
+            continue
+        box = (other.x, other.y, other.width, other.height)
+        overlap_x = min(box[0] + box[2], view_box[0] + view_box[2]) - max(box[0], view_box[0])
+        overlap_y = min(box[1] + box[3], view_box[1] + view_box[3]) - max(box[1], view_box[1])
+        if overlap_x > 0 and overlap_y > 0:
+            regions.append(other)
+    return regions
+
+
+def test_release_over_a_region_drawn_over_the_view_records_nothing(drag, view):
+    # With Region Overlap the toolbar (and, in 5.x, the header) lie inside the view's own
+    # rectangle, so region-relative coordinates there look like view pixels. The startup screen
+    # shows the toolbar; the sidebar works the same way (checked in the real GUI).
+    regions = shown_regions_over_the_view(view)
+    assert "TOOLS" in {r.type for r in regions}
+    before = snapshot(view.obj)
+    for region in regions:
+        # The middle of that region, in pixels of the view's region (as a modal operator gets it).
+        coord = (
+            region.x + region.width / 2 - view.region.x,
+            region.y + region.height / 2 - view.region.y,
+        )
+        assert 0 <= coord[0] < view.region.width and 0 <= coord[1] < view.region.height
+        for events in (["release"], ["move", "release"]):
+            session = start(drag, view, ridge_vertex(view))
+            far = pixel(view, view.points[ridge_vertex(view)] + 0.6 * view.right)
+            assert send(drag, session, "MOUSEMOVE", "NOTHING", far) == drag.RUNNING
+            status = None
+            for event in events:
+                event_type, value = (
+                    ("MOUSEMOVE", "NOTHING")
+                    if event == "move"
+                    else (
+                        "LEFTMOUSE",
+                        "RELEASE",
+                    )
+                )
+                status = send(drag, session, event_type, value, coord)
+                if status == drag.DONE:
+                    break
+            session.finish(bpy.context)
+            assert status == drag.DONE, (region.type, events)
+            assert drag.record_properties(session) is None, (region.type, events)
+            assert "Left the 3D view" in session.machine.message
+    assert snapshot(view.obj) == before
 
 
 def test_other_keys_are_swallowed_mid_drag(drag, view):

@@ -148,7 +148,7 @@ def test_stale_measurement_is_kept_but_not_painted(vg, capfd):
     surface = Surface(world(local_points(obj), obj), _triangles(obj))
     m = surface.measure([0.2, 0, 0], 0.4)
     np.testing.assert_array_equal(
-        colours(obj), expected_colours(vg, len(obj.data.vertices), [(m.indices, m.labels, 1)])
+        colours(obj), expected_colours(len(obj.data.vertices), [(m.indices, m.labels, 1)])
     )
     assert [i.stale for i in obj.vg.measurements] == [True, False]
 
@@ -197,4 +197,18 @@ def test_delete_with_nothing_selected(vg):
     before = snapshot(obj)
     with pytest.raises(RuntimeError, match="no measurement at list position 5"):
         bpy.ops.vg.delete_measurement(index=5)
+    assert snapshot(obj) == before
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"seg_param": -1.0}, r"λ \(SegParam\) must be a number from 0 .*got -1\.0"),
+        ({"radius": -1.0}, r"radius must be a finite number greater than 0; got -1\.0"),
+    ],
+)
+def test_negative_operator_values_are_refused_as_given(vg, kwargs, match):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    assert_refused(match, location=(0, 0, 0), **({"radius": 0.5} | kwargs))
     assert snapshot(obj) == before

@@ -1,6 +1,7 @@
 """CSV export and import (replication): the MeshLab header, bit-identical angles, all or nothing."""
 
 import csv
+import os
 import tomllib
 
 import bpy
@@ -166,6 +167,19 @@ BAD_CSVS = {
         "Mesh Name,Radius,x,y,z\nWedge,0.5,0,0,0\nWedge,0.5,0,0,7\nWedge,0.001,{x!r},{y!r},{z!r}\n",
         r"2 of 3 rows(.|\n)*row 3: .*farther than(.|\n)*row 4: .*larger radius",
     ),
+    "break number beyond 32 bits": (
+        "Mesh Name,Radius,x,y,z,Break #\nWedge,0.5,{x!r},{y!r},{z!r},2\n"
+        "Wedge,0.5,{x!r},{y!r},{z!r},2147483648\n",
+        r"row 3: Break # must be a whole number from 1 to 2147483647 \(got '2147483648'\)",
+    ),
+    "break number text": (
+        "Mesh Name,Radius,x,y,z,Break #\nWedge,0.5,{x!r},{y!r},{z!r},abc\n",
+        r"row 2: Break # must be a whole number .*'abc'",
+    ),
+    "break number fraction": (
+        "Mesh Name,Radius,x,y,z,Break #\nWedge,0.5,{x!r},{y!r},{z!r},1.5\n",
+        r"row 2: Break # must be a whole number .*'1\.5'",
+    ),
     "empty file": ("", r"empty"),
     "header only": ("x,y,z\n", r"no data rows"),
 }
@@ -227,3 +241,50 @@ def test_a_damaged_record_is_reported_not_crashed_on(vg, tmp_path):
     with pytest.raises(RuntimeError, match="Measurement 2 has lost its stored numbers"):
         bpy.ops.vg.export_csv(filepath=str(tmp_path / "x.csv"))
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_export_after_a_refused_break_number_still_works(vg, tmp_path):
+    obj = measured_wedge()
+    x, y, z = exact(obj.vg.measurements[0])["center"]
+    bad = write(
+        tmp_path / "bad.csv", f"Mesh Name,Radius,x,y,z,Break #\nWedge,0.5,{x},{y},{z},{2**31}\n"
+    )
+    with pytest.raises(RuntimeError, match="Break #"):
+        bpy.ops.vg.import_csv(filepath=bad)
+    bpy.ops.vg.export_csv(filepath=str(tmp_path / "after.csv"))
+    assert len(read_rows(tmp_path / "after.csv")) == 1 + len(obj.vg.measurements) == 4
+
+
+@pytest.mark.parametrize("operator", ["export_csv", "import_csv"])
+def test_a_blend_relative_path_in_an_unsaved_file_is_refused(vg, tmp_path, monkeypatch, operator):
+    obj = measured_wedge()
+    bpy.ops.vg.export_csv(filepath=str(tmp_path / "m.csv"))
+    before = snapshot(obj)
+    monkeypatch.chdir(tmp_path)  # where "//" would silently land
+    assert not bpy.data.filepath
+    with pytest.raises(RuntimeError, match=r"'//m\.csv' is relative to the \.blend file .*save"):
+        getattr(bpy.ops.vg, operator)(filepath="//m.csv")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.csv"]
+    assert snapshot(obj) == before
+
+
+def test_replicating_rows_with_a_break_number_blender_cannot_store_records_nothing(vg):
+    obj = measured_wedge()
+    before = snapshot(obj)
+    x, y, z = exact(obj.vg.measurements[0])["center"]
+    row = vg.vg_addon.formats.csvio.ReplicationRow
+    rows = [row(2, "Wedge", x, y, z, radius=0.5), row(3, "Wedge", x, y, z, 0.5, break_number=2**31)]
+    with pytest.raises(vg.vg_addon.GoniometerError, match=r"row 3: Break # 2147483648"):
+        vg.bridge.measuring.replicate_rows(obj, rows)
+    assert snapshot(obj) == before
+
+
+def test_export_through_a_symbolic_link_updates_its_target_and_keeps_the_link(vg, tmp_path):
+    obj = measured_wedge()
+    target = tmp_path / "real.csv"
+    target.write_text("old\n")
+    link = tmp_path / "link.csv"
+    link.symlink_to(target)
+    bpy.ops.vg.export_csv(filepath=str(link))
+    assert link.is_symlink() and os.readlink(link) == str(target)
+    assert len(read_rows(target)) == 1 + len(obj.vg.measurements)

@@ -35,7 +35,7 @@ def painted_by(vg, obj, keep):
     for i in keep:
         m = surface.measure(*CENTRES[i])
         sides.append((m.indices, m.labels, 2 if i == 2 else 1))
-    return expected_colours(vg, len(mesh.vertices), sides)
+    return expected_colours(len(mesh.vertices), sides)
 
 
 def test_save_and_reopen_keeps_everything(vg, tmp_path):

@@ -118,7 +118,7 @@ def test_colour_attribute_paints_the_sides_and_spares_the_users_colours(vg):
     assert obj.data.color_attributes.active_color_name == COLOUR_ATTRIBUTE
     n = len(obj.data.vertices)
     expected = expected_colours(
-        vg, n, [(first.indices, first.labels, 1), (second.indices, second.labels, 2)]
+        n, [(first.indices, first.labels, 1), (second.indices, second.labels, 2)]
     )
     np.testing.assert_array_equal(colours(obj), expected)
     assert obj.vg.measurements[1].colors == "vermillion/sky blue"
@@ -193,7 +193,7 @@ def test_deforming_modifier_is_applied(vg):
     m = surface.measure([0, 0, 0], 0.5)
     assert_same(item, m)
     np.testing.assert_array_equal(
-        colours(obj), expected_colours(vg, len(obj.data.vertices), [(m.indices, m.labels, 1)])
+        colours(obj), expected_colours(len(obj.data.vertices), [(m.indices, m.labels, 1)])
     )
 
 
@@ -261,7 +261,9 @@ def test_half_annulus_right_angle(vg, shared_data):
     ]
     item = vg.bridge.measuring.measure_on_object(obj, centre, 0.4)
     assert_same(item, core_surface(obj).measure(centre, 0.4))
-    assert abs(item.angle - 90.0) < 10.0
+    # The core on the file's float64 coordinates measures 94.727° here (the bevelled crease,
+    # see tests/core/test_reference_meshes.py); Blender's float32 copy stays within 0.05° of it.
+    assert abs(exact(item)["angle"] - 94.727) < 0.05
 
 
 def test_intersecting_spheres_rim(vg, shared_data):
@@ -274,7 +276,9 @@ def test_intersecting_spheres_rim(vg, shared_data):
     radius = 0.06 * float(np.ptp(points, axis=0).max())
     item = vg.bridge.measuring.measure_on_object(obj, centre, radius)
     assert_same(item, core_surface(obj).measure(centre, radius))
-    assert abs(item.angle - 70.53) < 5.0
+    # Measured 67.956° here, 2.57° under the exact 70.53° (the rim's bevel; the core on the
+    # file's float64 coordinates reads 68.092°, its rim vertex and radius differ a little).
+    assert abs(exact(item)["angle"] - 67.956) < 0.05
 
 
 def test_sample_bone_scan(vg, shared_data):
@@ -287,4 +291,40 @@ def test_sample_bone_scan(vg, shared_data):
     radius = 0.05 * float(np.ptp(points, axis=0).max())
     item = vg.bridge.measuring.measure_on_object(obj, centre, radius)
     assert_same(item, core_surface(obj).measure(centre, radius))
-    assert 0.0 < item.angle < 180.0
+    # No true angle is known for a real scan; what is recorded must hang together: the angle is
+    # the one between the recorded side normals, and the sides share out the patch.
+    numbers = exact(item)
+    cosine = np.dot(numbers["normal_plus"], numbers["normal_minus"])
+    assert numbers["angle"] == pytest.approx(180.0 - np.degrees(np.arccos(cosine)), abs=1e-9)
+    assert item.n_plus + item.n_minus == item.n_vertices and min(item.n_plus, item.n_minus) >= 5
+
+
+def cloud_object(name, points, edges=()):
+    """A mesh object with vertices (and optionally edges) but no faces: a point cloud."""
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(np.asarray(points, dtype=np.float64).tolist(), list(edges), [])
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.context.view_layer.update()
+    return obj
+
+
+@pytest.mark.parametrize("with_edges", [False, True], ids=["vertices only", "edges only"])
+def test_a_mesh_without_faces_is_measured_as_a_point_cloud(vg, with_edges):
+    from vg_addon.synthetic_meshes import wedge
+
+    shape = wedge(100.0, n=40)
+    edges = [(int(a), int(b)) for a, b, _ in shape.triangles[:50]] if with_edges else ()
+    obj = cloud_object("Cloud", shape.points, edges)
+    assert len(obj.data.polygons) == 0 and len(obj.data.edges) == len(edges)
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.5)
+    (item,) = obj.vg.measurements
+    # The core on the same world points, without triangles (PCA normals), is the oracle.
+    m = Surface(world(local_points(obj), obj)).measure([0.0, 0.0, 0.0], 0.5)
+    assert_same(item, m)
+    assert abs(item.angle - 100.0) < 1.0
+    painted = colours(obj)
+    assert painted is not None and painted.shape == (len(shape.points), 4)

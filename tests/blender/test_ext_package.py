@@ -16,6 +16,7 @@ def test_zip_holds_the_extension_and_nothing_else(extension_zip):
         "blender_manifest.toml",
         "__init__.py",
         "properties.py",
+        "numpy_missing.py",
         "LICENSE",
         "bridge/measuring.py",
         "ui/panels.py",
@@ -86,7 +87,12 @@ def test_scene_settings_defaults(vg):
 
 
 def test_panels_live_in_the_goniometer_tab(vg):
-    for name in ("VIEW3D_PT_vg_measure", "VIEW3D_PT_vg_selected", "VIEW3D_PT_vg_csv"):
+    for name in (
+        "VIEW3D_PT_vg_measure",
+        "VIEW3D_PT_vg_selected",
+        "VIEW3D_PT_vg_edges",
+        "VIEW3D_PT_vg_csv",
+    ):
         panel = getattr(bpy.types, name)
         assert (panel.bl_space_type, panel.bl_region_type) == ("VIEW_3D", "UI")
         assert panel.bl_category == "Goniometer"

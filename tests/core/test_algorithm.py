@@ -26,7 +26,14 @@ def test_wedges_measure_their_angle(angle, irregular):
     m = Surface(mesh.points, mesh.triangles).measure([0.0, 0.0, 0.0], radius=0.5)
     assert m.angle == pytest.approx(angle, abs=0.5)
     assert m.n_plus + m.n_minus == m.n_vertices == m.indices.size
-    assert min(m.n_plus, m.n_minus) >= 3
+    # The oracle is the construction: a vertex with y > 0 lies on one face, y < 0 on the other
+    # (crease vertices, y = 0, may go either way). Every one of them is on its face's side.
+    y = mesh.points[m.indices, 1]
+    (side_a,), (side_b,) = set(m.labels[y > 0]), set(m.labels[y < 0])
+    assert side_a != side_b
+    n_a = int((y > 0).sum())
+    n_a_side = m.n_plus if side_a else m.n_minus
+    assert n_a <= n_a_side <= n_a + int((y == 0).sum())
 
 
 @pytest.mark.parametrize("angle", [15, 20, 30, 45, 60, 90])
@@ -226,3 +233,29 @@ class TestErrors:
         normals = np.array([[0, 0, 1.0]] * 6 + [[1.0, 0, 0]] * 6)
         with pytest.raises(GoniometerError, match="line"):
             goniometer(points, normals, lam=0.0)
+
+
+@pytest.mark.parametrize("scale", [2e150, 1e160, 1e200, 1e300])
+def test_coordinates_too_large_to_square_are_refused_clearly(scale):
+    shape = wedge(90.0, n=30)
+    normals = Surface(shape.points, shape.triangles).normals
+    for triangles in (shape.triangles, None):
+        with pytest.raises(GoniometerError, match=r"beyond ±1e\+150.*scale the mesh"):
+            Surface(shape.points * scale, triangles).measure([0, 0, 0], 0.5 * scale)
+    with pytest.raises(GoniometerError, match=r"beyond ±1e\+150"):
+        goniometer(shape.points * scale, normals)
+
+
+@pytest.mark.parametrize("radius", [1e-153, 1e-200, 2e150, 1e200])
+def test_a_radius_whose_square_is_not_representable_is_refused(radius):
+    shape = wedge(90.0, n=30)
+    with pytest.raises(GoniometerError, match=r"radius must be from 1e-152 to 1e\+150"):
+        Surface(shape.points, shape.triangles).measure([0, 0, 0], radius)
+
+
+@pytest.mark.parametrize("scale", [1e-151, 1e150])
+def test_the_extreme_scales_still_allowed_measure_right(scale):
+    shape = wedge(90.0, n=30)
+    for triangles in (shape.triangles, None):
+        m = Surface(shape.points * scale, triangles).measure([0, 0, 0], 0.5 * scale)
+        assert abs(m.angle - shape.angle) < 1e-9

@@ -36,10 +36,25 @@ OUR_EXTRA_COLUMNS = [
     "Requested y",
     "Requested z",
     "Snap Distance",
+    "Edge #",
+    "Arc Length",
+    "Spacing",
     "Units",
+    "Precision",
     "Stale",
     "Extension Version",
     "Blender Version",
+    "Rule",
+    "Convexity",
+    "Convexity Correlation",
+    "Stability",
+    "Stability Centre",
+    "Stability Radius",
+    "Stability SegParam",
+    "Stability Bootstrap",
+    "Stability Orientation",
+    "Stability Runs",
+    "Stability Refused",
     "error",
 ]
 
@@ -77,6 +92,17 @@ def good_row(**changes) -> MeasurementRow:
         stale=False,
         extension_version="0.1.0",
         blender_version="5.0.1",
+        rule="oriented",
+        convexity="concave",
+        correlation=-0.8660254037844386,
+        stability=0.4123,
+        stability_center=0.4123,
+        stability_radius=0.1,
+        stability_lam=0.05,
+        stability_bootstrap=0.2,
+        stability_orientation=0.0,
+        stability_runs=21,
+        stability_refused=1,
         error="",
     )
     values.update(changes)
@@ -367,6 +393,7 @@ def test_meshlab_file_parses():
             number=1,
             break_number=1,
             source_format="meshlab",
+            rule="paper",
         ),
         ReplicationRow(
             row_number=3,
@@ -381,6 +408,7 @@ def test_meshlab_file_parses():
             number=2.05,
             break_number=2,
             source_format="meshlab",
+            rule="paper",
         ),
     ]
 
@@ -615,3 +643,151 @@ def test_format_colors():
     for bad in [("orange",), ("orange", "mauve"), ((256, 0, 0), (0, 0, 0)), ((1, 2), "blue")]:
         with pytest.raises(GoniometerError):
             csvio.format_colors(bad)
+
+
+# --------------------------------------------------------------------------- the rule column
+
+
+def test_rule_and_stability_columns_round_trip():
+    text = csvio.format_measurements_csv([good_row(), good_row(rule="paper", stability=None)])
+    back = csvio.parse_measurements_csv(text)
+    assert back[0] == good_row()
+    assert back[1].rule == "paper" and back[1].stability is None
+    by_column = dict(zip(csvio.EXPORT_COLUMNS, cells(text)[1], strict=True))
+    assert by_column["Rule"] == "oriented"
+    assert by_column["Convexity"] == "concave"
+    assert by_column["Stability"] == "0.4123"
+
+
+def test_replication_keeps_the_rule_each_row_was_taken_with():
+    text = csvio.format_measurements_csv([good_row(rule="paper"), good_row(rule="oriented")])
+    assert [row.rule for row in csvio.read_replication_csv(text)] == ["paper", "oriented"]
+
+
+def test_files_from_before_the_rule_replicate_with_the_papers_rule():
+    assert {r.rule for r in csvio.read_replication_csv(MESHLAB_FILE)} == {"paper"}
+    assert {r.rule for r in csvio.read_replication_csv(OLD_ADDON_FILE)} == {"paper"}
+    old_columns = [c for c in csvio.EXPORT_COLUMNS if c not in csvio.RULE_COLUMNS]
+    full = cells(csvio.format_measurements_csv([good_row()]))
+    keep = [csvio.EXPORT_COLUMNS.index(c) for c in old_columns]
+    old_export = "\n".join(",".join(f'"{row[i]}"' for i in keep) for row in full) + "\n"
+    rows = csvio.read_replication_csv(old_export)
+    assert rows[0].source_format == "extension" and rows[0].rule == "paper"
+    assert csvio.parse_measurements_csv(old_export)[0].rule == ""
+
+
+def test_points_files_take_the_default_rule_or_their_own():
+    assert csvio.read_replication_csv("x,y,z\n1,2,3\n")[0].rule is None
+    rows = csvio.read_replication_csv("x,y,z,rule\n1,2,3,Paper\n1,2,3,\n")
+    assert [r.rule for r in rows] == ["paper", None]
+    raises_with("x,y,z,rule\n1,2,3,literal\n", "row 2", "unknown rule 'literal'")
+
+
+# --------------------------------------------------------------------------- break numbers
+
+
+@pytest.mark.parametrize("cell", ["2147483648", "99999999999999999999", "abc", "1.5", "0", "-1"])
+def test_a_break_number_that_blender_cannot_store_is_refused(cell):
+    text = f"x,y,z,Break #\n1,2,3,2\n4,5,6,{cell}\n"
+    with pytest.raises(GoniometerError) as info:
+        csvio.read_replication_csv(text)
+    message = str(info.value)
+    assert "nothing was read" in message
+    assert f"row 3: Break # must be a whole number from 1 to 2147483647 (got '{cell}')" in message
+    assert "row 2" not in message
+
+
+def test_break_numbers_at_the_limits_and_blank():
+    text = "x,y,z,Break #\n1,2,3,1\n4,5,6,2147483647\n7,8,9,\n"
+    rows = csvio.read_replication_csv(text)
+    assert [row.break_number for row in rows] == [1, 2**31 - 1, None]
+
+
+def test_an_integer_too_long_for_python_is_a_clear_problem():
+    digits = "9" * 5000  # int() refuses text this long
+    rows = csvio.read_replication_csv(f"x,y,z,Measurement #\n1,2,3,{digits}\n")
+    assert rows[0].number is None  # Measurement # is informative only: not a number then
+    with pytest.raises(GoniometerError, match="row 2: Break # must be a whole number"):
+        csvio.read_replication_csv(f"x,y,z,Break #\n1,2,3,{digits}\n")
+
+
+def test_an_export_written_before_the_precision_column_still_reads_back():
+    text = csvio.format_measurements_csv([good_row(precision="float64")])
+    header, row = csv.reader(io.StringIO(text))
+    at = header.index("Precision")
+    assert row[at] == "float64"
+    stream = io.StringIO()
+    csv.writer(stream, lineterminator="\n").writerows(
+        cells[:at] + cells[at + 1 :] for cells in (header, row)
+    )
+    (read,) = csvio.read_measurements_csv(stream.getvalue())
+    assert read.precision == "" and read.angle == good_row().angle
+
+
+# --------------------------------------------------------------------------- edge profiles
+
+
+def test_station_rows_carry_their_edge_and_replicate_with_it(tmp_path):
+    station = good_row(edge_number=3, arc_length=1.2345678901234567, spacing=0.5)
+    single = good_row(number=2)
+    path = tmp_path / "m.csv"
+    csvio.write_measurements_csv(path, [station, single])
+    back = csvio.read_measurements_csv(path)
+    assert (back[0].edge_number, back[0].arc_length, back[0].spacing) == (
+        3,
+        station.arc_length,
+        0.5,
+    )
+    assert (back[1].edge_number, back[1].arc_length, back[1].spacing) == (None, None, None)
+    rows = csvio.read_replication_csv(path)
+    assert (rows[0].edge_number, rows[0].arc_length, rows[0].spacing) == (
+        3,
+        station.arc_length,
+        0.5,
+    )
+    assert rows[1].edge_number is None
+
+
+def test_an_export_from_before_the_edge_columns_still_reads():
+    old_columns = [c for c in csvio.EXPORT_COLUMNS if c not in csvio.LATER_COLUMNS]
+    written = cells(csvio.format_measurements_csv([good_row()]))
+    keep = [i for i, c in enumerate(written[0]) if c in old_columns]
+    text = "\n".join(",".join(f'"{line[i]}"' for i in keep) for line in written) + "\n"
+    (row,) = csvio.read_measurements_csv(text)
+    assert row.angle == good_row().angle and row.edge_number is None
+
+
+def test_edge_summary_file_round_trips_beside_the_export(tmp_path):
+    points = [(0.1, -2.0, 1e-17), (3.0, 4.0, 5.123456789012345)]
+    edge = csvio.EdgeRow(
+        mesh_name="bone_12",
+        date="2024-05-01T14:03:11+02:00",
+        edge_number=1,
+        break_number=4,
+        colors="#E69F00/#0072B2",
+        n_stations=12,
+        spacing=0.5,
+        radius=3.0,
+        seg_param=2.0,
+        patch="euclidean",
+        length=5.75,
+        mean=101.25,
+        std=0.3,
+        min=100.5,
+        max=102.0,
+        pooled_angle=101.2,
+        pooled_fit=0.004,
+        points=csvio.format_points(points),
+        units="BU",
+    )
+    path = csvio.edges_path_for(tmp_path / "m.csv")
+    assert path.name == "m_edges.csv"
+    csvio.write_edges_csv(path, [edge])
+    (back,) = csvio.read_edges_csv(path)
+    assert back == edge
+    assert csvio.parse_points(back.points) == points
+    assert path.read_text().split("\n")[0] == ",".join(csvio.EDGE_COLUMNS)
+    assert csvio.is_edges_csv(path)
+    assert not csvio.is_edges_csv(csvio.format_measurements_csv([good_row()]))
+    with pytest.raises(GoniometerError, match="three numbers"):
+        csvio.parse_points("1 2")

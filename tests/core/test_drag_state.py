@@ -6,6 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vg_addon import GoniometerError, Surface
+from vg_addon.method.algorithm import MIN_RADIUS
 from vg_addon.workflow.drag_state import (
     LAM_STEP,
     MIN_PATCH_VERTICES,
@@ -235,7 +236,7 @@ def test_event_sequences(sequence):
             if record is not None:
                 records.append(record)
         if m.phase is Phase.DRAGGING:
-            if m.radius > 0:
+            if m.radius >= MIN_RADIUS:  # smaller radii are refused: no patch
                 assert m.n_vertices == brute_ball(m.center, m.radius).size
             if m.typed:  # a typed radius is exactly the number typed
                 assert m.radius == (float(m.typed) if m.typed != "." else 0.0)

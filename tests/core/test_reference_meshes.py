@@ -52,21 +52,34 @@ def plane_angle_from_labels(surface, indices, labels, pair):
     return 180 - np.degrees(np.arccos(np.clip(normals[0] @ normals[1], -1, 1)))
 
 
+# The method's error (measured angle − exact angle, degrees) on each edge at each radius, as
+# measured on this mesh with NumPy 1.26 and 2.x (identical there). The bevelled creases and
+# curved faces of the marching-cubes mesh cause it: each edge is checked against its own value
+# with a margin of MARGIN_DEG, so a change in the method shows up as a change in one of these.
+MEASURED_ERROR_DEG = {
+    ((CUT, OUTER), 0.3): 1.967, ((CUT, OUTER), 0.4): -1.786, ((CUT, OUTER), 0.5): -2.679,
+    ((CUT_2, OUTER), 0.3): 1.967, ((CUT_2, OUTER), 0.4): -1.786, ((CUT_2, OUTER), 0.5): -2.730,
+    ((CUT, INNER), 0.3): 8.586, ((CUT, INNER), 0.4): 8.939, ((CUT, INNER), 0.5): 13.027,
+    ((CUT_2, INNER), 0.3): 8.586, ((CUT_2, INNER), 0.4): 8.905, ((CUT_2, INNER), 0.5): 11.043,
+    ((TOP, OUTER), 0.3): 5.588, ((TOP, OUTER), 0.4): 4.727, ((TOP, OUTER), 0.5): 3.985,
+    ((BOTTOM, INNER), 0.3): 4.142, ((BOTTOM, INNER), 0.4): 2.224, ((BOTTOM, INNER), 0.5): -0.295,
+    ((TOP, CUT), 0.3): 3.495, ((TOP, CUT), 0.4): 1.938, ((TOP, CUT), 0.5): 1.676,
+}  # fmt: skip
+MARGIN_DEG = 0.05  # the values above are rounded to 0.001°; this leaves room for BLAS rounding
+
+
 @pytest.mark.parametrize("radius", [0.3, 0.4, 0.5])
 @pytest.mark.parametrize(("name", "pair", "exact"), HALF_ANNULUS_EDGES)
 def test_half_annulus_edges(half_annulus, name, pair, exact, radius):
     surface, mesh, labels = half_annulus
     center = edge_midpoint(mesh, labels, pair)
     m = surface.measure(center, radius)
-    if "concave" in name and radius == 0.5:
-        # The curved inner face bends ~19° across this patch, so even the true segmentation's
-        # planes read about 10.5° high here (and the ball grazes the bottom face's bevel, which
-        # adds up to 3°): the method must stay near that, it cannot beat the geometry.
-        truth = plane_angle_from_labels(surface, m.indices, labels, pair)
-        assert abs(truth - exact) > 10
-        assert abs(m.angle - truth) < 3.0
-    else:
-        assert abs(m.angle - exact) < 10.0, f"{name}: {m.angle:.2f}° vs {exact}°"
+    expected = exact + MEASURED_ERROR_DEG[(pair, radius)]
+    assert abs(m.angle - expected) < MARGIN_DEG, f"{name}: {m.angle:.3f}° vs {expected:.3f}°"
+    # Independently of the recorded values: the error is the geometry's, not the method's. The
+    # planes of the true segmentation (from the labels) meet at nearly the same angle.
+    truth = plane_angle_from_labels(surface, m.indices, labels, pair)
+    assert abs(m.angle - truth) < 3.0, f"{name}: {m.angle:.2f}° vs labels' {truth:.2f}°"
 
 
 def test_half_annulus_segmentation_follows_the_labels(half_annulus):
@@ -101,9 +114,9 @@ def test_intersecting_spheres_rim_approaches_exact_as_radius_shrinks(spheres):
     center = rim_point(surface)
     extent = float(np.ptp(surface.points, axis=0).max())
     radii = [extent * f for f in (0.2, 0.12, 0.06)]
-    errors = [abs(surface.measure(center, r).angle - 70.53) for r in radii]
-    assert errors[0] > errors[1] > errors[2], errors
-    assert errors[2] < 5.0, errors
+    errors = [surface.measure(center, r).angle - 70.53 for r in radii]
+    # Measured (degrees, rounded to 0.001): the rim's bevel shrinks relative to the patch.
+    assert errors == pytest.approx([-10.036, -5.425, -2.438], abs=MARGIN_DEG)
 
 
 @pytest.mark.parametrize("name", ["HalfAnnulus", "IntersectingSpheres", "sample_mesh"])

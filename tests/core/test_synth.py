@@ -324,3 +324,31 @@ def test_roughness_is_deterministic_small_and_keeps_the_mesh_closed(fragment):
 def test_bone_fragment_rejects_bad_arguments(kwargs, message):
     with pytest.raises(GoniometerError, match=message):
         bone_fragment(**kwargs)
+
+
+@pytest.mark.parametrize("concave", [False, True])
+@pytest.mark.parametrize(("angle", "fillet"), [(30, 0.05), (90, 0.02), (150, 0.1), (60, 0.0)])
+def test_bevelled_wedge_geometry(angle, fillet, concave):
+    """Planar parts on the exact planes with the exact outward normals; the fillet an arc of the
+    given radius, tangent to both faces."""
+    from vg_addon import Surface
+    from vg_addon.synthetic_meshes import bevelled_wedge
+
+    mesh = bevelled_wedge(angle, fillet, concave=concave)
+    surface = Surface(mesh.points, mesh.triangles)
+    for side, normal in ((1, mesh.normal_plus), (-1, mesh.normal_minus)):
+        on_face = mesh.side == side
+        offset = mesh.points[on_face] @ normal
+        assert np.ptp(offset) < 1e-12  # one plane
+        interior = on_face & (np.abs(mesh.points[:, 0]) < 0.9)
+        assert (surface.normals[interior] @ normal).min() > 1 - 1e-9
+    half = np.radians(angle) / 2
+    # The faces' planes pass through the sharp crease (the x axis) when extended.
+    assert np.abs(mesh.points[mesh.side == 1] @ mesh.normal_plus).max() < 1e-12
+    if fillet:
+        arc = mesh.points[mesh.side == 0]
+        centre_z = (1 if concave else -1) * fillet / np.sin(half)
+        radius = np.hypot(arc[:, 1], arc[:, 2] - centre_z)
+        assert np.abs(radius - fillet).max() < 1e-12
+    else:
+        assert np.abs(mesh.points[mesh.side == 0][:, 1:]).max() == 0

@@ -6,6 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vg_addon import GoniometerError, withinss_split
+from vg_addon.method.algorithm import MIN_SIDE_VERTICES
 
 
 def brute_force(values, min_size=1):
@@ -22,17 +23,23 @@ def brute_force(values, min_size=1):
     return best
 
 
+@pytest.mark.parametrize("min_size", [1, MIN_SIDE_VERTICES])  # the default, and as measured
 @settings(max_examples=300, deadline=None)
 @given(
     st.lists(
         st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False), min_size=2, max_size=60
     ).filter(lambda v: len(set(v)) >= 2)
 )
-def test_split_matches_brute_force(values):
-    threshold, cost = withinss_split(values)
-    expected_cost, _ = brute_force(values)
+def test_split_matches_brute_force(min_size, values):
+    expected_cost, expected_threshold = brute_force(values, min_size)
+    if expected_threshold is None:  # no split leaves min_size values on both sides
+        with pytest.raises(GoniometerError):
+            withinss_split(values, min_size=min_size)
+        return
+    threshold, cost = withinss_split(values, min_size=min_size)
     p = np.asarray(values)
     upper, lower = p[p >= threshold], p[p < threshold]
+    assert min(upper.size, lower.size) >= min_size
     achieved = ((upper - upper.mean()) ** 2).sum() + ((lower - lower.mean()) ** 2).sum()
     assert achieved == pytest.approx(expected_cost, rel=1e-9, abs=1e-9)
     assert cost == pytest.approx(achieved, rel=1e-7, abs=1e-7)

@@ -38,6 +38,7 @@ from datetime import datetime
 from pathlib import Path
 
 from ..errors import GoniometerError, bounded_list
+from ..method.algorithm import RULES
 from ..method.surface import PATCH_MODES
 from ..palette import OKABE_ITO
 
@@ -85,15 +86,80 @@ _SCHEMA = (
     ("normal_minus", "vec3", ("Normal - x", "Normal - y", "Normal - z")),
     ("requested", "vec3", ("Requested x", "Requested y", "Requested z")),
     ("snap_distance", "float", ("Snap Distance",)),
+    ("edge_number", "int", ("Edge #",)),
+    ("arc_length", "float", ("Arc Length",)),
+    ("spacing", "float", ("Spacing",)),
     ("units", "text", ("Units",)),
+    ("precision", "text", ("Precision",)),
     ("stale", "bool", ("Stale",)),
+    ("extension_version", "text", ("Extension Version",)),
+    ("blender_version", "text", ("Blender Version",)),
+    ("rule", "text", ("Rule",)),
+    ("convexity", "text", ("Convexity",)),
+    ("correlation", "float", ("Convexity Correlation",)),
+    ("stability", "float", ("Stability",)),
+    ("stability_center", "float", ("Stability Centre",)),
+    ("stability_radius", "float", ("Stability Radius",)),
+    ("stability_lam", "float", ("Stability SegParam",)),
+    ("stability_bootstrap", "float", ("Stability Bootstrap",)),
+    ("stability_orientation", "float", ("Stability Orientation",)),
+    ("stability_runs", "int", ("Stability Runs",)),
+    ("stability_refused", "int", ("Stability Refused",)),
+    ("error", "text", ("error",)),
+)
+
+#: Columns added with the oriented rule (issue 8). Exports written before lack them; such a file
+#: still reads, and its rows replicate with the paper's rule, the only one there was then.
+RULE_COLUMNS = (
+    "Rule",
+    "Convexity",
+    "Convexity Correlation",
+    "Stability",
+    "Stability Centre",
+    "Stability Radius",
+    "Stability SegParam",
+    "Stability Bootstrap",
+    "Stability Orientation",
+    "Stability Runs",
+    "Stability Refused",
+)
+
+#: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
+EXPORT_COLUMNS = tuple(column for _, _, columns in _SCHEMA for column in columns)
+
+#: Columns added after the first exports: a file without them still reads (their cells empty).
+LATER_COLUMNS = ("Precision", *RULE_COLUMNS, "Edge #", "Arc Length", "Spacing")
+
+# The edge summary file: one row per measured edge profile (see EdgeRow).
+_EDGE_SCHEMA = (
+    ("mesh_name", "text", ("Mesh Name",)),
+    ("date", "text", ("Date",)),
+    ("edge_number", "int", ("Edge #",)),
+    ("break_number", "int", ("Break #",)),
+    ("colors", "text", ("Colors",)),
+    ("user_data", "text", ("User Data",)),
+    ("n_stations", "int", ("Stations",)),
+    ("spacing", "float", ("Spacing",)),
+    ("radius", "float", ("Radius",)),
+    ("seg_param", "float", ("SegParam",)),
+    ("patch", "text", ("Patch Mode",)),
+    ("length", "float", ("Length",)),
+    ("mean", "float", ("Mean Angle",)),
+    ("std", "float", ("SD Angle",)),
+    ("min", "float", ("Min Angle",)),
+    ("max", "float", ("Max Angle",)),
+    ("pooled_angle", "float", ("Pooled Angle",)),
+    ("pooled_fit", "float", ("Pooled Fit",)),
+    ("points", "text", ("Points",)),
+    ("flat_spans", "text", ("Flat Spans",)),
+    ("units", "text", ("Units",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
     ("error", "text", ("error",)),
 )
 
-#: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
-EXPORT_COLUMNS = tuple(column for _, _, columns in _SCHEMA for column in columns)
+#: Every column of an edge summary file.
+EDGE_COLUMNS = tuple(column for _, _, columns in _EDGE_SCHEMA for column in columns)
 
 #: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
 SOURCE_FORMATS = ("extension", "meshlab", "points")
@@ -107,7 +173,9 @@ _FALSE = "FALSE"
 _FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "'")
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_INTEGER = re.compile(r"[+-]?\d+")
+# At most 18 digits: every such integer fits 64 bits, and int() never meets Python's limit on
+# the length of integer text.
+_INTEGER = re.compile(r"[+-]?\d{1,18}")
 
 # File extensions a CSV's mesh name may carry (MeshLab writes the scan's file name).
 _MESH_FILE_SUFFIXES = frozenset(
@@ -172,11 +240,34 @@ class MeasurementRow:
         The centre that was asked for, before snapping.
     snap_distance : float or None
         Distance from ``requested`` to ``(x, y, z)``.
+    edge_number : int or None
+        The edge profile the row is a station of (``None`` for a single measurement).
+    arc_length : float or None
+        The station's arc length along its edge's traced path.
+    spacing : float or None
+        The edge's station spacing.
     units : str
         What one coordinate unit is.
+    precision : str
+        The coordinates measured: ``"float32"`` (a Blender mesh, as Blender stores it) or
+        ``"float64"`` (a mesh file's double-precision coordinates, measured as the file holds
+        them); empty for a failed row.
     stale : bool
         The mesh changed since the measurement was taken.
     extension_version, blender_version : str
+    rule : str
+        ``"oriented"`` or ``"paper"``: how the projection was signed (see ``vg_addon.method``).
+    convexity : str
+        ``"convex"``, ``"concave"`` (the angle is then the open wedge's) or ``"unclear"``.
+    correlation : float or None
+        The correlation whose sign gives the convexity (its size: how clearly).
+    stability : float or None
+        The stability figure, degrees (the "±"); empty when it was not computed.
+    stability_center, stability_radius, stability_lam, stability_bootstrap, stability_orientation : float or None
+        Its parts: the largest change of the angle with the centre moved, the radius ±10%, λ from
+        1 to 3, the bootstrap's 95% half-width, and the other sign's reading where unclear.
+    stability_runs, stability_refused : int or None
+        Perturbed measurements tried, and how many of them were refused.
     error : str
         Empty for a good row; why it failed otherwise.
     """
@@ -204,11 +295,96 @@ class MeasurementRow:
     normal_minus: tuple[float, float, float] | None = None
     requested: tuple[float, float, float] | None = None
     snap_distance: float | None = None
+    edge_number: int | None = None
+    arc_length: float | None = None
+    spacing: float | None = None
     units: str = ""
+    precision: str = ""
     stale: bool = False
     extension_version: str = ""
     blender_version: str = ""
+    rule: str = ""
+    convexity: str = ""
+    correlation: float | None = None
+    stability: float | None = None
+    stability_center: float | None = None
+    stability_radius: float | None = None
+    stability_lam: float | None = None
+    stability_bootstrap: float | None = None
+    stability_orientation: float | None = None
+    stability_runs: int | None = None
+    stability_refused: int | None = None
     error: str = ""
+
+
+@dataclass
+class EdgeRow:
+    """One row of an edge summary file: what the stations of one edge profile say together.
+
+    Attributes
+    ----------
+    mesh_name, date, colors, user_data, units, extension_version, blender_version, error : str
+        As in :class:`MeasurementRow`.
+    edge_number, break_number : int or None
+        The edge (its stations carry the same ``Edge #``) and its break.
+    n_stations : int or None
+    spacing, radius, seg_param : float or None
+        The settings every station was measured with; ``patch`` the patch mode.
+    length : float or None
+        Arc length of the traced path.
+    mean, std, min, max : float or None
+        Of the stations' angles (degrees); ``std`` is the sample standard deviation.
+    pooled_angle, pooled_fit : float or None
+        One plane pair fitted to all stations' sides (the whole-edge angle), and its fit error.
+    points : str
+        The clicked points that define the path, ``"x y z; x y z; ..."`` (start, via, end).
+    flat_spans : str
+        Arc-length intervals where the path crossed no ridge, ``"a-b; ..."``; empty if none.
+    """
+
+    mesh_name: str = ""
+    date: str = ""
+    edge_number: int | None = None
+    break_number: int | None = None
+    colors: str = ""
+    user_data: str = ""
+    n_stations: int | None = None
+    spacing: float | None = None
+    radius: float | None = None
+    seg_param: float | None = None
+    patch: str = ""
+    length: float | None = None
+    mean: float | None = None
+    std: float | None = None
+    min: float | None = None
+    max: float | None = None
+    pooled_angle: float | None = None
+    pooled_fit: float | None = None
+    points: str = ""
+    flat_spans: str = ""
+    units: str = ""
+    extension_version: str = ""
+    blender_version: str = ""
+    error: str = ""
+
+
+def format_points(points) -> str:
+    """The ``Points`` cell of an edge row: ``"x y z; x y z"`` with every float in full."""
+    return "; ".join(" ".join(repr(float(v)) for v in point) for point in points)
+
+
+def parse_points(text: str) -> list[tuple[float, float, float]]:
+    """The points of a ``Points`` cell (see :func:`format_points`)."""
+    points = []
+    for part in text.split(";"):
+        values = part.split()
+        if len(values) != 3:
+            raise GoniometerError(f"A point of the edge must be three numbers x y z; got {part!r}.")
+        try:
+            points.append(tuple(float(v) for v in values))
+        except ValueError:
+            raise GoniometerError(f"A point of the edge is not three numbers: {part!r}.") from None
+    return points
 
 
 @dataclass(frozen=True)
@@ -236,11 +412,20 @@ class ReplicationRow:
         The original ``Measurement #`` (MeshLab's burst measurements are fractional, e.g. 3.05);
         ``None`` when absent, blank or not a number.
     break_number : int or None
-        The original ``Break #``; ``None`` when absent, blank or not a whole number.
+        The original ``Break #`` (1 to :data:`MAX_BREAK_NUMBER`); ``None`` when absent or blank.
+    edge_number : int or None
+        The ``Edge #`` of an edge profile's station; ``None`` for a single measurement.
+    arc_length, spacing : float or None
+        A station's ``Arc Length`` and its edge's ``Spacing`` (kept with the re-measured station).
     source_format : str
         ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
         columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
         else with x, y, z columns).
+    rule : str or None
+        The rule to replicate with: the ``Rule`` cell of an export; ``"paper"`` for MeshLab and
+        earlier add-on files and for exports written before the ``Rule`` column existed (they
+        were all measured with the paper's rule); a points file's ``rule`` column, else ``None``
+        (the current default).
     """
 
     row_number: int
@@ -254,7 +439,11 @@ class ReplicationRow:
     label: str | None = None
     number: int | float | None = None
     break_number: int | None = None
+    edge_number: int | None = None
+    arc_length: float | None = None
+    spacing: float | None = None
     source_format: str = "points"
+    rule: str | None = None
 
 
 # --------------------------------------------------------------------------- small helpers
@@ -413,9 +602,9 @@ def _float_cell(value, index, row, column) -> str:
     return repr(number)
 
 
-def _row_cells(index: int, row: MeasurementRow) -> list[str]:
+def _row_cells(index: int, row, schema=_SCHEMA) -> list[str]:
     cells = []
-    for field, kind, columns in _SCHEMA:
+    for field, kind, columns in schema:
         value = getattr(row, field)
         if kind == "text":
             cells.append(_escape_text("" if value is None else str(value)))
@@ -477,6 +666,18 @@ def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
     return "".join(lines)
 
 
+#: The path that means standard output.
+STDOUT = "-"
+
+
+def format_edges_csv(rows: Iterable[EdgeRow]) -> str:
+    """The text of an edge summary file: the :data:`EDGE_COLUMNS` header and one line per edge,
+    written like :func:`format_measurements_csv`."""
+    lines = [_csv_line(EDGE_COLUMNS)]
+    lines.extend(_csv_line(_row_cells(index, row, _EDGE_SCHEMA)) for index, row in enumerate(rows))
+    return "".join(lines)
+
+
 def _replace_atomically(path: str, data: bytes) -> None:
     folder = os.path.dirname(os.path.abspath(path)) or "."
     if not os.path.isdir(folder):
@@ -517,23 +718,142 @@ def _replace_atomically(path: str, data: bytes) -> None:
         raise
 
 
-def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
-    """Write an export to ``path`` (UTF-8, comma-delimited, ``\\n`` line ends), atomically.
+def _write_into(path: str, data: bytes) -> None:
+    """Write ``data`` into an open-ended target (a pipe, a terminal, standard output), in place."""
+    try:
+        if path == STDOUT:
+            handle = os.dup(1)
+        else:
+            # No O_CREAT and no O_TRUNC: the target exists and is never replaced or emptied;
+            # O_APPEND keeps what a shell's ">>" already put in a file behind /dev/stdout.
+            handle = os.open(path, os.O_WRONLY | os.O_APPEND | getattr(os, "O_BINARY", 0))
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+            stream.flush()
+    except OSError as error:
+        where = "standard output" if path == STDOUT else repr(path)
+        raise GoniometerError(
+            f"Could not write the CSV to {where}: {error.strerror or error}."
+        ) from error
 
-    The whole text is formatted first (see :func:`format_measurements_csv`), then written to a
-    temporary file in the same folder and moved over ``path`` in one step, so ``path`` holds
-    either its old content or the complete new one; on any failure the temporary file is
-    removed. An existing file's permissions are kept.
+
+def _is_descriptor_alias(path: str) -> bool:
+    """Whether ``path`` reaches, through its symbolic links, a name of an open file descriptor
+    (``/dev/stdout`` -> ``/proc/self/fd/1``, ``/dev/fd/1``): writing to it means writing into
+    the file this process already has open, never replacing it."""
+    current = os.path.abspath(path)
+    for _ in range(40):  # the kernel's own limit on links followed
+        if current.startswith(("/proc/", "/dev/fd/")):
+            return True
+        if not os.path.islink(current):
+            return False
+        current = os.path.normpath(os.path.join(os.path.dirname(current), os.readlink(current)))
+    return False
+
+
+def output_target(path) -> str:
+    """How :func:`write_measurements_csv` will write to ``path``, or why it cannot.
+
+    Returns
+    -------
+    str
+        ``"file"``: a regular file (new, or replaced atomically; through a symbolic link, its
+        target is replaced and the link kept). ``"stream"``: ``"-"`` (standard output), a pipe,
+        a terminal or another character device such as ``/dev/null``, or a name of an open file
+        descriptor such as ``/dev/stdout``: the text is written into it, once, never replacing
+        it.
 
     Raises
     ------
     GoniometerError
-        A row that cannot be written, a missing folder, or a target that cannot be replaced.
+        A folder, a block device or a socket, or a folder that does not exist.
+    """
+    path = os.fspath(path)
+    if path == STDOUT:
+        return "stream"
+    try:
+        info = os.stat(path)  # follows symbolic links
+    except FileNotFoundError:
+        target = os.path.realpath(path)  # a dangling link is created at its target
+        folder = os.path.dirname(target) or "."
+        if not os.path.isdir(folder):
+            raise GoniometerError(
+                f"The folder {folder!r} does not exist: choose an existing folder to write "
+                f"{os.path.basename(path)!r} to."
+            ) from None
+        return "file"
+    except OSError as error:
+        raise GoniometerError(f"Cannot write to {path!r}: {error.strerror or error}.") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise GoniometerError(
+            f"{path!r} is a folder: give a file name for the CSV, e.g. "
+            f"{os.path.join(path, 'measurements.csv')!r}."
+        )
+    if stat.S_ISREG(info.st_mode):
+        if _is_descriptor_alias(path):
+            return "stream"
+        if not os.access(path, os.W_OK):
+            raise GoniometerError(
+                f"{path!r} is read-only: it is left as it is. Choose another file name, or make "
+                "it writable first."
+            )
+        return "file"
+    if stat.S_ISCHR(info.st_mode) or stat.S_ISFIFO(info.st_mode):
+        return "stream"
+    kind = "a block device" if stat.S_ISBLK(info.st_mode) else "a socket or other special file"
+    raise GoniometerError(
+        f"{path!r} is {kind}, not a file: choose a file name, or '-' for standard output."
+    )
+
+
+def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
+    """Write an export to ``path`` (UTF-8, comma-delimited, ``\\n`` line ends).
+
+    The whole text is formatted first (see :func:`format_measurements_csv`). A regular file is
+    written atomically: to a temporary file in the same folder, then moved over ``path`` in one
+    step, so ``path`` holds either its old content or the complete new one; on any failure the
+    temporary file is removed. An existing file's permissions are kept; through a symbolic link,
+    the link's target is replaced and the link stays. ``"-"``, a pipe, a terminal, a character
+    device (``/dev/null``) or a name of an open descriptor (``/dev/stdout``) is written into,
+    never replaced (see :func:`output_target`).
+
+    Raises
+    ------
+    GoniometerError
+        A row that cannot be written, a missing folder, a folder or other target that is not a
+        file, a target that cannot be replaced, or a stream that refuses the data (e.g.
+        ``/dev/full``).
     OSError
         Other file-system errors (disk full, no permission to create the file, ...).
     """
     data = format_measurements_csv(rows).encode("utf-8")
-    _replace_atomically(os.fspath(path), data)
+    replace_atomically(path, data)
+
+
+def replace_atomically(path, data: bytes) -> None:
+    """Write ``data`` to ``path``, the way every output file of the project is written.
+
+    A regular file (or a new one) is replaced in one step, through a temporary file beside it,
+    so it holds its old content or the new one, never part of it; a symbolic link keeps its link
+    and its target is replaced. ``-`` (standard output), devices and pipes are written into,
+    never replaced. See :func:`output_target` for what is refused.
+    """
+    path = os.fspath(path)
+    if output_target(path) == "stream":
+        _write_into(path, data)
+    else:
+        _replace_atomically(os.path.realpath(path), data)
+
+
+def edges_path_for(path) -> Path:
+    """Where the edge summary of the export ``path`` goes: ``name_edges.csv`` beside it."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}_edges{path.suffix or '.csv'}")
+
+
+def write_edges_csv(path, rows: Iterable[EdgeRow]) -> None:
+    """Write an edge summary file to ``path``, atomically, like :func:`write_measurements_csv`."""
+    replace_atomically(path, format_edges_csv(rows).encode("utf-8"))
 
 
 # --------------------------------------------------------------------------- reading
@@ -652,6 +972,10 @@ _REPLICATION_ALIASES = {
     "label": ("label", "user data", "note", "notes"),
     "number": ("measurement #", "measurement number", "measurement", "number"),
     "break_number": ("break #", "break number", "break"),
+    "rule": ("rule",),
+    "edge_number": ("edge #", "edge number", "edge"),
+    "arc_length": ("arc length", "arc"),
+    "spacing": ("spacing",),
     "error": ("error",),
 }
 _REQUIRED = ("x", "y", "z")
@@ -702,6 +1026,20 @@ def _lenient_number(raw: str) -> int | float | None:
         value = float(text)
         return value if math.isfinite(value) else None
     return None
+
+
+#: The largest ``Break #`` (Blender stores it as a 32-bit signed integer).
+MAX_BREAK_NUMBER = 2**31 - 1
+
+
+def _parse_break_number(raw: str) -> int | str | None:
+    """The break number of a cell, ``None`` when blank, or why it is not one (a str)."""
+    text = raw.strip()
+    if not text:
+        return None
+    if _INTEGER.fullmatch(text) and 1 <= int(text) <= MAX_BREAK_NUMBER:
+        return int(text)
+    return f"must be a whole number from 1 to {MAX_BREAK_NUMBER} (got {text!r})"
 
 
 def parse_replication_csv(text: str, source: str = "The CSV text") -> list[ReplicationRow]:
@@ -755,7 +1093,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
             skipped += 1
             continue
         values: dict[str, float | None] = {}
-        for field in ("x", "y", "z", "radius", "lam"):
+        for field in ("x", "y", "z", "radius", "lam", "arc_length", "spacing"):
             raw = cell(field)
             if not raw.strip():
                 values[field] = None
@@ -775,6 +1113,9 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
             problems.append(
                 f"row {number}: {name_of('lam')} (λ) must be 0 or more (got {cell('lam').strip()})"
             )
+        break_number = _parse_break_number(cell("break_number"))
+        if isinstance(break_number, str):
+            problems.append(f"row {number}: {name_of('break_number')} {break_number}")
         patch = _parse_optional_text(cell("patch"))
         if patch is not None:
             patch = patch.casefold()
@@ -783,9 +1124,18 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                     f"row {number}: unknown patch mode {cell('patch').strip()!r} "
                     f"(use {' or '.join(PATCH_MODES)})"
                 )
+        rule = _parse_optional_text(cell("rule"))
+        if rule is not None:
+            rule = rule.casefold()
+            if rule not in RULES:
+                problems.append(
+                    f"row {number}: unknown rule {cell('rule').strip()!r} (use {' or '.join(RULES)})"
+                )
+        elif fmt != "points":
+            rule = "paper"  # MeshLab, the earlier add-on, exports from before the Rule column
         if problems:
             continue  # nothing is returned anyway; keep collecting
-        break_number = _lenient_number(cell("break_number"))
+        edge_number = _lenient_number(cell("edge_number"))
         rows.append(
             ReplicationRow(
                 row_number=number,
@@ -798,8 +1148,12 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 patch=patch,
                 label=_parse_optional_text(cell("label")),
                 number=_lenient_number(cell("number")),
-                break_number=break_number if isinstance(break_number, int) else None,
+                break_number=break_number,
+                edge_number=edge_number if isinstance(edge_number, int) else None,
+                arc_length=values["arc_length"],
+                spacing=values["spacing"],
                 source_format=fmt,
+                rule=rule,
             )
         )
     if problems:
@@ -834,7 +1188,10 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
     aliases: ``Mesh Name``/``Mesh``/``Object``; ``x``/``Center x``; ``Radius``/``r``;
     ``SegParam``/``Seg Param``/``lambda``/``λ``/``Segmentation Parameter``;
     ``Patch Mode``/``patch``; ``label``/``User Data``/``note`` (``label`` wins over
-    ``User Data``); ``Measurement #``; ``Break #``; ``error``. Only x, y and z are required.
+    ``User Data``); ``Measurement #``; ``Break #``; ``Rule`` (``oriented`` or ``paper``);
+    ``error``. Only x, y and z are required. Rows of MeshLab and earlier add-on files, and of
+    exports without a ``Rule`` column, replicate with the paper's rule (see
+    :attr:`ReplicationRow.rule`).
     A UTF-8 byte-order mark is ignored; cells are read without surrounding whitespace, and the
     apostrophe the writer puts before formula-like text is removed.
 
@@ -847,7 +1204,8 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
         One error listing every problem (the first 20, then "and N more") with its row number
         and column name: missing x/y/z columns (naming those found), duplicate columns, a blank,
         non-numeric or non-finite x/y/z/radius/lambda, radius ≤ 0, λ < 0, an unknown patch
-        mode, a row with more cells than the header; or: an empty file, a header without data
+        mode, a ``Break #`` that is not a whole number from 1 to :data:`MAX_BREAK_NUMBER`, a row
+        with more cells than the header; or: an empty file, a header without data
         rows, only failed rows, a ``;`` or tab delimiter, text that is not UTF-8. Nothing is
         returned then.
     OSError
@@ -870,25 +1228,52 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     """Parse an export written by :func:`format_measurements_csv` back into rows.
 
     Every column of :data:`EXPORT_COLUMNS` must be present (in any order; names are matched
-    case-insensitively); text cells are kept as written (only the formula-guard apostrophe is
-    removed), numbers read back bit-identical. Blank lines are skipped.
+    case-insensitively), except the :data:`LATER_COLUMNS`, which older exports lack; text cells
+    are kept as written (only the formula-guard apostrophe is removed), numbers read back
+    bit-identical. Blank lines are skipped.
 
     Raises
     ------
     GoniometerError
         Listing every missing column and every cell that does not parse, with row numbers.
     """
+    return _parse_table(text, source, _SCHEMA, MeasurementRow, LATER_COLUMNS, "an export")
+
+
+def parse_edges_csv(text: str, source: str = "The CSV text") -> list[EdgeRow]:
+    """Parse an edge summary file written by :func:`format_edges_csv` back into rows."""
+    return _parse_table(text, source, _EDGE_SCHEMA, EdgeRow, (), "an edge summary file")
+
+
+def is_edges_csv(path_or_text) -> bool:
+    """Whether a CSV file (or text) is an edge summary file: its header has ``Edge #``,
+    ``Points`` and ``Spacing``."""
+    text, source = _load(path_or_text)
+    _, header = _header(_records(text, source), source)
+    names = {_normalise(name) for name in header}
+    return {"edge #", "points", "spacing"} <= names
+
+
+def read_edges_csv(path_or_text) -> list[EdgeRow]:
+    """Read an edge summary file (see :func:`parse_edges_csv`); arguments as for
+    :func:`read_replication_csv`."""
+    text, source = _load(path_or_text)
+    return parse_edges_csv(text, source)
+
+
+def _parse_table(text, source, schema, row_type, optional, what):
     records = _records(text, source)
     header_at, header = _header(records, source)
     problems: list[str] = []
-    aliases = {column: (_normalise(column),) for column in EXPORT_COLUMNS}
+    all_columns = [column for _, _, names in schema for column in names]
+    aliases = {column: (_normalise(column),) for column in all_columns}
     columns = _resolve_columns(header, aliases, problems)
-    missing = [column for column in EXPORT_COLUMNS if column not in columns]
+    missing = [c for c in all_columns if c not in columns and c not in optional]
     if missing:
         problems.insert(
             0,
             f"header: missing the column(s) {', '.join(missing)}; this reader needs a complete "
-            "export of this extension (use read_replication_csv for other files)",
+            f"{what} of this extension (use read_replication_csv for other files)",
         )
     if problems:
         raise _problems_error(source, problems)
@@ -899,8 +1284,8 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
             continue
 
         def cell(column: str, cells=cells) -> str:
-            index = columns[column]
-            return cells[index] if index < len(cells) else ""
+            index = columns.get(column)
+            return cells[index] if index is not None and index < len(cells) else ""
 
         def number_of(column: str, number=number) -> float | None:
             raw = cell(column)
@@ -912,7 +1297,7 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
             return value
 
         values = {}
-        for field, kind, names in _SCHEMA:
+        for field, kind, names in schema:
             if kind == "text":
                 values[field] = _unescape_text(cell(names[0]))
             elif kind == "float":
@@ -934,7 +1319,7 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
                     problems.append(
                         f"row {number}: {', '.join(names)} must be all filled or all empty"
                     )
-        rows.append(MeasurementRow(**values))
+        rows.append(row_type(**values))
     if problems:
         raise _problems_error(source, problems)
     return rows
@@ -948,3 +1333,72 @@ def read_measurements_csv(path_or_text) -> list[MeasurementRow]:
     """
     text, source = _load(path_or_text)
     return parse_measurements_csv(text, source)
+
+
+# --------------------------------------------------------------------------- radius sweeps
+
+#: The columns of a radius-sweep CSV: one row per radius, refused radii with their message.
+SWEEP_COLUMNS = (
+    "Mesh Name",
+    "Measurement #",
+    "Radius",
+    "Angle",
+    "fit",
+    "Number of Vertices",
+    "Vertices +",
+    "Vertices -",
+    "Convexity",
+    "x",
+    "y",
+    "z",
+    "Requested x",
+    "Requested y",
+    "Requested z",
+    "SegParam",
+    "Patch Mode",
+    "Rule",
+    "error",
+)
+
+
+def sweep_cells(mesh_name: str, number: int | None, point) -> list[str]:
+    """The cells of one :data:`SWEEP_COLUMNS` row for a ``vg_addon.method.sweep.SweepPoint``.
+
+    A refused radius keeps its radius and message; its measured cells are empty.
+    """
+    m = point.measurement
+
+    def cell(value, column):
+        return _float_cell(value, 0, point, column)
+
+    cells = [_escape_text(str(mesh_name)), "" if number is None else str(int(number))]
+    cells.append(cell(point.radius, "Radius"))
+    if m is None:
+        cells += [""] * (len(SWEEP_COLUMNS) - 4)
+    else:
+        cells += [
+            cell(m.angle, "Angle"),
+            cell(m.fit_error, "fit"),
+            str(int(m.n_vertices)),
+            str(int(m.n_plus)),
+            str(int(m.n_minus)),
+            m.convexity,
+            *(cell(v, "x") for v in m.center),
+            *(cell(v, "Requested x") for v in m.requested_center),
+            cell(m.lam, "SegParam"),
+            m.patch,
+            m.rule,
+        ]
+    cells.append(_escape_text(point.error))
+    return cells
+
+
+def format_sweep_rows(rows: Iterable[Sequence[str]]) -> str:
+    """A sweep CSV's text: the :data:`SWEEP_COLUMNS` header, then rows from :func:`sweep_cells`."""
+    return _csv_line(SWEEP_COLUMNS) + "".join(_csv_line(cells) for cells in rows)
+
+
+def write_sweep_csv(path, mesh_name: str, points, number: int | None = None) -> None:
+    """Write one site's sweep to ``path`` atomically (as :func:`write_measurements_csv`)."""
+    text = format_sweep_rows(sweep_cells(mesh_name, number, point) for point in points)
+    replace_atomically(os.fspath(path), text.encode("utf-8"))

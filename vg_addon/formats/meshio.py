@@ -155,9 +155,11 @@ def _finish(path: Path, points, triangles, normals, source_dtype: str) -> MeshDa
             low, high = int(triangles.min()), int(triangles.max())
             if low < 0 or high >= n:
                 bad_value = low if low < 0 else high
+                first = int(np.flatnonzero(((triangles < 0) | (triangles >= n)).any(axis=1))[0])
                 raise GoniometerError(
                     f"'{path}': face index out of range: a face refers to vertex {bad_value} "
-                    f"(counting from 0), but the file has {n} vertices (valid 0..{n - 1}). "
+                    f"(counting from 0; the first bad one is in triangle {first}, polygons "
+                    f"split into triangles), but the file has {n} vertices (valid 0..{n - 1}). "
                     "The file is corrupt or was written incorrectly; re-export it."
                 )
         else:
@@ -209,6 +211,22 @@ def _parse_numbers(text: bytes) -> np.ndarray | None:
             return np.fromstring(text, dtype=np.float64, sep=" ")
         except (ValueError, DeprecationWarning):
             return None
+
+
+_NOT_A_NUMBER = re.compile(
+    rb"(?<!\S)(?![+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?!\S)|[+-]?(?i:nan|inf(?:inity)?)(?!\S))\S+"
+)
+
+
+def _where_not_a_number(data: bytes, pos: int) -> str:
+    """``", line N ('token')"`` for the first word from ``pos`` on that is not a number (only
+    for error messages), or ``""`` if none is found."""
+    found = _NOT_A_NUMBER.search(data, pos)
+    if found is None:
+        return ""
+    line = data.count(b"\n", 0, found.start()) + 1
+    word = found.group().decode("utf-8", "replace")[:40]
+    return f", line {line} ({word!r})"
 
 
 # -------------------------------------------------------------------------------------------- PLY
@@ -557,8 +575,8 @@ def _ply_ascii_body(data, pos, elements, wanted, path) -> dict:
     numbers = _parse_numbers(data[pos:])
     if numbers is None:
         raise GoniometerError(
-            f"'{path}': the ASCII PLY data contains something that is not a number; "
-            "the file is corrupt."
+            f"'{path}'{_where_not_a_number(data, pos)}: the ASCII PLY data contains something "
+            "that is not a number; the file is corrupt."
         )
     found: dict[str, dict] = {}
     at = 0

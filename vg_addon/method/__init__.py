@@ -7,13 +7,25 @@
 - ``geodesic``: distances along mesh edges, for geodesic patches.
 - ``normals``: area-weighted vertex normals, and PCA normals for point clouds.
 - ``result``: ``Measurement``, what one measurement returns.
+- ``edge_profile``: a whole break edge: traced along the ridge, measured every ``spacing``.
 - ``ranges``: the vectorised index-range expansion the index and the graph share.
 """
 
 from .algorithm import goniometer
+from .edge_profile import EdgePath, EdgeProfile, EdgeSummary
 from .result import Measurement
 from .spatial import GridIndex
 from .surface import PATCH_MODES, Surface
 from .withinss import withinss_split
 
-__all__ = ["PATCH_MODES", "GridIndex", "Measurement", "Surface", "goniometer", "withinss_split"]
+__all__ = [
+    "PATCH_MODES",
+    "EdgePath",
+    "EdgeProfile",
+    "EdgeSummary",
+    "GridIndex",
+    "Measurement",
+    "Surface",
+    "goniometer",
+    "withinss_split",
+]

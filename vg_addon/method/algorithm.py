@@ -18,7 +18,33 @@ MAX_LAMBDA = 1e6
 FLAT_TOLERANCE_DEG = 0.5
 """Angles closer than this to 180° mean the patch holds no break edge."""
 
+RULES = ("oriented", "paper")
+"""How the position term of the projection is signed. ``"oriented"`` (the default) multiplies it
+by the sign of the covariance between ``Nᵀb`` and ``(X − x̄)ᵀb``, which makes concave edges and
+inward-wound meshes read right; ``"paper"`` is Algorithm 1 as printed, ``p = bᵀ[N + (λ/r)(X − x̄)]``,
+kept to replicate measurements taken with the MeshLab plugin and the earlier add-on."""
+
+CONVEXITIES = ("convex", "concave", "unclear")
+"""The edge labels of a measurement, relative to the given (outward) normals."""
+
+WEAK_CORRELATION = 0.2
+"""Below this absolute correlation between ``Nᵀb`` and ``(X − x̄)ᵀb`` the sign of the position term
+is weakly determined: the patch holds no clear convex or concave edge, so the oriented rule
+measures both signs and keeps the better plane fit, and the edge is labelled ``"unclear"``."""
+
+SHARED_ROW_FACTOR = 1.5
+"""A side whose vertices lie on one line borrows the other side's vertices within this factor of
+the nearest one's distance to that line: the row of vertices on the edge, which belongs to both
+faces."""
+
 _RANK_TOLERANCE = 1e-10
+
+MAX_MAGNITUDE = 1e150
+"""Largest coordinate and radius, in any unit: squares of larger values, and sums of them over
+many points, overflow float64 (from about 1e154). A scan in any real unit is far below this."""
+
+MIN_RADIUS = 1e-152
+"""Smallest patch radius: squared distances below about 1e-154 lose precision (subnormal)."""
 
 
 def canonical_order(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
@@ -40,17 +66,55 @@ def _smallest_eigenvector(matrix: np.ndarray) -> tuple[float, np.ndarray, np.nda
     return float(values[0]), vector, values
 
 
-def _fit_plane(points: np.ndarray, side: str) -> tuple[np.ndarray, float]:
-    """PCA plane fit: the unit normal and the mean squared distance of the points to the plane."""
+def _plane(points: np.ndarray) -> tuple[np.ndarray, float, bool]:
+    """PCA plane fit: unit normal, mean squared distance to the plane, and whether the points
+    span a plane at all (``False``: they lie on a line)."""
     centred = points - points.mean(axis=0)
     covariance = centred.T @ centred / points.shape[0]
     error, normal, values = _smallest_eigenvector(covariance)
-    if values[1] <= _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny):
-        raise GoniometerError(
-            f"The vertices on the {side} side lie on a line, so no plane can be fitted: "
-            "use a larger radius or move the centre onto the break edge."
-        )
-    return normal, max(error, 0.0)
+    spans = bool(values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny))
+    return normal, max(error, 0.0), spans
+
+
+def _row_beside(line_points: np.ndarray, others: np.ndarray) -> np.ndarray:
+    """Mask of ``others`` on the row nearest to and parallel with the line through
+    ``line_points``; all False when the nearest vertices do not form such a row."""
+    centred = line_points - line_points.mean(axis=0)
+    direction = np.linalg.eigh(centred.T @ centred)[1][:, 2]
+    offsets = others - line_points.mean(axis=0)
+    across = offsets - np.outer(offsets @ direction, direction)
+    distance = np.sqrt(np.einsum("ij,ij->i", across, across))
+    beside = distance <= SHARED_ROW_FACTOR * distance.min()
+    # A row parallel to the line sits at one offset across it; scattered neighbours do not.
+    scatter = np.linalg.norm(across[beside] - across[beside].mean(axis=0), axis=1).max()
+    if beside.sum() < 3 or scatter > 0.25 * distance.min():
+        beside[:] = False
+    return beside
+
+
+def _fit_side(points, normals, mask, side: str) -> tuple[np.ndarray, float, int]:
+    """The plane of one side, its fit error and how many vertices it borrowed from the other.
+
+    A side that is a single row of vertices (a coarse mesh across a near-flat edge) has no plane
+    of its own; the row of the other side nearest it (the vertices on the edge, which lie on both
+    faces) completes it.
+    """
+    normal, error, spans = _plane(points[mask])
+    borrowed = 0
+    if not spans:
+        beside = _row_beside(points[mask], points[~mask])
+        borrowed = int(beside.sum())
+        if borrowed:
+            normal, error, spans = _plane(np.vstack([points[mask], points[~mask][beside]]))
+        if not spans:
+            raise GoniometerError(
+                f"The vertices on the {side} side lie on a line, even with the row of vertices "
+                "beside it, so no plane can be fitted: use a larger radius (each side needs at "
+                "least two rows of vertices off the edge) or move the centre onto the break edge."
+            )
+    if np.dot(normal, normals[mask].mean(axis=0)) < 0:
+        normal = -normal
+    return normal, error, borrowed
 
 
 def _check_finite(name: str, array: np.ndarray) -> None:
@@ -63,12 +127,73 @@ def _check_finite(name: str, array: np.ndarray) -> None:
         )
 
 
+def check_rule(rule) -> str:
+    """Return the rule in lower case, or raise if it is not one of :data:`RULES`."""
+    name = str(rule).lower()
+    if name not in RULES:
+        raise GoniometerError(
+            f"Unknown rule {rule!r}: use 'oriented' (the default, right on concave edges and "
+            "inward-wound meshes) or 'paper' (Algorithm 1 as printed, to replicate old measurements)."
+        )
+    return name
+
+
+def _correlation(a: np.ndarray, b: np.ndarray) -> float:
+    """Pearson correlation of two vectors; 0 when either is constant."""
+    a = a - a.mean()
+    b = b - b.mean()
+    scale = float(np.sqrt(np.dot(a, a) * np.dot(b, b)))
+    return float(np.dot(a, b)) / scale if scale > 0 else 0.0
+
+
+def _split_and_fit(points, normals, projection) -> dict:
+    """Steps 9-13 of Algorithm 1: the WithinSS split of ``projection`` and a plane per side."""
+    threshold, _ = withinss_split(projection, min_size=MIN_SIDE_VERTICES)
+    labels = projection >= threshold
+    normal_plus, error_plus, shared_plus = _fit_side(points, normals, labels, "+")
+    normal_minus, error_minus, shared_minus = _fit_side(points, normals, ~labels, "-")
+    cosine = float(np.clip(np.dot(normal_plus, normal_minus), -1.0, 1.0))
+    angle = 180.0 - float(np.degrees(np.arccos(cosine)))
+    if angle < FLAT_TOLERANCE_DEG:
+        raise GoniometerError(
+            f"The two sides fit planes folded onto each other ({angle:.2f}°): the patch is too "
+            "small or straddles a thin sliver. Use a larger radius or move the centre."
+        )
+    if angle > 180.0 - FLAT_TOLERANCE_DEG:
+        raise GoniometerError(
+            f"No break edge found: the two sides fit planes within {180.0 - angle:.2f}° of each other, "
+            "so the patch is flat. Move the centre onto the break edge, or use a larger radius."
+        )
+    return {
+        "angle": angle,
+        "fit_error": error_plus + error_minus,
+        "fit_error_plus": error_plus,
+        "fit_error_minus": error_minus,
+        "normal_plus": normal_plus,
+        "normal_minus": normal_minus,
+        "threshold": threshold,
+        "labels": labels,
+        "n_plus": int(labels.sum()),
+        "n_minus": int((~labels).sum()),
+        "n_shared": shared_plus + shared_minus,
+    }
+
+
+def _planes_form_ridge(points, fields) -> bool:
+    """Whether the fitted planes meet in a ridge (convex) rather than a valley, relative to their
+    normals: moving from the "−" side's centroid to the "+" side's, the normal turns the same way."""
+    labels = fields["labels"]
+    step = points[labels].mean(axis=0) - points[~labels].mean(axis=0)
+    return float(np.dot(step, fields["normal_plus"] - fields["normal_minus"])) > 0
+
+
 def measure_patch(
     points: np.ndarray,
     normals: np.ndarray,
     center: np.ndarray,
     radius: float,
     lam: float,
+    rule: str = "oriented",
 ) -> dict:
     """Run Algorithm 1 on a validated, canonically ordered float64 patch.
 
@@ -91,46 +216,51 @@ def measure_patch(
             "cancel out): move the centre onto a break edge or use a larger radius."
         )
     binormal = cross / cross_norm
-    projection = (normals + (lam / radius) * (points - center)) @ binormal
-    threshold, _ = withinss_split(projection, min_size=MIN_SIDE_VERTICES)
-    labels = projection >= threshold
-
-    sides = {}
-    for name, mask in (("+", labels), ("-", ~labels)):
-        normal, error = _fit_plane(points[mask], name)
-        if np.dot(normal, normals[mask].mean(axis=0)) < 0:
-            normal = -normal
-        sides[name] = (normal, error, int(mask.sum()))
-
-    (normal_plus, error_plus, n_plus), (normal_minus, error_minus, n_minus) = sides["+"], sides["-"]
-    cosine = float(np.clip(np.dot(normal_plus, normal_minus), -1.0, 1.0))
-    angle = 180.0 - float(np.degrees(np.arccos(cosine)))
-    if angle < FLAT_TOLERANCE_DEG:
-        raise GoniometerError(
-            f"The two sides fit planes folded onto each other ({angle:.2f}°): the patch is too "
-            "small or straddles a thin sliver. Use a larger radius or move the centre."
+    correlation = _correlation(normals @ binormal, (points - center) @ binormal)
+    orientation = -1 if rule == "oriented" and correlation < 0 else 1
+    # The "+1" projection is the paper's expression, evaluated exactly as before, so ridges (and
+    # every measurement under the paper's rule) stay bit-identical.
+    paper_projection = (normals + (lam / radius) * (points - center)) @ binormal
+    flipped_projection = (normals - (lam / radius) * (points - center)) @ binormal
+    first, second = (
+        (paper_projection, flipped_projection)
+        if orientation > 0
+        else (flipped_projection, paper_projection)
+    )
+    weak = abs(correlation) < WEAK_CORRELATION
+    if not (rule == "oriented" and weak and lam > 0):
+        fields = _split_and_fit(points, normals, first)
+        other_angle = None
+    else:
+        # The sign is weakly determined: measure with both and keep the better plane fit.
+        readings = []
+        for sign, projection in ((orientation, first), (-orientation, second)):
+            try:
+                readings.append((sign, _split_and_fit(points, normals, projection)))
+            except GoniometerError as error:
+                refusal = error
+        if not readings:
+            raise refusal
+        orientation, fields = min(readings, key=lambda reading: reading[1]["fit_error"])
+        other_angle = next(
+            (r["angle"] for sign, r in readings if sign != orientation), fields["angle"]
         )
-    if angle > 180.0 - FLAT_TOLERANCE_DEG:
-        raise GoniometerError(
-            f"No break edge found: the two sides fit planes within {180.0 - angle:.2f}° of each other, "
-            "so the patch is flat. Move the centre onto the break edge, or use a larger radius."
-        )
-    return {
-        "angle": angle,
-        "fit_error": error_plus + error_minus,
-        "fit_error_plus": error_plus,
-        "fit_error_minus": error_minus,
-        "normal_plus": normal_plus,
-        "normal_minus": normal_minus,
-        "tangent": tangent,
-        "mean_normal": mean_normal / np.linalg.norm(mean_normal),
-        "binormal": binormal,
-        "threshold": threshold,
-        "labels": labels,
-        "n_vertices": n_points,
-        "n_plus": n_plus,
-        "n_minus": n_minus,
-    }
+    if weak or _planes_form_ridge(points, fields) != (correlation >= 0):
+        convexity = "unclear"
+    else:
+        convexity = "convex" if correlation >= 0 else "concave"
+    fields.update(
+        tangent=tangent,
+        mean_normal=mean_normal / np.linalg.norm(mean_normal),
+        binormal=binormal,
+        n_vertices=n_points,
+        rule=rule,
+        orientation=orientation,
+        correlation=correlation,
+        convexity=convexity,
+        orientation_difference=0.0 if other_angle is None else abs(other_angle - fields["angle"]),
+    )
+    return fields
 
 
 def as_points(name: str, values, *, allow_empty: bool = False) -> np.ndarray:
@@ -146,6 +276,12 @@ def as_points(name: str, values, *, allow_empty: bool = False) -> np.ndarray:
     if not allow_empty and array.shape[0] == 0:
         raise GoniometerError(f"There are no {name}: the mesh or patch is empty.")
     _check_finite(name, array)
+    largest = float(np.abs(array).max()) if array.size else 0.0
+    if largest > MAX_MAGNITUDE:
+        raise GoniometerError(
+            f"The {name} reach {largest:.3g}, beyond ±{MAX_MAGNITUDE:g}, where squared distances "
+            "overflow: scale the mesh to a real unit (e.g. millimetres) before measuring."
+        )
     return array
 
 
@@ -157,6 +293,11 @@ def as_radius(radius) -> float:
         raise GoniometerError(f"The radius must be a number; got {radius!r}.") from None
     if not np.isfinite(value) or value <= 0:
         raise GoniometerError(f"The radius must be a finite number greater than 0; got {value!r}.")
+    if not MIN_RADIUS <= value <= MAX_MAGNITUDE:
+        raise GoniometerError(
+            f"The radius must be from {MIN_RADIUS:g} to {MAX_MAGNITUDE:g}, where squared "
+            f"distances stay representable; got {value!r}. Scale the mesh to a real unit."
+        )
     return value
 
 
@@ -208,7 +349,9 @@ def as_normals(normals, n_points: int) -> np.ndarray:
     return unit_normals("normals", normals)
 
 
-def goniometer(points, normals, lam: float = 2.0, center=None, radius=None) -> Measurement:
+def goniometer(
+    points, normals, lam: float = 2.0, center=None, radius=None, rule: str = "oriented"
+) -> Measurement:
     """Measure the break angle of a patch you already have (Algorithm 1 of the paper).
 
     Parameters
@@ -223,6 +366,8 @@ def goniometer(points, normals, lam: float = 2.0, center=None, radius=None) -> M
         The centre ``x̄`` of the projection; default the mean of ``points``.
     radius : float, optional
         The ``r`` of the projection; default the largest distance from ``center`` to a point.
+    rule : {"oriented", "paper"}, optional
+        How the projection's position term is signed (see :data:`RULES`); default ``"oriented"``.
 
     Returns
     -------
@@ -238,6 +383,7 @@ def goniometer(points, normals, lam: float = 2.0, center=None, radius=None) -> M
     points = as_points("points", points)
     normals = as_normals(normals, points.shape[0])
     lam = as_lambda(lam)
+    rule = check_rule(rule)
     order = canonical_order(points, normals)
     ordered_points, ordered_normals = points[order], normals[order]
     center = ordered_points.mean(axis=0) if center is None else as_center(center)
@@ -246,7 +392,7 @@ def goniometer(points, normals, lam: float = 2.0, center=None, radius=None) -> M
         if radius <= 0:
             raise GoniometerError("All points coincide, so the patch has no extent to measure.")
     radius = as_radius(radius)
-    fields = measure_patch(ordered_points, ordered_normals, center, radius, lam)
+    fields = measure_patch(ordered_points, ordered_normals, center, radius, lam, rule)
     labels = np.empty_like(fields["labels"])
     labels[order] = fields["labels"]
     fields["labels"] = labels

@@ -10,6 +10,9 @@ from .ranges import expand_ranges
 class EdgeGraph:
     """The undirected edges of a triangle mesh in compressed sparse row form, built once.
 
+    Within a vertex's row the edges are in no particular order: the distances do not depend on
+    it (the relaxation below reaches the same least fixed point in any order).
+
     Parameters
     ----------
     points : ndarray, shape (n, 3)
@@ -20,13 +23,17 @@ class EdgeGraph:
         n = points.shape[0]
         a = triangles.ravel()
         b = triangles[:, [1, 2, 0]].ravel()
-        source = np.concatenate([a, b])
-        target = np.concatenate([b, a])
-        keys = np.unique(source * np.int64(n) + target)
-        self.source = keys // n
-        self.target = keys % n
+        # Each undirected edge once (low end, high end), then both directions grouped by source:
+        # two sorts of half the length of one sort of every directed edge.
+        keys = np.unique(np.minimum(a, b) * np.int64(n) + np.maximum(a, b))
+        low, high = keys // n, keys % n
+        lengths = np.linalg.norm(points[low] - points[high], axis=1)
+        source = np.concatenate([low, high])
+        order = np.argsort(source, kind="stable")
+        self.source = source[order]
+        self.target = np.concatenate([high, low])[order]
+        self.lengths = np.concatenate([lengths, lengths])[order]
         self.starts = np.searchsorted(self.source, np.arange(n + 1, dtype=np.int64))
-        self.lengths = np.linalg.norm(points[self.source] - points[self.target], axis=1)
         self._local = np.full(n, -1, dtype=np.int64)
 
     def distances(self, vertices: np.ndarray, source: int, radius: float) -> np.ndarray:

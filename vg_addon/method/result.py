@@ -7,6 +7,51 @@ from dataclasses import dataclass
 import numpy as np
 
 
+@dataclass(frozen=True)
+class Stability:
+    """How much a measurement's angle depends on where and how it was taken.
+
+    Each part is the largest change of the angle, in degrees, under one kind of perturbation of
+    the measurement (the changes that make two drag measurements of one edge differ); ``spread``,
+    the figure shown as "± 0.4°", is the largest part.
+
+    Attributes
+    ----------
+    spread : float
+        The largest of the parts below.
+    center : float
+        The centre moved to each vertex within two mean edge lengths of it.
+    radius : float
+        The radius 10% smaller and 10% larger.
+    lam : float
+        λ at 1, 1.5, 2, 2.5 and 3.
+    bootstrap : float
+        Half the width of the central 95% interval of the angle over bootstrap resamples of the
+        patch's vertices (Algorithm 1 redone on each: tangent, split and planes).
+    orientation : float
+        :attr:`Measurement.orientation_difference`: where convex or concave is unclear, how far
+        the reading with the other sign of the position term was.
+    n_runs : int
+        Perturbed measurements tried: centre, radius, λ and the bootstrap resamples.
+    n_failed : int
+        Of those, how many were refused (too few vertices, no edge, ...); they add nothing to
+        the parts, so a large count means the figure is optimistic.
+    """
+
+    spread: float
+    center: float
+    radius: float
+    lam: float
+    bootstrap: float
+    orientation: float
+    n_runs: int
+    n_failed: int
+
+    def text(self) -> str:
+        """The figure as shown: ``"± 0.4°"`` (two decimals below 0.1°)."""
+        return f"± {self.spread:.2f}°" if self.spread < 0.1 else f"± {self.spread:.1f}°"
+
+
 @dataclass(frozen=True, eq=False)
 class Measurement:
     """Everything one measurement produced, and everything needed to redo it.
@@ -14,7 +59,8 @@ class Measurement:
     Attributes
     ----------
     angle : float
-        Interior angle of the break edge in degrees, ``180 - arccos(v+ . v-)``.
+        ``180 - arccos(v+ . v-)`` in degrees: the solid's interior angle on a convex edge; on a
+        concave edge the angle of the open wedge (360° minus the solid's interior angle).
     fit_error : float
         ``fit_error_plus + fit_error_minus``: the summed mean squared distances of each side's
         vertices to its fitted plane (squared length units).
@@ -48,6 +94,26 @@ class Measurement:
         The segmentation parameter λ (the MeshLab plugin's ``SegParam``).
     patch : str
         How the patch was chosen: ``"euclidean"``, ``"geodesic"`` or ``"given"``.
+    rule : str
+        ``"oriented"`` (the default) or ``"paper"``: how the projection's position term was signed.
+    orientation : int
+        The sign ``s`` (+1 or -1) the position term was given; always +1 under the paper's rule.
+    correlation : float
+        The correlation between ``Nᵀb`` and ``(X - x̄)ᵀb`` over the patch, from -1 to 1: its
+        sign is the edge's convexity, its size how clearly the patch shows it.
+    convexity : str
+        ``"convex"``, ``"concave"`` or ``"unclear"`` (``|correlation| < 0.2``, or the fitted planes
+        disagree with its sign), relative to the normals as given: on an inward-wound mesh a
+        convex edge reads ``"concave"``.
+    orientation_difference : float
+        Where the convexity is unclear, the oriented rule measures with both signs and keeps the
+        better plane fit: how far the other reading was, in degrees (0 otherwise).
+    n_shared : int
+        Vertices used by both planes: a side that is one row of vertices (a coarse mesh across a
+        near-flat edge) borrows the row beside it on the edge. Usually 0.
+    stability : Stability or None
+        How much the angle moves under small changes of centre, radius and λ, and under a
+        bootstrap of the vertices (``None`` unless asked for).
     """
 
     angle: float
@@ -72,10 +138,28 @@ class Measurement:
     radius: float
     lam: float
     patch: str
+    rule: str
+    orientation: int
+    correlation: float
+    convexity: str
+    orientation_difference: float
+    n_shared: int
+    stability: Stability | None = None
+
+    @property
+    def angle_meaning(self) -> str:
+        """What the angle is, for the place it is shown: interior, open wedge, or either."""
+        if self.convexity == "convex":
+            return "interior angle of the solid"
+        if self.convexity == "concave":
+            return "open wedge angle (360° minus the solid's interior angle)"
+        return "angle between the fitted planes (convex or concave unclear)"
 
     def summary(self) -> str:
         """One line for reports: angle, fit error, radius, λ and vertex counts."""
+        spread = "" if self.stability is None else f" {self.stability.text()}"
         return (
-            f"{self.angle:.2f}° (fit {self.fit_error:.3g}, r={self.radius:g}, λ={self.lam:g}, "
-            f"{self.n_vertices} vertices: {self.n_plus}+/{self.n_minus}-)"
+            f"{self.angle:.2f}°{spread} {self.convexity} (fit {self.fit_error:.3g}, "
+            f"r={self.radius:g}, λ={self.lam:g}, {self.n_vertices} vertices: "
+            f"{self.n_plus}+/{self.n_minus}-)"
         )

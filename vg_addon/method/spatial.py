@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import GoniometerError
@@ -74,6 +76,7 @@ class GridIndex:
         cell_size = max(float(cell_size), float(extent.max()) / _MAX_CELLS_PER_AXIS, 1e-300)
         self.cell_size = cell_size
         self.dims = (np.floor(extent / cell_size).astype(np.int64) + 1).astype(np.int64)
+        self._top = tuple(int(d) - 1 for d in self.dims)
         ijk = self._cells(points)
         keys = (ijk[:, 0] * self.dims[1] + ijk[:, 1]) * self.dims[2] + ijk[:, 2]
         order = np.argsort(keys, kind="stable")
@@ -86,14 +89,20 @@ class GridIndex:
         ijk = np.floor((coordinates - self.origin) / self.cell_size).astype(np.int64)
         return np.clip(ijk, 0, self.dims - 1)
 
-    def _candidates(self, center: np.ndarray, radius: float) -> np.ndarray:
+    def _candidates(self, center, radius: float) -> np.ndarray:
         """Positions (into the sorted arrays) of the points in the cells the ball's box overlaps."""
-        low = np.floor((center - radius - self.origin) / self.cell_size)
-        high = np.floor((center + radius - self.origin) / self.cell_size)
-        if (high < 0).any() or (low > self.dims - 1).any():
-            return np.empty(0, dtype=np.int64)
-        low = np.clip(low, 0, self.dims - 1).astype(np.int64)
-        high = np.clip(high, 0, self.dims - 1).astype(np.int64)
+        # Plain float arithmetic: the same IEEE operations as NumPy's on 3-vectors, without the
+        # per-call overhead of tiny arrays.
+        size = self.cell_size
+        low, high = [], []
+        for axis in range(3):
+            c, o, top = float(center[axis]), float(self.origin[axis]), self._top[axis]
+            lo = math.floor((c - radius - o) / size) if math.isfinite(radius) else -math.inf
+            hi = math.floor((c + radius - o) / size) if math.isfinite(radius) else math.inf
+            if hi < 0 or lo > top:
+                return np.empty(0, dtype=np.int64)
+            low.append(int(min(max(lo, 0), top)))
+            high.append(int(min(max(hi, 0), top)))
         ix = np.arange(low[0], high[0] + 1, dtype=np.int64)
         iy = np.arange(low[1], high[1] + 1, dtype=np.int64)
         column = ((ix[:, None] * self.dims[1] + iy[None, :]) * self.dims[2]).ravel()
@@ -124,10 +133,19 @@ class GridIndex:
                 squared = np.einsum("ij,ij->i", offsets, offsets)
                 inside = squared <= radius * radius
                 if inside.any():
-                    positions, squared = positions[inside], squared[inside]
-                    coords = self.points[positions]
-                    best = np.lexsort((coords[:, 2], coords[:, 1], coords[:, 0], squared))[0]
-                    return int(self.ids[positions[best]]), float(np.sqrt(squared[best]))
+                    best = self._closest(positions[inside], squared[inside])
+                    return int(self.ids[best[0]]), best[1]
             if radius >= max_distance:
                 return -1, float("inf")
             radius = min(radius * 4.0, max_distance)
+
+    def _closest(self, positions: np.ndarray, squared: np.ndarray) -> tuple[int, float]:
+        """The position with the smallest squared distance (ties broken by x, y, z), and its
+        distance."""
+        smallest = squared.min()
+        tied = np.flatnonzero(squared == smallest)
+        best = tied[0]
+        if tied.size > 1:
+            coords = self.points[positions[tied]]
+            best = tied[np.lexsort((coords[:, 2], coords[:, 1], coords[:, 0]))[0]]
+        return int(positions[best]), math.sqrt(float(smallest))

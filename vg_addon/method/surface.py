@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..errors import GoniometerError
@@ -12,13 +14,16 @@ from .algorithm import (
     as_normals,
     as_points,
     as_radius,
-    canonical_order,
+    check_rule,
     measure_patch,
 )
 from .geodesic import EdgeGraph
 from .normals import pca_normals, vertex_normals
+from .ordering import canonical_ranks
 from .result import Measurement
 from .spatial import GridIndex
+from .stability import estimate_stability
+from .winding import mesh_winding
 
 PATCH_MODES = ("euclidean", "geodesic")
 
@@ -75,6 +80,7 @@ class Surface:
         if self.triangles is not None and self.triangles.shape[0] == 0:
             self.triangles = None
         self._graph = None
+        self._winding = None
         full_index = None
         if normals is not None:
             self.normals = as_normals(normals, n)
@@ -94,11 +100,20 @@ class Surface:
             self.index = full_index  # the same points: the normals' index serves the queries
         else:
             self.index = GridIndex(self.points[self.valid_ids], ids=self.valid_ids)
+        self.ranks = canonical_ranks(self.points, self.normals)
 
     @property
     def n_points(self) -> int:
         """Number of vertices (including any without a normal)."""
         return self.points.shape[0]
+
+    @property
+    def winding(self) -> str:
+        """``"outward"``, ``"inward"``, ``"mixed"`` or ``"open"`` (see ``winding.WINDINGS``);
+        computed on first use. On an ``"inward"`` surface convex edges are labelled concave."""
+        if self._winding is None:
+            self._winding = mesh_winding(self.points, self.triangles)
+        return self._winding
 
     def snap(self, center, radius: float) -> tuple[int, float]:
         """Index of the vertex nearest ``center`` and its distance; an error if farther than ``radius``."""
@@ -106,11 +121,7 @@ class Surface:
         radius = as_radius(radius)
         vertex, distance = self.index.nearest(center, radius)
         if vertex < 0:
-            raise GoniometerError(
-                f"The centre ({center[0]:g}, {center[1]:g}, {center[2]:g}) is farther than the radius "
-                f"{radius:g} from every vertex of the surface: pick a point on the surface, or check "
-                "that the coordinates are in the mesh's units and frame."
-            )
+            raise _too_far(center, radius)
         return vertex, distance
 
     def patch(self, center_index: int, radius: float, patch: str = "euclidean") -> np.ndarray:
@@ -126,8 +137,11 @@ class Surface:
                 f"Vertex {center_index} cannot be a patch centre: it is not a vertex of this "
                 "surface with a normal. Use Surface.snap to find one."
             )
-        center = self.points[center_index]
-        indices, _ = self.index.ball(center, radius)
+        indices, _ = self.index.ball(self.points[center_index], radius)
+        return self._restrict(indices, int(center_index), radius, mode)
+
+    def _restrict(self, indices: np.ndarray, center_index: int, radius: float, mode: str):
+        """The patch within the Euclidean ball ``indices``: all of it, or its geodesic part."""
         if mode == "geodesic":
             if self.triangles is None:
                 raise GoniometerError(
@@ -141,7 +155,13 @@ class Surface:
         return indices
 
     def measure(
-        self, center, radius: float, lam: float = 2.0, patch: str = "euclidean"
+        self,
+        center,
+        radius: float,
+        lam: float = 2.0,
+        patch: str = "euclidean",
+        rule: str = "oriented",
+        stability: bool = False,
     ) -> Measurement:
         """Measure the break angle at ``center`` (Algorithm 1 on the patch around it).
 
@@ -155,6 +175,12 @@ class Surface:
             Segmentation parameter λ ≥ 0 (default 2).
         patch : {"euclidean", "geodesic"}, optional
             How the patch is chosen (default ``"euclidean"``).
+        rule : {"oriented", "paper"}, optional
+            How the projection's position term is signed (default ``"oriented"``; ``"paper"`` is
+            Algorithm 1 as printed, for replicating old measurements).
+        stability : bool, optional
+            Also compute :attr:`Measurement.stability` (about as costly as a dozen measurements,
+            batched; default ``False``).
 
         Returns
         -------
@@ -170,20 +196,30 @@ class Surface:
         radius = as_radius(radius)
         lam = as_lambda(lam)
         mode = check_patch_mode(patch)
-        center_index, snap_distance = self.snap(requested, radius)
-        indices = self.patch(center_index, radius, mode)
+        rule = check_rule(rule)
+        # The snap looks up the few cells around the click, the ball those around the snapped
+        # vertex: cheaper than one lookup of a box large enough for both (measured).
+        center_index, snap_distance = self.index.nearest(requested, radius)
+        if center_index < 0:
+            raise _too_far(requested, radius)
+        ball, _ = self.index.ball(self.points[center_index], radius)
+        indices = self._restrict(ball, center_index, radius, mode)
         if indices.size < 2 * MIN_SIDE_VERTICES:
             raise GoniometerError(
                 f"The patch of radius {radius:g} holds only {indices.size} vertices; at least "
                 f"{2 * MIN_SIDE_VERTICES} are needed: use a larger radius."
             )
-        points, normals = self.points[indices], self.normals[indices]
-        order = canonical_order(points, normals)
-        indices = indices[order]
+        # The canonical order (see algorithm.canonical_order), from the ranks sorted at build.
+        indices = indices[np.argsort(self.ranks[indices], kind="stable")]
         fields = measure_patch(
-            points[order], normals[order], self.points[center_index], radius, lam
+            self.points[indices],
+            self.normals[indices],
+            self.points[center_index],
+            radius,
+            lam,
+            rule,
         )
-        return Measurement(
+        measurement = Measurement(
             **fields,
             indices=indices,
             center=self.points[center_index].copy(),
@@ -194,6 +230,31 @@ class Surface:
             lam=lam,
             patch=mode,
         )
+        if stability:
+            measurement = replace(measurement, stability=estimate_stability(self, measurement))
+        return measurement
+
+    def trace_edge(self, start, end, via=()):
+        """The break edge from ``start`` through ``via`` to ``end``, as an ``EdgePath`` of mesh
+        vertices following the ridge; see :func:`vg_addon.method.edge_profile.trace_edge`."""
+        from .edge_profile import trace_edge
+
+        return trace_edge(self, start, end, via)
+
+    def measure_along(self, path, spacing, radius, lam=2.0, patch="euclidean"):
+        """Measure stations every ``spacing`` along ``path``: an ``EdgeProfile``; see
+        :func:`vg_addon.method.edge_profile.measure_along`."""
+        from .edge_profile import measure_along
+
+        return measure_along(self, path, spacing, radius, lam, patch)
+
+
+def _too_far(center: np.ndarray, radius: float) -> GoniometerError:
+    return GoniometerError(
+        f"The centre ({center[0]:g}, {center[1]:g}, {center[2]:g}) is farther than the radius "
+        f"{radius:g} from every vertex of the surface: pick a point on the surface, or check "
+        "that the coordinates are in the mesh's units and frame."
+    )
 
 
 def check_patch_mode(patch) -> str:

@@ -1,2 +1,3 @@
 """How measurements are driven, without Blender: the batch plan (``batchplan``: which rows are
-measured on which mesh) and the click-and-drag tool's state machine (``drag_state``)."""
+measured on which mesh) the click-and-drag tool's state machine (``drag_state``) and the edge-profile
+clicks' (``edge_state``)."""

@@ -56,6 +56,9 @@ class Task:
         The mesh name as the input gave it (for rows that match no mesh).
     error : str
         Why this task cannot be measured at all; empty for a task to measure.
+    rule : str
+        ``"oriented"`` or ``"paper"``: a CSV row's own rule (MeshLab and earlier add-on rows
+        carry the paper's), else the run's.
     """
 
     index: int
@@ -70,6 +73,7 @@ class Task:
     source_row: int | None = None
     mesh_name: str = ""
     error: str = ""
+    rule: str = "oriented"
 
 
 # --------------------------------------------------------------------------- command line values
@@ -175,7 +179,13 @@ def mesh_names(files: Sequence[str | os.PathLike]) -> list[str]:
 
 
 def plan_points(
-    n_meshes: int, points: Sequence[Sequence[float]], *, radius, lam: float, patch: str
+    n_meshes: int,
+    points: Sequence[Sequence[float]],
+    *,
+    radius,
+    lam: float,
+    patch: str,
+    rule: str = "oriented",
 ) -> list[Task]:
     """Tasks for ``--at`` points: every point on every mesh (mesh by mesh, points in order).
 
@@ -199,6 +209,7 @@ def plan_points(
                     lam=lam,
                     patch=patch,
                     number=number,
+                    rule=rule,
                 )
             )
     return tasks
@@ -213,6 +224,7 @@ def plan_rows(
     patch: str = "euclidean",
     ignore_mesh_names: bool = False,
     source: str = "the points CSV",
+    rule: str = "oriented",
 ) -> list[Task]:
     """Tasks for the rows of a points or measurements CSV, in file order.
 
@@ -222,8 +234,9 @@ def plan_rows(
         Per mesh, the names it is known by (its primary name first, e.g. the file name without
         extension; for a Blender object also its mesh data name).
     rows : sequence of csvio.ReplicationRow
-    radius, lam, patch
-        Defaults for rows that carry none (``radius=None``: every row must carry one).
+    radius, lam, patch, rule
+        Defaults for rows that carry none (``radius=None``: every row must carry one); rows
+        from MeshLab and earlier add-on files carry the paper's rule.
     ignore_mesh_names : bool
         With a single mesh, measure every row on it whatever mesh the row names.
     source : str
@@ -285,6 +298,7 @@ def plan_rows(
                 source_row=row.row_number,
                 mesh_name=row.mesh_name or "",
                 error=error,
+                rule=row.rule or rule,
             )
         )
     return tasks

@@ -294,7 +294,7 @@ class DragMachine:
         self.measurement = None
 
 
-def surface_callbacks(surface, patch: str = "euclidean") -> dict:
+def surface_callbacks(surface, patch: str = "euclidean", rule: str = "oriented") -> dict:
     """The ``snap``, ``query`` and ``measure`` callables of a :class:`DragMachine` on a Surface.
 
     ``snap`` moves a point to its nearest measurable vertex (however far), ``query`` returns the
@@ -304,6 +304,8 @@ def surface_callbacks(surface, patch: str = "euclidean") -> dict:
     ----------
     surface : Surface
     patch : {"euclidean", "geodesic"}, optional
+    rule : {"oriented", "paper"}, optional
+        The rule the measurement (and so the preview) uses.
     """
 
     def snap(point):
@@ -317,6 +319,6 @@ def surface_callbacks(surface, patch: str = "euclidean") -> dict:
         return surface.patch(vertex, radius, patch)
 
     def measure(center, radius, lam):
-        return surface.measure(center, radius, lam, patch)
+        return surface.measure(center, radius, lam, patch, rule=rule)
 
     return {"snap": snap, "query": query, "measure": measure}

@@ -1,0 +1,41 @@
+"""Headless batch runs: measure break angles on many meshes and points, write a CSV.
+
+Entered from ``vg_batch.py`` (``blender -b --python vg_batch.py -- ARGS`` or
+``python vg_batch.py ARGS`` with the PyPI ``bpy``). ``cli`` parses, ``run`` plans and drives a
+run, ``sources`` imports the meshes, ``measure`` measures one mesh through the bridge,
+``workers`` runs ``--jobs`` processes, ``render`` and ``blend_file`` write the pictures and the
+.blend, ``demo`` is ``--demo``. Imports run batch → bridge → vg_addon.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from . import extension
+from .cli import UsageError, build_parser, check_args
+
+
+def main(argv: list[str]) -> int:
+    """Run the batch command with the script's arguments; returns the process exit status."""
+    from .demo import run_demo
+    from .run import run_batch
+    from .workers import worker_main
+
+    args = build_parser().parse_args(argv)
+    try:
+        if args.worker:
+            return worker_main(args.worker)
+        check_args(args)
+        if args.demo:
+            return run_demo(args)
+        code, _ = run_batch(args)
+        return code
+    except UsageError as error:
+        print(f"vg_batch: error: {error}", file=sys.stderr, flush=True)
+        return 2
+    except KeyboardInterrupt:
+        print("vg_batch: interrupted; the CSV holds what was measured so far", file=sys.stderr)
+        return 130
+
+
+__all__ = ["extension", "main"]

@@ -1,0 +1,77 @@
+"""The .blend a batch run saves: measured objects gathered, framed and written as a copy."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from ..bridge import measuring, mesh_data
+from .measure import MeshResult
+from .stdio import quiet_stdout
+
+
+def prepare_saved_file(objects) -> None:
+    """Make the saved .blend open on the measurements: the first object active, solid views
+    showing attribute colours and framing the meshes."""
+    import mathutils
+
+    objects = [o for o in objects if o is not None]
+    if not objects:
+        return
+    view_layer = bpy.context.view_layer
+    view_layer.objects.active = objects[0]
+    for obj in objects:
+        obj.select_set(obj == objects[0])
+    corners = np.array(
+        [list(obj.matrix_world @ mathutils.Vector(c)) for obj in objects for c in obj.bound_box]
+    )
+    centre = (corners.min(axis=0) + corners.max(axis=0)) / 2
+    size = float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0))) or 1.0
+    for screen in bpy.data.screens:
+        for area in screen.areas:
+            for space in area.spaces:
+                if space.type != "VIEW_3D":
+                    continue
+                space.shading.color_type = "VERTEX"
+                space.clip_end = max(space.clip_end, size * 20)
+                space.clip_start = min(space.clip_start, size * 1e-4)
+                region = space.region_3d
+                if region is not None:
+                    region.view_location = centre
+                    region.view_distance = size * 1.2
+
+
+def save_blend(path: str, objects) -> None:
+    prepare_saved_file(objects)
+    Path(path).resolve().parent.mkdir(parents=True, exist_ok=True)
+    with quiet_stdout():
+        bpy.ops.wm.save_as_mainfile(filepath=str(Path(path).resolve()), copy=True)
+
+
+def forget(object_name: str) -> None:
+    """Remove an object and its mesh, and the cached surfaces (frees memory between meshes)."""
+    obj = bpy.data.objects.get(object_name)
+    if obj is not None:
+        mesh = obj.data
+        bpy.data.objects.remove(obj)
+        if mesh is not None and mesh.users == 0:
+            bpy.data.meshes.remove(mesh)
+    mesh_data.clear_cache()
+    measuring.clear_cache()
+
+
+def append_objects(results: list[MeshResult]) -> list:
+    """Bring the objects the workers saved into this file, in mesh order."""
+    objects = []
+    for result in sorted(results, key=lambda r: r.mesh):
+        if not result.blend or not Path(result.blend).is_file():
+            continue
+        with bpy.data.libraries.load(result.blend, link=False) as (source, target):
+            target.objects = [name for name in source.objects if name == result.object_name]
+        for obj in target.objects:
+            if obj is not None:
+                bpy.context.scene.collection.objects.link(obj)
+                objects.append(obj)
+    return objects

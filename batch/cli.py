@@ -1,0 +1,336 @@
+"""The batch command line: the parser, its help text and the checks made before anything runs."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..vg_addon import GoniometerError
+from ..vg_addon.method.sweep import sweep_radii
+
+# --units: Blender's unit system, unit scale and length unit for what one coordinate unit is.
+UNITS = {
+    "none": ("NONE", 1.0, None),
+    "m": ("METRIC", 1.0, "METERS"),
+    "cm": ("METRIC", 0.01, "CENTIMETERS"),
+    "mm": ("METRIC", 0.001, "MILLIMETERS"),
+    "um": ("METRIC", 1e-6, "MICROMETERS"),
+    "in": ("IMPERIAL", 0.0254, "INCHES"),
+}
+
+EPILOG = """\
+inputs:
+  MESH is a .ply, .obj or .stl file, a folder (its .ply/.obj/.stl files, not subfolders), or a
+  .blend file (then name the objects with --object; under `blender -b file.blend` the open file
+  is used). Coordinates and radii are in the mesh file's own units; the file's coordinates are
+  used as they are (no axis conversion).
+
+points:
+  --at X Y Z (repeatable) measures each point on every mesh given.
+  --points CSV reads a plain CSV (x,y,z and optional radius, lambda, patch, label, break, mesh
+  columns) or a measurements CSV exported by the extension, the MeshLab plugin or the earlier
+  Blender add-on: each row is re-measured with its own radius and lambda and matched to its
+  mesh by its mesh name (the file name without extension). --radius, --lambda and --patch are
+  the defaults for rows that carry none.
+
+rule and checks:
+  --rule oriented (the default) reads concave edges and inward-wound meshes right; --rule paper
+  is Algorithm 1 as printed. Rows of MeshLab and earlier add-on CSVs, and extension exports
+  without a Rule column, are always re-measured with the paper's rule they were taken with.
+  --stability adds each measurement's stability figure (the Stability columns; it costs about
+  ten measurements). A closed mesh wound inward is named once in the output: its angles are
+  right, its convex/concave labels swapped.
+  --sweep R0 R1 N also measures every point at N radii from R0 to R1: rows in
+  <out>_sweep.csv, and a plot per point in the folder <out>_sweep/.
+
+edges:
+  --edge X1 Y1 Z1 X2 Y2 Z2 (repeatable) measures a whole break edge on every mesh given: the
+  path from the first point to the second is traced along the ridge (through the --via X Y Z
+  points that follow that --edge, in order) and measured at stations every --spacing D of arc
+  length, each with --radius, --lambda and --patch. Its stations are rows of --out (after the
+  points, with Edge #, Arc Length and Spacing), its summary a row of OUT_edges.csv, and its
+  profile plot OUT_<mesh>_edge<N>.png beside --out. --edges CSV re-measures the edges of an
+  edge summary file (an export's NAME_edges.csv): each row's Points with its own Spacing,
+  Radius, SegParam and Patch Mode, on the mesh its Mesh Name names. Edges run in this process
+  (not with --jobs or --shard).
+
+output:
+  --out CSV gets one row per requested point, in input order, in the extension's export
+  schema (MeshLab's 14 columns first). A row that cannot be measured has its message in the
+  `error` column and the run goes on. While meshes finish, the CSV is rewritten every few
+  seconds, so a run that is stopped keeps what it measured. --out - writes it to standard
+  output (once, at the end). An output that is an input, or cannot be written, is refused
+  before anything is read or written.
+
+exit status:
+  0  every point measured
+  1  some rows failed (see their `error` column)
+  2  bad arguments, missing or unreadable files, a malformed points CSV, an output refused
+     or a .blend/picture that could not be written
+
+scaling:
+  --jobs N measures N meshes at a time, each in its own Blender/bpy process (a crash in one
+  mesh loses only that mesh's rows). --shard K/N keeps the K-th of N equal, contiguous shares
+  of the rows: shard CSVs concatenated in K order (headers dropped after the first) equal the
+  unsharded CSV. Measurements per second are printed (mesh import and surface preparation
+  excluded).
+
+examples:
+  python vg_batch.py scan.ply --at 12.1 3.4 -7.9 --radius 2 --out angles.csv
+  python vg_batch.py scans/ --points sites.csv --radius 2 --jobs 2 --out angles.csv
+  python vg_batch.py scan.ply --points old_meshlab.csv --out replicated.csv --save-blend s.blend
+  blender -b study.blend --python vg_batch.py -- --object Bone_12 --points p.csv --out a.csv
+  python vg_batch.py scan.ply --edge 0 0 0 10 2 0 --via 5 1.5 0.2 --spacing 1 --radius 2 \
+      --out edge.csv
+  python vg_batch.py --demo
+"""
+
+
+class EdgeAction(argparse.Action):
+    """``--edge X1 Y1 Z1 X2 Y2 Z2``: a new edge ``{"start", "end", "via"}`` on ``args.edge``."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        edges = list(getattr(namespace, self.dest) or [])
+        edges.append({"start": list(values[:3]), "end": list(values[3:]), "via": []})
+        setattr(namespace, self.dest, edges)
+
+
+class ViaAction(argparse.Action):
+    """``--via X Y Z``: a via point of the last ``--edge`` given before it."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        edges = getattr(namespace, "edge", None)
+        if not edges:
+            parser.error("--via X Y Z must follow the --edge it belongs to.")
+        edges[-1]["via"].append(list(values))
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="vg_batch.py",
+        usage="blender -b [file.blend] --python vg_batch.py -- ARGS\n"
+        "       python vg_batch.py ARGS\n\n"
+        "ARGS:  MESH... [--object NAME] (--at X Y Z ... | --points CSV) [--radius R]\n"
+        "       [--edge X1 Y1 Z1 X2 Y2 Z2 [--via X Y Z]... --spacing D]... [--edges CSV]\n"
+        "       [--lambda L] [--patch euclidean|geodesic] [--rule oriented|paper]\n"
+        "       [--stability] [--sweep R0 R1 N] --out CSV [--save-blend PATH]\n"
+        "       [--render DIR] [--jobs N] [--shard K/N]\n"
+        "   or: --demo [--out-dir DIR]",
+        description="Measure break-edge angles (the Virtual Goniometer) on meshes and point "
+        "lists, headless, and write them to a CSV.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "inputs",
+        nargs="*",
+        metavar="MESH",
+        help="mesh files (.ply .obj .stl), folders of them, or one .blend file",
+    )
+    parser.add_argument(
+        "--object",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="an object of the .blend to measure (repeatable; default: its only mesh object)",
+    )
+    where = parser.add_argument_group("points (one of)")
+    where.add_argument(
+        "--at",
+        nargs=3,
+        type=float,
+        action="append",
+        default=[],
+        metavar=("X", "Y", "Z"),
+        help="a point to measure at (repeatable); it snaps to the nearest vertex",
+    )
+    where.add_argument("--points", metavar="CSV", help="a points or measurements CSV")
+    edges = parser.add_argument_group("edges (with or without points)")
+    edges.add_argument(
+        "--edge",
+        nargs=6,
+        type=float,
+        action=EdgeAction,
+        default=[],
+        metavar=("X1", "Y1", "Z1", "X2", "Y2", "Z2"),
+        help="a whole break edge from the first point to the second, traced along the ridge "
+        "(repeatable)",
+    )
+    edges.add_argument(
+        "--via",
+        nargs=3,
+        type=float,
+        action=ViaAction,
+        metavar=("X", "Y", "Z"),
+        help="a point the path of the preceding --edge passes through (repeatable, in order)",
+    )
+    edges.add_argument(
+        "--edges",
+        dest="edges_csv",
+        metavar="CSV",
+        help="an edge summary CSV (NAME_edges.csv): re-measure each of its edges on its mesh",
+    )
+    edges.add_argument(
+        "--spacing",
+        type=float,
+        metavar="D",
+        help="arc length between the stations of every --edge (needed with --edge)",
+    )
+    how = parser.add_argument_group("measuring")
+    how.add_argument(
+        "--radius",
+        type=float,
+        metavar="R",
+        help="patch radius in the mesh's units (needed with --at; default for CSV rows without one)",
+    )
+    how.add_argument(
+        "--lambda",
+        dest="lam",
+        type=float,
+        default=2.0,
+        metavar="L",
+        help="segmentation parameter λ (MeshLab's SegParam); default 2",
+    )
+    how.add_argument(
+        "--patch",
+        choices=("euclidean", "geodesic"),
+        default="euclidean",
+        help="patch shape: a ball (euclidean, default) or along mesh edges (geodesic)",
+    )
+    how.add_argument(
+        "--rule",
+        choices=("oriented", "paper"),
+        default="oriented",
+        help="how the projection is signed: oriented (default; right on concave edges) or paper "
+        "(Algorithm 1 as printed); rows of MeshLab/earlier add-on CSVs keep the paper's",
+    )
+    how.add_argument(
+        "--stability",
+        action="store_true",
+        help="also compute each measurement's stability figure (about ten measurements' cost)",
+    )
+    how.add_argument(
+        "--sweep",
+        nargs=3,
+        type=float,
+        metavar=("R0", "R1", "N"),
+        help="also measure each point at N radii from R0 to R1: <out>_sweep.csv and plots",
+    )
+    how.add_argument(
+        "--units",
+        choices=tuple(UNITS),
+        help="what one coordinate unit of the meshes is, recorded in the CSV's Units column and "
+        "the .blend's scene units (default: none, i.e. the file's own units, unnamed; a .blend "
+        "input keeps its scene's units)",
+    )
+    how.add_argument(
+        "--ignore-mesh-names",
+        action="store_true",
+        help="with a single mesh, measure every CSV row on it whatever mesh the row names",
+    )
+    out = parser.add_argument_group("output")
+    out.add_argument(
+        "--out", metavar="CSV", help="the measurements CSV to write (required; - for stdout)"
+    )
+    out.add_argument(
+        "--save-blend",
+        metavar="PATH",
+        help="also save a .blend with the meshes, their side colours and stored measurements",
+    )
+    out.add_argument(
+        "--render",
+        metavar="DIR",
+        help="write DIR/<mesh>.png per mesh: the coloured sides, Cycles on the CPU",
+    )
+    out.add_argument(
+        "--render-size",
+        nargs=2,
+        type=int,
+        default=[640, 480],
+        metavar=("W", "H"),
+        help="render resolution in pixels (default 640 480)",
+    )
+    out.add_argument(
+        "--render-samples",
+        type=int,
+        default=16,
+        metavar="N",
+        help="Cycles samples per pixel (default 16)",
+    )
+    out.add_argument("--quiet", action="store_true", help="no progress lines (summary only)")
+    scale = parser.add_argument_group("scaling")
+    scale.add_argument(
+        "--jobs",
+        type=int,
+        default=1,
+        metavar="N",
+        help="meshes measured in parallel, one process each (default 1: in this process)",
+    )
+    scale.add_argument(
+        "--shard", metavar="K/N", help="do only the K-th of N equal shares of the rows"
+    )
+    demo = parser.add_argument_group("demo")
+    demo.add_argument(
+        "--demo",
+        action="store_true",
+        help="generate a bone-shaft fragment with known break angles, measure it, print true "
+        "against measured angles and write CSV, .blend and PNG",
+    )
+    demo.add_argument(
+        "--out-dir", metavar="DIR", help="the demo's output folder (default ./vg_demo_output)"
+    )
+    parser.add_argument("--worker", help=argparse.SUPPRESS)
+    return parser
+
+
+class UsageError(Exception):
+    """Bad arguments or input files: exit status 2."""
+
+
+def check_args(args) -> None:
+    if args.demo:
+        extra = [
+            name
+            for name, value in (
+                ("MESH", args.inputs),
+                ("--object", args.object),
+                ("--at", args.at),
+                ("--points", args.points),
+                ("--edge", args.edge),
+                ("--edges", args.edges_csv),
+                ("--out", args.out),
+                ("--shard", args.shard),
+            )
+            if value
+        ]
+        if extra:
+            raise UsageError(f"--demo takes no {', '.join(extra)} (only --out-dir and --jobs).")
+        return
+    if args.out_dir:
+        raise UsageError("--out-dir is for --demo; use --out CSV for a batch run.")
+    if args.at and args.points:
+        raise UsageError(
+            "give the points to measure with --at X Y Z (repeatable) or --points CSV, not both."
+        )
+    if not (args.at or args.points or args.edge or args.edges_csv):
+        raise UsageError(
+            "give what to measure: --at X Y Z (repeatable), --points CSV, --edge "
+            "X1 Y1 Z1 X2 Y2 Z2 (repeatable) or --edges CSV."
+        )
+    if args.edge and (args.spacing is None or args.radius is None):
+        raise UsageError("--edge needs --spacing D and --radius R (in the mesh's units).")
+    if (args.edge or args.edges_csv) and (args.jobs > 1 or args.shard):
+        raise UsageError("edges are measured in this process: drop --jobs and --shard.")
+    if not args.out:
+        raise UsageError("--out CSV is required: the measurements CSV to write.")
+    if args.jobs < 1:
+        raise UsageError(f"--jobs must be 1 or more (got {args.jobs}).")
+    if min(args.render_size) < 1 or args.render_samples < 1:
+        raise UsageError("--render-size and --render-samples must be positive.")
+    if args.sweep:
+        start, stop, count = args.sweep
+        if count != int(count):
+            raise UsageError(f"--sweep R0 R1 N: N must be a whole number (got {count:g}).")
+        try:
+            sweep_radii(start, stop, int(count))
+        except GoniometerError as error:
+            raise UsageError(f"--sweep R0 R1 N: {error}") from None

@@ -1,0 +1,133 @@
+"""Measuring ``--edge`` profiles on one mesh of a batch run, through the extension's pipeline."""
+
+from __future__ import annotations
+
+import bpy
+
+from ..bridge import edges, records
+from ..properties import exact_numbers
+from ..vg_addon import GoniometerError
+from ..vg_addon.errors import bounded_list
+from ..vg_addon.formats import csvio, profile_plot
+from .cli import UsageError
+
+
+def edge_specs(args, sources) -> list[dict]:
+    """The edges of a run: ``--edge`` (with ``--via``, on every mesh) and the rows of
+    ``--edges CSV`` (each on the mesh its Mesh Name names), as dicts of ``points``, ``spacing``,
+    ``radius``, ``lam``, ``patch`` and ``mesh_name`` ("" for every mesh).
+
+    Raises
+    ------
+    UsageError
+        An unreadable edges CSV, a row without Points, Spacing or Radius, or naming no mesh given.
+    """
+    specs = [
+        {
+            "points": [spec["start"], *spec["via"], spec["end"]],
+            "spacing": args.spacing,
+            "radius": args.radius,
+            "lam": args.lam,
+            "patch": args.patch,
+            "mesh_name": "",
+        }
+        for spec in args.edge
+    ]
+    if not args.edges_csv:
+        return specs
+    try:
+        rows = csvio.read_edges_csv(args.edges_csv)
+    except OSError as error:
+        raise UsageError(f"{args.edges_csv}: {error.strerror or error}") from None
+    except GoniometerError as error:
+        raise UsageError(str(error)) from None
+    problems = []
+    for number, row in enumerate(rows, start=2):
+        try:
+            points = csvio.parse_points(row.points)
+        except GoniometerError as error:
+            problems.append(f"row {number}: {error}")
+            continue
+        if row.spacing is None or row.radius is None or len(points) < 2:
+            problems.append(f"row {number}: an edge needs two Points, a Spacing and a Radius")
+            continue
+        name = "" if args.ignore_mesh_names else row.mesh_name
+        if name and not any(csvio.mesh_name_matches(name, s.names) for s in sources):
+            problems.append(f"row {number}: no mesh given is named {name!r}")
+            continue
+        specs.append(
+            {
+                "points": [list(p) for p in points],
+                "spacing": row.spacing,
+                "radius": row.radius,
+                "lam": args.lam if row.seg_param is None else row.seg_param,
+                "patch": row.patch or args.patch,
+                "mesh_name": name,
+            }
+        )
+    if problems:
+        raise UsageError(
+            f"{args.edges_csv}: {len(problems)} edge row(s) cannot be measured:\n"
+            + bounded_list(problems, lines=True)
+        )
+    return specs
+
+
+def spec_applies(spec: dict, source) -> bool:
+    """Whether edge ``spec`` is measured on the mesh ``source``."""
+    return csvio.mesh_name_matches(spec["mesh_name"], source.names)
+
+
+def failed_edge_row(number: int, spec: dict, mesh_name: str, message: str, units):
+    """The output row of an edge that could not be measured."""
+    return csvio.MeasurementRow(
+        mesh_name=mesh_name,
+        date=csvio.now_iso(),
+        radius=spec["radius"],
+        seg_param=spec["lam"],
+        patch=spec["patch"],
+        requested=tuple(float(v) for v in spec["points"][0]),
+        edge_number=number,
+        spacing=spec["spacing"],
+        units=units,
+        extension_version=records.extension_version(),
+        blender_version=bpy.app.version_string,
+        error=f"edge not measured: {message}",
+    )
+
+
+def measure_edges(obj, source, options: dict, units: str, safe_name: str):
+    """Measure the run's edges that apply to ``source`` on its object ``obj``, record each as one
+    break of stations, and write each profile's plot beside the output CSV.
+
+    Returns
+    -------
+    station_rows : list of csvio.MeasurementRow
+        Every edge's stations in order, or one error row for an edge that failed.
+    edge_rows : list of csvio.EdgeRow
+        One summary per measured edge.
+    """
+    station_rows, edge_rows = [], []
+    for spec in options["edges"]:
+        if not spec_applies(spec, source):
+            continue
+        number = obj.vg.next_edge_number
+        try:
+            edge = edges.measure_edge_on_object(
+                obj, spec["points"], spec["spacing"], spec["radius"], spec["lam"], spec["patch"]
+            )
+        except GoniometerError as error:
+            obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
+            station_rows.append(failed_edge_row(number, spec, obj.name, str(error), units))
+            continue
+        station_rows.extend(
+            records.to_row(obj, item, stale=False, units=units)
+            for item in obj.vg.measurements
+            if item.edge_number == edge.number
+        )
+        edge_rows.append(records.edge_row(obj, edge, units=units))
+        numbers = exact_numbers(edge)
+        image = profile_plot.render_profile(numbers["arc_lengths"], numbers["angles"])
+        path = f"{options['plots']}_{safe_name}_edge{edge.number}.png"
+        profile_plot.write_png(path, image, overwrite=True)
+    return station_rows, edge_rows

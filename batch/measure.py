@@ -1,0 +1,264 @@
+"""Measuring one mesh's rows in a batch run, through the extension's own pipeline."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+import traceback
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from ..bridge import colors, measuring, mesh_data, records
+from ..vg_addon import GoniometerError, Surface
+from ..vg_addon.formats import csvio, sweep_plot
+from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
+from .cli import UNITS
+from .edges import failed_edge_row, measure_edges, spec_applies
+from .render import add_sides_material, render_object
+from .sources import MeshSource, import_mesh
+
+
+@dataclasses.dataclass
+class MeshResult:
+    """What measuring one mesh produced (sent from a worker to its parent as JSON)."""
+
+    mesh: int
+    rows: list = dataclasses.field(default_factory=list)  # [(task index, MeasurementRow)]
+    station_rows: list = dataclasses.field(default_factory=list)  # --edge stations (in-process)
+    edge_rows: list = dataclasses.field(default_factory=list)  # --edge summaries (in-process)
+    object_name: str = ""
+    bad_file: str = ""  # why the mesh file could not be read
+    n_vertices: int = 0
+    measured: int = 0
+    failed: int = 0
+    load_seconds: float = 0.0
+    prepare_seconds: float = 0.0
+    measure_seconds: float = 0.0
+    render: str = ""
+    render_error: str = ""
+    blend: str = ""  # a worker's one-object .blend, for --save-blend
+    winding: str = ""  # see vg_addon.method.winding.WINDINGS
+    sweep_rows: list = dataclasses.field(default_factory=list)  # [(task index, [cells])]
+    sweep_plots: int = 0
+
+    def to_json(self) -> dict:
+        out = dataclasses.asdict(self)
+        out["rows"] = [[index, dataclasses.asdict(row)] for index, row in self.rows]
+        return out
+
+    @classmethod
+    def from_json(cls, data: dict, row_type) -> MeshResult:
+        rows = []
+        for index, fields in data.pop("rows"):
+            for key in ("normal_plus", "normal_minus", "requested"):
+                if fields.get(key) is not None:
+                    fields[key] = tuple(fields[key])
+            rows.append((index, row_type(**fields)))
+        return cls(rows=rows, **data)
+
+
+def error_row(task, mesh_name: str, message: str, units: str):
+    """The output row of a task that could not be measured."""
+    return csvio.MeasurementRow(
+        mesh_name=mesh_name,
+        date=csvio.now_iso(),
+        number=task.number or None,
+        break_number=task.break_number,
+        user_data=task.label,
+        radius=task.radius,
+        seg_param=task.lam,
+        patch=task.patch,
+        requested=tuple(task.center),
+        units=units,
+        extension_version=records.extension_version(),
+        blender_version=bpy.app.version_string,
+        error=message,
+    )
+
+
+def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
+    """Load (or find) one mesh, measure its tasks, record them on the object, colour it and
+    optionally render it. Never raises for a problem of this mesh: it becomes the rows' error.
+
+    The numbers come from the extension's own pipeline: the object's evaluated mesh in world
+    space (``mesh_data.evaluated_geometry``), its cached ``Surface`` (``mesh_data.surface_for``)
+    and ``records.add_measurement``; a mesh file whose float64 coordinates float32 would round
+    is measured at the file's coordinates instead (:func:`exact_surface`, ``Precision``
+    float64 in the CSV). The colours are painted once per mesh at the end by
+    ``measuring.repaint``, the extension's own painter, from the sides kept while measuring.
+    """
+    result = MeshResult(mesh=index)
+    units = records.units_label(bpy.context.scene)
+
+    def fail_all(message: str) -> MeshResult:
+        name = result.object_name or source.name
+        result.rows = [(t.index, error_row(t, name, message, units)) for t in tasks]
+        result.failed = len(tasks)
+        applying = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
+        result.station_rows = [
+            failed_edge_row(number, spec, name, message, units)
+            for number, spec in enumerate(applying, start=1)
+        ]
+        return result
+
+    start = time.perf_counter()
+    exact_points = None
+    try:
+        if source.path:
+            obj, exact_points = import_mesh(source)
+        else:
+            obj = bpy.data.objects[source.name]
+    except GoniometerError as error:
+        result.bad_file = str(error)
+        return fail_all(f"could not read the mesh: {error}")
+    except MemoryError:
+        result.bad_file = f"'{source.path}' is too large for this machine's memory"
+        return fail_all(f"could not read the mesh: {result.bad_file}")
+    result.object_name = obj.name
+    result.load_seconds = time.perf_counter() - start
+
+    start = time.perf_counter()
+    try:
+        mesh_data.check_measurable(obj)
+        geometry = mesh_data.evaluated_geometry(obj)
+        if exact_points is None:
+            surface, precision = mesh_data.surface_for(obj, geometry), "float32"
+        else:
+            surface, precision = exact_surface(source, exact_points, geometry), "float64"
+    except GoniometerError as error:
+        return fail_all(str(error))
+    result.n_vertices = int(geometry.points.shape[0])
+    result.prepare_seconds = time.perf_counter() - start
+    result.winding = surface.winding
+    measuring.note_winding(obj, surface)
+
+    data = obj.vg
+    base = data.next_number - 1  # measurements already on a .blend object keep their numbers
+    view = np.zeros(3)
+    last_report = start = time.perf_counter()
+    for done, task in enumerate(tasks, start=1):
+        try:
+            m = surface.measure(
+                task.center,
+                task.radius,
+                task.lam,
+                task.patch,
+                rule=task.rule,
+                stability=bool(options.get("stability")),
+            )
+        except GoniometerError as error:
+            result.rows.append((task.index, error_row(task, obj.name, str(error), units)))
+            result.failed += 1
+        else:
+            data.next_number = base + task.number
+            item = records.add_measurement(
+                obj, m, geometry.fingerprint, note=task.label, break_number=task.break_number
+            )
+            row = records.to_row(obj, item, stale=False, units=units, precision=precision)
+            result.rows.append((task.index, row))
+            measuring.keep_sides(obj, geometry, item, m)
+            view += m.mean_normal
+            result.measured += 1
+        now = time.perf_counter()
+        if progress is not None and now - last_report >= 1.0:
+            progress(done)
+            last_report = now
+    result.measure_seconds = time.perf_counter() - start
+    if options.get("sweep"):
+        sweep_sites(result, surface, obj.name, tasks, options)
+    if len(data.measurements):
+        data.next_number = max(item.number for item in data.measurements) + 1
+        records.continue_after_recorded_breaks(obj)
+
+    if result.measured:
+        measuring.repaint(obj, geometry=geometry)
+        add_sides_material(obj, colors.ATTRIBUTE_NAME)
+
+    if options.get("edges"):
+        result.station_rows, result.edge_rows = measure_edges(
+            obj, source, options, units, safe_file_name(obj.name)
+        )
+
+    if options.get("render"):
+        path = Path(options["render"]) / f"{safe_file_name(obj.name)}.png"
+        try:
+            render_object(obj, path, options, view.tolist())
+            result.render = str(path)
+        except Exception as error:  # a render problem must not lose the measurements
+            result.render_error = f"{type(error).__name__}: {error}"
+    return result
+
+
+def sweep_sites(result: MeshResult, surface, name: str, tasks, options) -> None:
+    """``--sweep``: each task's site at the sweep's radii, as CSV cells and a plot per site."""
+    start, stop, count = options["sweep"]
+    folder = Path(options["sweep_plots"])
+    for task in tasks:
+        try:
+            points = radius_sweep(
+                surface, task.center, start, stop, int(count), task.lam, task.patch, task.rule
+            )
+        except GoniometerError as error:
+            points = [
+                SweepPoint(float(r), None, str(error)) for r in sweep_radii(start, stop, count)
+            ]
+        else:
+            path = folder / f"{safe_file_name(name)}_{task.number}.png"
+            sweep_plot.write_sweep_png(path, points)
+            result.sweep_plots += 1
+        result.sweep_rows.extend(
+            (task.index, csvio.sweep_cells(name, task.number, point)) for point in points
+        )
+
+
+def exact_surface(source: MeshSource, points: np.ndarray, geometry) -> Surface:
+    """The surface of a mesh file at its own float64 coordinates, with the faces Blender kept.
+
+    The imported object sits at the world origin untransformed, so the file's coordinates are
+    its world coordinates; Blender's float32 copy would round them (by up to a few
+    thousandths of a unit at a thousand units from the origin, which tilts small patches).
+    """
+    if points.shape != geometry.points.shape:
+        raise GoniometerError(
+            f"'{source.path}' has float64 coordinates that Blender's float32 mesh rounds, and "
+            f"Blender's import changed its vertices ({points.shape[0]} in the file, "
+            f"{geometry.points.shape[0]} in Blender), so it cannot be measured at the file's "
+            "precision. Move the mesh near the origin (subtract an offset) and measure again."
+        )
+    triangles = geometry.triangles if geometry.triangles.size else None
+    return Surface(points, triangles)
+
+
+def set_units(scene, unit: str | None) -> None:
+    """Set the scene's length units to ``unit`` (a key of :data:`UNITS`); None: leave them."""
+    if not unit:
+        return
+    system, scale, length = UNITS[unit]
+    settings = scene.unit_settings
+    settings.system = system
+    settings.scale_length = scale
+    if length is not None:
+        settings.length_unit = length
+
+
+def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress):
+    """:func:`measure_mesh`, with an unexpected error (a bug) turned into failed rows for this
+    mesh only, its traceback on stderr, so the other meshes are still measured."""
+    try:
+        return measure_mesh(index, source, tasks, options, progress)
+    except Exception as error:
+        traceback.print_exc()
+        message = (
+            f"internal error while measuring this mesh ({type(error).__name__}: {error}); "
+            "please report it with the traceback printed on stderr"
+        )
+        units = records.units_label(bpy.context.scene)
+        result = MeshResult(mesh=index, failed=len(tasks))
+        result.rows = [(t.index, error_row(t, source.name, message, units)) for t in tasks]
+        return result
+
+
+def safe_file_name(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_.+" else "_" for c in name) or "mesh"

@@ -1,0 +1,128 @@
+"""Where a batch run writes, checked before anything is read or written: no output may be an
+input (or another output), and every output must be a place the run can write to."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import bpy
+
+from ..vg_addon import GoniometerError
+from ..vg_addon.formats import csvio
+from ..vg_addon.workflow import batchplan
+from .cli import UsageError
+
+
+def _same_file(a: str, b: str) -> bool:
+    try:
+        return os.path.samefile(a, b)  # also a hard link or a symbolic link to the same file
+    except OSError:  # one of them does not exist (yet): compare where they lead
+        return os.path.normcase(os.path.realpath(a)) == os.path.normcase(os.path.realpath(b))
+
+
+def input_files(args) -> list[tuple[str, str]]:
+    """``(what, path)`` of every file the run reads: mesh files (also those in given folders),
+    the .blend and the points CSV."""
+    found = []
+    meshes = [p for p in args.inputs if not p.lower().endswith(".blend")]
+    blends = [p for p in args.inputs if p.lower().endswith(".blend")]
+    try:
+        files = batchplan.find_mesh_files(meshes)
+    except GoniometerError:
+        files = [Path(p) for p in meshes]  # reported as missing later; still compared here
+    found += [("mesh file", str(path)) for path in files]
+    found += [("input .blend", path) for path in blends]
+    if bpy.app.binary_path and bpy.data.filepath and not blends:  # blender -b file.blend
+        found.append(("input .blend", bpy.data.filepath))
+    if args.points:
+        found.append(("points CSV", args.points))
+    return found
+
+
+def _writable_folder(folder: Path, option: str, given: str) -> None:
+    """Raise unless ``folder`` exists and is writable, or can be created."""
+    existing = folder
+    while not existing.exists():
+        if existing.parent == existing:
+            break
+        existing = existing.parent
+    if not existing.is_dir():
+        raise UsageError(f"{option} {given}: {existing} is a file, not a folder.")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        what = "write into" if existing == folder else f"create {folder} in"
+        raise UsageError(
+            f"{option} {given}: no permission to {what} {existing}; choose another place."
+        )
+
+
+def check_outputs(args) -> None:
+    """Refuse outputs that are inputs or each other, and outputs that cannot be written.
+
+    Raises
+    ------
+    UsageError
+        Naming the option, the path and what to do; nothing has been read or written then.
+    """
+    outputs = [("--out", args.out), ("--save-blend", args.save_blend)]
+    outputs = [(option, path) for option, path in outputs if path and path != csvio.STDOUT]
+    inputs = input_files(args)
+    for option, path in outputs:
+        for what, source in inputs:
+            if _same_file(path, source):
+                raise UsageError(
+                    f"{option} {path} is the {what} {source}: writing there would destroy an "
+                    "input. Choose another file name; nothing was read or written."
+                )
+    if len(outputs) == 2 and _same_file(outputs[0][1], outputs[1][1]):
+        raise UsageError(
+            f"--out and --save-blend are the same file ({args.out}): give them different names."
+        )
+    if args.out and args.out != csvio.STDOUT:
+        if os.path.exists(args.out):
+            try:
+                kind = csvio.output_target(args.out)
+            except GoniometerError as error:
+                raise UsageError(f"--out {args.out}: {error}") from None
+            if kind == "file":
+                _writable_folder(Path(args.out).resolve().parent, "--out", args.out)
+        else:
+            _writable_folder(Path(args.out).resolve().parent, "--out", args.out)
+    if args.save_blend:
+        path = Path(args.save_blend)
+        if path.is_dir():
+            raise UsageError(
+                f"--save-blend {args.save_blend} is a folder: give a file name, e.g. "
+                f"{path / 'measured.blend'}."
+            )
+        if path.exists() and not path.is_file():
+            raise UsageError(f"--save-blend {args.save_blend} is not a regular file.")
+        if path.exists() and not os.access(path, os.W_OK):
+            raise UsageError(f"--save-blend {args.save_blend} is read-only; it is left as it is.")
+        _writable_folder(path.resolve().parent, "--save-blend", args.save_blend)
+    if args.render:
+        path = Path(args.render)
+        if path.exists() and not path.is_dir():
+            raise UsageError(
+                f"--render {args.render} is a file: --render takes a folder, where each mesh's "
+                "picture is written as <mesh>.png."
+            )
+        _writable_folder(path.resolve(), "--render", args.render)
+
+
+def make_folders(args) -> None:
+    """Create the folders the outputs go into (after :func:`check_outputs`)."""
+    folders = []
+    if args.out and args.out != csvio.STDOUT:
+        folders.append(Path(args.out).resolve().parent)
+    if args.save_blend:
+        folders.append(Path(args.save_blend).resolve().parent)
+    if args.render:
+        folders.append(Path(args.render).resolve())
+    for folder in folders:
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as error:
+            raise UsageError(
+                f"cannot create the folder {folder}: {error.strerror or error}."
+            ) from None

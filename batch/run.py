@@ -1,0 +1,333 @@
+"""A batch run: plan the rows, measure mesh after mesh (or in worker processes), write the CSV."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import shutil
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import bpy
+
+from ..bridge import records
+from ..vg_addon import GoniometerError
+from ..vg_addon.formats import csvio
+from ..vg_addon.method.winding import winding_message
+from ..vg_addon.workflow import batchplan
+from . import extension
+from .blend_file import append_objects, forget, save_blend
+from .cli import UsageError
+from .edges import edge_specs, spec_applies
+from .measure import MeshResult, error_row, safe_measure_mesh, set_units
+from .outputs import check_outputs, make_folders
+from .sources import blend_objects, file_sources, start_file
+from .stdio import say
+from .workers import run_workers
+
+
+class Run:
+    """The state of a batch run in the parent process: results, progress, partial CSV writes."""
+
+    def __init__(self, args, sources, tasks, total_meshes):
+        self.args, self.sources, self.tasks = args, sources, tasks
+        self.total_meshes = total_meshes
+        self.jobs = 1  # processes measuring at once
+        self.rows: dict[int, object] = {}
+        self.sweep_rows: list = []  # (task index, cells), --sweep
+        self.station_rows: list = []  # edge profiles' stations (and failed edges), after the rows
+        self.edge_rows: list = []  # one summary per edge profile, for OUT_edges.csv
+        self.results: list[MeshResult] = []
+        self.bad_files: list[str] = []
+        self.lock = threading.Lock()
+        self.started = time.perf_counter()
+        self.last_progress = 0.0
+        self.last_write = 0.0  # when the CSV was last written (perf_counter seconds)
+        self.write_seconds = 0.0  # how long that took
+        self.in_flight: dict[int, int] = {}  # mesh -> points done so far (running meshes)
+        self.units = records.units_label(bpy.context.scene)
+        # A pipe or standard output gets the CSV once, at the end; a file is rewritten as the
+        # meshes finish, so a run that is stopped keeps what it measured.
+        self.stream = csvio.output_target(args.out) == "stream"
+        self.failed_outputs: list[str] = []  # .blend or pictures that could not be written
+        for task in tasks:
+            if task.mesh < 0:
+                self.rows[task.index] = error_row(task, task.mesh_name, task.error, self.units)
+
+    @property
+    def done_points(self) -> int:
+        return len(self.rows) + sum(self.in_flight.values())
+
+    def say(self, text: str) -> None:
+        say(text)
+
+    def progress(self, mesh: int, done: int, force: bool = False) -> None:
+        with self.lock:
+            self.in_flight[mesh] = done
+            now = time.perf_counter()
+            if self.args.quiet or (not force and now - self.last_progress < 1.0):
+                return
+            self.last_progress = now
+            failed = sum(1 for row in self.rows.values() if row.error)
+            self.say(
+                f"[{now - self.started:6.1f} s] {len(self.results)}/{self.total_meshes} meshes, "
+                f"{self.done_points:,}/{len(self.tasks):,} points, {failed:,} failed"
+            )
+
+    def add(self, result: MeshResult) -> None:
+        with self.lock:
+            self.in_flight.pop(result.mesh, None)
+            self.results.append(result)
+            for index, row in result.rows:
+                self.rows[index] = row
+            self.sweep_rows.extend(result.sweep_rows)
+            self.station_rows.extend(result.station_rows)
+            self.edge_rows.extend(result.edge_rows)
+            if result.bad_file:
+                self.bad_files.append(result.bad_file)
+            if result.render_error:
+                name = self.sources[result.mesh].name
+                self.failed_outputs.append(f"render of {name}: {result.render_error}")
+            # Rewrite the CSV now and then (each write costs more as rows accumulate), so a run
+            # that is killed keeps what it measured; finish() always writes.
+            if not self.stream and (
+                time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds)
+            ):
+                self.write_csv()
+        source = self.sources[result.mesh]
+        rate = result.measured / result.measure_seconds if result.measure_seconds > 0 else 0
+        note = f", render failed: {result.render_error}" if result.render_error else ""
+        if not self.args.quiet:
+            self.say(
+                f"{source.name}: {result.measured:,} measured, {result.failed:,} failed"
+                + (f" ({result.n_vertices:,} vertices, {rate:,.0f}/s)" if result.n_vertices else "")
+                + note
+            )
+        elif note:
+            self.say(f"{source.name}{note}")
+        if message := winding_message(result.object_name or source.name, result.winding):
+            self.say(f"note: {message}")  # once per mesh, also with --quiet
+
+    def write_csv(self) -> None:
+        start = time.perf_counter()
+        rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
+        csvio.write_measurements_csv(self.args.out, rows)
+        if self.args.edge or self.args.edges_csv:
+            csvio.write_edges_csv(csvio.edges_path_for(self.args.out), self.edge_rows)
+        self.last_write = time.perf_counter()
+        self.write_seconds = self.last_write - start
+
+    def finish(self) -> int:
+        missing = [t for t in self.tasks if t.index not in self.rows]
+        for task in missing:  # e.g. a worker that could not even start
+            name = self.sources[task.mesh].name if task.mesh >= 0 else task.mesh_name
+            self.rows[task.index] = error_row(
+                task, name, "not measured: the run stopped before this mesh", self.units
+            )
+        try:
+            self.write_csv()
+        except (OSError, GoniometerError) as error:
+            where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+            self.say(f"could not write the CSV to {where}: {error}")
+            return 2
+        if self.args.sweep:
+            csv_path, plots = sweep_paths(self.args.out)
+            rows = [cells for _, cells in sorted(self.sweep_rows, key=lambda pair: pair[0])]
+            csvio.replace_atomically(str(csv_path), csvio.format_sweep_rows(rows).encode("utf-8"))
+            drawn = sum(r.sweep_plots for r in self.results)
+            self.say(f"wrote {csv_path} ({len(rows):,} sweep rows) and {drawn} plot(s) in {plots}")
+        failed = [(i, row) for i, row in sorted(self.rows.items()) if row.error]
+        failed_edges = [row for row in self.station_rows if row.error]
+        measured = len(self.rows) - len(failed)
+        elapsed = time.perf_counter() - self.started
+        load = sum(r.load_seconds for r in self.results)
+        prepare = sum(r.prepare_seconds for r in self.results)
+        measuring = sum(r.measure_seconds for r in self.results)
+        tried = sum(r.measured + r.failed for r in self.results if r.measure_seconds > 0)
+        rate = tried / measuring if measuring > 0 else 0.0
+        self.say(
+            f"{measured:,} measured, {len(failed):,} failed, {len(self.rows):,} points on "
+            f"{self.total_meshes:,} mesh(es) in {elapsed:.1f} s"
+        )
+        per = f" per process, {self.jobs} processes" if self.jobs > 1 else ""
+        self.say(
+            f"mesh import {load:.1f} s, surface preparation {prepare:.1f} s, measuring "
+            f"{measuring:.2f} s: {rate:,.0f} measurements/s{per} (import excluded)"
+        )
+        by_index = {t.index: t for t in self.tasks}
+        for index, row in failed[:10]:
+            task = by_index[index]
+            where = f"row {task.source_row}" if task.source_row else f"point {task.number}"
+            self.say(f"  failed: {where} on {row.mesh_name!r}: {row.error}")
+        if len(failed) > 10:
+            self.say(f"  ... and {len(failed) - 10} more failed rows (see the error column)")
+        for edge in self.edge_rows:
+            self.say(
+                f"edge {edge.edge_number} on {edge.mesh_name!r}: {edge.n_stations} stations every "
+                f"{edge.spacing:g} over {edge.length:.4g}: mean {edge.mean:.2f}° ± {edge.std:.2f}° "
+                f"(min {edge.min:.2f}°, max {edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°"
+                + (
+                    f"; the path crosses no ridge at arc lengths {edge.flat_spans}"
+                    if edge.flat_spans
+                    else ""
+                )
+            )
+        for row in failed_edges:
+            self.say(f"  failed: edge {row.edge_number} on {row.mesh_name!r}: {row.error}")
+        if self.edge_rows or failed_edges:
+            self.say(f"wrote {csvio.edges_path_for(self.args.out)}")
+        for message in self.bad_files:
+            self.say(f"  unreadable mesh: {message}")
+        where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+        self.say(f"wrote the CSV to {where}")
+        return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
+
+
+def sweep_paths(out) -> tuple[Path, Path]:
+    """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``."""
+    out = Path(out).resolve()
+    return out.with_name(out.stem + "_sweep.csv"), out.with_name(out.stem + "_sweep")
+
+
+def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
+    """Run a batch from parsed arguments; returns the exit status and the run's results.
+
+    ``file_ready``: the caller has already opened the file to measure in (and activated the
+    extension), as the demo does; otherwise the .blend among the inputs is opened here.
+    """
+    check_outputs(args)  # before anything is read or written
+    blend = ""
+    if file_ready:
+        inputs = list(args.inputs)
+    else:
+        inputs, blend = start_file(list(args.inputs))
+        extension.activate()
+    bp = batchplan
+    sources = blend_objects(list(args.object), blend) + file_sources(inputs)
+    if not sources:
+        raise UsageError("no mesh given: name mesh files, folders, or a .blend with --object.")
+    seen = {}
+    for source in sources:
+        if source.name in seen:
+            raise UsageError(f"two inputs are both named {source.name!r}: rename one.")
+        seen[source.name] = source
+    try:
+        if args.at:
+            tasks = bp.plan_points(
+                len(sources),
+                args.at,
+                radius=args.radius,
+                lam=args.lam,
+                patch=args.patch,
+                rule=args.rule,
+            )
+        elif not args.points:
+            tasks = []  # edges only
+        else:
+            try:
+                rows = csvio.read_replication_csv(args.points)
+            except OSError as error:
+                raise UsageError(f"{args.points}: {error.strerror or error}") from None
+            tasks = bp.plan_rows(
+                [s.names for s in sources],
+                rows,
+                radius=args.radius,
+                lam=args.lam,
+                patch=args.patch,
+                ignore_mesh_names=args.ignore_mesh_names,
+                source=f"'{Path(args.points).name}'",
+                rule=args.rule,
+            )
+        if args.shard:
+            k, n = bp.parse_shard(args.shard)
+            tasks = bp.shard(tasks, k, n)
+    except GoniometerError as error:
+        raise UsageError(str(error)) from None
+    edges = edge_specs(args, sources)
+    groups = {mesh: ts for mesh, ts in bp.by_mesh(tasks).items() if mesh >= 0}
+    if edges:  # every mesh with edges is measured, whether or not it has points
+        groups = {
+            mesh: groups.get(mesh, [])
+            for mesh in range(len(sources))
+            if mesh in groups or any(spec_applies(spec, sources[mesh]) for spec in edges)
+        }
+    units = args.units or ("none" if not blend else None)
+    set_units(bpy.context.scene, units)
+    make_folders(args)
+    options = {
+        "render": str(Path(args.render).resolve()) if args.render else "",
+        "render_size": list(args.render_size),
+        "render_samples": args.render_samples,
+        "save_blend": bool(args.save_blend),
+        "units": units,
+        "stability": bool(args.stability),
+        "sweep": list(args.sweep) if args.sweep else None,
+        "sweep_plots": str(sweep_paths(args.out)[1]) if args.sweep else "",
+        "edges": edges,
+        "plots": str(Path(args.out).resolve().parent / Path(args.out).stem) if edges else "",
+    }
+    if args.sweep:
+        sweep_paths(args.out)[1].mkdir(parents=True, exist_ok=True)
+    run = Run(args, sources, tasks, len(groups))
+    if args.shard and not args.quiet:
+        run.say(f"shard {args.shard}: {len(tasks):,} point(s) on {len(groups)} mesh(es)")
+    if not run.stream:
+        try:
+            run.write_csv()  # the header now: a place that cannot be written fails here
+        except (OSError, GoniometerError) as error:
+            raise UsageError(f"cannot write {args.out}: {error}") from None
+
+    parallel = args.jobs > 1 and len(groups) > 1 and not blend
+    if args.jobs > 1 and blend and not args.quiet:
+        run.say("a .blend input is measured in this process (--jobs applies to mesh files only)")
+    folder = tempfile.mkdtemp(prefix="vg-batch-") if parallel else ""
+    kept = []  # objects measured in this process, kept for --save-blend
+    try:
+        try:
+            if parallel:
+                plan = {
+                    "folder": folder,
+                    "parent_session": bpy.app.tempdir,  # removed by the workers if this dies
+                    "sources": [dataclasses.asdict(s) for s in sources],
+                    "tasks": {
+                        str(m): [dataclasses.asdict(t) for t in ts] for m, ts in groups.items()
+                    },
+                    "options": options,
+                }
+                run.jobs = min(args.jobs, len(groups))
+                run_workers(run, groups, plan, args.jobs)
+            else:
+                for mesh, mesh_tasks in groups.items():
+                    progress = functools.partial(run.progress, mesh)
+                    result = safe_measure_mesh(mesh, sources[mesh], mesh_tasks, options, progress)
+                    run.add(result)
+                    if args.save_blend or not sources[mesh].path:
+                        kept.append(result.object_name)
+                    elif result.object_name:
+                        forget(result.object_name)
+        finally:
+            code = run.finish()  # also after an error or Ctrl-C: write what was measured
+        if args.save_blend:
+            if parallel:
+                objects = append_objects(run.results)
+            else:
+                objects = [bpy.data.objects.get(name) for name in kept if name]
+            try:
+                save_blend(args.save_blend, objects)
+            except (RuntimeError, OSError) as error:
+                run.failed_outputs.append(f".blend {args.save_blend}: {str(error).strip()}")
+            else:
+                run.say(f"wrote {args.save_blend}")
+    finally:
+        if folder:
+            shutil.rmtree(folder, ignore_errors=True)
+    if args.render:
+        rendered = sum(1 for r in run.results if r.render)
+        run.say(f"wrote {rendered} render(s) to {args.render}")
+    for message in run.failed_outputs:
+        run.say(f"  could not write the {message}")
+    if run.failed_outputs:
+        code = max(code, 2)  # the CSV is complete, but an output asked for is missing
+    return code, run

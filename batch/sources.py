@@ -1,0 +1,153 @@
+"""What a batch run measures: mesh files imported as Blender objects, or objects of a .blend."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from ..bridge import mesh_data
+from ..vg_addon import GoniometerError
+from ..vg_addon.formats import meshio
+from ..vg_addon.workflow import batchplan
+from .cli import UsageError
+from .stdio import quiet_stdout
+
+
+@dataclasses.dataclass
+class MeshSource:
+    """A mesh to measure: a file to import, or an object of the open .blend."""
+
+    name: str
+    path: str = ""  # the mesh file; "" for a .blend object
+    aliases: tuple[str, ...] = ()
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return (self.name, *self.aliases)
+
+
+def start_file(inputs: list[str]) -> tuple[list[str], str]:
+    """Open the .blend among ``inputs`` (or keep the one Blender opened), else start empty.
+
+    Returns the other inputs and the .blend path ("" if none).
+    """
+    blends = [p for p in inputs if p.lower().endswith(".blend")]
+    others = [p for p in inputs if not p.lower().endswith(".blend")]
+    if len(blends) > 1:
+        raise UsageError(f"give at most one .blend file (got {', '.join(blends)}).")
+    if blends:
+        path = Path(blends[0])
+        if not path.is_file():
+            raise UsageError(f"{blends[0]}: no such .blend file.")
+        try:
+            with quiet_stdout():
+                bpy.ops.wm.open_mainfile(filepath=str(path.resolve()), load_ui=False)
+        except RuntimeError as error:
+            raise UsageError(
+                f"{blends[0]}: cannot open it as a .blend file ({str(error).strip()})."
+            ) from None
+        return others, str(path)
+    if bpy.app.binary_path and bpy.data.filepath:  # `blender -b file.blend --python ...`
+        return others, bpy.data.filepath
+    bpy.ops.wm.read_homefile(use_empty=True)
+    return others, ""
+
+
+def blend_objects(names: list[str], blend: str) -> list[MeshSource]:
+    if not blend:
+        if names:
+            raise UsageError("--object names an object of a .blend file: give the .blend too.")
+        return []
+    if not names:
+        meshes = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+        if len(meshes) != 1:
+            listed = ", ".join(o.name for o in meshes[:10]) or "none"
+            raise UsageError(
+                f"{blend} has {len(meshes)} mesh objects ({listed}): name the ones to measure "
+                "with --object NAME."
+            )
+        names = [meshes[0].name]
+    sources, problems = [], []
+    for name in names:
+        obj = bpy.data.objects.get(name)
+        if obj is None:
+            problems.append(f"{blend} has no object named {name!r}")
+            continue
+        try:
+            mesh_data.check_measurable(obj)
+        except GoniometerError as error:
+            problems.append(str(error))
+            continue
+        sources.append(MeshSource(obj.name, "", (obj.data.name,)))
+    if problems:
+        raise UsageError("\n  ".join(["cannot measure these objects:", *problems]))
+    return sources
+
+
+def file_sources(inputs: list[str]) -> list[MeshSource]:
+    if not inputs:
+        return []
+    try:
+        files = batchplan.find_mesh_files(inputs)
+        names = batchplan.mesh_names(files)
+    except GoniometerError as error:
+        raise UsageError(str(error)) from None
+    return [MeshSource(name, str(path)) for name, path in zip(names, files, strict=True)]
+
+
+def import_mesh(source: MeshSource):
+    """A new mesh object made from ``source``'s file (float32 coordinates, as Blender stores
+    them), linked to the scene at the world origin.
+
+    Returns
+    -------
+    obj : bpy.types.Object
+    exact_points : ndarray of float64, shape (n, 3), or None
+        The file's own coordinates when they are float64 values that float32 rounds (e.g. a
+        scan far from the origin), to be measured at the file's precision; ``None`` when
+        Blender's float32 mesh holds them exactly.
+    """
+    data = meshio.read_mesh(source.path)
+    points = np.ascontiguousarray(data.points, dtype=np.float32)
+    rounded = not np.array_equal(points.astype(np.float64), data.points)
+    exact_points = data.points if rounded else None
+    mesh = bpy.data.meshes.new(source.name)
+    mesh.vertices.add(points.shape[0])
+    # The attribute arrays take plain copies: much faster than the per-vertex properties.
+    mesh.attributes["position"].data.foreach_set("vector", points.ravel())
+    if data.triangles is not None:
+        triangles = np.ascontiguousarray(data.triangles, dtype=np.int32)
+        mesh.loops.add(triangles.size)
+        mesh.attributes[".corner_vert"].data.foreach_set("value", triangles.ravel())
+        mesh.polygons.add(triangles.shape[0])
+        mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
+    mesh.update(calc_edges=True)
+    if data.triangles is not None and needs_validation(data.triangles):
+        # Drop degenerate and duplicate faces as Blender's own importers do, so the object is
+        # the one File > Import would make from the same file. (Indices are in range: the
+        # reader checked them; so a list with neither has nothing for validate() to change.)
+        mesh.validate(verbose=False)
+    obj = bpy.data.objects.new(source.name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj, exact_points
+
+
+def needs_validation(triangles: np.ndarray) -> bool:
+    """Whether a triangle list has a degenerate face (a vertex twice) or the same face twice
+    (the same three vertices, in any order)."""
+    a, b, c = (np.ascontiguousarray(triangles[:, k], dtype=np.int64) for k in range(3))
+    if ((a == b) | (b == c) | (a == c)).any():
+        return True
+    low = np.minimum(np.minimum(a, b), c)
+    high = np.maximum(np.maximum(a, b), c)
+    middle = a + b + c - low - high
+    n = int(high.max()) + 1
+    if n < 1 << 21:  # the three indices packed into one int64 key
+        keys = np.sort((low << 42) | (middle << 21) | high)
+        return bool((keys[1:] == keys[:-1]).any())
+    order = np.lexsort((high, low * n + middle))
+    first, second = (low * n + middle)[order], high[order]
+    return bool(((first[1:] == first[:-1]) & (second[1:] == second[:-1])).any())

@@ -1,0 +1,246 @@
+"""``--jobs N``: meshes measured in worker processes, each a Blender or bpy process of its own.
+
+A worker reads mesh indices on stdin and, per mesh, writes its result as JSON into the run's
+temporary folder, then a line ``MARK done N`` on stdout.
+
+Nothing outlives the run: a worker watches its parent and, when the parent is gone (killed, even
+with SIGKILL), removes the run's temporary folder and exits; Ctrl-C is the parent's to handle
+(workers ignore SIGINT), and an interrupted parent stops its workers before it removes the
+folder, so no worker writes into a folder that is gone.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections import deque
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import bpy
+
+from ..vg_addon.formats import csvio
+from ..vg_addon.workflow import batchplan
+from . import extension
+from .blend_file import forget
+from .measure import MeshResult, error_row, safe_measure_mesh, set_units
+from .sources import MeshSource
+from .stdio import quiet_stdout
+
+if TYPE_CHECKING:
+    from .run import Run
+
+PARENT_POLL_SECONDS = 0.2  # how often a worker checks that its parent is still there
+STOP_SECONDS = 10.0  # how long a stopped worker may take to end before it is killed
+MARK = "@@vg-batch@@"  # prefix of the lines a worker sends to its parent on stdout
+
+
+def worker_command(plan_path: str) -> list[str]:
+    """The command line of a worker: the same Blender binary, or the same Python with bpy."""
+    script = str(extension.package_folder() / "vg_batch.py")
+    if bpy.app.binary_path:
+        return [
+            bpy.app.binary_path,
+            "-b",
+            "--factory-startup",
+            "-noaudio",
+            "--python",
+            script,
+            "--",
+            "--worker",
+            plan_path,
+        ]
+    return [sys.executable, script, "--worker", plan_path]
+
+
+def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
+    """Measure the meshes in ``groups`` in up to ``jobs`` worker processes, handing each idle
+    worker the next mesh. A worker that dies loses only the mesh it was on; a new one takes
+    over the rest."""
+    folder = plan["folder"]
+    plan_path = str(Path(folder) / "plan.json")
+    with open(plan_path, "w", encoding="utf-8") as handle:
+        json.dump(plan, handle)
+    queue = deque(groups)
+    lock = threading.Lock()
+    row_type = csvio.MeasurementRow
+    processes: set[subprocess.Popen] = set()
+    stopping = threading.Event()
+
+    # One BLAS/OpenMP thread per worker: the workers are the parallelism.
+    env = dict(os.environ)
+    for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        env.setdefault(name, "1")
+    # Blender makes a session folder in the temporary directory of every process: the workers'
+    # go inside the run's folder, so removing it removes them, however a worker ended.
+    for name in ("TMPDIR", "TEMP", "TMP"):
+        env[name] = folder
+
+    def start():
+        process = subprocess.Popen(
+            worker_command(plan_path),
+            env=env,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+            encoding="utf-8",
+            errors="replace",
+            bufsize=1,
+        )
+        with lock:
+            processes.add(process)
+        return process
+
+    def fail(mesh: int, message: str) -> None:
+        name = run.sources[mesh].name
+        result = MeshResult(mesh=mesh, failed=len(groups[mesh]))
+        result.rows = [(t.index, error_row(t, name, message, run.units)) for t in groups[mesh]]
+        run.add(result)
+
+    def slot():
+        process = None
+        while True:
+            with lock:
+                if not queue or stopping.is_set():
+                    break
+                mesh = queue.popleft()
+            if process is None:
+                try:
+                    process = start()
+                except OSError as error:
+                    fail(mesh, f"could not start a worker process: {error}")
+                    continue
+            finished = False
+            try:
+                process.stdin.write(f"{mesh}\n")
+                process.stdin.flush()
+                for line in process.stdout:
+                    at = line.find(MARK)
+                    if at < 0:
+                        continue
+                    words = line[at + len(MARK) :].split()
+                    if words[:1] == ["progress"]:
+                        run.progress(mesh, int(words[2]))
+                    elif words[:1] == ["done"]:
+                        finished = True
+                        break
+            except (BrokenPipeError, OSError):
+                pass
+            if finished:
+                with open(Path(folder) / f"mesh-{mesh}.json", encoding="utf-8") as handle:
+                    run.add(MeshResult.from_json(json.load(handle), row_type))
+                continue
+            code = process.wait()
+            process = None
+            if stopping.is_set():
+                break  # the run is being interrupted: its rows are "not measured"
+            fail(
+                mesh,
+                f"the worker process measuring this mesh stopped (exit status {code}); see its "
+                "messages above. The other meshes are not affected.",
+            )
+        if process is not None:
+            with contextlib.suppress(OSError):
+                process.stdin.close()
+            process.wait()
+
+    threads = [threading.Thread(target=slot, daemon=True) for _ in range(min(jobs, len(queue)))]
+    for thread in threads:
+        thread.start()
+    try:
+        for thread in threads:
+            thread.join()
+    except BaseException:
+        # Ctrl-C (or any error) in the parent: stop every worker before the caller writes the
+        # CSV and removes the temporary folder they write into.
+        stopping.set()
+        with lock:
+            running = list(processes)
+        for process in running:
+            with contextlib.suppress(OSError):
+                process.terminate()
+        for process in running:
+            try:
+                process.wait(timeout=STOP_SECONDS)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
+        raise
+
+
+def _quit(folders, status: int) -> None:
+    for folder in folders:
+        if folder:
+            shutil.rmtree(folder, ignore_errors=True)
+    os._exit(status)
+
+
+def watch_parent(folder: str, parent_session: str) -> None:
+    """In a worker: when the parent process is gone, remove the run's temporary folder (with
+    this worker's Blender session folder inside it) and the parent's Blender session folder,
+    and exit at once: a parent killed with SIGKILL cannot clean up after itself. SIGTERM (the
+    parent stopping its workers) ends the worker the same way, without a traceback."""
+    parent = os.getppid()
+    signal.signal(signal.SIGTERM, lambda signum, frame: _quit([bpy.app.tempdir], 143))
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(PARENT_POLL_SECONDS)
+        _quit([folder, parent_session], 1)
+
+    threading.Thread(target=watch, name="vg-parent-watch", daemon=True).start()
+
+
+def worker_main(plan_path: str) -> int:
+    """A worker: measure the meshes whose indices arrive on stdin, one JSON result each."""
+    # Ctrl-C in a terminal reaches the whole process group; the parent handles it and stops
+    # the workers itself.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    with open(plan_path, encoding="utf-8") as handle:
+        plan = json.load(handle)
+    watch_parent(plan["folder"], plan.get("parent_session", ""))
+    bpy.ops.wm.read_homefile(use_empty=True)
+    extension.activate()
+    set_units(bpy.context.scene, plan["options"]["units"])
+    sources = [MeshSource(**s) for s in plan["sources"]]
+    tasks = {int(k): [batchplan.Task(**t) for t in v] for k, v in plan["tasks"].items()}
+    for t in tasks.values():
+        for i, task in enumerate(t):
+            t[i] = dataclasses.replace(task, center=tuple(task.center))
+    options = plan["options"]
+    for line in sys.stdin:
+        line = line.strip()
+        if not line:
+            continue
+        mesh = int(line)
+
+        def progress(done, mesh=mesh):
+            print(f"{MARK} progress {mesh} {done}", flush=True)
+
+        result = safe_measure_mesh(mesh, sources[mesh], tasks[mesh], options, progress)
+        if options.get("save_blend") and result.object_name:
+            obj = bpy.data.objects.get(result.object_name)
+            if obj is not None:
+                path = str(Path(plan["folder"]) / f"mesh-{mesh}.blend")
+                with quiet_stdout():
+                    bpy.data.libraries.write(path, {obj})
+                result.blend = path
+        if result.object_name:
+            forget(result.object_name)
+        target = Path(plan["folder"]) / f"mesh-{mesh}.json"
+        temporary = target.with_suffix(".tmp")
+        try:
+            temporary.write_text(json.dumps(result.to_json()), encoding="utf-8")
+            temporary.replace(target)
+        except FileNotFoundError:
+            return 1  # the run is over and its folder removed: nobody waits for this result
+        print(f"{MARK} done {mesh}", flush=True)
+    return 0

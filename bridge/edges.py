@@ -1,0 +1,254 @@
+"""Edge profiles on Blender objects: measure a whole edge, record its stations as one break,
+keep its summary and plot, rebuild an edge from re-measured stations, delete one.
+
+Each raises :class:`GoniometerError` for bad input before changing anything.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from ..properties import exact_numbers
+from ..vg_addon import GoniometerError
+from ..vg_addon.errors import bounded_list
+from ..vg_addon.formats import csvio, profile_plot
+from ..vg_addon.method.edge_profile import summarize
+from . import measuring, records
+from .mesh_data import check_measurable, evaluated_geometry, surface_for
+
+PLOT_SIZE = (480, 240)
+
+
+def free_break(obj) -> int:
+    """The object's current break number if no measurement uses it yet, else the next unused."""
+    used = {item.break_number for item in obj.vg.measurements}
+    number = obj.vg.break_number
+    while number in used:
+        number += 1
+    return number
+
+
+def measure_edge(obj, points, spacing, radius, lam=2.0, patch="euclidean", *, depsgraph=None):
+    """Trace and measure the edge through ``points`` on ``obj`` without recording anything:
+    ``(EdgeProfile, Geometry)``."""
+    check_measurable(obj)
+    points = np.asarray(points, dtype=np.float64)
+    if points.ndim != 2 or points.shape[1] != 3 or points.shape[0] < 2:
+        raise GoniometerError(
+            "An edge needs at least two points (start and end, optionally via points between), "
+            "each x, y, z."
+        )
+    geometry = evaluated_geometry(obj, depsgraph)
+    surface = surface_for(obj, geometry)
+    profile = surface.measure_along(points, spacing, radius, lam, patch)
+    return profile, geometry
+
+
+def measure_edge_on_object(
+    obj, points, spacing, radius, lam=2.0, patch="euclidean", *, depsgraph=None, note=""
+):
+    """Measure the edge through ``points`` and record every station as a measurement of one new
+    break (its own colour pair), plus the edge's record with its summary and plot.
+
+    Parameters
+    ----------
+    obj : bpy.types.Object
+    points : array_like, shape (k, 3)
+        Start, via points and end, world space (float64 is kept exactly); each snaps to the
+        nearest vertex and the path is traced along the ridge between them.
+    spacing, radius, lam, patch
+        Station spacing (arc length) and the measuring settings of every station.
+    note : str
+        Free text stored with the edge and each station.
+
+    Returns
+    -------
+    The new ``VG_EdgeProfile`` item (now the active edge).
+
+    Raises
+    ------
+    GoniometerError
+        Anything that stops the edge being traced or any station being measured; nothing is
+        recorded then.
+    """
+    profile, geometry = measure_edge(obj, points, spacing, radius, lam, patch, depsgraph=depsgraph)
+    break_number = free_break(obj)
+    edge_number = obj.vg.next_edge_number
+    sides = profile.figures.plus_left
+    for m, arc, left in zip(profile.stations, profile.arc_lengths, sides, strict=True):
+        item = records.add_measurement(
+            obj,
+            m,
+            geometry.fingerprint,
+            note=note,
+            break_number=break_number,
+            station=(edge_number, arc, profile.spacing, left),
+        )
+        measuring.keep_sides(obj, geometry, item, m)
+    clicks = np.asarray(points, dtype=np.float64)
+    edge = records.add_edge(
+        obj, profile, clicks, geometry.fingerprint, break_number=break_number, note=note
+    )
+    obj.vg.break_number = break_number + 1  # the next measurement starts a new break
+    edge.plot = make_plot(obj, edge).name
+    measuring.repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    return edge
+
+
+def import_edges_csv(
+    obj, path, *, ignore_mesh_names=False, lam=2.0, patch="euclidean", depsgraph=None
+):
+    """Re-measure every edge of an edge summary file on ``obj``: all of them, or none.
+
+    Each row's ``Points`` are traced again and measured with its ``Spacing``, ``Radius``,
+    ``SegParam`` and ``Patch Mode`` (``lam`` and ``patch`` for blank cells), and recorded like
+    an edge measured here, with the row's User Data as its note.
+
+    Returns
+    -------
+    list of int
+        The new edges' numbers.
+
+    Raises
+    ------
+    GoniometerError
+        Listing every row that names another mesh or cannot be measured; nothing is recorded.
+    """
+    check_measurable(obj)
+    rows = csvio.read_edges_csv(path)
+    source = f"'{Path(path).name}'"
+    if not rows:
+        raise GoniometerError(f"{source} has no edges: nothing to import.")
+    names = (obj.name, obj.data.name)
+    failures, jobs = [], []
+    for number, row in enumerate(rows, start=2):
+        try:
+            if not ignore_mesh_names and not csvio.mesh_name_matches(row.mesh_name, names):
+                raise GoniometerError(
+                    f"it names the mesh {row.mesh_name!r}, not '{obj.name}' (tick Ignore Names "
+                    "to measure it here)"
+                )
+            if row.spacing is None or row.radius is None:
+                raise GoniometerError("it has no Spacing or no Radius")
+            points = csvio.parse_points(row.points)
+            settings = (
+                row.spacing,
+                row.radius,
+                lam if row.seg_param is None else row.seg_param,
+                row.patch or patch,
+            )
+            measure_edge(obj, points, *settings, depsgraph=depsgraph)  # checked before recording
+        except GoniometerError as error:
+            failures.append(f"row {number}: {error}")
+            continue
+        jobs.append((points, settings, row.user_data))
+    if failures:
+        raise GoniometerError(
+            f"{len(failures)} of {len(rows)} edges of {source} could not be measured on "
+            f"'{obj.name}'; nothing was imported.\n" + bounded_list(failures, lines=True)
+        )
+    return [
+        measure_edge_on_object(obj, points, *settings, depsgraph=depsgraph, note=note).number
+        for points, settings, note in jobs
+    ]
+
+
+def make_plot(obj, edge):
+    """The profile plot of ``edge`` as a packed image (saved inside the .blend)."""
+    numbers = exact_numbers(edge)
+    rgba = profile_plot.render_profile(
+        numbers["arc_lengths"], numbers["angles"], width=PLOT_SIZE[0], height=PLOT_SIZE[1]
+    )
+    width, height = PLOT_SIZE
+    image = bpy.data.images.new(f"VG {obj.name} edge {edge.number}", width, height, alpha=True)
+    # Blender's rows run bottom-up.
+    image.pixels.foreach_set((rgba[::-1].astype(np.float32) / 255.0).ravel())
+    image.pack()
+    image.use_fake_user = True  # only the edge names it: without a user it would not be saved
+    image.preview_ensure()  # the panel shows the plot as the image's preview icon
+    return image
+
+
+def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
+    """Rebuild edge records from re-measured stations (a CSV import).
+
+    Parameters
+    ----------
+    stations : dict
+        ``{csv edge number: [(measurement item, Measurement, arc length, spacing), ...]}``;
+        the items are already recorded, in the order the CSV listed them.
+
+    Returns
+    -------
+    list of int
+        The new edges' numbers. Each item's ``edge_number`` is set to its new edge.
+    """
+    surface = surface_for(obj, geometry)
+    numbers_made = []
+    for _, group in sorted(stations.items()):
+        group = sorted(group, key=lambda entry: entry[2])
+        items, measurements = [g[0] for g in group], [g[1] for g in group]
+        figures = summarize(surface, measurements)
+        centers = [[float(v) for v in m.center] for m in measurements]
+        numbers = {
+            "points": [centers[0], centers[-1]] if len(centers) > 1 else centers,
+            "path": centers,
+            "spacing": float(group[0][3]),
+            "radius": float(measurements[0].radius),
+            "lam": float(measurements[0].lam),
+            "length": float(group[-1][2] - group[0][2]),
+            "arc_lengths": [float(g[2]) for g in group],
+            "angles": [float(m.angle) for m in measurements],
+            "mean": figures.mean,
+            "std": figures.std,
+            "min": figures.min,
+            "max": figures.max,
+            "pooled_angle": figures.pooled_angle,
+            "pooled_fit": figures.pooled_fit_error,
+            "flat_spans": [],
+        }
+        edge = records.add_edge_from_numbers(
+            obj,
+            numbers,
+            measurements[0].patch,
+            geometry.fingerprint,
+            break_number=items[0].break_number,
+            note=items[0].note,
+        )
+        for item, left in zip(items, figures.plus_left, strict=True):
+            item.edge_number = edge.number
+            numbers = exact_numbers(item)
+            numbers["plus_left"] = bool(left)
+            item.exact = json.dumps(numbers)
+            item.colors = "/".join(records.station_colours(item.break_number, left))
+        edge.plot = make_plot(obj, edge).name
+        numbers_made.append(edge.number)
+    return numbers_made
+
+
+def delete_edge(obj, index: int, *, depsgraph=None) -> int:
+    """Delete the edge at list position ``index``, its stations and its plot; repaint.
+
+    Returns the deleted edge's number.
+    """
+    data = obj.vg
+    if not 0 <= index < len(data.edges):
+        raise GoniometerError(f"'{obj.name}' has no edge profile at list position {index}.")
+    geometry = evaluated_geometry(obj, depsgraph)
+    edge = data.edges[index]
+    number = edge.number
+    image = bpy.data.images.get(edge.plot)
+    for position in reversed(range(len(data.measurements))):
+        if data.measurements[position].edge_number == number:
+            data.measurements.remove(position)
+    data.active_index = min(data.active_index, max(len(data.measurements) - 1, 0))
+    data.edges.remove(index)
+    data.active_edge_index = min(index, max(len(data.edges) - 1, 0))
+    if image is not None:
+        bpy.data.images.remove(image)
+    measuring.repaint(obj, geometry=geometry)
+    return number

@@ -1,0 +1,362 @@
+"""Edge profiles: ``vg.measure_edge`` (click along a break edge, or give the points) and
+``vg.delete_edge``.
+
+Invoked from the panel, ``vg.measure_edge`` runs a modal session: click the start, any via
+points and the end on the active mesh; the path is traced along the ridge and drawn as it is
+found; Enter measures every station and records them, Backspace drops the last click, Esc
+cancels. The interaction is :class:`~vg_addon.workflow.edge_state.EdgeMachine` (pure, tested
+without a screen); a confirmed session records through ``execute`` with its clicks, the same
+call a script makes, so the stations are the same bit for bit, and one undo step removes the
+whole profile.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+
+import bpy
+import numpy as np
+from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
+
+from ..bridge import edges
+from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
+from ..properties import PATCH_ITEMS
+from ..vg_addon import GoniometerError
+from ..vg_addon.workflow.edge_state import EdgeMachine, EdgePhase
+from .drag import format_length, object_alive, ray_cast_object
+from .edge_overlay import EdgeOverlay
+from .measure import typed_value
+
+_NAVIGATION = {
+    "MIDDLEMOUSE",
+    "WHEELUPMOUSE",
+    "WHEELDOWNMOUSE",
+    "WHEELINMOUSE",
+    "WHEELOUTMOUSE",
+    "TRACKPADPAN",
+    "TRACKPADZOOM",
+    "NDOF_MOTION",
+    "MOUSEROTATE",
+    "MOUSESMARTZOOM",
+    "MOUSEMOVE",
+}
+
+HINTS = (
+    (("MOUSE_LMB",), "Click start, via points, end"),
+    (("EVENT_RETURN",), "Measure"),
+    (("EVENT_BACKSPACE",), "Undo click"),
+    (("EVENT_ESC", "MOUSE_RMB"), "Cancel"),
+    (("MOUSE_MMB",), "Navigate"),
+)
+
+
+def translate_edge_event(event_type: str, value: str, *, ctrl=False, alt=False):
+    """What a Blender event means to the edge session: ``"click"``, ``"confirm"``, ``"undo"``,
+    ``"cancel"``, ``"pass"`` (navigation, let Blender have it) or ``"ignore"``."""
+    if event_type in _NAVIGATION:
+        return "pass"
+    if event_type == "WINDOW_DEACTIVATE":
+        return "cancel"
+    if value != "PRESS":
+        return "ignore"
+    if event_type == "LEFTMOUSE" and not (ctrl or alt):
+        return "click"
+    if event_type in ("RET", "NUMPAD_ENTER", "SPACE"):
+        return "confirm"
+    if event_type == "BACK_SPACE" or (event_type == "Z" and ctrl):
+        return "undo"
+    if event_type in ("ESC", "RIGHTMOUSE"):
+        return "cancel"
+    return "ignore"
+
+
+def parse_points(text: str) -> np.ndarray:
+    """The ``points`` property: JSON ``[[x, y, z], ...]`` (float64, exactly as written)."""
+    try:
+        points = np.array(json.loads(text), dtype=np.float64)
+    except (ValueError, TypeError):
+        raise GoniometerError(
+            f"The edge points must be JSON like [[x, y, z], [x, y, z]]; got {text!r}."
+        ) from None
+    if points.ndim != 2 or points.shape[1] != 3 or points.shape[0] < 2:
+        raise GoniometerError(
+            "The edge needs at least two points [[x, y, z], [x, y, z]] (start and end, with any "
+            f"via points between); got {text!r}."
+        )
+    if not np.isfinite(points).all():
+        raise GoniometerError(f"The edge points must be finite numbers; got {text!r}.")
+    return points
+
+
+def format_points(points) -> str:
+    """JSON text of ``points`` that :func:`parse_points` reads back bit for bit."""
+    return json.dumps([[float(v) for v in point] for point in np.asarray(points)])
+
+
+class EdgeSession:
+    """One edge-picking session on one object: the machine, the overlay and the texts."""
+
+    def __init__(self, context, obj):
+        self.obj = obj
+        area = context.area
+        # Started from the sidebar's button, the context's region is the sidebar: clicks are
+        # taken in the area's main (WINDOW) region, with its view.
+        self._region = next((r for r in area.regions if r.type == "WINDOW"), None)
+        self._region_data = getattr(area.spaces.active, "region_3d", None)
+        if self._region is None or self._region_data is None:
+            raise GoniometerError("Edge profiles are picked in a 3D viewport.")
+        depsgraph = context.evaluated_depsgraph_get()
+        self.machine = EdgeMachine(surface_for(obj, evaluated_geometry(obj, depsgraph)))
+        self.overlay = EdgeOverlay()
+        self._area, self._workspace = area, context.workspace
+        self.overlay.start()
+        self.refresh(context)
+
+    def region_coord(self, mouse) -> tuple | None:
+        """Window-pixel ``mouse`` relative to the viewport's main region, or None if outside."""
+        x, y = mouse[0] - self._region.x, mouse[1] - self._region.y
+        inside = 0 <= x < self._region.width and 0 <= y < self._region.height
+        return (x, y) if inside else None
+
+    def handle(self, context, action: str, mouse=None) -> str:
+        """Apply one translated event (``mouse``: window pixel coordinates); returns
+        ``"running"``, ``"pass"`` or ``"done"``."""
+        machine = self.machine
+        if not object_alive(context, self.obj):
+            machine.cancel("The object was deleted: nothing was recorded.")
+            return "done"
+        if action == "pass":
+            return "pass"
+        if action == "click":
+            coord = self.region_coord(mouse)
+            if coord is None:  # on the sidebar or a header: let Blender have it
+                return "pass"
+            hit = ray_cast_object(
+                self.obj,
+                context.evaluated_depsgraph_get(),
+                self._region,
+                self._region_data,
+                coord,
+            )
+            machine.click(hit)
+        elif action == "undo":
+            machine.undo()
+        elif action == "confirm":
+            settings = context.scene.vg_settings
+            machine.confirm(
+                typed_value(settings.edge_spacing),
+                typed_value(settings.radius),
+                typed_value(settings.seg_param),
+                settings.patch,
+            )
+        elif action == "cancel":
+            machine.cancel()
+        else:
+            return "running"
+        if machine.phase is EdgePhase.PICKING:
+            self.refresh(context)
+            return "running"
+        return "done"
+
+    def refresh(self, context) -> None:
+        """Hand the clicks and path to the overlay; update header and status bar."""
+        self.overlay.update(self.machine.clicks, self.machine.path)
+        if self._area is not None:
+            self._area.header_text_set(self.header_text(context.scene))
+            self._area.tag_redraw()
+        if self._workspace is not None:
+            self._workspace.status_text_set(_draw_status_hints)
+
+    def header_text(self, scene) -> str:
+        machine = self.machine
+        parts = [f"Edge profile: {len(machine.clicks)} point(s)"]
+        if machine.path is not None:
+            parts.append(f"path {format_length(scene, machine.path.length)}")
+        settings = scene.vg_settings
+        parts.append(
+            f"spacing {format_length(scene, settings.edge_spacing)}, radius "
+            f"{format_length(scene, settings.radius)}"
+        )
+        if machine.message:
+            parts.append(machine.message.splitlines()[0])
+        return "  ·  ".join(parts)
+
+    def finish(self) -> None:
+        """Remove the drawing and the texts; safe to call more than once."""
+        self.overlay.stop()
+        area, self._area = self._area, None
+        workspace, self._workspace = self._workspace, None
+        for clear in (
+            lambda: area.header_text_set(None),
+            lambda: area.tag_redraw(),
+            lambda: workspace.status_text_set(None),
+        ):
+            with contextlib.suppress(AttributeError, ReferenceError):
+                clear()
+
+
+def _draw_status_hints(header, context):
+    row = header.layout.row(align=True)
+    for icons, text in HINTS:
+        for icon in icons:
+            row.label(text="", icon=icon)
+        row.label(text=text)
+        row.separator(factor=2.0)
+
+
+class VG_OT_measure_edge(bpy.types.Operator):
+    """Measure a whole break edge: click its start, any via points and its end on the active
+    mesh, then Enter; every station is recorded as a measurement of one new break"""
+
+    bl_idname = "vg.measure_edge"
+    bl_label = "Edge Profile"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+
+    points: StringProperty(
+        name="Points",
+        description="Start, via points and end of the edge, world space, as JSON "
+        "[[x, y, z], ...] (exact float64); each snaps to the nearest vertex",
+    )
+    spacing: FloatProperty(
+        name="Spacing",
+        description="Arc length between stations; default: the panel's",
+        min=0.0,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    radius: FloatProperty(
+        name="Radius",
+        description="Patch radius of every station; default: the panel's",
+        min=0.0,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    seg_param: FloatProperty(
+        name="λ (SegParam)", description="Segmentation parameter; default: the panel's", min=0.0
+    )
+    patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
+    note: StringProperty(name="Note", description="Free text stored with the edge")
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return obj is not None and obj.type == "MESH"
+
+    def execute(self, context):
+        settings = context.scene.vg_settings
+        given = self.properties.is_property_set
+        if not given("spacing"):
+            self.spacing = settings.edge_spacing
+        if not given("radius"):
+            self.radius = settings.radius
+        if not given("seg_param"):
+            self.seg_param = settings.seg_param
+        if not given("patch"):
+            self.patch = settings.patch
+        obj = context.active_object
+        try:
+            edge = edges.measure_edge_on_object(
+                obj,
+                parse_points(self.points),
+                typed_value(self.spacing),
+                typed_value(self.radius),
+                typed_value(self.seg_param),
+                self.patch,
+                depsgraph=context.evaluated_depsgraph_get(),
+                note=self.note,
+            )
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report(
+            {"INFO"},
+            f"Edge {edge.number} (break {edge.break_number}) on '{obj.name}': {edge.n_stations} "
+            f"stations, mean {edge.mean:.2f}° ± {edge.std:.2f}° (min {edge.min:.2f}°, max "
+            f"{edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°",
+        )
+        warning = json.loads(edge.exact).get("flat_spans")
+        if warning:
+            self.report(
+                {"WARNING"},
+                f"Part of edge {edge.number}'s path crosses surface with no ridge (arc lengths "
+                + ", ".join(f"{a:.4g}-{b:.4g}" for a, b in warning)
+                + "); check those stations.",
+            )
+        return {"FINISHED"}
+
+    def invoke(self, context, event):
+        if self.properties.is_property_set("points"):
+            return self.execute(context)
+        if context.area is None or context.area.type != "VIEW_3D":
+            self.report({"WARNING"}, "Edge profiles are picked in the 3D viewport.")
+            return {"CANCELLED"}
+        obj = context.active_object
+        try:
+            check_measurable(obj)
+            self._session = EdgeSession(context, obj)
+        except GoniometerError as error:
+            self.report({"WARNING"}, str(error))
+            return {"CANCELLED"}
+        context.window_manager.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        session = self._session
+        try:
+            action = translate_edge_event(event.type, event.value, ctrl=event.ctrl, alt=event.alt)
+            status = session.handle(context, action, (event.mouse_x, event.mouse_y))
+        except BaseException:
+            session.finish()
+            raise
+        if status == "pass":
+            return {"PASS_THROUGH"}
+        if status == "running":
+            return {"RUNNING_MODAL"}
+        session.finish()
+        machine = session.machine
+        if machine.phase is not EdgePhase.CONFIRMED:
+            self.report({"INFO"}, machine.message or "Nothing was recorded.")
+            return {"CANCELLED"}
+        self.points = format_points(machine.clicks)  # stored for redo as well
+        return self.execute(context)
+
+    def cancel(self, context):
+        """Blender ends the modal operator (file load, window closed, ...): clean up."""
+        session = getattr(self, "_session", None)
+        if session is not None:
+            session.finish()
+
+
+class VG_OT_delete_edge(bpy.types.Operator):
+    """Delete an edge profile with all its stations"""
+
+    bl_idname = "vg.delete_edge"
+    bl_label = "Delete Edge Profile"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+
+    index: IntProperty(
+        name="Index", description="Position in the list; -1: the selected one", default=-1, min=-1
+    )
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return obj is not None and obj.type == "MESH" and len(obj.vg.edges) > 0
+
+    def execute(self, context):
+        obj = context.active_object
+        index = obj.vg.active_edge_index if self.index < 0 else self.index
+        try:
+            check_measurable(obj)
+            number = edges.delete_edge(obj, index, depsgraph=context.evaluated_depsgraph_get())
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"Deleted edge profile {number} of '{obj.name}' and its stations")
+        return {"FINISHED"}
+
+
+classes = (VG_OT_measure_edge, VG_OT_delete_edge)

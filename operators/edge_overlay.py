@@ -1,0 +1,101 @@
+"""The edge-profile preview in the 3D viewport: the traced path and the clicked points.
+
+It belongs to the edge operator's modal session, which installs and removes it (like the drag
+tool's overlay beside its operator). Clicks only hand over new NumPy arrays; GPU batches are
+built lazily in the draw callback, the one place a GPU context is guaranteed.
+"""
+
+from __future__ import annotations
+
+import bpy
+import gpu
+import numpy as np
+from gpu_extras.batch import batch_for_shader
+
+PATH_COLOR = (1.0, 0.85, 0.1, 1.0)
+CLICK_COLOR = (1.0, 1.0, 1.0, 1.0)
+FLAT_COLOR = (0.9, 0.2, 0.1, 1.0)  # stretches of the path on no ridge
+LINE_WIDTH = 3.0
+CLICK_SIZE = 8.0
+
+
+def path_segments(points: np.ndarray, arc_lengths: np.ndarray, flat_spans) -> tuple:
+    """The path as float32 line-segment endpoints, split into ridge and flat stretches:
+    ``(ridge_pairs, flat_pairs)``, each ``(2k, 3)`` for the ``LINES`` primitive."""
+    points = np.asarray(points, dtype=np.float64)
+    if points.shape[0] < 2:
+        empty = np.zeros((0, 3), dtype=np.float32)
+        return empty, empty
+    middle = (arc_lengths[:-1] + arc_lengths[1:]) / 2.0
+    flat = np.zeros(middle.size, dtype=bool)
+    for low, high in flat_spans:
+        flat |= (middle >= low) & (middle <= high)
+    pairs = np.stack([points[:-1], points[1:]], axis=1).astype(np.float32)
+    return pairs[~flat].reshape(-1, 3), pairs[flat].reshape(-1, 3)
+
+
+class EdgeOverlay:
+    """The viewport drawing of one edge session; ``start``/``stop`` like ``DragOverlay``."""
+
+    def __init__(self):
+        self._handle = None
+        self._clicks: np.ndarray | None = None
+        self._ridge = self._flat = None
+        self._batches = None
+
+    @property
+    def active(self) -> bool:
+        """Whether the draw handler is installed."""
+        return self._handle is not None
+
+    def start(self) -> None:
+        """Install the draw handler in every 3D viewport (a no-op when already installed)."""
+        if self._handle is None:
+            self._handle = bpy.types.SpaceView3D.draw_handler_add(
+                self._draw, (), "WINDOW", "POST_VIEW"
+            )
+
+    def stop(self) -> None:
+        """Remove the draw handler and drop the data; safe to call more than once."""
+        handle, self._handle = self._handle, None
+        self._clicks = self._ridge = self._flat = self._batches = None
+        if handle is not None:
+            bpy.types.SpaceView3D.draw_handler_remove(handle, "WINDOW")
+
+    def update(self, clicks, path) -> None:
+        """New data: the clicked points and the traced ``EdgePath`` (or ``None``)."""
+        self._clicks = np.asarray(clicks, dtype=np.float32).reshape(-1, 3)
+        if path is None:
+            self._ridge = self._flat = None
+        else:
+            self._ridge, self._flat = path_segments(path.points, path.arc_lengths, path.flat_spans)
+        self._batches = None
+
+    def _build(self, shader) -> list:
+        batches = []
+        for pairs, color in ((self._ridge, PATH_COLOR), (self._flat, FLAT_COLOR)):
+            if pairs is not None and len(pairs):
+                batches.append(("LINES", batch_for_shader(shader, "LINES", {"pos": pairs}), color))
+        if self._clicks is not None and len(self._clicks):
+            batches.append(
+                ("POINTS", batch_for_shader(shader, "POINTS", {"pos": self._clicks}), CLICK_COLOR)
+            )
+        return batches
+
+    def _draw(self) -> None:
+        if bpy.context.region_data is None or self._clicks is None:
+            return
+        shader = gpu.shader.from_builtin("UNIFORM_COLOR")
+        gpu.state.blend_set("ALPHA")
+        gpu.state.depth_test_set("NONE")
+        shader.bind()
+        if self._batches is None:
+            self._batches = self._build(shader)
+        gpu.state.line_width_set(LINE_WIDTH)
+        gpu.state.point_size_set(CLICK_SIZE)
+        for _, batch, color in self._batches:
+            shader.uniform_float("color", color)
+            batch.draw(shader)
+        gpu.state.line_width_set(1.0)
+        gpu.state.point_size_set(1.0)
+        gpu.state.blend_set("NONE")

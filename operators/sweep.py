@@ -1,0 +1,88 @@
+"""The radius sweep operator: angle and fit error over a range of radii at one site, written as a
+CSV and a plot PNG beside it (nothing is recorded on the object)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import bpy
+from bpy.props import FloatProperty, FloatVectorProperty, IntProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper
+
+from ..bridge import measuring
+from ..vg_addon import GoniometerError
+from ..vg_addon.formats import csvio, sweep_plot
+from .measure import typed_value
+
+
+class VG_OT_radius_sweep(bpy.types.Operator, ExportHelper):
+    """Measure at the 3D cursor over a range of radii (the MeshLab plugin's burst) and write the
+    angles and fit errors to a CSV, with a plot of them as a PNG of the same name"""
+
+    bl_idname = "vg.radius_sweep"
+    bl_label = "Radius Sweep"
+    bl_options = {"REGISTER"}  # noqa: RUF012 (Blender wants a set)
+
+    filename_ext = ".csv"
+    filter_glob: StringProperty(default="*.csv", options={"HIDDEN"})
+    location: FloatVectorProperty(
+        name="Location",
+        description="Centre to measure at, world space; default: the 3D cursor",
+        size=3,
+        subtype="TRANSLATION",
+        unit="LENGTH",
+    )
+    start: FloatProperty(name="From", description="First radius; default: the panel's", min=0.0)
+    stop: FloatProperty(name="To", description="Last radius; default: the panel's", min=0.0)
+    count: IntProperty(name="Radii", description="Default: the panel's", min=2, max=1000)
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return obj is not None and obj.type == "MESH"
+
+    def execute(self, context):
+        settings = context.scene.vg_settings
+        given = self.properties.is_property_set
+        if not given("location"):
+            self.location = context.scene.cursor.location
+        for name, setting in (("start", "sweep_start"), ("stop", "sweep_stop")):
+            if not given(name):
+                setattr(self, name, getattr(settings, setting))
+        if not given("count"):
+            self.count = settings.sweep_count
+        path = bpy.path.abspath(self.filepath) if self.filepath else ""
+        obj = context.active_object
+        try:
+            if not path:
+                raise GoniometerError("No file name given: choose where to write the sweep CSV.")
+            points = measuring.sweep(
+                obj,
+                [typed_value(v) for v in self.location],
+                typed_value(self.start),
+                typed_value(self.stop),
+                self.count,
+                typed_value(settings.seg_param),
+                settings.patch,
+                depsgraph=context.evaluated_depsgraph_get(),
+                rule=settings.rule,
+            )
+            image = str(Path(path).with_suffix(".png"))
+            csvio.write_sweep_csv(path, obj.name, points)
+            sweep_plot.write_sweep_png(image, points)
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        except OSError as error:
+            self.report({"ERROR"}, f"Could not write the sweep: {error}")
+            return {"CANCELLED"}
+        measured = [p.measurement.angle for p in points if p.measurement is not None]
+        self.report(
+            {"INFO"},
+            f"Sweep of {len(points)} radii on '{obj.name}' ({len(measured)} measured, "
+            f"{min(measured):.2f}° to {max(measured):.2f}°): {path} and {image}",
+        )
+        return {"FINISHED"}
+
+
+classes = (VG_OT_radius_sweep,)

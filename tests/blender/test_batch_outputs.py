@@ -1,0 +1,200 @@
+"""Where a batch run writes: inputs are never outputs, '-' is standard output, places that
+cannot be written are refused before anything is read or written, and an output that fails late
+(a .blend, a picture) makes the exit status say so. Run as a user runs it, and the checks that
+depend on permissions also as an unprivileged user."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from unprivileged import as_user
+
+from vg_addon.formats import csvio, meshio
+from vg_addon.synthetic_meshes import wedge
+
+ROOT = Path(__file__).resolve().parents[2]
+SCRIPT = ROOT / "vg_batch.py"
+AT = ("--at", "0.05", "0", "0", "--radius", "0.3")
+
+
+def batch(*args, cwd=None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, str(SCRIPT), *(str(a) for a in args)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=cwd,
+        check=False,
+    )
+
+
+@pytest.fixture
+def scan(tmp_path) -> Path:
+    shape = wedge(90.0, n=24, irregular=True, seed=3)
+    return meshio.write_ply(tmp_path / "scan.ply", shape.points, shape.triangles)
+
+
+def refused(result, *phrases):
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert "Traceback" not in result.stderr
+    for phrase in phrases:
+        assert phrase in result.stderr, result.stderr
+
+
+def test_out_onto_the_input_mesh_is_refused_and_the_scan_kept(scan):
+    before = scan.read_bytes()
+    refused(batch(scan, *AT, "--out", scan), f"--out {scan} is the mesh file", "nothing was read")
+    assert scan.read_bytes() == before
+
+
+def test_out_onto_a_mesh_found_in_a_given_folder_or_through_a_link_is_refused(scan, tmp_path):
+    before = scan.read_bytes()
+    link = tmp_path / "link.csv"
+    link.symlink_to(scan)
+    hard = tmp_path / "hard.csv"
+    os.link(scan, hard)
+    for out in (link, hard):
+        refused(batch(tmp_path / "scan.ply", *AT, "--out", out), "is the mesh file")
+        refused(batch(tmp_path, *AT, "--out", out), "is the mesh file")
+    assert scan.read_bytes() == before and link.is_symlink()
+
+
+def test_out_onto_the_points_csv_is_refused_and_its_columns_kept(scan, tmp_path):
+    points = tmp_path / "points.csv"
+    points.write_text("x,y,z,site,notes\n0.05,0,0,A,keep me\n")
+    before = points.read_bytes()
+    refused(batch(scan, "--points", points, "--radius", "0.3", "--out", points),
+            "is the points CSV")  # fmt: skip
+    assert points.read_bytes() == before
+
+
+def test_save_blend_onto_an_input_or_onto_the_out_csv_is_refused(scan, tmp_path):
+    before = scan.read_bytes()
+    refused(batch(scan, *AT, "--out", tmp_path / "o.csv", "--save-blend", scan),
+            f"--save-blend {scan} is the mesh file")  # fmt: skip
+    assert scan.read_bytes() == before
+    same = tmp_path / "both"
+    refused(batch(scan, *AT, "--out", same, "--save-blend", same), "are the same file")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scan.ply"]
+
+
+def test_out_dash_writes_the_csv_to_standard_output_once(scan, tmp_path):
+    result = batch(scan, *AT, "--out", "-", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    rows = csvio.parse_measurements_csv(result.stdout)
+    assert len(rows) == 1 and abs(rows[0].angle - 90.0) < 0.01
+    assert result.stdout.count("Mesh Name,") == 1
+    assert "wrote the CSV to standard output" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scan.ply"]  # no file named "-"
+
+
+def test_out_dash_with_jobs(scan, tmp_path):
+    other = wedge(60.0, n=24, irregular=True, seed=4)
+    meshio.write_ply(tmp_path / "other.ply", other.points, other.triangles)
+    result = batch(scan, tmp_path / "other.ply", *AT, "--jobs", "2", "--out", "-", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    rows = csvio.parse_measurements_csv(result.stdout)
+    assert [row.mesh_name for row in rows] == ["scan", "other"]
+
+
+def test_save_blend_to_a_folder_is_refused_before_measuring(scan, tmp_path):
+    out = tmp_path / "o.csv"
+    refused(batch(scan, *AT, "--out", out, "--save-blend", tmp_path),
+            "--save-blend", "is a folder: give a file name")  # fmt: skip
+    assert not out.exists()
+
+
+def test_render_to_a_file_is_refused_before_measuring(scan, tmp_path):
+    out, picture = tmp_path / "o.csv", tmp_path / "picture.png"
+    picture.write_bytes(b"not a folder")
+    refused(batch(scan, *AT, "--out", out, "--render", picture), "--render takes a folder")
+    assert not out.exists() and picture.read_bytes() == b"not a folder"
+
+
+def test_out_into_a_folder_that_is_a_file_is_refused(scan, tmp_path):
+    refused(batch(scan, *AT, "--out", tmp_path / "scan.ply" / "x.csv"), "is a file, not a folder")
+
+
+def test_a_render_that_fails_late_gives_a_nonzero_exit_and_keeps_the_csv(scan, tmp_path):
+    renders, out = tmp_path / "renders", tmp_path / "o.csv"
+    (renders / "scan.png").mkdir(parents=True)  # Cycles cannot write its picture there
+    result = batch(scan, *AT, "--out", out, "--render", renders, "--render-size", 16, 16,
+                   "--render-samples", 1)  # fmt: skip
+    assert result.returncode == 2, result.stderr
+    assert "could not write the render of scan" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert abs(csvio.read_measurements_csv(out)[0].angle - 90.0) < 0.01
+
+
+def test_a_blend_that_fails_late_gives_a_nonzero_exit_and_keeps_the_csv(scan, tmp_path):
+    saved, out = tmp_path / "saved.blend", tmp_path / "o.csv"
+    # Blender writes "<name>@" first and renames it: a folder there makes the save fail late.
+    blocker = tmp_path / "saved.blend@"
+    blocker.mkdir()
+    (blocker / "keep").write_text("x")
+    result = batch(scan, *AT, "--out", out, "--save-blend", saved)
+    assert result.returncode == 2, result.stderr
+    assert "could not write the .blend" in result.stderr and "Traceback" not in result.stderr
+    assert abs(csvio.read_measurements_csv(out)[0].angle - 90.0) < 0.01
+    assert (blocker / "keep").read_text() == "x"
+
+
+# --------------------------------------------------------------------------- as a normal user
+
+
+def arguments(**given) -> argparse.Namespace:
+    values = {"inputs": [], "points": None, "out": None, "save_blend": None, "render": None}
+    return argparse.Namespace(**(values | given))
+
+
+def outcome_of_check(outputs, args) -> str:
+    try:
+        outputs.check_outputs(args)
+    except outputs.UsageError as error:
+        return f"refused: {error}"
+    return "accepted"
+
+
+@pytest.mark.skipif(os.name != "posix", reason="POSIX permissions")
+def test_unprivileged_outputs_in_a_read_only_folder_are_refused_early(vg, user_folder):
+    read_only = user_folder / "ro"
+    read_only.mkdir()
+    (read_only / "old.blend").write_bytes(b"BLENDER")
+    (read_only / "old.blend").chmod(0o444)
+    read_only.chmod(0o555)
+    cases = {
+        "out": arguments(out=str(read_only / "sub" / "x.csv")),
+        "out here": arguments(out=str(read_only / "x.csv")),
+        "blend": arguments(save_blend=str(read_only / "s.blend")),
+        "old blend": arguments(save_blend=str(read_only / "old.blend")),
+        "render": arguments(render=str(read_only / "renders")),
+        "fine": arguments(out=str(user_folder / "x.csv"), render=str(user_folder / "r")),
+    }
+    # Imported here: the unprivileged child cannot read the installed extension's files.
+    outputs = importlib.import_module(f"{vg.__name__}.batch.outputs")
+    results = {name: as_user(outcome_of_check, outputs, args) for name, args in cases.items()}
+    assert all(kind == "ok" for kind, _ in results.values()), results
+    said = {name: text for name, (_, text) in results.items()}
+    assert said["out"].startswith("refused: --out") and "no permission to create" in said["out"]
+    assert "no permission to write into" in said["out here"]
+    assert "no permission to write into" in said["blend"]
+    assert "is read-only; it is left as it is" in said["old blend"]
+    assert "no permission to create" in said["render"]
+    assert said["fine"] == "accepted"
+    assert sorted(p.name for p in read_only.iterdir()) == ["old.blend"]
+
+
+@pytest.mark.parametrize("cell", ["2147483648", "abc", "1.5"])
+def test_a_break_number_blender_cannot_store_refuses_the_points_csv(scan, tmp_path, cell):
+    points = tmp_path / "points.csv"
+    points.write_text(f"x,y,z,Break #\n0.05,0,0,1\n0.1,0,0,{cell}\n")
+    out = tmp_path / "o.csv"
+    refused(batch(scan, "--points", points, "--radius", "0.3", "--out", out),
+            f"row 3: Break # must be a whole number from 1 to 2147483647 (got '{cell}')")  # fmt: skip
+    assert not out.exists()

@@ -1,0 +1,62 @@
+"""Float64 mesh files in batch runs: measured at the file's own coordinates (Blender's float32
+mesh would round them), and the CSV's Precision column says which coordinates were measured."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vg_addon import Surface
+from vg_addon.formats import csvio, meshio
+from vg_addon.synthetic_meshes import wedge
+
+ROOT = Path(__file__).resolve().parents[2]
+SCRIPT = ROOT / "vg_batch.py"
+
+
+def batch(*args) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, str(SCRIPT), *(str(a) for a in args)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+
+
+@pytest.mark.parametrize(
+    "offset",
+    [(1000.0, 2000.0, 50.0), (500_000.0, 4_000_000.0, 100.0)],
+    ids=["kilometre", "UTM-like"],
+)
+def test_a_float64_file_far_from_the_origin_is_measured_at_its_precision(tmp_path, offset):
+    shape = wedge(90.0, n=24, irregular=True, seed=3)
+    points = shape.points + np.array(offset)
+    assert not np.array_equal(points.astype(np.float32).astype(np.float64), points)
+    path = meshio.write_ply(tmp_path / "far.ply", points, shape.triangles)
+    at = [repr(float(v)) for v in np.add(offset, (0.05, 0.0, 0.0))]
+    out = tmp_path / "out.csv"
+    result = batch(path, "--at", *at, "--radius", "0.3", "--out", out)
+    assert result.returncode == 0, result.stderr
+    (row,) = csvio.read_measurements_csv(out)
+    # The oracle: the core on the file's own float64 coordinates and triangles.
+    m = Surface(points, shape.triangles).measure([float(v) for v in at], 0.3)
+    assert abs(row.angle - 90.0) < 1e-6
+    assert row.angle == m.angle and (row.x, row.y, row.z) == tuple(m.center)
+    assert row.precision == "float64"
+
+
+def test_a_file_that_float32_holds_exactly_is_measured_as_blender_stores_it(tmp_path):
+    shape = wedge(90.0, n=24, irregular=True, seed=3)
+    points = shape.points.astype(np.float32).astype(np.float64)
+    path = meshio.write_ply(tmp_path / "near.ply", points, shape.triangles)
+    out = tmp_path / "out.csv"
+    result = batch(path, "--at", "0.05", "0", "0", "--radius", "0.3", "--out", out)
+    assert result.returncode == 0, result.stderr
+    (row,) = csvio.read_measurements_csv(out)
+    assert row.precision == "float32"
+    assert row.angle == Surface(points, shape.triangles).measure([0.05, 0, 0], 0.3).angle

@@ -1,0 +1,184 @@
+"""--jobs worker processes under real signals: a worker killed with SIGKILL loses only its mesh;
+the parent killed with SIGKILL leaves no worker and no temporary folder behind; SIGINT to the
+parent alone stops the run cleanly (exit 130, the CSV written, no traceback from any process).
+
+The signals are real ones sent from the test to the real processes; a slow mesh (many rows)
+keeps a worker busy long enough to be caught in the middle of its work.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from vg_addon.formats import csvio, meshio
+from vg_addon.synthetic_meshes import wedge
+
+ROOT = Path(__file__).resolve().parents[2]
+SCRIPT = ROOT / "vg_batch.py"
+SLOW_ROWS = 20_000  # ~1 ms each: keeps the slow mesh's worker busy far longer than a test waits
+WAIT = 120.0  # seconds to wait for a process state (the machine is shared and may be loaded)
+
+pytestmark = pytest.mark.skipif(
+    not Path("/proc/self/stat").exists(), reason="finds worker processes through /proc"
+)
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("processes")
+    fast = wedge(90.0, n=24, irregular=True, seed=3)
+    slow = wedge(60.0, n=60, irregular=True, seed=4)
+    meshio.write_ply(folder / "fast.ply", fast.points, fast.triangles)
+    meshio.write_ply(folder / "slow.ply", slow.points, slow.triangles)
+    points = folder / "points.csv"
+    with open(points, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle, lineterminator="\n")
+        writer.writerow(["mesh", "x", "y", "z"])
+        writer.writerows(["fast", x, 0, 0] for x in ("-0.3", "0", "0.3"))
+        xs = [f"{x:.6f}" for x in (-0.4 + 0.8 * (i % 997) / 997 for i in range(SLOW_ROWS))]
+        writer.writerows(["slow", x, 0, 0] for x in xs)
+    return {"fast": folder / "fast.ply", "slow": folder / "slow.ply", "points": points}
+
+
+def children(pid: int) -> list[int]:
+    """Living (not zombie) processes whose parent is ``pid``."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+        except OSError:
+            continue
+        state, ppid = stat.rpartition(")")[2].split()[:2]
+        if int(ppid) == pid and state != "Z":
+            found.append(int(entry.name))
+    return found
+
+
+def alive(pid: int) -> bool:
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat.rpartition(")")[2].split()[0] != "Z"
+
+
+def wait_for(condition, what: str):
+    deadline = time.monotonic() + WAIT
+    while time.monotonic() < deadline:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.1)
+    pytest.fail(f"gave up waiting for {what} after {WAIT:.0f} s")
+
+
+class Batch:
+    """``python vg_batch.py ARGS`` started in the background, its stderr collected by line."""
+
+    def __init__(self, tmp_path, *args):
+        self.temp = tmp_path / "tmp"  # TMPDIR: the run's temporary folder is made here
+        self.temp.mkdir()
+        self.process = subprocess.Popen(
+            [sys.executable, str(SCRIPT), *(str(a) for a in args)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env={**os.environ, "TMPDIR": str(self.temp)},
+        )
+        self.lines: list[str] = []
+        self.reader = threading.Thread(target=self._read, daemon=True)
+        self.reader.start()
+
+    def _read(self):
+        for line in self.process.stderr:
+            self.lines.append(line)
+
+    def said(self, text: str) -> bool:
+        return any(text in line for line in self.lines)
+
+    def workers(self) -> list[int]:
+        return children(self.process.pid)
+
+    def finish(self) -> tuple[int, str]:
+        code = self.process.wait(timeout=WAIT)
+        self.reader.join(timeout=WAIT)
+        return code, "".join(self.lines)
+
+    def stop(self):
+        for pid in [*self.workers(), self.process.pid]:
+            if alive(pid):
+                os.kill(pid, signal.SIGKILL)
+        self.process.wait()
+
+
+@pytest.fixture
+def started(tmp_path, inputs):
+    runs = []
+
+    def start(*args):
+        run = Batch(tmp_path, inputs["fast"], inputs["slow"], "--points", inputs["points"],
+                    "--radius", "0.3", "--jobs", "2", *args)  # fmt: skip
+        runs.append(run)
+        return run
+
+    yield start
+    for run in runs:
+        run.stop()
+
+
+def test_a_worker_killed_with_sigkill_loses_only_its_mesh(started, tmp_path):
+    out = tmp_path / "out.csv"
+    run = started("--out", out)
+    wait_for(lambda: run.said("fast: 3 measured"), "the fast mesh to be measured")
+    (worker,) = wait_for(lambda: run.workers() if len(run.workers()) == 1 else None, "one worker")
+    os.kill(worker, signal.SIGKILL)
+    code, stderr = run.finish()
+    assert code == 1, stderr
+    rows = csvio.read_measurements_csv(out)
+    assert len(rows) == 3 + SLOW_ROWS
+    assert all(not row.error and abs(row.angle - 90.0) < 0.05 for row in rows[:3])
+    assert all(
+        "worker process measuring this mesh stopped (exit status -9)" in row.error
+        for row in rows[3:]
+    )
+    assert "Traceback" not in stderr
+    assert list(run.temp.iterdir()) == []
+
+
+def test_the_parent_killed_with_sigkill_leaves_no_worker_and_no_temporary_folder(started, tmp_path):
+    run = started("--out", tmp_path / "out.csv")
+    workers = wait_for(lambda: run.workers() if len(run.workers()) == 2 else None, "two workers")
+    wait_for(lambda: run.said("fast: 3 measured") or None, "a worker to have started measuring")
+    assert any(p.name.startswith("vg-batch-") for p in run.temp.iterdir())
+    os.kill(run.process.pid, signal.SIGKILL)
+    run.process.wait(timeout=WAIT)
+    wait_for(lambda: not any(alive(pid) for pid in workers), "the workers to end")
+    wait_for(lambda: list(run.temp.iterdir()) == [], "the temporary folder to be removed")
+
+
+def test_sigint_to_the_parent_alone_stops_the_run_cleanly(started, tmp_path):
+    out = tmp_path / "out.csv"
+    run = started("--out", out)
+    workers = wait_for(lambda: run.workers() if len(run.workers()) >= 1 else None, "a worker")
+    wait_for(lambda: run.said("fast: 3 measured") or None, "the fast mesh to be measured")
+    os.kill(run.process.pid, signal.SIGINT)
+    code, stderr = run.finish()
+    assert code == 130, stderr
+    assert "interrupted" in stderr and "Traceback" not in stderr and "Error" not in stderr
+    assert not any(alive(pid) for pid in workers)
+    assert list(run.temp.iterdir()) == []
+    rows = csvio.read_measurements_csv(out)
+    assert len(rows) == 3 + SLOW_ROWS
+    assert all(not row.error for row in rows[:3])
+    assert all("the run stopped before this mesh" in row.error for row in rows[3:])

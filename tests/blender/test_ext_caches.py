@@ -1,0 +1,201 @@
+"""Kept geometry, incremental painting and fingerprint migration (issue 10).
+
+Every check compares with an oracle computed here from scratch: the core's Surface of the
+object's own vertices for the sides, and the old fingerprint format for migration.
+"""
+
+import hashlib
+
+import bpy
+import numpy as np
+import pytest
+from bpy_helpers import colours, expected_colours, local_points, wedge_object, world
+
+from vg_addon import Surface
+
+
+def triangles_of(obj) -> np.ndarray:
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", tris)
+    return tris.reshape(-1, 3)
+
+
+def painted_from_scratch(vg, obj) -> np.ndarray:
+    """The colours the records should give: each current measurement re-measured on a Surface
+    built here, painted later over earlier."""
+    surface = Surface(world(local_points(obj), obj), triangles_of(obj).astype(np.int64))
+    sides = []
+    for item in obj.vg.measurements:
+        if item.stale:
+            continue
+        args = vg.bridge.records.replay_args(item)
+        m = surface.measure(**args)
+        sides.append((m.indices, m.labels, item.break_number))
+    return expected_colours(len(obj.data.vertices), sides)
+
+
+def measure_at(x, radius=0.3, **kwargs):
+    assert bpy.ops.vg.measure_xyz(location=(x, 0.0, 0.0), radius=radius, **kwargs) == {"FINISHED"}
+
+
+def test_repeat_clicks_reuse_the_geometry(vg):
+    mesh_data = vg.bridge.mesh_data
+    obj = wedge_object(80.0)
+    vg.bridge.watch._pending.clear()  # left by earlier tests (timers do not run in bpy)
+    measure_at(0.1)
+    first = mesh_data.evaluated_geometry(obj)
+    measure_at(-0.2)
+    # Painting (our own write) left the kept geometry current: the very same object comes back.
+    assert mesh_data.evaluated_geometry(obj) is first
+    assert not vg.bridge.watch._pending  # and woke no staleness check
+    obj.location.z += 0.5
+    bpy.context.view_layer.update()
+    moved = mesh_data.evaluated_geometry(obj)
+    assert moved is not first
+    assert np.array_equal(moved.points, world(local_points(obj), obj))
+
+
+def test_an_edit_between_two_scripted_clicks_is_seen(vg):
+    """No depsgraph evaluation between the paint and the edit: the edit must still count."""
+    obj = wedge_object(80.0)
+    measure_at(0.1)
+    co = local_points(obj).copy()
+    co[:, 2] *= 1.01
+    obj.data.vertices.foreach_set("co", co.ravel())
+    obj.data.update()
+    measure_at(-0.2)
+    assert [item.stale for item in obj.vg.measurements] == [True, False]
+    # The second measurement is the one the edited mesh gives.
+    m = Surface(world(local_points(obj), obj), triangles_of(obj).astype(np.int64)).measure(
+        [-0.2, 0, 0], 0.3
+    )
+    assert vg.bridge.records.numbers_of(obj.vg.measurements[1])["angle"] == m.angle
+    np.testing.assert_array_equal(colours(obj), painted_from_scratch(vg, obj))
+
+
+def test_undo_restores_a_geometry_that_is_read_again(vg):
+    obj = wedge_object(80.0)
+    bpy.ops.ed.undo_push(message="start")
+    bpy.ops.vg.measure_xyz("EXEC_DEFAULT", True, location=(0.1, 0, 0), radius=0.3)
+    bpy.ops.transform.translate(value=(0, 0, 0.25))
+    bpy.ops.ed.undo_push(message="moved")
+    bpy.context.view_layer.update()
+    obj = bpy.data.objects["Wedge"]
+    bpy.ops.vg.repaint()
+    assert obj.vg.measurements[0].stale
+    bpy.ops.ed.undo()
+    obj = bpy.data.objects["Wedge"]
+    bpy.ops.vg.repaint()
+    assert not obj.vg.measurements[0].stale
+    np.testing.assert_array_equal(colours(obj), painted_from_scratch(vg, obj))
+
+
+def test_undone_measurements_are_unpainted_by_the_next_click(vg):
+    obj = wedge_object(80.0)
+    bpy.ops.ed.undo_push(message="start")
+    for x in (-0.3, 0.0, 0.3):
+        bpy.ops.vg.measure_xyz("EXEC_DEFAULT", True, location=(x, 0, 0), radius=0.3)
+    bpy.ops.vg.delete_measurement("EXEC_DEFAULT", True, index=0)
+    bpy.ops.ed.undo()  # the delete
+    bpy.ops.ed.undo()  # the third measurement
+    obj = bpy.data.objects["Wedge"]
+    assert [item.number for item in obj.vg.measurements] == [1, 2]
+    bpy.ops.vg.measure_xyz(location=(0.15, 0, 0), radius=0.25)  # number 3 again, elsewhere
+    assert [item.number for item in obj.vg.measurements] == [1, 2, 3]
+    np.testing.assert_array_equal(colours(obj), painted_from_scratch(vg, obj))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_incremental_painting_equals_painting_from_scratch(vg, seed):
+    """Measures, deletes (first, middle, last, active), next breaks and a stale measurement in
+    a random order; after each, the colours are what the records give from scratch."""
+    rng = np.random.default_rng(seed)
+    obj = wedge_object(70.0, n=50)
+    for step in range(40):
+        action = rng.choice(["measure", "measure", "measure", "delete", "break"])
+        if action == "measure" or not len(obj.vg.measurements):
+            measure_at(float(rng.uniform(-0.8, 0.8)), radius=float(rng.uniform(0.15, 0.5)))
+        elif action == "delete":
+            index = int(rng.integers(len(obj.vg.measurements)))
+            assert bpy.ops.vg.delete_measurement(index=index) == {"FINISHED"}
+        else:
+            bpy.ops.vg.next_break()
+        if step == 20:  # an edit: everything so far goes stale and grey
+            co = local_points(obj).copy()
+            co[0, 2] += 0.05
+            obj.data.vertices.foreach_set("co", co.ravel())
+            obj.data.update()
+            bpy.ops.vg.repaint()
+        np.testing.assert_array_equal(colours(obj), painted_from_scratch(vg, obj), f"step {step}")
+    assert any(item.stale for item in obj.vg.measurements) or step < 20
+
+
+def test_clicks_do_not_measure_the_stored_measurements_again(vg, monkeypatch):
+    obj = wedge_object(80.0)
+    for x in (-0.5, 0.0, 0.5):
+        measure_at(x)
+    calls = []
+    surface_type = type(
+        vg.bridge.mesh_data.surface_for(obj, vg.bridge.mesh_data.evaluated_geometry(obj))
+    )
+    original = surface_type.measure
+    monkeypatch.setattr(
+        surface_type, "measure", lambda self, *a, **k: calls.append(a) or original(self, *a, **k)
+    )
+    measure_at(0.25)
+    bpy.ops.vg.delete_measurement(index=1)
+    assert len(calls) == 1  # the new click only
+    np.testing.assert_array_equal(colours(obj), painted_from_scratch(vg, obj))
+
+
+def old_fingerprint(obj) -> str:
+    """The fingerprint format of files written before issue 10, written out from its
+    definition: BLAKE2b-128 over (dtype, shape, bytes) of the float32 positions, the int32 loop
+    triangles and the float64 world matrix."""
+    digest = hashlib.blake2b(digest_size=16)
+    for array in (
+        local_points(obj),
+        triangles_of(obj),
+        np.array(obj.matrix_world, dtype=np.float64),
+    ):
+        array = np.ascontiguousarray(array)
+        digest.update(f"{array.dtype.str}{array.shape}".encode())
+        digest.update(array.tobytes())
+    return digest.hexdigest()
+
+
+def test_old_fingerprints_are_migrated_not_marked_stale(vg, tmp_path):
+    obj = wedge_object(80.0, location=(0.5, 0, 0))
+    for x in (0.3, 0.6, 0.9):
+        measure_at(x)
+    legacy = old_fingerprint(obj)
+    items = obj.vg.measurements
+    items[0].fingerprint = legacy
+    items[1].fingerprint = legacy
+    items[2].fingerprint = "0123456789abcdef0123456789abcdef"  # an old file, another geometry
+    path = tmp_path / "old.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    obj = bpy.data.objects["Wedge"]
+    bpy.context.view_layer.update()
+    assert vg.bridge.watch.refresh(obj)  # the third is stale now: repainted
+    items = obj.vg.measurements
+    assert [item.stale for item in items] == [False, False, True]
+    current = vg.bridge.mesh_data.evaluated_geometry(obj).fingerprint
+    assert [item.fingerprint for item in items][:2] == [current, current]
+    assert items[2].fingerprint == "0123456789abcdef0123456789abcdef"
+    np.testing.assert_array_equal(colours(obj), painted_from_scratch(vg, obj))
+
+
+def test_fingerprint_follows_faces_not_only_positions(vg):
+    """Flipping the faces keeps every position but turns the normals: measurements go stale."""
+    obj = wedge_object(80.0)
+    measure_at(0.1)
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="SELECT")
+    bpy.ops.mesh.flip_normals()
+    bpy.ops.object.mode_set(mode="OBJECT")
+    bpy.ops.vg.repaint()
+    assert obj.vg.measurements[0].stale

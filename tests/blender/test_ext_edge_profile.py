@@ -1,0 +1,247 @@
+"""vg.measure_edge against the core: one break of stations, bit-identical to Surface.measure_along
+and replayable with vg.measure_xyz; its record, plot, CSV rows, re-import, undo and delete."""
+
+import json
+
+import bpy
+import numpy as np
+import pytest
+from bpy_helpers import exact, local_points, mesh_object, world
+from test_ext_measure import core_surface
+
+from vg_addon.formats import csvio
+from vg_addon.synthetic_meshes import varying_wedge
+
+POINTS = [[-1.5, 0.01, 0.0], [0.0, -0.01, 0.0], [1.5, 0.0, 0.0]]
+
+
+def ramp_object(name="Ramp", **transform):
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+    return mesh_object(name, shape.points, shape.triangles, **transform), shape
+
+
+def measure_edge(*args, points=POINTS, spacing=0.5, radius=0.3, **options):
+    return bpy.ops.vg.measure_edge(
+        *args, points=json.dumps(points), spacing=spacing, radius=radius, **options
+    )
+
+
+def test_stations_are_the_core_profile_bit_for_bit_and_one_break(vg):
+    obj, shape = ramp_object(location=(0.25, -1.0, 0.5), rotation=(0.3, 0.0, 0.2))
+    points = world(np.array(POINTS), obj)
+    bpy.ops.vg.measure_xyz(location=tuple(points[0]), radius=0.3)  # break 1 is taken
+    assert measure_edge(points=points.tolist()) == {"FINISHED"}
+    profile = core_surface(obj).measure_along(points, 0.5, 0.3)
+    stations = [item for item in obj.vg.measurements if item.edge_number == 1]
+    assert len(stations) == profile.n_stations == len(obj.vg.measurements) - 1
+    for item, m, arc in zip(stations, profile.stations, profile.arc_lengths, strict=True):
+        numbers = exact(item)
+        assert (numbers["angle"], numbers["fit"]) == (m.angle, m.fit_error)
+        assert numbers["center"] == m.center.tolist()
+        assert (numbers["arc_length"], numbers["spacing"]) == (arc, 0.5)
+    assert {item.break_number for item in stations} == {2}  # its own break, its own colours
+    assert obj.vg.break_number == 3
+    edge = obj.vg.edges[0]
+    assert (edge.number, edge.break_number, edge.n_stations) == (1, 2, profile.n_stations)
+    numbers = exact(edge)
+    assert numbers["mean"] == profile.mean and numbers["pooled_angle"] == profile.pooled_angle
+    assert numbers["angles"] == profile.angles.tolist()
+    assert numbers["points"] == points.tolist()
+    # Each station is within 1° of the exact local angle of the ramp.
+    local = np.array([exact(i)["center"] for i in stations]) - np.array(obj.matrix_world)[:3, 3]
+    local = local @ np.array(obj.matrix_world)[:3, :3]  # rotation only: back to object space
+    exact_angles = shape.angle_at(local)
+    assert np.abs(np.array([exact(i)["angle"] for i in stations]) - exact_angles).max() < 1.0
+
+
+def test_stations_replay_with_measure_xyz(vg):
+    obj, _ = ramp_object()
+    measure_edge(spacing=0.75, radius=0.35, seg_param=1.5)
+    stations = [exact(item) for item in obj.vg.measurements]
+    for numbers in stations:
+        bpy.ops.vg.measure_xyz(
+            location=numbers["center"], radius=numbers["radius"], seg_param=numbers["lam"]
+        )
+    replayed = [exact(item) for item in obj.vg.measurements[len(stations) :]]
+    for a, b in zip(stations, replayed, strict=True):
+        assert (a["angle"], a["fit"], a["center"]) == (b["angle"], b["fit"], b["center"])
+
+
+def test_plot_image_is_made_packed_and_saved(vg, tmp_path):
+    from vg_addon.formats import profile_plot
+
+    obj, _ = ramp_object()
+    measure_edge()
+    edge = obj.vg.edges[0]
+    image = bpy.data.images[edge.plot]
+    assert tuple(image.size) == (480, 240) and image.packed_file is not None
+    numbers = exact(edge)
+    expected = profile_plot.render_profile(numbers["arc_lengths"], numbers["angles"])
+    path = tmp_path / "edge.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.read_homefile(use_empty=True)
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    edge = bpy.data.objects["Ramp"].vg.edges[0]
+    image = bpy.data.images[edge.plot]
+    pixels = np.empty(480 * 240 * 4, dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    rgba = np.round(pixels.reshape(240, 480, 4)[::-1] * 255).astype(np.uint8)
+    assert np.array_equal(rgba, expected)  # the plot drawn from the recorded numbers
+
+
+def test_refusals_record_nothing(vg):
+    obj, _ = ramp_object()
+    with pytest.raises(RuntimeError, match="could not be measured"):
+        measure_edge(radius=0.001)
+    with pytest.raises(RuntimeError, match="at least two points"):
+        bpy.ops.vg.measure_edge(points="[[0, 0, 0]]", spacing=0.5, radius=0.3)
+    with pytest.raises(RuntimeError, match="JSON"):
+        bpy.ops.vg.measure_edge(points="start", spacing=0.5, radius=0.3)
+    with pytest.raises(RuntimeError, match="finer than the mesh"):
+        measure_edge(spacing=0.001)
+    assert len(obj.vg.measurements) == 0 and len(obj.vg.edges) == 0
+    assert len(bpy.data.images) == 0
+
+
+def test_one_undo_removes_the_whole_profile(vg):
+    ramp_object()
+    bpy.ops.ed.undo_push(message="start")
+    measure_edge("EXEC_DEFAULT", True)
+    obj = bpy.data.objects["Ramp"]
+    assert len(obj.vg.measurements) > 3 and len(obj.vg.edges) == 1
+    bpy.ops.ed.undo()
+    obj = bpy.data.objects["Ramp"]  # undo reloads the data
+    assert len(obj.vg.measurements) == 0 and len(obj.vg.edges) == 0
+    bpy.ops.ed.redo()
+    obj = bpy.data.objects["Ramp"]
+    assert len(obj.vg.edges) == 1
+
+
+def test_delete_edge_removes_its_stations_only(vg):
+    obj, _ = ramp_object()
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.3)
+    measure_edge()
+    measure_edge(points=[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    first = obj.vg.edges[0].plot
+    assert bpy.ops.vg.delete_edge(index=0) == {"FINISHED"}
+    assert [e.number for e in obj.vg.edges] == [2]
+    assert {item.edge_number for item in obj.vg.measurements} == {0, 2}
+    assert first not in bpy.data.images
+
+
+def test_export_writes_station_rows_and_the_edge_file_and_import_rebuilds_the_edge(vg, tmp_path):
+    obj, _ = ramp_object()
+    measure_edge()
+    path = tmp_path / "m.csv"
+    assert bpy.ops.vg.export_csv(filepath=str(path)) == {"FINISHED"}
+    rows = csvio.read_measurements_csv(path)
+    stations = [exact(item) for item in obj.vg.measurements]
+    assert [r.edge_number for r in rows] == [1] * len(stations)
+    assert [r.arc_length for r in rows] == [s["arc_length"] for s in stations]
+    assert {r.spacing for r in rows} == {0.5}
+    (edge_row,) = csvio.read_edges_csv(csvio.edges_path_for(path))
+    edge = exact(obj.vg.edges[0])
+    assert (edge_row.mean, edge_row.pooled_angle, edge_row.n_stations) == (
+        edge["mean"],
+        edge["pooled_angle"],
+        len(stations),
+    )
+    assert csvio.parse_points(edge_row.points) == [tuple(p) for p in edge["points"]]
+
+    # Re-import on a copy: every station re-measured, grouped back into one edge.
+    copy, _ = ramp_object("Ramp.copy")
+    assert bpy.ops.vg.import_csv(filepath=str(path), ignore_mesh_names=True) == {"FINISHED"}
+    again = [exact(item) for item in copy.vg.measurements]
+    assert [a["angle"] for a in again] == [s["angle"] for s in stations]
+    assert [a["arc_length"] for a in again] == [s["arc_length"] for s in stations]
+    (rebuilt,) = copy.vg.edges
+    assert {item.edge_number for item in copy.vg.measurements} == {rebuilt.number}
+    numbers = exact(rebuilt)
+    assert numbers["mean"] == edge["mean"] and numbers["angles"] == edge["angles"]
+    assert numbers["pooled_angle"] == pytest.approx(edge["pooled_angle"], abs=1e-9)
+
+
+def test_edge_session_event_translation(vg):
+    from importlib import import_module
+
+    edge_module = import_module(f"{vg.__name__}.operators.edge")
+    translate = edge_module.translate_edge_event
+    assert translate("LEFTMOUSE", "PRESS") == "click"
+    assert translate("LEFTMOUSE", "RELEASE") == "ignore"
+    assert translate("RET", "PRESS") == "confirm"
+    assert translate("BACK_SPACE", "PRESS") == "undo"
+    assert translate("Z", "PRESS", ctrl=True) == "undo"
+    assert translate("ESC", "PRESS") == "cancel"
+    assert translate("MIDDLEMOUSE", "PRESS") == "pass"
+    assert translate("MOUSEMOVE", "NOTHING") == "pass"
+    points = edge_module.parse_points(edge_module.format_points(np.array(POINTS) / 3.0))
+    assert points.tolist() == (np.array(POINTS) / 3.0).tolist()
+
+
+def test_local_points_are_measured_in_world_space(vg):
+    obj, _ = ramp_object(scale=(2.0, 2.0, 2.0))
+    points = world(np.array(POINTS), obj)
+    measure_edge(points=points.tolist(), spacing=1.0, radius=0.6)
+    assert all(
+        exact(i)["center"] in world(local_points(obj), obj).tolist() for i in obj.vg.measurements
+    )
+
+
+def test_each_side_of_a_curved_edge_is_painted_in_one_colour(vg):
+    from bpy_helpers import colours
+
+    from vg_addon import palette
+    from vg_addon.synthetic_meshes import lens
+
+    shape = lens(70.53, n_around=300)
+    obj = mesh_object("Lens", shape.points, shape.triangles)
+    rim = shape.points[shape.edge]
+    measure_edge(points=rim[[0, 150, 299]].tolist(), spacing=0.1, radius=0.04)
+    stations = [item for item in obj.vg.measurements if item.edge_number == 1]
+    # The binormal turns over somewhere along the rim: some stations' "+" side is the lower cap.
+    assert len({exact(item)["plus_left"] for item in stations}) == 2
+    rgba = colours(obj)
+    plus, minus = (np.asarray(c, dtype=np.float32) for c in palette.pair_linear(1))
+    painted = ~np.all(np.isclose(rgba, palette.neutral_linear()), axis=1)
+    upper = painted & (shape.points[:, 2] > 1e-9)
+    lower = painted & (shape.points[:, 2] < -1e-9)
+    for side in (upper, lower):
+        assert len(np.unique(rgba[side], axis=0)) == 1  # one colour along the whole rim
+    assert not np.array_equal(rgba[upper][0], rgba[lower][0])
+    assert {tuple(rgba[upper][0]), tuple(rgba[lower][0])} == {tuple(plus), tuple(minus)}
+
+
+def test_panel_shows_only_for_a_mesh_and_the_settings_have_lengths(vg):
+    panel = bpy.types.VIEW3D_PT_vg_edges
+    assert not panel.poll(bpy.context)  # no active mesh
+    ramp_object()
+    assert panel.poll(bpy.context)
+    settings = bpy.context.scene.vg_settings
+    assert settings.edge_spacing > 0
+    assert settings.bl_rna.properties["edge_spacing"].unit == "LENGTH"
+    assert bpy.types.VG_OT_measure_edge.poll(bpy.context)
+    assert not bpy.types.VG_OT_delete_edge.poll(bpy.context)  # no edge yet
+
+
+def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):
+    obj, _ = ramp_object()
+    measure_edge(note="ridge A")
+    measure_edge(points=[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]], spacing=0.4, radius=0.25)
+    path = tmp_path / "m.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    edge_file = csvio.edges_path_for(path)
+    before = [exact(item) for item in obj.vg.measurements]
+
+    copy, _ = ramp_object("Ramp.copy")
+    assert bpy.ops.vg.import_csv(filepath=str(edge_file), ignore_mesh_names=True) == {"FINISHED"}
+    assert [e.note for e in copy.vg.edges] == ["ridge A", ""]
+    after = [exact(item) for item in copy.vg.measurements]
+    assert [(a["angle"], a["arc_length"]) for a in after] == [
+        (b["angle"], b["arc_length"]) for b in before
+    ]
+    assert [exact(e)["points"] for e in copy.vg.edges] == [exact(e)["points"] for e in obj.vg.edges]
+    # Another object's name without Ignore Names: refused, nothing recorded.
+    other, _ = ramp_object("Other")
+    with pytest.raises(RuntimeError, match="names the mesh 'Ramp'"):
+        bpy.ops.vg.import_csv(filepath=str(edge_file))
+    assert len(other.vg.edges) == 0 and len(other.vg.measurements) == 0

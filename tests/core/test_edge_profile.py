@@ -1,0 +1,278 @@
+"""Whole-edge measuring: tracing the ridge, stations along it, the profile's summary.
+
+Oracles: the exact geometry of the shapes (a crease whose angle changes linearly along the x
+axis, the circular rim of two intersecting spheres), a textbook Dijkstra for the cheapest path,
+and on the real scan Algorithm 1's own split of each patch (the ridge is where the sides meet).
+"""
+
+import heapq
+
+import numpy as np
+import pytest
+
+from vg_addon import GoniometerError, Surface
+from vg_addon.formats.meshio import read_mesh
+from vg_addon.synthetic_meshes import lens, varying_wedge, wedge
+
+
+@pytest.fixture(scope="module")
+def ramp():
+    shape = varying_wedge(80.0, 130.0, half_width=4.0, depth=1.0, n=30)
+    return shape, Surface(shape.points, shape.triangles)
+
+
+@pytest.fixture(scope="module")
+def rim():
+    shape = lens(70.53, radius=1.0, n_around=600)
+    return shape, Surface(shape.points, shape.triangles)
+
+
+def mean_edge_length(points, triangles):
+    edges = np.vstack([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    edges = np.unique(np.sort(edges, axis=1), axis=0)
+    return float(np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1).mean())
+
+
+def test_varying_wedge_path_follows_the_crease_and_stations_match_the_local_angle(ramp):
+    shape, surface = ramp
+    h = mean_edge_length(shape.points, shape.triangles)
+    # Clicks a little off the crease, as a user's would be.
+    path = surface.trace_edge([-3.5, 0.01, -0.005], [3.5, -0.01, -0.005])
+    off_crease = np.linalg.norm(path.points[:, 1:], axis=1)
+    assert off_crease.max() <= h
+    assert path.flat_spans == () and path.warning == ""
+    profile = surface.measure_along(path, spacing=0.5, radius=0.3)
+    assert profile.n_stations == int(np.floor(path.length / 0.5)) + 1
+    exact = shape.angle_at(np.array([m.center for m in profile.stations]))
+    assert np.abs(profile.angles - exact).max() < 1.0, profile.angles - exact
+    # The angle rises along the edge: the profile is a ramp of the right slope.
+    slope = np.polyfit(profile.arc_lengths, profile.angles, 1)[0]
+    assert slope == pytest.approx(50.0 / 8.0, rel=0.03)
+
+
+def test_summary_equals_what_the_stations_say(ramp):
+    _, surface = ramp
+    profile = surface.measure_along([[-3, 0, 0], [3, 0, 0]], spacing=0.75, radius=0.3)
+    angles = [m.angle for m in profile.stations]
+    assert profile.angles.tolist() == angles
+    assert profile.mean == pytest.approx(sum(angles) / len(angles), abs=1e-12)
+    assert profile.min == min(angles) and profile.max == max(angles)
+    mean = sum(angles) / len(angles)
+    sample_std = (sum((a - mean) ** 2 for a in angles) / (len(angles) - 1)) ** 0.5
+    assert profile.std == pytest.approx(sample_std, rel=1e-12)
+    # One plane pair over all the sides averages the ramp: near the mean, inside the range.
+    assert profile.min < profile.pooled_angle < profile.max
+    assert profile.pooled_angle == pytest.approx(profile.mean, abs=1.0)
+    assert f"{profile.n_stations} stations" in profile.summary()
+
+
+@pytest.mark.parametrize("patch", ["euclidean", "geodesic"])
+def test_stations_replay_bit_for_bit(ramp, patch):
+    _, surface = ramp
+    profile = surface.measure_along(
+        [[-2, 0, 0], [2, 0, 0]], spacing=1.0, radius=0.3, lam=1.5, patch=patch
+    )
+    fresh = Surface(surface.points, surface.triangles)  # nothing cached
+    for station in profile.stations:
+        assert station.patch == patch
+        again = fresh.measure(station.center, 0.3, 1.5, patch)
+        assert again.angle == station.angle
+        assert again.fit_error == station.fit_error
+        assert np.array_equal(again.indices, station.indices)
+        assert station.snap_distance == 0.0  # the centre is a path vertex
+
+
+def test_stations_are_evenly_spaced_path_vertices(ramp):
+    _, surface = ramp
+    path = surface.trace_edge([-3, 0, 0], [3, 0, 0])
+    profile = surface.measure_along(path, spacing=0.4, radius=0.3)
+    on_path = {tuple(p) for p in path.points}
+    assert all(tuple(m.center) in on_path for m in profile.stations)
+    gaps = np.diff(profile.arc_lengths)
+    step = path.length / (path.vertices.size - 1)
+    assert np.abs(gaps - 0.4).max() <= step + 1e-12
+    # Centred: the leftover length is split between both ends.
+    assert abs(profile.arc_lengths[0] - (path.length - profile.arc_lengths[-1])) <= step + 1e-12
+
+
+def test_lens_rim_constant_angle_all_round(rim):
+    shape, surface = rim
+    h = mean_edge_length(shape.points, shape.triangles)
+    rho = np.linalg.norm(shape.points[shape.edge[0]])
+    start, via, end = (shape.points[shape.edge[i]] for i in (0, 100, 200))
+    path = surface.trace_edge(start, end, via=[via])
+    # Distance of each path vertex to the rim circle (z = 0, radius rho).
+    radial = np.linalg.norm(path.points[:, :2], axis=1)
+    assert np.hypot(radial - rho, path.points[:, 2]).max() <= h
+    assert path.length == pytest.approx(rho * 2 * np.pi * 200 / 600, rel=0.01)
+    profile = surface.measure_along(path, spacing=0.1, radius=0.02)
+    assert np.abs(profile.angles - 70.53).max() < 1.0, profile.angles
+    assert profile.std < 0.1
+    # Pooled in each station's own frame, a curved edge pools like a straight one.
+    assert profile.pooled_angle == pytest.approx(profile.mean, abs=0.2)
+
+
+def test_reference_lens_rim_is_traced_within_an_edge(shared_data):
+    mesh = read_mesh(shared_data / "IntersectingSpheres.ply")
+    surface = Surface(mesh.points, mesh.triangles)
+    h = mean_edge_length(mesh.points, mesh.triangles)
+    centred = surface.points - surface.points.mean(axis=0)
+    axes = np.linalg.svd(centred, full_matrices=False)[2]
+    axis = axes[2]  # the lens is thin along its axis
+    height = centred @ axis
+    radial = np.linalg.norm(centred - np.outer(height, axis), axis=1)
+    rho = radial.max()
+    ring = np.flatnonzero(radial > rho - h)
+    in_plane = centred[ring] @ axes[:2].T
+    angle = np.arctan2(in_plane[:, 1], in_plane[:, 0])
+    start, end = ring[np.argmin(angle)], ring[np.argmin(np.abs(angle - 1.5))]
+    path = surface.trace_edge(surface.points[start], surface.points[end])
+    off_rim = np.hypot(radial[path.vertices] - rho, height[path.vertices])
+    assert off_rim.max() <= h, (off_rim.max(), h)
+
+
+def split_boundary_distance(surface, m):
+    """Distance from ``m.center`` to where Algorithm 1's two sides meet: the nearest midpoint of
+    a mesh edge inside the patch whose ends are on different sides."""
+    side = np.full(surface.n_points, -1)
+    side[m.indices] = m.labels.astype(int)
+    t = surface.triangles
+    edges = np.vstack([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+    ends = side[edges]
+    mixed = (ends >= 0).all(axis=1) & (ends[:, 0] != ends[:, 1])
+    middles = surface.points[edges[mixed]].mean(axis=1)
+    return np.linalg.norm(middles - m.center, axis=1).min()
+
+
+def test_real_scan_path_stays_on_the_ridge(shared_data):
+    mesh = read_mesh(shared_data / "sample_mesh.ply")
+    surface = Surface(mesh.points, mesh.triangles)
+    h = mean_edge_length(mesh.points, mesh.triangles)
+    # The broken end: the sharpest vertices at the far end of the long axis (bends by brute force).
+    centred = surface.points - surface.points.mean(axis=0)
+    axes = np.linalg.svd(centred, full_matrices=False)[2]
+    along, across = centred @ axes[0], centred @ axes[1]
+    normals = np.cross(
+        mesh.points[mesh.triangles[:, 1]] - mesh.points[mesh.triangles[:, 0]],
+        mesh.points[mesh.triangles[:, 2]] - mesh.points[mesh.triangles[:, 0]],
+    )
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    faces_of = {}
+    for face, tri in enumerate(mesh.triangles):
+        for k in range(3):
+            faces_of.setdefault(tuple(sorted((tri[k], tri[(k + 1) % 3]))), []).append(face)
+    sharpness = np.zeros(surface.n_points)
+    for (a, b), faces in faces_of.items():
+        if len(faces) == 2:
+            bend = np.degrees(np.arccos(np.clip(normals[faces[0]] @ normals[faces[1]], -1, 1)))
+            sharpness[a] = max(sharpness[a], bend)
+            sharpness[b] = max(sharpness[b], bend)
+    end_ridge = np.flatnonzero((sharpness > 60) & (along < along.min() + 6))
+    a, b = end_ridge[np.argmin(across[end_ridge])], end_ridge[np.argmax(across[end_ridge])]
+    path = surface.trace_edge(surface.points[a], surface.points[b])
+    assert path.vertices.size > 20
+    # The ridge as Algorithm 1 sees it in the smallest patches (radius about 2.3 mean edge
+    # lengths): every path vertex within one edge length of it; larger patches blur the corner
+    # at the path's end, but still place nearly all of the path on the ridge.
+    local = [split_boundary_distance(surface, surface.measure(p, 1.5)) for p in path.points]
+    assert max(local) <= h
+    wider = [split_boundary_distance(surface, surface.measure(p, 2.0)) for p in path.points]
+    assert np.mean(np.array(wider) <= h) >= 0.95
+    profile = surface.measure_along(path, spacing=2.0, radius=3.0)
+    assert 0.0 < profile.min <= profile.mean <= profile.max < 180.0
+
+
+def textbook_dijkstra(points, triangles, costs_of, source, target):
+    """Cheapest path by heapq Dijkstra over the mesh edges with a given edge-cost function."""
+    neighbours = {}
+    for tri in triangles:
+        for k in range(3):
+            u, v = int(tri[k]), int(tri[(k + 1) % 3])
+            neighbours.setdefault(u, set()).add(v)
+            neighbours.setdefault(v, set()).add(u)
+    best = {source: 0.0}
+    queue = [(0.0, source)]
+    while queue:
+        d, u = heapq.heappop(queue)
+        if u == target:
+            return d
+        if d > best[u]:
+            continue
+        for v in neighbours[u]:
+            candidate = d + costs_of(u, v)
+            if candidate < best.get(v, np.inf):
+                best[v] = candidate
+                heapq.heappush(queue, (candidate, v))
+    return np.inf
+
+
+def test_traced_path_is_the_cheapest_under_the_documented_cost():
+    mesh = wedge(120, n=14, irregular=True, seed=3)
+    surface = Surface(mesh.points, mesh.triangles)
+    normals = np.cross(
+        mesh.points[mesh.triangles[:, 1]] - mesh.points[mesh.triangles[:, 0]],
+        mesh.points[mesh.triangles[:, 2]] - mesh.points[mesh.triangles[:, 0]],
+    )
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    faces_of = {}
+    for face, tri in enumerate(mesh.triangles):
+        for k in range(3):
+            faces_of.setdefault(tuple(sorted((tri[k], tri[(k + 1) % 3]))), []).append(face)
+
+    def cost(u, v):
+        faces = faces_of[tuple(sorted((u, v)))]
+        bend = 0.0
+        if len(faces) == 2:
+            bend = np.arccos(np.clip(normals[faces[0]] @ normals[faces[1]], -1, 1))
+        length = np.linalg.norm(mesh.points[u] - mesh.points[v])
+        return length * (0.02 + np.exp(-bend / np.radians(10.0)))
+
+    rng = np.random.default_rng(7)
+    for _ in range(6):
+        a, b = rng.choice(mesh.points.shape[0], size=2, replace=False)
+        path = surface.trace_edge(mesh.points[a], mesh.points[b])
+        total = sum(cost(u, v) for u, v in zip(path.vertices[:-1], path.vertices[1:], strict=True))
+        expected = textbook_dijkstra(mesh.points, mesh.triangles, cost, int(a), int(b))
+        assert total == pytest.approx(expected, rel=1e-9)
+
+
+def test_a_path_across_a_flat_face_is_reported():
+    mesh = wedge(100, n=30)
+    surface = Surface(mesh.points, mesh.triangles)
+    c = np.cos(np.radians(50.0))
+    s = np.sin(np.radians(50.0))
+    # Both clicks on face +, far from the crease: no ridge joins them.
+    path = surface.trace_edge([-0.8, 0.8 * s, -0.8 * c], [0.8, 0.8 * s, -0.8 * c])
+    assert path.flat_spans and "no ridge" in path.warning
+    with pytest.raises(GoniometerError, match="could not be measured") as caught:
+        surface.measure_along(path, spacing=0.3, radius=0.2)
+    assert "no ridge" in str(caught.value)  # the refusal carries the tracer's warning
+
+
+def test_refusals_name_what_to_change(ramp):
+    shape, surface = ramp
+    with pytest.raises(GoniometerError, match="point cloud"):
+        Surface(shape.points).trace_edge([-1, 0, 0], [1, 0, 0])
+    with pytest.raises(GoniometerError, match="same vertex"):
+        surface.trace_edge([0, 0, 0], [0.001, 0, 0])
+    with pytest.raises(GoniometerError, match="spacing"):
+        surface.measure_along([[-1, 0, 0], [1, 0, 0]], spacing=0.0, radius=0.3)
+    with pytest.raises(GoniometerError, match="finer than the mesh"):
+        surface.measure_along([[-1, 0, 0], [1, 0, 0]], spacing=0.001, radius=0.3)
+    with pytest.raises(GoniometerError, match="at least two"):
+        surface.measure_along([[0, 0, 0]], spacing=0.5, radius=0.3)
+    with pytest.raises(GoniometerError, match="far from every vertex"):
+        surface.trace_edge([0, 0, 0], [1e6, 0, 0])
+
+
+def test_profile_does_not_depend_on_vertex_order(ramp):
+    shape, surface = ramp
+    rng = np.random.default_rng(1)
+    order = rng.permutation(shape.points.shape[0])
+    inverse = np.argsort(order)
+    shuffled = Surface(shape.points[order], inverse[shape.triangles])
+    a = surface.measure_along([[-2, 0, 0], [2, 0, 0]], spacing=0.5, radius=0.3)
+    b = shuffled.measure_along([[-2, 0, 0], [2, 0, 0]], spacing=0.5, radius=0.3)
+    assert a.angles.tolist() == b.angles.tolist()
+    assert np.array_equal(a.path.points, b.path.points)
+    assert a.pooled_angle == b.pooled_angle

@@ -1,0 +1,117 @@
+"""The radius sweep: measurements per radius, its CSV, and its plot as a PNG read back by hand."""
+
+import csv
+import io
+import struct
+import zlib
+
+import numpy as np
+import pytest
+
+from vg_addon import GoniometerError, Surface
+from vg_addon.formats import csvio, sweep_plot
+from vg_addon.formats.png import encode_png
+from vg_addon.method.sweep import radius_sweep, sweep_radii
+from vg_addon.synthetic_meshes import wedge
+
+
+@pytest.fixture(scope="module")
+def surface():
+    mesh = wedge(75, n=40, irregular=True, seed=4, concave=True)
+    return Surface(mesh.points, mesh.triangles)
+
+
+def test_each_radius_is_the_measurement_at_that_radius(surface):
+    points = radius_sweep(surface, [0.01, 0.0, 0.0], 0.02, 0.6, 12, lam=1.5)
+    assert [p.radius for p in points] == list(np.linspace(0.02, 0.6, 12))
+    for point in points:
+        try:
+            single = surface.measure([0.01, 0.0, 0.0], point.radius, 1.5)
+        except GoniometerError as error:
+            assert point.measurement is None and point.error == str(error)
+            continue
+        assert point.error == ""
+        assert point.measurement.angle == single.angle
+        assert point.measurement.fit_error == single.fit_error
+    assert points[0].measurement is None  # 0.02 holds too few vertices
+    assert abs(points[-1].measurement.angle - 75) < 0.1
+    assert points[-1].measurement.convexity == "concave"
+
+
+def test_nothing_measurable_says_what_happened_at_both_ends(surface):
+    with pytest.raises(
+        GoniometerError, match=r"No radius from 0.001 to 0.002.*At 0.001: .* At 0.002: "
+    ):
+        radius_sweep(surface, [0, 0, 0], 0.001, 0.002, 3)
+
+
+@pytest.mark.parametrize(
+    ("start", "stop", "count", "match"),
+    [
+        (0.5, 0.1, 5, "smaller than its last"),
+        (0, 1, 5, "radius"),
+        (0.1, 1, 1, "2 to 1000"),
+        (0.1, 1, 2.5, "whole number"),
+        (0.1, 1, True, "whole number"),
+    ],
+)
+def test_bad_sweeps_are_refused(start, stop, count, match):
+    with pytest.raises(GoniometerError, match=match):
+        sweep_radii(start, stop, count)
+
+
+def test_sweep_csv_reads_back_exactly(surface):
+    points = radius_sweep(surface, [0.01, 0.0, 0.0], 0.02, 0.5, 5)
+    text = csvio.format_sweep_rows(csvio.sweep_cells("=wedge", 3, p) for p in points)
+    rows = list(csv.DictReader(io.StringIO(text)))
+    assert list(rows[0]) == list(csvio.SWEEP_COLUMNS)
+    assert rows[0]["Mesh Name"] == "'=wedge" and rows[0]["Measurement #"] == "3"
+    assert rows[0]["Angle"] == "" and "larger radius" in rows[0]["error"]
+    for row, point in zip(rows[1:], points[1:], strict=True):
+        m = point.measurement
+        assert float(row["Radius"]) == point.radius
+        assert float(row["Angle"]) == m.angle and float(row["fit"]) == m.fit_error
+        assert int(row["Vertices +"]) + int(row["Vertices -"]) == int(row["Number of Vertices"])
+        assert (row["Convexity"], row["Rule"], row["error"]) == ("concave", "oriented", "")
+
+
+def read_png(data: bytes) -> np.ndarray:
+    """A PNG decoder for what the writer may produce (8-bit RGB, filter 0), checking every CRC."""
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    position, chunks = 8, {}
+    while position < len(data):
+        (length,) = struct.unpack(">I", data[position : position + 4])
+        kind = data[position + 4 : position + 8]
+        body = data[position + 8 : position + 8 + length]
+        (crc,) = struct.unpack(">I", data[position + 8 + length : position + 12 + length])
+        assert crc == zlib.crc32(kind + body)
+        chunks[kind] = chunks.get(kind, b"") + body
+        position += 12 + length
+    width, height, depth, colour, _, _, _ = struct.unpack(">IIBBBBB", chunks[b"IHDR"])
+    assert (depth, colour) == (8, 2) and b"IEND" in chunks
+    rows = np.frombuffer(zlib.decompress(chunks[b"IDAT"]), dtype=np.uint8).reshape(height, -1)
+    assert (rows[:, 0] == 0).all()
+    return rows[:, 1:].reshape(height, width, 3)
+
+
+def test_png_round_trip():
+    image = np.random.default_rng(0).integers(0, 256, size=(7, 11, 3), dtype=np.uint8)
+    assert np.array_equal(read_png(encode_png(image)), image)
+    with pytest.raises(GoniometerError, match="uint8"):
+        encode_png(image.astype(np.float32))
+
+
+def test_plot_marks_every_measured_radius_in_both_panels(surface, tmp_path):
+    points = radius_sweep(surface, [0.01, 0.0, 0.0], 0.02, 0.6, 9)
+    path = tmp_path / "sweep.png"
+    sweep_plot.write_sweep_png(path, points)
+    image = read_png(path.read_bytes())
+    assert image.shape == (sweep_plot.HEIGHT, sweep_plot.WIDTH, 3)
+    span = sweep_plot.WIDTH - sweep_plot._RIGHT - sweep_plot._LEFT
+    for point in points:
+        x = int(np.rint(sweep_plot._LEFT + (point.radius - 0.02) / 0.58 * span))
+        angle_panel = image[slice(*sweep_plot._ANGLE_PANEL), x]
+        fit_panel = image[slice(*sweep_plot._FIT_PANEL), x]
+        has_angle = (angle_panel == sweep_plot._ANGLE_COLOUR).all(axis=1).any()
+        has_fit = (fit_panel == sweep_plot._FIT_COLOUR).all(axis=1).any()
+        assert has_angle == has_fit == (point.measurement is not None)
