@@ -22,11 +22,13 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "gui"))
+sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "gui")]
 
 from driver import GuiBlender  # noqa: E402 (the GUI lane's driver)
 
-SITES = ("oblique/outer acute", "oblique/outer right", "transverse/outer")
+from vg_addon.synthetic_meshes import bone_fragment  # noqa: E402 (the fragment of scene.py)
+
+SITES = ("oblique/outer acute", "oblique/outer 45°", "oblique/outer side")
 TOOL = "vg.measure_drag_tool"
 
 
@@ -76,8 +78,8 @@ def main(argv=None) -> int:
         gui.wait_for(lambda s: s["tool"] == TOOL, 10, "the Goniometer tool")
         gui.settle(5)
         for site in SITES[:2]:
-            drag(gui, site, 22)
-        drag(gui, SITES[2], 22, hold=True)
+            drag(gui, site, 40)
+        drag(gui, SITES[2], 40, hold=True)
         window = gui.state()["regions"]["WINDOW"]
         view = (window[0], window[1], left - window[0], min(window[3], 900))
         gui.save_png("drag", args.out_dir / "drag.png", crop=view)
@@ -87,8 +89,14 @@ def main(argv=None) -> int:
         gui.save_png("sides", args.out_dir / "sides.png", crop=view)
         gui.save_png("panel", args.out_dir / "panel.png", crop=(left, top, width, 900))
         items = gui.state()["objects"]["BoneFragment"]["measurements"]
-        for item in items:
-            print(f"measurement {item['number']}: {item['exact']['angle']:.4f}°")
+        truth = {site.label: site.angle for site in bone_fragment(spacing=0.4).sites}
+        for site, item in zip(SITES, items, strict=False):
+            exact = item["exact"]
+            print(
+                f"measurement {item['number']} at {site} (true {truth[site]:.2f}°): "
+                f"{exact['angle']:.4f}°, radius {exact['radius']:.3f} mm, "
+                f"{item['n_vertices']} vertices"
+            )
     finally:
         gui.close()
     print(f"pictures in {args.out_dir}")

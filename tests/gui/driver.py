@@ -32,7 +32,12 @@ class RootShell:
     """A bash inside a Blender root; :meth:`run` runs one command line and returns its output."""
 
     def __init__(self, suite: str, host_tmp: Path, log: Path):
-        loop = f'while IFS= read -r line; do eval "$line" </dev/null 2>&1; echo "{END} $?"; done'
+        # Background jobs (Xvfb, Blender) end with the shell, which ends when this side closes
+        # its input (also when the test process is killed).
+        loop = (
+            "trap 'kill $(jobs -p) 2>/dev/null' EXIT; "
+            f'while IFS= read -r line; do eval "$line" </dev/null 2>&1; echo "{END} $?"; done'
+        )
         self._log = open(log, "ab")  # noqa: SIM115 (closed in close())
         self.process = subprocess.Popen(
             [
@@ -228,14 +233,20 @@ class GuiBlender:
         self.settle()
 
     def find_button(
-        self, region: str, copied: str, step: int = 8, key: str = "ctrl+c", upward: bool = False
+        self,
+        region: str,
+        copied: str,
+        step: int = 8,
+        key: str = "ctrl+c",
+        upward: bool = False,
+        rows: range | None = None,
     ) -> tuple[float, float]:
         """Screen position of the button in ``region`` whose copy to the clipboard contains
         ``copied``: Ctrl+C over an operator button copies its Python call, Ctrl+Shift+C over a
-        property its data path. Buttons are hovered top to bottom (or bottom to top), as a user
-        would."""
+        property its data path. Buttons are hovered top to bottom (or bottom to top; only ``rows``
+        when given), as a user would."""
         left, top, width, height = self.state()["regions"][region]
-        rows = range(top + 4, top + height - 4, step)
+        rows = range(top + 4, top + height - 4, step) if rows is None else rows
         for x in (left + width // 2, left + width // 4, left + 3 * width // 4):
             for y in reversed(rows) if upward else rows:
                 self.move((x, y))

@@ -75,7 +75,7 @@ FRAGMENT_NAME = "BoneFragment"
 def build_fragment():
     """A synthetic long-bone fragment (mm), for the README's pictures; return it and its sites."""
     synthetic = importlib.import_module(EXTENSION + ".vg_addon.synthetic_meshes")
-    fragment = synthetic.bone_fragment(spacing=0.5, roughness=0.08, seed=2)
+    fragment = synthetic.bone_fragment(spacing=0.4)
     for obj in list(bpy.data.objects):
         if obj.type == "MESH":
             bpy.data.objects.remove(obj)
@@ -103,14 +103,16 @@ def build_fragment():
 
 
 def frame_fragment(space) -> None:
-    """Look at the fragment's oblique break from the side, the sidebar open."""
-    from mathutils import Euler, Vector
+    """Look at the fragment's oblique break face from above its outer acute rim, the sidebar
+    open."""
+    from mathutils import Vector
 
     region_3d = space.region_3d
     region_3d.view_perspective = "PERSP"
-    region_3d.view_rotation = Euler((math.radians(62.0), 0.0, math.radians(35.0))).to_quaternion()
-    region_3d.view_location = Vector((0.0, 0.0, 45.0))
-    region_3d.view_distance = 70.0
+    towards_viewer = Vector((0.35, 0.55, 0.85)).normalized()
+    region_3d.view_rotation = towards_viewer.to_track_quat("Z", "Y")
+    region_3d.view_location = Vector((5.0, 2.0, 60.0))
+    region_3d.view_distance = 58.0
     space.clip_end = 10000.0
     space.show_region_ui = True
     space.show_region_toolbar = True

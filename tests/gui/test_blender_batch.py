@@ -48,8 +48,17 @@ def module_run(inputs) -> list[csvio.MeasurementRow]:
     out = inputs / "module.csv"
     at = [a for point in AT for a in ("--at", *point)]
     result = subprocess.run(
-        [sys.executable, str(REPO / "vg_batch.py"), str(inputs), *at, "--radius", RADIUS]
-        + ["--out", str(out), "--quiet"],
+        [
+            sys.executable,
+            str(REPO / "vg_batch.py"),
+            str(inputs),
+            *at,
+            "--radius",
+            RADIUS,
+            "--out",
+            str(out),
+            "--quiet",
+        ],
         capture_output=True,
         text=True,
         timeout=600,

@@ -77,6 +77,18 @@ def drag_measure(gui, distance: float = 70.0) -> dict:
     return items[-1]
 
 
+def closed_headers(shot, region, below: float) -> list[int]:
+    """Screen rows of the panel headers in the sidebar below row ``below``: the rows where a
+    disclosure triangle shows in the column just inside the panels' left edge."""
+    left, top, _width, height = (int(v) for v in region)
+    band = shot[int(below) + 12 : top + height, left + 18 : left + 36].min(axis=2) > 140
+    rows = np.flatnonzero(band.any(axis=1)) + int(below) + 12
+    if rows.size == 0:
+        return []
+    groups = np.split(rows, np.flatnonzero(np.diff(rows) > 8) + 1)
+    return [int(group.mean()) for group in groups]
+
+
 # -- the tests -----------------------------------------------------------------------------------
 def test_blender_starts_with_the_extension_and_scene(gui):
     state = gui.state()
@@ -235,18 +247,19 @@ def test_measure_at_cursor_after_shift_right_click(gui):
 def test_csv_export_through_the_file_browser(gui):
     """Open the CSV panel, press Export, name the file in the file browser, export."""
     items = gui.measurements(OBJ)
-    # The CSV panel (closed) follows the Selected Measurement panel, whose last field is the
-    # note: open it by clicking its header, found just below that field.
-    note = gui.find_button("UI", ".note", step=10, key="ctrl+shift+c")
-    for below in range(18, 60, 6):
-        gui.click((note[0], note[1] + below))
+    # The CSV panel is closed; it is one of the closed panels below the Selected panel, whose
+    # last field is the note. Their headers are found by their disclosure triangles.
+    left, top, width, height = gui.state()["regions"]["UI"]
+    note = gui.find_button("UI", ".note", step=10, key="ctrl+shift+c", upward=True)
+    export = None
+    for header in closed_headers(gui.screenshot("panels"), (left, top, width, height), note[1]):
+        gui.click((left + width // 3, header))
         try:
-            export = gui.find_button("UI", "vg.export_csv")
+            export = gui.find_button("UI", "vg.export_csv", rows=range(header + 10, header + 70, 8))
             break
         except LookupError:
-            continue
-    else:
-        raise AssertionError("no CSV panel with an Export button below the Selected panel")
+            gui.click((left + width // 3, header))  # not this one: close it again
+    assert export is not None, "no CSV panel with an Export button below the Selected panel"
     gui.click(export)
     browser = gui.wait_for(lambda s: s["file_browser"], 20, "the file browser")["file_browser"]
     # A new window swallows its first click (no window manager): spend it on an empty spot.
