@@ -81,7 +81,8 @@ def main(argv=None) -> int:
             drag(gui, site, 40)
         drag(gui, SITES[2], 40, hold=True)
         window = gui.state()["regions"]["WINDOW"]
-        view = (window[0], window[1], left - window[0], min(window[3], 900))
+        tall = min(window[3], 800)  # the middle of the (tall) viewport, where the view centre is
+        view = (window[0], window[1] + (window[3] - tall) // 2, left - window[0], tall)
         gui.save_png("drag", args.out_dir / "drag.png", crop=view)
         gui.xdotool("mouseup", "1")
         gui.wait_for(lambda s: s["drag"] is None, 30, "the drag to end")

@@ -23,7 +23,7 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[2]
 ROOT_SCRIPT = REPO / "scripts" / "blender_root.sh"
-SCREEN = (1280, 1440)  # tall: the whole sidebar shows without scrolling
+SCREEN = (1280, 1800)  # tall: the whole sidebar shows without scrolling
 GUEST_REPO, GUEST_TMP = "/vg/repo", "/vg/tmp"
 END = "__vg_end__"
 
@@ -224,6 +224,16 @@ class GuiBlender:
             self.xdotool("keyup", modifier)
         self.settle()
 
+    def focus_window_at(self, xy) -> None:
+        """Give the X input focus to the window at ``xy`` (with no window manager, a window
+        Blender opens, e.g. the file browser, is not focused by clicking it in Blender 5.2)."""
+        self.move(xy)
+        self.shell.check(
+            f"eval $(DISPLAY={self.display} xdotool getmouselocation --shell) && "
+            f"DISPLAY={self.display} xdotool windowfocus --sync $WINDOW"
+        )
+        self.settle()
+
     def key(self, *keys: str) -> None:
         self.xdotool("key", "--delay", "60", *keys)
         self.settle()
@@ -231,6 +241,14 @@ class GuiBlender:
     def type_text(self, text: str) -> None:
         self.xdotool("type", "--delay", "60", text)
         self.settle()
+
+    def copies(self, xy, key: str = "ctrl+c") -> str | None:
+        """What ``key`` over ``xy`` copies to the clipboard (None: nothing, not a button)."""
+        self.move(xy)
+        seq = self.state()["seq"]
+        self.xdotool("key", key)
+        state = self.settle(2)
+        return next((text for s, text in state["clipboard"] if s >= seq), None)
 
     def find_button(
         self,

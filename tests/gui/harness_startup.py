@@ -76,13 +76,27 @@ def _projections(window, area) -> dict:
     return out
 
 
-def _drag():
+def _drag(window, area):
+    """The running drag: its machine's numbers and its circle's centre and radius on screen."""
+    from bpy_extras import view3d_utils
+    from mathutils import Vector
+
     drag = scene.extension().operators.drag
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    region_3d = area.spaces.active.region_3d
     for obj in gc.get_objects():
         if isinstance(obj, drag.DragSession):
             machine = obj.machine
             if machine.phase.name == "DRAGGING":
+                centre = Vector(machine.center)
+                right = region_3d.view_rotation @ Vector((1.0, 0.0, 0.0))
+                ends = [
+                    view3d_utils.location_3d_to_region_2d(region, region_3d, point)
+                    for point in (centre, centre + machine.radius * right)
+                ]
                 return {
+                    "center_screen": _to_screen(window, region.x + ends[0].x, region.y + ends[0].y),
+                    "radius_px": (ends[1] - ends[0]).length,
                     "phase": machine.phase.name,
                     "radius": machine.radius,
                     "lam": machine.lam,
@@ -154,7 +168,7 @@ def _tick():
             "cursor": list(window.scene.cursor.location),
             "active": getattr(window.view_layer.objects.active, "name", None),
             "objects": _objects(window.scene),
-            "drag": _drag(),
+            "drag": _drag(window, area),
             "points": _projections(window, area),
             "clipboard": _status["clipboard"][-20:],
             "errors": _status["errors"][-5:],

@@ -111,8 +111,8 @@ def frame_fragment(space) -> None:
     region_3d.view_perspective = "PERSP"
     towards_viewer = Vector((0.35, 0.55, 0.85)).normalized()
     region_3d.view_rotation = towards_viewer.to_track_quat("Z", "Y")
-    region_3d.view_location = Vector((5.0, 2.0, 60.0))
-    region_3d.view_distance = 58.0
+    region_3d.view_location = Vector((5.0, 4.0, 60.0))
+    region_3d.view_distance = 62.0
     space.clip_end = 10000.0
     space.show_region_ui = True
     space.show_region_toolbar = True
