@@ -8,14 +8,15 @@ has no NumPy (a Linux distribution's Blender), it registers an explanation with 
 
 import bpy
 
+# Checked first, so that a Blender without NumPy gets an explanation, not a bare import error.
 try:
     import numpy
 except ImportError as error:
-    _numpy_error = error
+    numpy_import_error = error
 else:
-    _numpy_error = None
+    numpy_import_error = None
 
-if _numpy_error is None:
+if numpy_import_error is None:
     from . import operators, properties, ui
     from .bridge import measuring, mesh_data, watch
 
@@ -27,8 +28,10 @@ if _numpy_error is None:
         properties.register_properties()
         operators.drag.register_tool()
         watch.register()
+        ui.labels.register()
 
     def unregister():
+        ui.labels.unregister()
         operators.drag.unregister_tool()
         watch.unregister()
         properties.unregister_properties()
@@ -43,7 +46,7 @@ else:
     classes = numpy_missing.classes
 
     def register():
-        numpy_missing.register(_numpy_error)
+        numpy_missing.register(numpy_import_error)
 
     def unregister():
         numpy_missing.unregister()

@@ -74,7 +74,10 @@ def _popup() -> None:
             menu.layout.label(text=line)
 
     window_manager = bpy.context.window_manager
-    if window_manager is not None and len(window_manager.windows):
+    if window_manager is None or not len(window_manager.windows):
+        return
+    # A timer runs without a window in its context: give it the first one.
+    with bpy.context.temp_override(window=window_manager.windows[0]):
         window_manager.popup_menu(draw, title="Virtual Goniometer: NumPy is missing", icon="ERROR")
 
 

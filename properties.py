@@ -24,9 +24,12 @@ from bpy.props import (
     StringProperty,
 )
 from bpy.types import PropertyGroup
+from mathutils import Vector
 
 from .vg_addon import palette
 
+# Paths may start with // (the .blend's folder); Blender 4.5 and later want that declared.
+BLEND_RELATIVE = {"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else set()
 RULE_ITEMS = (
     (
         "oriented",
@@ -78,6 +81,19 @@ def _vector(key):
         return tuple(value) if value else (0.0, 0.0, 0.0)
 
     return get
+
+
+def _world_centre(self):
+    numbers = exact_numbers(self)
+    centre = numbers.get("center")
+    if not centre:
+        return (0.0, 0.0, 0.0)
+    if numbers.get("space", "world") == "world":
+        return tuple(centre)
+    matrix = getattr(self.id_data, "matrix_world", None)
+    if matrix is None:
+        return tuple(centre)
+    return tuple(matrix @ Vector(centre))
 
 
 def _text_value(key, default=""):
@@ -132,12 +148,12 @@ class VG_Measurement(PropertyGroup):
     )
     fingerprint: StringProperty(
         name="Geometry fingerprint",
-        description="Hash of the evaluated mesh and transform the measurement was taken on",
+        description="Hash of the evaluated mesh the measurement was taken on",
         options={"HIDDEN"},
     )
     stale: BoolProperty(
         name="Stale",
-        description="The mesh or its transform changed since this measurement was taken: its "
+        description="The mesh or its modifiers changed since this measurement was taken: its "
         "numbers are kept as recorded, but it is no longer painted",
     )
     edge_number: IntProperty(
@@ -162,10 +178,28 @@ class VG_Measurement(PropertyGroup):
         name="Snap distance", subtype="DISTANCE", unit="LENGTH", get=_number("snap_distance")
     )
     center: FloatVectorProperty(
-        name="Centre", size=3, subtype="XYZ", unit="LENGTH", get=_vector("center")
+        name="Centre (mesh)",
+        description="The vertex measured at, in the mesh's own coordinates (the CSV's x, y, z)",
+        size=3,
+        subtype="XYZ",
+        unit="LENGTH",
+        get=_vector("center"),
+    )
+    center_world: FloatVectorProperty(
+        name="Centre (world)",
+        description="The vertex measured at, in world space where the object is now",
+        size=3,
+        subtype="XYZ",
+        unit="LENGTH",
+        get=_world_centre,
     )
     requested_center: FloatVectorProperty(
-        name="Requested centre", size=3, subtype="XYZ", unit="LENGTH", get=_vector("requested")
+        name="Requested centre",
+        description="The point asked for before snapping, in mesh coordinates",
+        size=3,
+        subtype="XYZ",
+        unit="LENGTH",
+        get=_vector("requested"),
     )
     normal_plus: FloatVectorProperty(
         name="Plane normal +", size=3, subtype="DIRECTION", get=_vector("normal_plus")
@@ -260,6 +294,12 @@ class VG_ObjectData(PropertyGroup):
     next_number: IntProperty(
         name="Next measurement #", description="Number the next measurement gets", default=1, min=1
     )
+    sides_shown: BoolProperty(
+        name="Sides shown",
+        description="The viewports were switched to show the sides, on the first measurement",
+        default=False,
+        options={"HIDDEN"},
+    )
     winding: StringProperty(
         name="Winding",
         description="Which way the measured mesh's faces are wound: outward, inward, mixed, or "
@@ -272,7 +312,8 @@ class VG_SceneSettings(PropertyGroup):
 
     radius: FloatProperty(
         name="Radius",
-        description="Patch radius around the centre, in scene units (world space)",
+        description="Patch radius around the centre, in the mesh's own units (its coordinates, "
+        "whatever the object's scale)",
         default=1.0,
         min=0.0,
         soft_min=1e-4,
@@ -338,6 +379,33 @@ class VG_SceneSettings(PropertyGroup):
         name="All objects",
         description="Export the measurements of every object in the scene, not only the active one",
         default=False,
+    )
+    show_labels: BoolProperty(
+        name="Labels",
+        description="Draw each current measurement's number and angle beside it in the viewport "
+        "(stale ones are not labelled; labels too close to a more important one are left out)",
+        default=True,
+    )
+    labels_active_break: BoolProperty(
+        name="Active Break Only",
+        description="Label only the measurements of the current break",
+        default=False,
+    )
+    map_views: EnumProperty(
+        name="Views",
+        items=(
+            ("SIX", "Six Views", "Front, back, right, left, top and bottom, orthographic"),
+            ("FLAKE", "Two Faces", "The two faces of a flat piece, seen along its thinnest axis"),
+        ),
+        default="SIX",
+        description="What the measurement map shows",
+    )
+    map_directory: StringProperty(
+        name="Map Folder",
+        description="Folder the map's pictures are written to (// is the .blend's folder)",
+        default="//vg_map",
+        subtype="DIR_PATH",
+        options=BLEND_RELATIVE,
     )
     ignore_mesh_names: BoolProperty(
         name="Ignore mesh names",

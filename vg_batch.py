@@ -12,6 +12,7 @@ does it (see docs/BATCH.md).
 
 import importlib.util
 import os
+import shutil
 import sys
 import traceback
 from pathlib import Path
@@ -29,6 +30,23 @@ def script_argv() -> list[str]:
     if IN_BLENDER:
         return sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
     return sys.argv[1:]
+
+
+def import_bpy() -> None:
+    """Import the bpy module with what it prints while starting sent to stderr: bpy 5.x logs on
+    stdout (e.g. "Using OCIO=..." where the OCIO variable is set, as it is in any child of a
+    process that runs bpy 5.x), and stdout may be the CSV (``--out -``)."""
+    if "bpy" in sys.modules:
+        return
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        import bpy  # noqa: F401
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
 
 
 def extension_package():
@@ -64,7 +82,12 @@ def main() -> int:
             file=sys.stderr,
         )
         return 2
+    import_bpy()
     package = extension_package()
+    if package.numpy_import_error is not None:  # a distribution's Blender without NumPy
+        error = package.numpy_missing.message(str(package.numpy_import_error))
+        print(f"vg_batch: error: {error}", file=sys.stderr)
+        return 2
     importlib.import_module(f"{package.__name__}.batch")
     try:
         return package.batch.main(script_argv())
@@ -82,7 +105,12 @@ if __name__ == "__main__":
         status = 2
     sys.stdout.flush()
     sys.stderr.flush()
-    if IN_BLENDER:
-        # Blender would otherwise carry on and exit with 0; end the process with our status.
+    if "bpy" in sys.modules:
+        # All written and closed. Blender would carry on and exit with 0, and the bpy 4.x modules
+        # fail at exit (4.2 can crash; 4.5 hangs once a .blend was read or written): end here,
+        # removing Blender's session folder (blender_XXXXXX) as its own exit would.
+        session = Path(sys.modules["bpy"].app.tempdir or ".").resolve()
+        if session.name.startswith("blender_"):
+            shutil.rmtree(session, ignore_errors=True)
         os._exit(status)
     sys.exit(status)

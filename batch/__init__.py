@@ -9,10 +9,17 @@ run, ``sources`` imports the meshes, ``measure`` measures one mesh through the b
 
 from __future__ import annotations
 
+import signal
 import sys
 
 from . import extension
 from .cli import UsageError, build_parser, check_args
+
+
+def _stop(signum, frame):
+    # SIGTERM (`kill PID`, a job scheduler's stop) ends the run as Ctrl-C does: the workers
+    # stopped, the CSV written with what was measured, the temporary folder removed.
+    raise KeyboardInterrupt
 
 
 def main(argv: list[str]) -> int:
@@ -25,6 +32,7 @@ def main(argv: list[str]) -> int:
     try:
         if args.worker:
             return worker_main(args.worker)
+        signal.signal(signal.SIGTERM, _stop)
         check_args(args)
         if args.demo:
             return run_demo(args)

@@ -239,7 +239,16 @@ def build_parser() -> argparse.ArgumentParser:
     out.add_argument(
         "--render",
         metavar="DIR",
-        help="write DIR/<mesh>.png per mesh: the coloured sides, Cycles on the CPU",
+        help="write the measurement map of each mesh into DIR: DIR/<mesh>_map_<view>.png per "
+        "view and the contact sheet DIR/<mesh>_map.png (the coloured sides and numbered labels, "
+        "Cycles on the CPU; the same map as the extension's Render Map)",
+    )
+    out.add_argument(
+        "--render-views",
+        choices=("six", "flake"),
+        default="six",
+        help="the map's views: six orthographic views, or the two faces of a flat flake "
+        "(default six)",
     )
     out.add_argument(
         "--render-size",
@@ -247,7 +256,7 @@ def build_parser() -> argparse.ArgumentParser:
         type=int,
         default=[640, 480],
         metavar=("W", "H"),
-        help="render resolution in pixels (default 640 480)",
+        help="resolution of each view in pixels, at least 16 (default 640 480)",
     )
     out.add_argument(
         "--render-samples",
@@ -324,8 +333,8 @@ def check_args(args) -> None:
         raise UsageError("--out CSV is required: the measurements CSV to write.")
     if args.jobs < 1:
         raise UsageError(f"--jobs must be 1 or more (got {args.jobs}).")
-    if min(args.render_size) < 1 or args.render_samples < 1:
-        raise UsageError("--render-size and --render-samples must be positive.")
+    if min(args.render_size) < 16 or args.render_samples < 1:
+        raise UsageError("--render-size must be at least 16 16 and --render-samples positive.")
     if args.sweep:
         start, stop, count = args.sweep
         if count != int(count):

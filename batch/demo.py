@@ -107,7 +107,7 @@ def run_demo(args) -> int:
         ply,
         points,
         *(p for p in outputs.values() if p != out),
-        out / "bone_fragment.png",
+        out / "bone_fragment_map.png",
         out / "measurements_edges.csv",
         *sorted(out.glob("measurements_*_edge*.png")),
     ):

@@ -63,6 +63,9 @@ def edge_specs(args, sources) -> list[dict]:
                 "lam": args.lam if row.seg_param is None else row.seg_param,
                 "patch": row.patch or args.patch,
                 "mesh_name": name,
+                # Files of earlier versions hold world-space points (a mesh file's object is
+                # untransformed: the same numbers).
+                "space": "world" if row.coordinates == csvio.WORLD_COORDINATES else "mesh",
             }
         )
     if problems:
@@ -114,7 +117,13 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str):
         number = obj.vg.next_edge_number
         try:
             edge = edges.measure_edge_on_object(
-                obj, spec["points"], spec["spacing"], spec["radius"], spec["lam"], spec["patch"]
+                obj,
+                spec["points"],
+                spec["spacing"],
+                spec["radius"],
+                spec["lam"],
+                spec["patch"],
+                space=spec.get("space", "mesh"),
             )
         except GoniometerError as error:
             obj.vg.next_edge_number = number + 1  # the number stays with the failed edge

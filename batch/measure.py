@@ -11,12 +11,13 @@ import bpy
 import numpy as np
 
 from ..bridge import colors, measuring, mesh_data, records
+from ..bridge.measurement_map import safe_file_name
 from ..vg_addon import GoniometerError, Surface
 from ..vg_addon.formats import csvio, sweep_plot
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
 from .edges import failed_edge_row, measure_edges, spec_applies
-from .render import add_sides_material, render_object
+from .render import add_sides_material, render_map
 from .sources import MeshSource, import_mesh
 
 
@@ -82,12 +83,13 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     """Load (or find) one mesh, measure its tasks, record them on the object, colour it and
     optionally render it. Never raises for a problem of this mesh: it becomes the rows' error.
 
-    The numbers come from the extension's own pipeline: the object's evaluated mesh in world
-    space (``mesh_data.evaluated_geometry``), its cached ``Surface`` (``mesh_data.surface_for``)
-    and ``records.add_measurement``; a mesh file whose float64 coordinates float32 would round
-    is measured at the file's coordinates instead (:func:`exact_surface`, ``Precision``
-    float64 in the CSV). The colours are painted once per mesh at the end by
-    ``measuring.repaint``, the extension's own painter, from the sides kept while measuring.
+    The numbers come from the extension's own pipeline: the object's evaluated mesh in its own
+    coordinates (``mesh_data.evaluated_geometry``), its cached ``Surface``
+    (``mesh_data.surface_for``) and ``records.add_measurement``; a mesh file whose float64
+    coordinates float32 would round is measured at the file's coordinates instead
+    (:func:`exact_surface`, ``Precision`` float64 in the CSV). The colours are painted once per
+    mesh at the end by ``measuring.repaint``, the extension's own painter, from the sides kept
+    while measuring.
     """
     result = MeshResult(mesh=index)
     units = records.units_label(bpy.context.scene)
@@ -131,18 +133,21 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         return fail_all(str(error))
     result.n_vertices = int(geometry.points.shape[0])
     result.prepare_seconds = time.perf_counter() - start
+    units = records.units_label(bpy.context.scene, obj)  # a .blend object may be scaled
     result.winding = surface.winding
     measuring.note_winding(obj, surface)
 
     data = obj.vg
     base = data.next_number - 1  # measurements already on a .blend object keep their numbers
-    view = np.zeros(3)
     last_report = start = time.perf_counter()
     for done, task in enumerate(tasks, start=1):
         try:
+            center, radius = task.center, task.radius
+            if task.coordinates == records.WORLD:  # a row of an export of earlier versions
+                center, radius = measuring.from_world(center, radius, geometry.matrix)
             m = surface.measure(
-                task.center,
-                task.radius,
+                center,
+                radius,
                 task.lam,
                 task.patch,
                 rule=task.rule,
@@ -159,7 +164,6 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             row = records.to_row(obj, item, stale=False, units=units, precision=precision)
             result.rows.append((task.index, row))
             measuring.keep_sides(obj, geometry, item, m)
-            view += m.mean_normal
             result.measured += 1
         now = time.perf_counter()
         if progress is not None and now - last_report >= 1.0:
@@ -167,7 +171,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             last_report = now
     result.measure_seconds = time.perf_counter() - start
     if options.get("sweep"):
-        sweep_sites(result, surface, obj.name, tasks, options)
+        sweep_sites(result, surface, obj.name, tasks, options, geometry.matrix)
     if len(data.measurements):
         data.next_number = max(item.number for item in data.measurements) + 1
         records.continue_after_recorded_breaks(obj)
@@ -175,6 +179,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     if result.measured:
         measuring.repaint(obj, geometry=geometry)
         add_sides_material(obj, colors.ATTRIBUTE_NAME)
+        colors.show_sides_once(obj)
 
     if options.get("edges"):
         result.station_rows, result.edge_rows = measure_edges(
@@ -182,23 +187,25 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         )
 
     if options.get("render"):
-        path = Path(options["render"]) / f"{safe_file_name(obj.name)}.png"
         try:
-            render_object(obj, path, options, view.tolist())
-            result.render = str(path)
+            result.render = str(render_map(obj, Path(options["render"]), options))
         except Exception as error:  # a render problem must not lose the measurements
             result.render_error = f"{type(error).__name__}: {error}"
     return result
 
 
-def sweep_sites(result: MeshResult, surface, name: str, tasks, options) -> None:
-    """``--sweep``: each task's site at the sweep's radii, as CSV cells and a plot per site."""
+def sweep_sites(result: MeshResult, surface, name: str, tasks, options, matrix) -> None:
+    """``--sweep``: each task's site at the sweep's radii, as CSV cells and a plot per site.
+    ``matrix`` is the object's ``matrix_world`` (for world-space rows of older exports)."""
     start, stop, count = options["sweep"]
     folder = Path(options["sweep_plots"])
     for task in tasks:
         try:
+            center = task.center
+            if task.coordinates == records.WORLD:
+                center, _ = measuring.from_world(center, None, matrix)
             points = radius_sweep(
-                surface, task.center, start, stop, int(count), task.lam, task.patch, task.rule
+                surface, center, start, stop, int(count), task.lam, task.patch, task.rule
             )
         except GoniometerError as error:
             points = [
@@ -216,8 +223,8 @@ def sweep_sites(result: MeshResult, surface, name: str, tasks, options) -> None:
 def exact_surface(source: MeshSource, points: np.ndarray, geometry) -> Surface:
     """The surface of a mesh file at its own float64 coordinates, with the faces Blender kept.
 
-    The imported object sits at the world origin untransformed, so the file's coordinates are
-    its world coordinates; Blender's float32 copy would round them (by up to a few
+    The imported object is untransformed, and measurements are taken in mesh coordinates, so the
+    file's coordinates are the ones measured in; Blender's float32 copy would round them (by up to a few
     thousandths of a unit at a thousand units from the origin, which tilts small patches).
     """
     if points.shape != geometry.points.shape:
@@ -258,7 +265,3 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress):
         result = MeshResult(mesh=index, failed=len(tasks))
         result.rows = [(t.index, error_row(t, source.name, message, units)) for t in tasks]
         return result
-
-
-def safe_file_name(name: str) -> str:
-    return "".join(c if c.isalnum() or c in "-_.+" else "_" for c in name) or "mesh"

@@ -56,6 +56,12 @@ def _writable_folder(folder: Path, option: str, given: str) -> None:
         )
 
 
+def sweep_paths(out) -> tuple[Path, Path]:
+    """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``."""
+    out = Path(out).resolve()
+    return out.with_name(out.stem + "_sweep.csv"), out.with_name(out.stem + "_sweep")
+
+
 def check_outputs(args) -> None:
     """Refuse outputs that are inputs or each other, and outputs that cannot be written.
 
@@ -66,6 +72,18 @@ def check_outputs(args) -> None:
     """
     outputs = [("--out", args.out), ("--save-blend", args.save_blend)]
     outputs = [(option, path) for option, path in outputs if path and path != csvio.STDOUT]
+    if args.sweep:
+        if args.out == csvio.STDOUT or (
+            os.path.exists(args.out) and csvio.output_target(args.out) == "stream"
+        ):
+            raise UsageError(
+                f"--sweep writes <out>_sweep.csv and a plot folder beside --out, so --out "
+                f"{args.out} must be a file name, not standard output or a stream."
+            )
+        csv_path, plots = sweep_paths(args.out)
+        outputs.append(("--sweep's CSV", str(csv_path)))
+        if plots.exists() and not plots.is_dir():
+            raise UsageError(f"--sweep: {plots} (its plot folder) is a file; move it away.")
     inputs = input_files(args)
     for option, path in outputs:
         for what, source in inputs:
@@ -74,10 +92,12 @@ def check_outputs(args) -> None:
                     f"{option} {path} is the {what} {source}: writing there would destroy an "
                     "input. Choose another file name; nothing was read or written."
                 )
-    if len(outputs) == 2 and _same_file(outputs[0][1], outputs[1][1]):
-        raise UsageError(
-            f"--out and --save-blend are the same file ({args.out}): give them different names."
-        )
+    for at, (option, path) in enumerate(outputs):
+        for other, other_path in outputs[at + 1 :]:
+            if _same_file(path, other_path):
+                raise UsageError(
+                    f"{option} and {other} are the same file ({path}): give them different names."
+                )
     if args.out and args.out != csvio.STDOUT:
         if os.path.exists(args.out):
             try:

@@ -22,7 +22,7 @@ from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
 from .edges import edge_specs, spec_applies
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
-from .outputs import check_outputs, make_folders
+from .outputs import check_outputs, make_folders, sweep_paths
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
 from .workers import run_workers
@@ -185,12 +185,6 @@ class Run:
         return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
 
 
-def sweep_paths(out) -> tuple[Path, Path]:
-    """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``."""
-    out = Path(out).resolve()
-    return out.with_name(out.stem + "_sweep.csv"), out.with_name(out.stem + "_sweep")
-
-
 def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     """Run a batch from parsed arguments; returns the exit status and the run's results.
 
@@ -260,6 +254,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "render": str(Path(args.render).resolve()) if args.render else "",
         "render_size": list(args.render_size),
         "render_samples": args.render_samples,
+        "render_views": args.render_views.upper(),
         "save_blend": bool(args.save_blend),
         "units": units,
         "stability": bool(args.stability),
@@ -325,7 +320,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             shutil.rmtree(folder, ignore_errors=True)
     if args.render:
         rendered = sum(1 for r in run.results if r.render)
-        run.say(f"wrote {rendered} render(s) to {args.render}")
+        run.say(f"wrote {rendered} measurement map(s) to {args.render}")
     for message in run.failed_outputs:
         run.say(f"  could not write the {message}")
     if run.failed_outputs:

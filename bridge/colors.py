@@ -1,7 +1,9 @@
 """The "VG Sides" colour attribute: each measurement's two sides in a palette pair, the rest grey.
 
-Only this one attribute is ever written; the user's own colour attributes are left alone (the
-"VG Sides" attribute is made the active one so that the viewport shows it).
+Only this one attribute is ever written; the user's own colour attributes are left alone. The
+"VG Sides" attribute is made the active one, and solid viewports are switched to attribute
+colours, once per object, on its first measurement (:func:`show_sides_once`); a repaint never
+changes either, so a user who picks another attribute or shading keeps it.
 """
 
 from __future__ import annotations
@@ -9,7 +11,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-from .mesh_data import read_positions, world_points
+from .mesh_data import own_write, read_positions
 
 ATTRIBUTE_NAME = "VG Sides"
 
@@ -42,7 +44,7 @@ def original_sides(obj, geometry, m) -> tuple[np.ndarray, np.ndarray]:
     mesh = obj.data
     if len(mesh.vertices) == geometry.points.shape[0]:
         return m.indices, m.labels
-    original = world_points(read_positions(mesh), geometry.matrix)
+    original = read_positions(mesh).astype(np.float64)
     offsets = original - m.center
     inside = np.flatnonzero(np.einsum("ij,ij->i", offsets, offsets) <= m.radius * m.radius)
     return inside, _nearest_labels(original[inside], geometry.points[m.indices], m.labels)
@@ -65,7 +67,8 @@ def _ours(mesh):
 
 
 def write_attribute(mesh, rgba: np.ndarray) -> None:
-    """Write ``rgba`` into the mesh's "VG Sides" point colour attribute and make it active."""
+    """Write ``rgba`` into the mesh's "VG Sides" point colour attribute (the active colour
+    attribute is left as it is; see :func:`show_sides_once`)."""
     attribute = _ours(mesh)
     if attribute is None:
         existing = mesh.attributes.get(ATTRIBUTE_NAME)  # of another domain or type
@@ -73,14 +76,30 @@ def write_attribute(mesh, rgba: np.ndarray) -> None:
             mesh.attributes.remove(existing)
         attribute = mesh.color_attributes.new(ATTRIBUTE_NAME, "FLOAT_COLOR", "POINT")
     attribute.data.foreach_set("color", np.ascontiguousarray(rgba, dtype=np.float32).ravel())
-    if mesh.color_attributes.active_color_name != ATTRIBUTE_NAME:
-        mesh.color_attributes.active_color = attribute
     mesh.update()
 
 
 def has_attribute(mesh) -> bool:
     """Whether the mesh has the "VG Sides" attribute as :func:`write_attribute` makes it."""
     return _ours(mesh) is not None
+
+
+def show_sides_once(obj, context=None) -> bool:
+    """On an object's first measurement, make "VG Sides" its active colour attribute and switch
+    solid viewports to attribute colours; afterwards do nothing (the user's choice stands).
+
+    Returns True when it switched.
+    """
+    if obj.vg.sides_shown:
+        return False
+    attribute = obj.data.color_attributes.get(ATTRIBUTE_NAME)
+    if attribute is None:
+        return False
+    with own_write(obj.data):  # not an edit: wakes no staleness check, keeps the geometry
+        obj.data.color_attributes.active_color = attribute
+    obj.vg.sides_shown = True
+    show_in_viewports(context)
+    return True
 
 
 def read_attribute(mesh) -> np.ndarray | None:

@@ -18,7 +18,13 @@ from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, profile_plot
 from ..vg_addon.method.edge_profile import summarize
 from . import measuring, records
-from .mesh_data import check_measurable, evaluated_geometry, surface_for
+from .mesh_data import (
+    check_measurable,
+    evaluated_geometry,
+    mesh_points,
+    surface_for,
+    uniform_scale,
+)
 
 PLOT_SIZE = (480, 240)
 
@@ -32,9 +38,16 @@ def free_break(obj) -> int:
     return number
 
 
-def measure_edge(obj, points, spacing, radius, lam=2.0, patch="euclidean", *, depsgraph=None):
+def measure_edge(
+    obj, points, spacing, radius, lam=2.0, patch="euclidean", *, depsgraph=None, space="mesh"
+):
     """Trace and measure the edge through ``points`` on ``obj`` without recording anything:
-    ``(EdgeProfile, Geometry)``."""
+    ``(EdgeProfile, Geometry, points)``, the last the points in mesh coordinates.
+
+    ``points`` are in mesh coordinates, or world space with ``space="world"`` (converted by the
+    object's ``matrix_world``); ``spacing`` and ``radius`` are in mesh units either way, like
+    ``measuring.measure_on_object``'s radius.
+    """
     check_measurable(obj)
     points = np.asarray(points, dtype=np.float64)
     if points.ndim != 2 or points.shape[1] != 3 or points.shape[0] < 2:
@@ -42,14 +55,27 @@ def measure_edge(obj, points, spacing, radius, lam=2.0, patch="euclidean", *, de
             "An edge needs at least two points (start and end, optionally via points between), "
             "each x, y, z."
         )
+    if space not in ("mesh", "world"):
+        raise GoniometerError(f"Unknown coordinate space {space!r}: use 'mesh' or 'world'.")
     geometry = evaluated_geometry(obj, depsgraph)
+    if space == "world":
+        points = mesh_points(points, geometry.matrix)
     surface = surface_for(obj, geometry)
     profile = surface.measure_along(points, spacing, radius, lam, patch)
-    return profile, geometry
+    return profile, geometry, points
 
 
 def measure_edge_on_object(
-    obj, points, spacing, radius, lam=2.0, patch="euclidean", *, depsgraph=None, note=""
+    obj,
+    points,
+    spacing,
+    radius,
+    lam=2.0,
+    patch="euclidean",
+    *,
+    depsgraph=None,
+    note="",
+    space="mesh",
 ):
     """Measure the edge through ``points`` and record every station as a measurement of one new
     break (its own colour pair), plus the edge's record with its summary and plot.
@@ -58,12 +84,16 @@ def measure_edge_on_object(
     ----------
     obj : bpy.types.Object
     points : array_like, shape (k, 3)
-        Start, via points and end, world space (float64 is kept exactly); each snaps to the
-        nearest vertex and the path is traced along the ridge between them.
+        Start, via points and end, in mesh coordinates (float64 is kept exactly); each snaps
+        to the nearest vertex and the path is traced along the ridge between them.
     spacing, radius, lam, patch
-        Station spacing (arc length) and the measuring settings of every station.
+        Station spacing (arc length) and the measuring settings of every station, lengths in
+        mesh units. Every station replays with ``vg.measure_xyz(..., space="MESH")`` at its
+        stored centre, radius, λ and patch mode.
     note : str
         Free text stored with the edge and each station.
+    space : {"mesh", "world"}
+        The coordinates ``points`` are given in; the edge records them in mesh coordinates.
 
     Returns
     -------
@@ -75,7 +105,9 @@ def measure_edge_on_object(
         Anything that stops the edge being traced or any station being measured; nothing is
         recorded then.
     """
-    profile, geometry = measure_edge(obj, points, spacing, radius, lam, patch, depsgraph=depsgraph)
+    profile, geometry, clicks = measure_edge(
+        obj, points, spacing, radius, lam, patch, depsgraph=depsgraph, space=space
+    )
     break_number = free_break(obj)
     edge_number = obj.vg.next_edge_number
     sides = profile.figures.plus_left
@@ -89,7 +121,6 @@ def measure_edge_on_object(
             station=(edge_number, arc, profile.spacing, left),
         )
         measuring.keep_sides(obj, geometry, item, m)
-    clicks = np.asarray(points, dtype=np.float64)
     edge = records.add_edge(
         obj, profile, clicks, geometry.fingerprint, break_number=break_number, note=note
     )
@@ -135,9 +166,19 @@ def import_edges_csv(
             if row.spacing is None or row.radius is None:
                 raise GoniometerError("it has no Spacing or no Radius")
             points = csvio.parse_points(row.points)
+            spacing, radius = row.spacing, row.radius
+            if row.coordinates == csvio.WORLD_COORDINATES:  # a file of an earlier version
+                scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
+                if scale is None:
+                    raise GoniometerError(
+                        "its points are in world space and the object's scale is not uniform, "
+                        "so its lengths have no single size on the mesh"
+                    )
+                points = mesh_points(points, np.array(obj.matrix_world, dtype=np.float64))
+                spacing, radius = spacing / scale, radius / scale
             settings = (
-                row.spacing,
-                row.radius,
+                spacing,
+                radius,
                 lam if row.seg_param is None else row.seg_param,
                 row.patch or patch,
             )
@@ -210,6 +251,7 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
             "pooled_angle": figures.pooled_angle,
             "pooled_fit": figures.pooled_fit_error,
             "flat_spans": [],
+            "space": records.MESH,
         }
         edge = records.add_edge_from_numbers(
             obj,

@@ -15,8 +15,16 @@ from ..vg_addon import GoniometerError, Measurement
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
 from ..vg_addon.method.sweep import radius_sweep
-from . import colors, painting, records
-from .mesh_data import Geometry, check_measurable, evaluated_geometry, own_write, surface_for
+from . import colors, legacy, painting, records
+from .mesh_data import (
+    Geometry,
+    check_measurable,
+    evaluated_geometry,
+    mesh_points,
+    own_write,
+    surface_for,
+    uniform_scale,
+)
 
 
 def _sides_key(obj, geometry: Geometry, item) -> tuple:
@@ -61,13 +69,19 @@ def measure(
     depsgraph=None,
     rule="oriented",
     stability=False,
+    space="mesh",
 ):
     """Measure ``obj`` without recording anything: ``(Measurement, Geometry)``.
 
-    The building block for previews (e.g. a drag tool) and for :func:`measure_on_object`.
+    The building block for previews (e.g. a drag tool) and for :func:`measure_on_object`;
+    the arguments are those of :func:`measure_on_object`.
     """
     check_measurable(obj)
     geometry = evaluated_geometry(obj, depsgraph)
+    if space == "world":
+        location = mesh_points(location, geometry.matrix)
+    elif space != "mesh":
+        raise GoniometerError(f"Unknown coordinate space {space!r}: use 'mesh' or 'world'.")
     surface = surface_for(obj, geometry)
     m = surface.measure(location, radius, lam, patch, rule=rule, stability=stability)
     note_winding(obj, surface)
@@ -91,10 +105,16 @@ def sweep(
     *,
     depsgraph=None,
     rule="oriented",
+    space="mesh",
 ):
-    """A radius sweep at ``location`` on ``obj`` (nothing is recorded): ``SweepPoint`` list."""
+    """A radius sweep at ``location`` on ``obj`` (nothing is recorded): ``SweepPoint`` list.
+
+    ``location`` is in mesh coordinates, or world space with ``space="world"``; the radii are
+    in mesh units."""
     check_measurable(obj)
     geometry = evaluated_geometry(obj, depsgraph)
+    if space == "world":
+        location = mesh_points(location, geometry.matrix)
     surface = surface_for(obj, geometry)
     note_winding(obj, surface)
     return radius_sweep(surface, location, start, stop, count, lam, patch, rule)
@@ -111,18 +131,22 @@ def measure_on_object(
     note="",
     rule="oriented",
     stability=False,
+    space="mesh",
 ):
     """Measure the active mesh at ``location``, record the measurement and repaint the sides.
 
     Parameters
     ----------
     obj : bpy.types.Object
-        The mesh object; its evaluated mesh (modifiers applied) is measured in world space.
+        The mesh object; its evaluated mesh (modifiers applied) is measured in its own
+        coordinates (object space), so the object's transform changes nothing.
     location : array_like, shape (3,)
-        Requested centre, world space, scene units (float64 is kept exactly); it snaps to the
-        nearest vertex within ``radius``.
+        Requested centre, in mesh coordinates (float64 is kept exactly) or, with
+        ``space="world"``, in world space (converted by the object's ``matrix_world``); it snaps
+        to the nearest vertex within ``radius``.
     radius : float
-        Patch radius, world space, scene units.
+        Patch radius, in mesh units (the units of the mesh's coordinates, whatever the object's
+        scale).
     lam : float
         Segmentation parameter λ (MeshLab's SegParam).
     patch : {"euclidean", "geodesic"}
@@ -130,6 +154,8 @@ def measure_on_object(
         Default: the context's evaluated depsgraph.
     note : str
         Free text stored with the measurement (the CSV's User Data).
+    space : {"mesh", "world"}
+        The coordinates ``location`` is given in.
     rule : {"oriented", "paper"}
         How the projection is signed (``vg_addon.method.algorithm.RULES``).
     stability : bool
@@ -137,7 +163,9 @@ def measure_on_object(
 
     Returns
     -------
-    The new ``VG_Measurement`` item on ``obj.vg.measurements`` (now the active one).
+    The new ``VG_Measurement`` item on ``obj.vg.measurements`` (now the active one). The first
+    measurement of an object also shows the sides in the viewports (``colors.show_sides_once``),
+    once per object.
 
     Raises
     ------
@@ -146,11 +174,20 @@ def measure_on_object(
         ``radius`` from the surface, too few vertices, ...; nothing is changed then.
     """
     m, geometry = measure(
-        obj, location, radius, lam, patch, depsgraph=depsgraph, rule=rule, stability=stability
+        obj,
+        location,
+        radius,
+        lam,
+        patch,
+        depsgraph=depsgraph,
+        rule=rule,
+        stability=stability,
+        space=space,
     )
     item = records.add_measurement(obj, m, geometry.fingerprint, note=note)
     keep_sides(obj, geometry, item, m)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    colors.show_sides_once(obj)
     return obj.vg.measurements[obj.vg.active_index]
 
 
@@ -180,7 +217,9 @@ def repaint(
     later measurements over earlier ones, with the sides it has at its exact stored centre,
     radius, λ and patch mode (kept from when it was measured, or measured again once). The
     others are flagged stale and left unpainted. Only what changed since the last painting of
-    this object is repainted (see ``painting``).
+    this object is repainted (see ``painting``). Records from versions that measured in world
+    space are first brought into mesh coordinates where they still match (see ``legacy``). The
+    viewports' shading is left as the user set it.
 
     Parameters
     ----------
@@ -208,6 +247,9 @@ def repaint(
         and colors.has_attribute(mesh)
     )
     trusted = usable and not verify and state.generation == painting.generation()
+    if not trusted and legacy.has_world_records(obj):
+        # Only a file load or an undo brings world-space records, and neither is trusted.
+        legacy.migrate(obj, geometry, surface_for(obj, geometry))
     known = state.known if trusted else {}
     keys, sides, stale, remembered = [], {}, [], {}
     for position, signature in enumerate(_signatures(items)):
@@ -240,7 +282,6 @@ def repaint(
     state.known, state.generation = remembered, painting.generation()
     with own_write(mesh, depsgraph):
         colors.write_attribute(mesh, state.colours)
-    colors.show_in_viewports()
     return stale
 
 
@@ -272,6 +313,29 @@ def stale_numbers(obj, *, depsgraph=None) -> set[int]:
     }
 
 
+def from_world(location, radius, matrix, *, scale_radius=True):
+    """A world-space centre and radius in mesh coordinates: ``(location, radius)``.
+
+    The radius is divided by the object's scale (when ``scale_radius``; a default radius given
+    in mesh units is kept).
+
+    Raises
+    ------
+    GoniometerError
+        The object's scale is not uniform: a world-space radius has no single length on the
+        mesh.
+    """
+    scale = uniform_scale(matrix)
+    if scale is None:
+        raise GoniometerError(
+            "its coordinates are in world space and the object's scale is not uniform, so its "
+            "radius has no single length on the mesh: re-export the CSV in mesh coordinates, or "
+            "set a uniform scale"
+        )
+    location = mesh_points(np.asarray(location, dtype=np.float64), matrix)
+    return location, (radius / scale if scale_radius and radius is not None else radius)
+
+
 def replicate_rows(
     obj,
     rows,
@@ -284,6 +348,7 @@ def replicate_rows(
     source="the CSV",
     rule="oriented",
     stability=False,
+    progress=None,
 ):
     """Re-measure every replication row on ``obj`` and record them all, or nothing.
 
@@ -300,6 +365,14 @@ def replicate_rows(
         Also compute and record each measurement's stability figure.
     source : str
         How to name the rows' origin in messages (e.g. the file name).
+    progress : callable, optional
+        Called as ``progress(done, total)`` before each row is measured; returning False
+        cancels the import (a GoniometerError; nothing is recorded).
+
+    Rows in mesh coordinates (``row.coordinates == "mesh"``: every file but this extension's
+    exports from before it measured in mesh coordinates) are measured as they are. Rows in
+    world space are brought into mesh coordinates by the object's current transform, the radius
+    divided by its scale; that needs a transform that scales every direction alike.
 
     Each new measurement keeps the row's break number when it has one (else the object's
     current break) and takes the row's label or User Data as its note. Rows that are stations
@@ -316,6 +389,48 @@ def replicate_rows(
     GoniometerError
         Listing every row that names another mesh or cannot be measured; nothing is recorded.
     """
+    steps = replicate_steps(
+        obj,
+        rows,
+        ignore_mesh_names=ignore_mesh_names,
+        radius=radius,
+        lam=lam,
+        patch=patch,
+        depsgraph=depsgraph,
+        source=source,
+        rule=rule,
+        stability=stability,
+    )
+    try:
+        while True:
+            done, total = next(steps)
+            if progress is not None and progress(done, total) is False:
+                steps.close()
+                raise GoniometerError(
+                    f"Import of {source} cancelled after {done} of {total} rows: nothing was "
+                    "imported."
+                )
+    except StopIteration as finished:
+        return finished.value
+
+
+def replicate_steps(
+    obj,
+    rows,
+    *,
+    ignore_mesh_names=False,
+    radius=None,
+    lam=2.0,
+    patch="euclidean",
+    depsgraph=None,
+    source="the CSV",
+    rule="oriented",
+    stability=False,
+):
+    """:func:`replicate_rows` a row at a time: a generator that yields ``(done, total)`` before
+    each row is measured and returns the new measurements' numbers (``StopIteration.value``)
+    once all are recorded. Closing it before the end records nothing; so does a mesh that
+    changed between steps (a GoniometerError)."""
     check_measurable(obj)
     if not rows:
         raise GoniometerError(f"{source} has no measurement rows: nothing to import.")
@@ -325,7 +440,8 @@ def replicate_rows(
     surface = surface_for(obj, geometry)
     note_winding(obj, surface)
     results, failures = [], []
-    for row in rows:
+    for done, row in enumerate(rows):
+        yield done, len(rows)
         try:
             row_radius = radius if row.radius is None else row.radius
             if row.break_number is not None and not (
@@ -336,8 +452,13 @@ def replicate_rows(
                 )
             if row_radius is None:
                 raise GoniometerError("no radius (the CSV has no Radius for this row)")
+            location = (row.x, row.y, row.z)
+            if row.coordinates == records.WORLD:
+                location, row_radius = from_world(
+                    location, row_radius, geometry.matrix, scale_radius=row.radius is not None
+                )
             m = surface.measure(
-                (row.x, row.y, row.z),
+                location,
                 row_radius,
                 lam if row.lam is None else row.lam,
                 row.patch or patch,
@@ -352,6 +473,11 @@ def replicate_rows(
         raise GoniometerError(
             f"{len(failures)} of {len(rows)} rows of {source} could not be measured on "
             f"'{obj.name}'; nothing was imported.\n" + bounded_list(failures, lines=True)
+        )
+    check_measurable(obj)
+    if evaluated_geometry(obj, depsgraph).fingerprint != geometry.fingerprint:
+        raise GoniometerError(
+            f"'{obj.name}' changed while {source} was being measured; nothing was imported."
         )
     numbers = []
     stations: dict[int, list] = {}
@@ -387,21 +513,27 @@ def replicate_rows(
         )
     records.continue_after_recorded_breaks(obj)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    colors.show_sides_once(obj)
     return numbers
+
+
+def read_rows(path) -> tuple[list, str]:
+    """The replication rows of the CSV at ``path`` and how messages name it."""
+    return csvio.read_replication_csv(Path(path)), f"'{Path(path).name}'"
 
 
 def import_csv(obj, path, *, depsgraph=None, **options) -> list[int]:
     """Read a measurement CSV (ours, MeshLab's, the earlier add-on's or plain x, y, z points) and
     replicate it on ``obj``; ``options`` as for :func:`replicate_rows`."""
-    rows = csvio.read_replication_csv(Path(path))
-    return replicate_rows(obj, rows, depsgraph=depsgraph, source=f"'{Path(path).name}'", **options)
+    rows, source = read_rows(path)
+    return replicate_rows(obj, rows, depsgraph=depsgraph, source=source, **options)
 
 
 def export_rows(objects, scene, *, depsgraph=None) -> list:
     """CSV rows of every measurement of ``objects`` (stale ones flagged), in list order."""
-    units = records.units_label(scene)
     rows = []
     for obj in objects:
+        units = records.units_label(scene, obj)
         stale = stale_numbers(obj, depsgraph=depsgraph)
         rows.extend(
             records.to_row(obj, item, stale=item.number in stale, units=units)

@@ -1,14 +1,21 @@
-"""From a Blender mesh object to NumPy: world-space float64 vertices, triangles, a fingerprint,
-and caches of each object's evaluated geometry and prepared :class:`~vg_addon.Surface`.
+"""From a Blender mesh object to NumPy: float64 vertices in the mesh's own coordinates,
+triangles, a fingerprint, and caches of each object's evaluated geometry and prepared
+:class:`~vg_addon.Surface`.
 
-The geometry of an object is read once and kept until a depsgraph update says its geometry or
-transform changed (``watch`` calls :func:`invalidate`), so a click reads nothing it already has.
-After an invalidation the mesh is read again; if its fingerprint is unchanged (e.g. an undo
-step that only restored colours) the kept geometry and Surface are reused.
+Measurements are taken in mesh coordinates (object space: the coordinates of the file the scan
+came from), so moving, rotating or scaling the object changes none of them; the object's
+``matrix_world`` only converts a world-space point (the 3D cursor, a click) into them and back.
+
+The geometry of an object is read once and kept until a depsgraph update says its geometry
+changed (``watch`` calls :func:`invalidate`; a transform alone does not), so a click reads
+nothing it already has. After an invalidation the mesh is read again; if its fingerprint is
+unchanged (e.g. an undo step that only restored colours) the kept geometry and Surface are
+reused.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -24,11 +31,12 @@ _CACHE_SIZE = 3
 _surfaces: OrderedDict[str, Surface] = OrderedDict()
 
 FINGERPRINT_PREFIX = "2-"
-"""Fingerprints written since issue 10 (SHA-256 of positions, face corners and face offsets);
-older files hold 32-hex-digit BLAKE2b fingerprints of positions and loop triangles."""
+"""Fingerprints written since issue 10 (SHA-256 of positions, face corners and face offsets;
+since issue 12 without the transform). Older files hold 32-hex-digit BLAKE2b fingerprints of
+positions and loop triangles (and the transform, for world-space records)."""
 
 # Per object (its session_uid): the geometry last read, and whether it is still current, i.e. no
-# depsgraph update has touched the object's geometry or transform since. Only trusted while the
+# depsgraph update has touched the object's geometry since. Only trusted while the
 # watcher's depsgraph handler is registered (``watching``).
 _geometries: OrderedDict[int, Geometry] = OrderedDict()
 _current: set[int] = set()
@@ -46,14 +54,17 @@ class Geometry:
     local : ndarray of float32, shape (n, 3)
         Vertex coordinates in object space, as Blender stores them.
     triangles : ndarray of int64, shape (m, 3)
-        Triangulated faces, wound so that normals point outward in world space.
+        Triangulated faces, as the mesh winds them.
     matrix : ndarray of float64, shape (4, 4)
-        The evaluated object's ``matrix_world``.
+        The evaluated object's ``matrix_world`` (not part of the measurement).
     points : ndarray of float64, shape (n, 3)
-        World-space vertex coordinates (see :func:`world_points`).
+        ``local`` as float64: the coordinates every measurement is taken in.
     fingerprint : str
-        Hash of ``local``, the face topology and ``matrix``: equal fingerprints mean equal
-        measurements.
+        Hash of ``local`` and the face topology: equal fingerprints mean equal measurements.
+        The object's transform is not part of it.
+    corners, faces : ndarray of int32
+        What :func:`read_corners` gave (``faces`` None when every face is a triangle); kept to
+        recognise the world-space fingerprints of older files.
     """
 
     local: np.ndarray
@@ -61,19 +72,29 @@ class Geometry:
     matrix: np.ndarray
     points: np.ndarray
     fingerprint: str
+    corners: np.ndarray | None = None
+    faces: np.ndarray | None = None
 
     @cached_property
     def legacy_fingerprint(self) -> str:
-        """The fingerprint files written before issue 10 hold for this geometry (BLAKE2b of the
-        positions, the loop triangles as Blender gives them and the matrix)."""
-        triangles = self.triangles
-        if np.linalg.det(self.matrix[:3, :3]) < 0.0:
-            triangles = triangles[:, ::-1]
-        return legacy_fingerprint(self.local, triangles.astype(np.int32), self.matrix)
+        """The mesh-space fingerprint of this geometry in the format before issue 10 (BLAKE2b
+        of the positions and the loop triangles as Blender gives them)."""
+        return legacy_fingerprint(self.local, self.triangles.astype(np.int32))
+
+    @cached_property
+    def world_fingerprints(self) -> frozenset[str]:
+        """The fingerprints world-space records (files written before issue 12) hold for this
+        geometry at its current transform: BLAKE2b of positions, loop triangles and the matrix
+        (before issue 10), and SHA-256 of positions, face corners and the matrix (issue 10)."""
+        old = legacy_fingerprint(self.local, self.triangles.astype(np.int32), self.matrix)
+        if self.corners is None:
+            return frozenset((old,))
+        return frozenset((old, fingerprint(self.local, self.corners, self.faces, self.matrix)))
 
     def matches(self, stored: str) -> bool:
-        """Whether a measurement recorded with fingerprint ``stored`` was taken on this
-        geometry (a fingerprint of either format)."""
+        """Whether a mesh-space measurement recorded with fingerprint ``stored`` was taken on
+        this geometry (a fingerprint of either format). World-space records are matched by
+        ``bridge.legacy`` against :attr:`world_fingerprints`."""
         if stored == self.fingerprint:
             return True
         return is_legacy(stored) and stored == self.legacy_fingerprint
@@ -89,6 +110,44 @@ def world_points(local: np.ndarray, matrix: np.ndarray) -> np.ndarray:
     return local @ matrix[:3, :3].T + matrix[:3, 3]
 
 
+def mesh_points(world: np.ndarray, matrix: np.ndarray) -> np.ndarray:
+    """Mesh (object-space) float64 coordinates of world-space points: the inverse of
+    :func:`world_points`.
+
+    Raises
+    ------
+    GoniometerError
+        The transform cannot be inverted (a scale of 0 on some axis).
+    """
+    matrix = np.asarray(matrix, dtype=np.float64)
+    linear = matrix[:3, :3]
+    if not np.isfinite(matrix).all() or abs(np.linalg.det(linear)) <= 1e-300:
+        raise GoniometerError(
+            "The object's transform flattens it (a scale of 0 on some axis): a point in world "
+            "space has no place on its mesh. Give it a non-zero scale."
+        )
+    world = np.asarray(world, dtype=np.float64)
+    return np.linalg.solve(linear, (world - matrix[:3, 3]).T).T
+
+
+def uniform_scale(matrix: np.ndarray, rtol: float = 1e-6) -> float | None:
+    """The scale factor of ``matrix`` if it scales every direction alike (a rotation, a
+    mirror, a uniform scale and a move), else None (a non-uniform scale or a shear).
+
+    A non-uniform object scale changes angles in world space; measurements are taken in mesh
+    coordinates and do not see it. The factor is rounded to float32, the precision Blender keeps
+    transforms in (so a scale of 3 under a rotation is 3, not 2.99999996).
+    """
+    linear = np.asarray(matrix, dtype=np.float64)[:3, :3]
+    gram = linear.T @ linear
+    scale2 = float(np.trace(gram)) / 3.0
+    if not np.isfinite(scale2) or scale2 <= 0.0:
+        return None
+    if np.abs(gram - scale2 * np.eye(3)).max() > rtol * scale2:
+        return None
+    return float(np.float32(np.sqrt(scale2)))
+
+
 def _digest(digest, arrays) -> None:
     for array in arrays:
         array = np.ascontiguousarray(array)
@@ -98,8 +157,8 @@ def _digest(digest, arrays) -> None:
         digest.update(memoryview(array.reshape(-1)).cast("B"))
 
 
-def fingerprint(local: np.ndarray, corners: np.ndarray, faces, matrix: np.ndarray) -> str:
-    """A short digest of the geometry a measurement depends on.
+def fingerprint(local: np.ndarray, corners: np.ndarray, faces, matrix=None) -> str:
+    """A short digest of the geometry a measurement depends on (not the transform).
 
     Parameters
     ----------
@@ -109,7 +168,9 @@ def fingerprint(local: np.ndarray, corners: np.ndarray, faces, matrix: np.ndarra
         The vertex of each face corner, face after face.
     faces : ndarray of int32 or None
         Each face's first corner; None when every face is a triangle (implied by ``corners``).
-    matrix : ndarray of float64, shape (4, 4)
+    matrix : ndarray of float64, shape (4, 4), optional
+        Only to recognise world-space records written before issue 12, whose fingerprint
+        included the object's transform.
 
     Notes
     -----
@@ -118,14 +179,16 @@ def fingerprint(local: np.ndarray, corners: np.ndarray, faces, matrix: np.ndarra
     (about 2.5x BLAKE2b here), and collisions are out of reach.
     """
     digest = hashlib.sha256()
-    _digest(digest, (local, corners, np.zeros(0, np.int32) if faces is None else faces, matrix))
+    arrays = (local, corners, np.zeros(0, np.int32) if faces is None else faces)
+    _digest(digest, arrays if matrix is None else (*arrays, matrix))
     return FINGERPRINT_PREFIX + digest.hexdigest()[:32]
 
 
-def legacy_fingerprint(local: np.ndarray, triangles: np.ndarray, matrix: np.ndarray) -> str:
-    """The fingerprint of files written before issue 10 (kept to migrate them)."""
+def legacy_fingerprint(local: np.ndarray, triangles: np.ndarray, matrix=None) -> str:
+    """The fingerprint of files written before issue 10 (kept to migrate them): with
+    ``matrix`` that of world-space records, without it that of mesh-space ones."""
     digest = hashlib.blake2b(digest_size=16)
-    _digest(digest, (local, triangles, matrix))
+    _digest(digest, (local, triangles) if matrix is None else (local, triangles, matrix))
     return digest.hexdigest()
 
 
@@ -205,9 +268,9 @@ def check_measurable(obj) -> None:
 
 
 def evaluated_geometry(obj, depsgraph=None) -> Geometry:
-    """The evaluated mesh of ``obj`` (modifiers applied) in world space.
+    """The evaluated mesh of ``obj`` (modifiers applied) in its own coordinates.
 
-    Read once and kept until a depsgraph update touches the object's geometry or transform
+    Read once and kept until a depsgraph update touches the object's geometry
     (see the module notes); the kept geometry is returned without reading the mesh.
 
     Parameters
@@ -222,14 +285,13 @@ def evaluated_geometry(obj, depsgraph=None) -> Geometry:
     obj_eval = obj.evaluated_get(depsgraph)
     key = obj.session_uid
     kept = _geometries.get(key)
-    if (
-        _watching
-        and kept is not None
-        and key in _current
-        # Belt and braces: a transform is 16 numbers to compare.
-        and np.array_equal(np.array(obj_eval.matrix_world, dtype=np.float64), kept.matrix)
-    ):
+    if _watching and kept is not None and key in _current:
         _geometries.move_to_end(key)
+        matrix = np.array(obj_eval.matrix_world, dtype=np.float64)
+        if not np.array_equal(matrix, kept.matrix):
+            # Moved, rotated or scaled: the same measurements, only world positions differ.
+            kept = dataclasses.replace(kept, matrix=matrix)
+            _geometries[key] = kept
         return kept
     geometry = _read_geometry(obj, obj_eval, kept)
     _geometries[key] = geometry
@@ -248,28 +310,24 @@ def _read_geometry(obj, obj_eval, kept: Geometry | None) -> Geometry:
             raise GoniometerError(f"'{obj.name}' has no vertices: there is nothing to measure.")
         corners, faces = read_corners(mesh)
         matrix = np.array(obj_eval.matrix_world, dtype=np.float64)
-        key = fingerprint(local, corners, faces, matrix)
+        key = fingerprint(local, corners, faces)
         if kept is not None and kept.fingerprint == key:
-            return kept
+            if np.array_equal(matrix, kept.matrix):
+                return kept
+            return dataclasses.replace(kept, matrix=matrix)
         triangles = read_triangles(mesh, corners, faces)
     finally:
         obj_eval.to_mesh_clear()
-    triangles = triangles.astype(np.int64)
-    if np.linalg.det(matrix[:3, :3]) < 0.0:
-        # A mirroring transform turns the faces inside out in world space: flip the winding so
-        # the normals the core derives from it still point outward.
-        triangles = triangles[:, ::-1].copy()
-    points = world_points(local, matrix)
+    points = local.astype(np.float64)
     if not np.isfinite(points).all():
         raise GoniometerError(
-            f"'{obj.name}' has vertices with infinite or NaN coordinates (check its transform "
-            "and modifiers)."
+            f"'{obj.name}' has vertices with infinite or NaN coordinates (check its modifiers)."
         )
-    return Geometry(local, triangles, matrix, points, key)
+    return Geometry(local, triangles.astype(np.int64), matrix, points, key, corners, faces)
 
 
 def invalidate(obj) -> None:
-    """Note that ``obj``'s geometry or transform may have changed: the next
+    """Note that ``obj``'s geometry may have changed: the next
     :func:`evaluated_geometry` reads it again."""
     _current.discard(obj.session_uid)
 
@@ -328,7 +386,7 @@ def set_watching(watching: bool) -> None:
 
 def surface_for(obj, geometry: Geometry) -> Surface:
     """The prepared :class:`Surface` of ``geometry``, built once per fingerprint (objects with
-    equal geometry and transform share it)."""
+    equal meshes share it, wherever they are placed)."""
     key = geometry.fingerprint
     surface = _surfaces.get(key)
     if surface is None:

@@ -14,8 +14,15 @@ import numpy as np
 from ..properties import exact_numbers
 from ..vg_addon import GoniometerError, palette
 from ..vg_addon.formats import csvio
+from .mesh_data import uniform_scale
 
 _MANIFEST = Path(__file__).resolve().parents[1] / "blender_manifest.toml"
+
+# The coordinates a record's centre, radius and normals are in (its "space"): the mesh's own
+# since this extension measures in them; records made before that have no "space" and are in
+# world space (see ``legacy``).
+MESH = csvio.MESH_COORDINATES
+WORLD = csvio.WORLD_COORDINATES
 
 
 @cache
@@ -45,6 +52,38 @@ def _stability(stability) -> dict:
     }
 
 
+def exact_record(m, station=None) -> dict:
+    """The exact numbers stored for measurement ``m`` (taken in mesh coordinates); ``station``
+    as for :func:`add_measurement`."""
+    numbers = {}
+    if station is not None:
+        _, arc_length, spacing, plus_left = station
+        numbers = {
+            "arc_length": float(arc_length),
+            "spacing": float(spacing),
+            "plus_left": bool(plus_left),
+        }
+    return {
+        **numbers,
+        "angle": float(m.angle),
+        "fit": float(m.fit_error),
+        "fit_plus": float(m.fit_error_plus),
+        "fit_minus": float(m.fit_error_minus),
+        "radius": float(m.radius),
+        "lam": float(m.lam),
+        "snap_distance": float(m.snap_distance),
+        "center": _floats(m.center),
+        "requested": _floats(m.requested_center),
+        "normal_plus": _floats(m.normal_plus),
+        "normal_minus": _floats(m.normal_minus),
+        "rule": m.rule,
+        "convexity": m.convexity,
+        "correlation": float(m.correlation),
+        "stability": None if m.stability is None else _stability(m.stability),
+        "space": MESH,
+    }
+
+
 def add_measurement(
     obj, m, geometry_fingerprint: str, *, note: str = "", break_number=None, station=None
 ):
@@ -54,7 +93,7 @@ def add_measurement(
     ----------
     obj : bpy.types.Object
     m : vg_addon.Measurement
-        A surface measurement (world space).
+        A surface measurement, in the mesh's own coordinates.
     geometry_fingerprint : str
         Fingerprint of the geometry it was taken on (see ``mesh_data.fingerprint``).
     note : str
@@ -84,34 +123,8 @@ def add_measurement(
             f"Break # must be a whole number from 1 to {csvio.MAX_BREAK_NUMBER}; got "
             f"{break_number!r}. Nothing was recorded."
         )
-    numbers = {}
-    if station is not None:
-        _, arc_length, spacing, plus_left = station
-        numbers = {
-            "arc_length": float(arc_length),
-            "spacing": float(spacing),
-            "plus_left": bool(plus_left),
-        }
-    exact = json.dumps(
-        {
-            **numbers,
-            "angle": float(m.angle),
-            "fit": float(m.fit_error),
-            "fit_plus": float(m.fit_error_plus),
-            "fit_minus": float(m.fit_error_minus),
-            "radius": float(m.radius),
-            "lam": float(m.lam),
-            "snap_distance": float(m.snap_distance),
-            "center": _floats(m.center),
-            "requested": _floats(m.requested_center),
-            "normal_plus": _floats(m.normal_plus),
-            "normal_minus": _floats(m.normal_minus),
-            "rule": m.rule,
-            "convexity": m.convexity,
-            "correlation": float(m.correlation),
-            "stability": None if m.stability is None else _stability(m.stability),
-        }
-    )
+    numbers = exact_record(m, station)
+    exact = json.dumps(numbers)
     # Everything that can fail is done: from here on the item is written whole.
     item = data.measurements.add()
     item.number = data.next_number
@@ -187,6 +200,12 @@ def numbers_of(item) -> dict:
     return numbers
 
 
+def space_of(item) -> str:
+    """The coordinates ``item`` was recorded in: ``"mesh"``, or ``"world"`` for a record made
+    before measurements were taken in mesh coordinates."""
+    return exact_numbers(item).get("space", WORLD)
+
+
 def replay_args(item) -> dict:
     """The exact inputs that reproduce ``item``: ``center``, ``radius``, ``lam``, ``patch``,
     ``rule`` (``"paper"`` for records from before the rule existed: that is what they used)."""
@@ -200,12 +219,26 @@ def replay_args(item) -> dict:
     }
 
 
-def units_label(scene) -> str:
-    """What one coordinate unit is: Blender units, and their length in the scene's unit system."""
+def units_label(scene, obj=None) -> str:
+    """What one coordinate unit is: Blender units and their length in the scene's unit system,
+    for a mesh shown at its own size; for an object scaled by ``s``, one mesh unit is ``s``
+    Blender units in the scene, and the label says so."""
     units = scene.unit_settings
+    scale = None
+    if obj is not None:
+        scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
+        if scale is None:
+            return "mesh units (the object's scale is not uniform)"
     if units.system == "NONE":
-        return "BU"
-    return f"BU (1 BU = {units.scale_length:g} m, shown in {units.length_unit.lower()})"
+        base = "BU"
+        metres = None
+    else:
+        base = f"BU (1 BU = {units.scale_length:g} m, shown in {units.length_unit.lower()})"
+        metres = units.scale_length
+    if scale is None or scale == 1.0:
+        return base
+    shown = f"{scale:g} BU" if metres is None else f"{scale * metres:g} m"
+    return f"mesh units (1 unit = {shown} in the scene, object scale {scale:g})"
 
 
 def to_row(
@@ -245,6 +278,7 @@ def to_row(
         arc_length=numbers.get("arc_length") if station else None,
         spacing=numbers.get("spacing") if station else None,
         units=units,
+        coordinates=numbers.get("space", WORLD),
         precision=precision,
         stale=stale,
         extension_version=extension_version(),
@@ -306,6 +340,7 @@ def edge_numbers(profile, clicks) -> dict:
         "pooled_angle": float(figures.pooled_angle),
         "pooled_fit": float(figures.pooled_fit_error),
         "flat_spans": [[float(a), float(b)] for a, b in spans],
+        "space": MESH,
     }
 
 
@@ -360,6 +395,7 @@ def edge_row(obj, edge, *, units: str) -> csvio.EdgeRow:
         points=csvio.format_points(numbers.get("points", [])),
         flat_spans="; ".join(f"{a!r}-{b!r}" for a, b in spans),
         units=units,
+        coordinates=numbers.get("space", WORLD),
         extension_version=extension_version(),
         blender_version=bpy.app.version_string,
     )

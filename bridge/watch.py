@@ -1,13 +1,22 @@
 """Keep the geometry caches, stale flags and colours in step with the mesh while the user edits it.
 
-Every depsgraph update of an object's geometry or transform drops its kept geometry
+Every depsgraph update of an object's geometry drops its kept geometry
 (``mesh_data.invalidate``), except the update our own colour write causes
-(``mesh_data.own_write``). After an edit (or a move) of an object that has measurements, and
-once the edits pause, the object's measurements are checked against its geometry; if a stale flag
-no longer matches, the object is repainted, so the colours never show sides of a mesh that has
-changed. The check runs from a timer, not inside the depsgraph handler (writing data there would
-re-trigger it), and not in Edit Mode (leaving Edit Mode triggers it again). Undo, redo and file
-loads drop every kept geometry.
+(``mesh_data.own_write``). After an edit of the mesh or its modifiers of an object that has
+measurements, and once the edits pause, the object's measurements are checked against its
+geometry; if a stale flag no longer matches, the object is repainted, so the colours never show
+sides of a mesh that has changed. Moving, rotating or scaling the object changes no measurement
+(they are in mesh coordinates) and triggers nothing. The check runs from a timer, not inside the
+depsgraph handler (writing data there would re-trigger it), and not in Edit Mode (leaving Edit
+Mode triggers it again). Undo and redo drop every kept geometry.
+
+The timer writes only what follows from the mesh the user edited (the stale flags and the "VG
+Sides" colours), never the viewport shading or the active colour attribute: undoing the edit
+brings the mesh back, and the next check brings the flags and colours back with it, so there is
+nothing of the timer's own for the user to undo. Its writes join the edit's undo step.
+
+On file load (``on_load``) the caches are emptied and measurements recorded in world space by
+earlier versions are brought into mesh coordinates (see ``legacy``).
 """
 
 from __future__ import annotations
@@ -16,7 +25,7 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..vg_addon import GoniometerError
-from . import mesh_data, painting
+from . import legacy, mesh_data, painting
 from .measuring import forget_paint, migrate_fingerprints, repaint
 from .mesh_data import check_measurable, evaluated_geometry
 
@@ -57,10 +66,10 @@ def _check_pending():
 
 @persistent
 def on_depsgraph_update(scene, depsgraph):
-    """Drop the kept geometry of objects whose geometry or transform changed; note the measured
-    ones, to check them soon."""
+    """Drop the kept geometry of objects whose geometry changed (not a mere move); note the
+    measured ones, to check them soon."""
     for update in depsgraph.updates:
-        if not (update.is_updated_geometry or update.is_updated_transform):
+        if not update.is_updated_geometry:
             continue
         obj = update.id.original
         if not isinstance(obj, bpy.types.Object) or obj.type != "MESH":
@@ -85,11 +94,41 @@ def on_undo_or_redo(*_args):
     painting.new_generation()
 
 
-@persistent
-def on_load(*_args):
-    """Another file: forget everything kept for the previous one."""
+def clear_caches() -> None:
+    """Forget every kept geometry, surface, paint state and measurement, and every pending
+    check."""
     mesh_data.clear_cache()
     forget_paint()
+    _pending.clear()
+    if bpy.app.timers.is_registered(_check_pending):
+        bpy.app.timers.unregister(_check_pending)
+
+
+@persistent
+def on_load(*_args):
+    """Another file: forget everything kept for the previous one, and bring world-space
+    measurements of earlier versions into mesh coordinates."""
+    clear_caches()
+    for obj in bpy.data.objects:
+        if obj.type == "MESH" and legacy.has_world_records(obj):
+            migrate(obj)
+
+
+def migrate(obj) -> list[int]:
+    """Bring ``obj``'s world-space records into mesh coordinates where they still match, and
+    repaint it if any were; returns their numbers. Objects that cannot be measured now are
+    left as they are."""
+    try:
+        check_measurable(obj)
+        geometry = evaluated_geometry(obj)
+    except GoniometerError:
+        return []
+    migrated = legacy.migrate(obj, geometry, mesh_data.surface_for(obj, geometry))
+    if migrated:
+        repaint(obj, geometry=geometry, verify=True)
+    else:
+        refresh(obj)  # the flags of records that stay in world space
+    return migrated
 
 
 _HANDLERS = (

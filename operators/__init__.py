@@ -3,6 +3,13 @@
 its viewport preview in ``drag_overlay``; ``sweep`` writes a radius sweep's CSV and plot;
 ``edge`` measures whole edges (edge profiles), with its path preview in ``edge_overlay``."""
 
-from . import csv_ops, drag, edge, measure, sweep
+from . import csv_ops, drag, edge, map_ops, measure, sweep
 
-classes = (*measure.classes, *csv_ops.classes, *drag.classes, *sweep.classes, *edge.classes)
+classes = (
+    *measure.classes,
+    *csv_ops.classes,
+    *drag.classes,
+    *sweep.classes,
+    *edge.classes,
+    *map_ops.classes,
+)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import bpy
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
@@ -10,7 +12,8 @@ from ..bridge import edges, measuring
 from ..bridge.mesh_data import check_measurable
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
-from .measure import typed_value
+from .measure import poll_measurable, typed_value
+from .progress import Progress
 
 
 def _path(operator) -> str:
@@ -45,6 +48,13 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
         description="Export the measurements of every object in the scene, not only the active one",
         default=False,
     )
+
+    @classmethod
+    def poll(cls, context):
+        if any(o.type == "MESH" and len(o.vg.measurements) for o in context.scene.objects):
+            return True
+        cls.poll_message_set("No object in this scene has measurements to export.")
+        return False
 
     def execute(self, context):
         try:
@@ -118,8 +128,28 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         description="Measure rows whose Mesh Name is not this object's on this object too",
         default=False,
     )
+    interactive: BoolProperty(
+        name="Interactive",
+        description="Started from the file browser: measure in steps, with progress, and let "
+        "Esc cancel (scripts measure in one go)",
+        default=False,
+        options={"HIDDEN", "SKIP_SAVE"},
+    )
 
-    def execute(self, context):
+    # Rows measured per timer step: a step stays short enough for Esc to be noticed.
+    STEP_SECONDS = 0.1
+
+    @classmethod
+    def poll(cls, context):
+        return poll_measurable(cls, context)
+
+    def invoke(self, context, event):
+        self.interactive = True
+        return ImportHelper.invoke(self, context, event)
+
+    def _start(self, context):
+        """Read the file and prepare the steps; report and return None on a problem (an edge
+        summary file is imported at once: the operator's result)."""
         path = self.filepath
         obj = context.active_object
         try:
@@ -143,29 +173,91 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                     f"{bpy.path.basename(path)} on '{obj.name}'",
                 )
                 return {"FINISHED"}
-            numbers = measuring.import_csv(
+            rows, source = measuring.read_rows(path)
+            steps = measuring.replicate_steps(
                 obj,
-                path,
+                rows,
                 ignore_mesh_names=self.ignore_mesh_names,
                 radius=typed_value(settings.radius),
                 lam=typed_value(settings.seg_param),
                 patch=settings.patch,
                 depsgraph=context.evaluated_depsgraph_get(),
+                source=source,
                 rule=settings.rule,
                 stability=settings.stability,
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
+            return None
         except OSError as error:
             self.report({"ERROR"}, f"Could not read {path}: {error}")
+            return None
+        self._obj, self._path_name, self._steps = obj, bpy.path.basename(path), steps
+        return steps
+
+    def execute(self, context):
+        steps = self._start(context)
+        if steps is None:
+            return {"CANCELLED"}
+        if isinstance(steps, set):  # an edge summary file, imported at once
+            return steps
+        if self.interactive and context.window is not None:
+            wm = context.window_manager
+            self._progress = Progress(context, f"Re-measuring {self._path_name} (Esc cancels)")
+            self._timer = wm.event_timer_add(0.01, window=context.window)
+            wm.modal_handler_add(self)
+            return {"RUNNING_MODAL"}
+        with Progress(context, f"Re-measuring {self._path_name}") as progress:
+            return self._advance(progress, until=None)
+
+    def _advance(self, progress, until):
+        """Measure rows until the time ``until`` (None: to the end); the operator's result, or
+        None to go on."""
+        try:
+            while True:
+                done, total = next(self._steps)
+                progress.step(done, total)
+                if until is not None and time.perf_counter() > until:
+                    return None
+        except StopIteration as finished:
+            numbers = finished.value
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         self.report(
             {"INFO"},
-            f"Re-measured {len(numbers)} row(s) of {bpy.path.basename(path)} on '{obj.name}' "
+            f"Re-measured {len(numbers)} row(s) of {self._path_name} on '{self._obj.name}' "
             f"(measurements {numbers[0]}–{numbers[-1]})",
         )
         return {"FINISHED"}
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self._finish(context)
+            self.report({"INFO"}, f"Import of {self._path_name} cancelled: nothing was imported.")
+            return {"CANCELLED"}
+        if event.type != "TIMER" or event.timer is not self._timer:
+            return {"RUNNING_MODAL"}
+        try:
+            result = self._advance(self._progress, until=time.perf_counter() + self.STEP_SECONDS)
+        except ReferenceError:  # the object was deleted meanwhile
+            result = {"CANCELLED"}
+            self.report({"ERROR"}, "The object was deleted: nothing was imported.")
+        if result is None:
+            return {"RUNNING_MODAL"}
+        self._finish(context)
+        return result
+
+    def cancel(self, context):
+        """Blender ends the operator (file load, window closed): nothing is imported."""
+        self._finish(context)
+
+    def _finish(self, context) -> None:
+        self._steps.close()
+        timer, self._timer = getattr(self, "_timer", None), None
+        if timer is not None:
+            context.window_manager.event_timer_remove(timer)
+        self._progress.__exit__(None, None, None)
 
 
 classes = (VG_OT_export_csv, VG_OT_import_csv)

@@ -16,11 +16,18 @@ import numpy as np
 from bpy_extras import view3d_utils
 from mathutils import Vector
 
-from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
+from ..bridge.mesh_data import (
+    check_measurable,
+    evaluated_geometry,
+    mesh_points,
+    surface_for,
+    uniform_scale,
+    world_points,
+)
 from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.drag_state import DragMachine, Phase, surface_callbacks
 from .drag_overlay import DragOverlay, patch_vertex_data
-from .measure import MeasureProperties, VG_OT_measure_xyz, typed_value
+from .measure import MeasureProperties, VG_OT_measure_xyz, poll_measurable, typed_value
 
 TOOL_ID = "vg.measure_drag_tool"
 
@@ -113,9 +120,10 @@ def format_length(scene, value: float) -> str:
 
 
 def ray_cast_object(obj, depsgraph, region, region_data, coord):
-    """World-space point where the view ray through region pixel ``coord`` first hits ``obj``.
+    """Point where the view ray through region pixel ``coord`` first hits ``obj``, in mesh
+    coordinates (object space, where it is measured).
 
-    Only ``obj`` is tested (its evaluated mesh, in object space); ``None`` when the ray misses.
+    Only ``obj`` is tested (its evaluated mesh); ``None`` when the ray misses.
     """
     coord = Vector(coord)
     origin = view3d_utils.region_2d_to_origin_3d(region, region_data, coord)
@@ -126,15 +134,19 @@ def ray_cast_object(obj, depsgraph, region, region_data, coord):
     local_origin = to_local @ origin
     local_direction = to_local.to_3x3() @ direction
     hit, location, _normal, _face = obj_eval.ray_cast(local_origin, local_direction)
-    return np.array(to_world @ location, dtype=np.float64) if hit else None
+    return np.array(location, dtype=np.float64) if hit else None
 
 
-def view_plane_radius(region, region_data, coord, center) -> float:
-    """Distance from ``center`` to the point under ``coord`` on the view plane through it."""
+def view_plane_radius(region, region_data, coord, center, matrix) -> float:
+    """Distance, in mesh units, from ``center`` (mesh coordinates) to the point under ``coord``
+    on the view plane through it; ``matrix`` is the object's ``matrix_world``."""
+    matrix = np.asarray(matrix, dtype=np.float64)
+    world_center = world_points(center, matrix)
     point = view3d_utils.region_2d_to_location_3d(
-        region, region_data, Vector(coord), Vector(center)
+        region, region_data, Vector(coord), Vector(world_center)
     )
-    return float(np.linalg.norm(np.array(point, dtype=np.float64) - center))
+    local = mesh_points(np.array(point, dtype=np.float64), matrix)
+    return float(np.linalg.norm(local - center))
 
 
 def object_alive(context, obj) -> bool:
@@ -175,9 +187,10 @@ class DragSession:
     call repeatedly) removes the drawing and the header and status texts on every way out.
     """
 
-    def __init__(self, obj, surface, patch: str, lam: float, rule: str = "oriented"):
+    def __init__(self, obj, surface, patch: str, lam: float, rule: str = "oriented", matrix=None):
         self.obj = obj
         self.surface = surface
+        self.matrix = np.eye(4) if matrix is None else np.asarray(matrix, dtype=np.float64)
         self.patch = patch
         self.rule = rule
         self.machine = DragMachine(
@@ -194,7 +207,8 @@ class DragSession:
         Raises
         ------
         GoniometerError
-            Not a 3D viewport, no measurable active mesh, or the press missed it.
+            Not a 3D viewport, a press over the sidebar, toolbar or header, no measurable
+            active mesh, or the press missed it.
         """
         region, region_data = context.region, context.region_data
         if (
@@ -207,12 +221,25 @@ class DragSession:
                 "Drag measuring works in the 3D viewport: choose the Goniometer tool in its "
                 "toolbar and press on the mesh."
             )
+        if not pointer_in_view(context.area, region, coord):
+            raise GoniometerError(
+                "Press on the mesh in the 3D view itself, not over the sidebar, toolbar or "
+                "header drawn over it."
+            )
         obj = context.active_object
         check_measurable(obj)
         settings = context.scene.vg_settings
         depsgraph = context.evaluated_depsgraph_get()
-        surface = surface_for(obj, evaluated_geometry(obj, depsgraph))
-        session = cls(obj, surface, settings.patch, typed_value(settings.seg_param), settings.rule)
+        geometry = evaluated_geometry(obj, depsgraph)
+        surface = surface_for(obj, geometry)
+        session = cls(
+            obj,
+            surface,
+            settings.patch,
+            typed_value(settings.seg_param),
+            settings.rule,
+            matrix=geometry.matrix,
+        )
         hit = ray_cast_object(obj, depsgraph, region, region_data, coord)
         if not session.machine.press(hit):
             raise GoniometerError(session.machine.message)
@@ -246,7 +273,7 @@ class DragSession:
             machine.cancel("Left the 3D view: nothing was recorded.")
             return DONE
         if action == "move":
-            machine.move(view_plane_radius(region, region_data, coord, machine.center))
+            machine.move(view_plane_radius(region, region_data, coord, machine.center, self.matrix))
         elif action == "type":
             machine.type_character(argument)
         elif action == "backspace":
@@ -275,7 +302,7 @@ class DragSession:
             labels = measurement.labels
         else:
             coords, labels = patch_vertex_data(self.surface.points, machine.indices), None
-        self.overlay.update(machine.center, machine.radius, coords, labels)
+        self.overlay.update(machine.center, machine.radius, coords, labels, matrix=self.matrix)
         if self._area is not None:
             self._area.header_text_set(self.header_text(context.scene))
             self._area.tag_redraw()
@@ -285,7 +312,11 @@ class DragSession:
     def header_text(self, scene) -> str:
         """The header line: radius, vertex count, λ, the angle after a λ change, and any hint."""
         machine = self.machine
-        parts = [f"Goniometer radius {format_length(scene, machine.radius)}"]
+        if uniform_scale(self.matrix) == 1.0:
+            radius = format_length(scene, machine.radius)
+        else:  # the scene's units measure world lengths, not the scaled mesh's
+            radius = f"{machine.radius:.5g} mesh units"
+        parts = [f"Goniometer radius {radius}"]
         if machine.typed:
             parts[0] += f" (typed {machine.typed})"
         parts.append(f"{machine.n_vertices} vertices")
@@ -313,14 +344,15 @@ class DragSession:
 def record_properties(session: DragSession) -> dict | None:
     """The operator properties that record a finished drag (None when it recorded nothing).
 
-    ``location`` is the snapped centre vertex, so ``vg.measure_xyz`` with these values snaps to
-    the same vertex and measures the same patch.
+    ``location`` is the snapped centre vertex in mesh coordinates, so ``vg.measure_xyz`` with
+    these values snaps to the same vertex and measures the same patch wherever the object is.
     """
     record = session.machine.record
     if session.machine.phase is not Phase.MEASURED or record is None:
         return None
     return {
         "location": tuple(record.center),
+        "space": "MESH",
         "radius": record.radius,
         "seg_param": record.lam,
         "patch": session.patch,
@@ -344,6 +376,10 @@ class VG_OT_measure_drag(MeasureProperties, bpy.types.Operator):
     bl_idname = "vg.measure_drag"
     bl_label = "Measure by Dragging"
     bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender reads a set)
+
+    @classmethod
+    def poll(cls, context):
+        return poll_measurable(cls, context)
 
     def invoke(self, context, event):
         try:

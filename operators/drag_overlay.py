@@ -5,8 +5,14 @@ Blender's modal-draw operator template), so it lives beside the operator, not in
 
 The operator owns one :class:`DragOverlay`; it starts drawing when the drag starts and must be
 stopped on every way out (release, cancel, error, the window manager cancelling the operator).
-Mouse moves only hand over new data (NumPy arrays); the GPU batch is built lazily in the draw
-callback, the one place a GPU context is guaranteed.
+Mouse moves only hand over new data (NumPy arrays, in mesh coordinates, drawn through the
+object's ``matrix_world``); the GPU batch is built lazily in the draw callback, the one place a
+GPU context is guaranteed.
+
+Lines use the ``POLYLINE_UNIFORM_COLOR`` shader and points ``POINT_UNIFORM_COLOR``, which set
+their width and size as uniforms and so work on Metal and Vulkan (where ``line_width_set`` and
+``point_size_set`` do nothing); Blender 4.2 has no ``POINT_UNIFORM_COLOR``, so points fall back
+to ``UNIFORM_COLOR`` with ``point_size_set`` there.
 """
 
 from __future__ import annotations
@@ -15,6 +21,7 @@ import bpy
 import gpu
 import numpy as np
 from gpu_extras.batch import batch_for_shader
+from mathutils import Matrix
 
 from ..vg_addon import palette
 
@@ -22,7 +29,17 @@ PATCH_COLOR = (1.0, 1.0, 0.6, 0.9)
 SIDE_COLORS = tuple((*(c / 255.0 for c in rgb), 0.95) for rgb in palette.pair_srgb8(1))
 CIRCLE_COLOR = (1.0, 1.0, 1.0, 0.9)
 POINT_SIZE = 4.0
+LINE_WIDTH = 2.0
 CIRCLE_SEGMENTS = 96
+
+
+def point_shader():
+    """``(shader, uses_size_uniform)``: POINT_UNIFORM_COLOR where Blender has it, else the 4.2
+    fallback UNIFORM_COLOR (sized by ``gpu.state.point_size_set``)."""
+    try:
+        return gpu.shader.from_builtin("POINT_UNIFORM_COLOR"), True
+    except (ValueError, TypeError):  # 4.2: not one of its built-in shaders
+        return gpu.shader.from_builtin("UNIFORM_COLOR"), False
 
 
 def patch_vertex_data(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
@@ -55,6 +72,7 @@ class DragOverlay:
         self._batches = None
         self.center: np.ndarray | None = None
         self.radius = 0.0
+        self.matrix = np.eye(4)
 
     @property
     def active(self) -> bool:
@@ -80,12 +98,17 @@ class DragOverlay:
         if handle is not None:
             bpy.types.SpaceView3D.draw_handler_remove(handle, "WINDOW")
 
-    def update(self, center, radius: float, coords: np.ndarray | None, labels=None) -> None:
+    def update(
+        self, center, radius: float, coords: np.ndarray | None, labels=None, *, matrix=None
+    ) -> None:
         """New preview: the circle ``center``/``radius`` and the patch vertices.
 
         ``coords`` is a float32 (k, 3) array (see :func:`patch_vertex_data`); ``labels``, when a
         measurement of the patch exists, is its bool "+" side per vertex, drawn in two colours.
+        Everything is in mesh coordinates; ``matrix`` (the object's ``matrix_world``, default
+        the identity) places it in the viewport.
         """
+        self.matrix = np.eye(4) if matrix is None else np.asarray(matrix, dtype=np.float64)
         self.center = None if center is None else np.asarray(center, dtype=np.float64)
         self.radius = float(radius)
         self._coords = coords
@@ -108,24 +131,40 @@ class DragOverlay:
 
     def _draw(self) -> None:
         region_data = bpy.context.region_data
-        if region_data is None or self.center is None:
+        region = bpy.context.region
+        if region_data is None or region is None or self.center is None:
             return
-        shader = gpu.shader.from_builtin("UNIFORM_COLOR")
+        points, sized = point_shader()
         gpu.state.blend_set("ALPHA")
         gpu.state.depth_test_set("NONE")  # the whole patch is measured, hidden side included
-        shader.bind()
-        if self._batches is None:
-            self._batches = self._build_batches(shader)
-        gpu.state.point_size_set(POINT_SIZE)
-        for batch, color in self._batches:
-            shader.uniform_float("color", color)
-            batch.draw(shader)
-        if self.radius > 0.0:
-            rotation = np.array(region_data.view_rotation.to_matrix())
-            ring = circle_points(self.center, self.radius, rotation[:, 0], rotation[:, 1])
-            gpu.state.line_width_set(2.0)
-            shader.uniform_float("color", CIRCLE_COLOR)
-            batch_for_shader(shader, "LINE_STRIP", {"pos": ring}).draw(shader)
-            gpu.state.line_width_set(1.0)
-        gpu.state.point_size_set(1.0)
+        with gpu.matrix.push_pop():
+            gpu.matrix.multiply_matrix(Matrix(self.matrix.tolist()))
+            points.bind()
+            if self._batches is None:
+                self._batches = self._build_batches(points)
+            if sized:
+                points.uniform_float("size", POINT_SIZE)
+            else:
+                gpu.state.point_size_set(POINT_SIZE)
+            for batch, color in self._batches:
+                points.uniform_float("color", color)
+                batch.draw(points)
+            if not sized:
+                gpu.state.point_size_set(1.0)
+            if self.radius > 0.0:
+                # The view plane's axes, brought into mesh coordinates: the circle is drawn
+                # there, so it is the patch's outline under any object transform.
+                to_mesh = np.linalg.inv(self.matrix[:3, :3])
+                view = np.array(region_data.view_rotation.to_matrix())
+                right, up = (to_mesh @ view[:, i] for i in (0, 1))
+                right /= np.linalg.norm(right)
+                up -= right * (up @ right)
+                up /= np.linalg.norm(up)
+                ring = circle_points(self.center, self.radius, right, up)
+                lines = gpu.shader.from_builtin("POLYLINE_UNIFORM_COLOR")
+                lines.bind()
+                lines.uniform_float("viewportSize", (region.width, region.height))
+                lines.uniform_float("lineWidth", LINE_WIDTH)
+                lines.uniform_float("color", CIRCLE_COLOR)
+                batch_for_shader(lines, "LINE_STRIP", {"pos": ring}).draw(lines)
         gpu.state.blend_set("NONE")

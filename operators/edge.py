@@ -26,7 +26,7 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.edge_state import EdgeMachine, EdgePhase
 from .drag import format_length, object_alive, ray_cast_object
 from .edge_overlay import EdgeOverlay
-from .measure import typed_value
+from .measure import SPACE_ITEMS, poll_measurable, typed_value
 
 _NAVIGATION = {
     "MIDDLEMOUSE",
@@ -161,7 +161,8 @@ class EdgeSession:
 
     def refresh(self, context) -> None:
         """Hand the clicks and path to the overlay; update header and status bar."""
-        self.overlay.update(self.machine.clicks, self.machine.path)
+        matrix = np.array(self.obj.matrix_world, dtype=np.float64)
+        self.overlay.update(self.machine.clicks, self.machine.path, matrix)
         if self._area is not None:
             self._area.header_text_set(self.header_text(context.scene))
             self._area.tag_redraw()
@@ -215,12 +216,18 @@ class VG_OT_measure_edge(bpy.types.Operator):
 
     points: StringProperty(
         name="Points",
-        description="Start, via points and end of the edge, world space, as JSON "
-        "[[x, y, z], ...] (exact float64); each snaps to the nearest vertex",
+        description="Start, via points and end of the edge, as JSON [[x, y, z], ...] (exact "
+        "float64) in the coordinates Space says; each snaps to the nearest vertex",
+    )
+    space: EnumProperty(
+        name="Space",
+        items=SPACE_ITEMS,
+        default="WORLD",
+        description="The coordinates Points are given in (clicks are recorded in mesh coordinates)",
     )
     spacing: FloatProperty(
         name="Spacing",
-        description="Arc length between stations; default: the panel's",
+        description="Arc length between stations, in mesh units; default: the panel's",
         min=0.0,
         precision=4,
         subtype="DISTANCE",
@@ -228,7 +235,7 @@ class VG_OT_measure_edge(bpy.types.Operator):
     )
     radius: FloatProperty(
         name="Radius",
-        description="Patch radius of every station; default: the panel's",
+        description="Patch radius of every station, in mesh units; default: the panel's",
         min=0.0,
         precision=4,
         subtype="DISTANCE",
@@ -242,8 +249,7 @@ class VG_OT_measure_edge(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        obj = context.active_object
-        return obj is not None and obj.type == "MESH"
+        return poll_measurable(cls, context)
 
     def execute(self, context):
         settings = context.scene.vg_settings
@@ -267,6 +273,7 @@ class VG_OT_measure_edge(bpy.types.Operator):
                 self.patch,
                 depsgraph=context.evaluated_depsgraph_get(),
                 note=self.note,
+                space=self.space.lower(),
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
@@ -321,6 +328,7 @@ class VG_OT_measure_edge(bpy.types.Operator):
             self.report({"INFO"}, machine.message or "Nothing was recorded.")
             return {"CANCELLED"}
         self.points = format_points(machine.clicks)  # stored for redo as well
+        self.space = "MESH"  # clicks are taken on the mesh, in its coordinates
         return self.execute(context)
 
     def cancel(self, context):
@@ -343,8 +351,12 @@ class VG_OT_delete_edge(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        obj = context.active_object
-        return obj is not None and obj.type == "MESH" and len(obj.vg.edges) > 0
+        if not poll_measurable(cls, context):
+            return False
+        if not len(context.active_object.vg.edges):
+            cls.poll_message_set(f"'{context.active_object.name}' has no edge profiles.")
+            return False
+        return True
 
     def execute(self, context):
         obj = context.active_object

@@ -12,6 +12,9 @@ import gpu
 import numpy as np
 from gpu_extras.batch import batch_for_shader
 
+from ..bridge.mesh_data import world_points
+from .drag_overlay import point_shader
+
 PATH_COLOR = (1.0, 0.85, 0.1, 1.0)
 CLICK_COLOR = (1.0, 1.0, 1.0, 1.0)
 FLAT_COLOR = (0.9, 0.2, 0.1, 1.0)  # stretches of the path on no ridge
@@ -62,40 +65,55 @@ class EdgeOverlay:
         if handle is not None:
             bpy.types.SpaceView3D.draw_handler_remove(handle, "WINDOW")
 
-    def update(self, clicks, path) -> None:
-        """New data: the clicked points and the traced ``EdgePath`` (or ``None``)."""
-        self._clicks = np.asarray(clicks, dtype=np.float32).reshape(-1, 3)
+    def update(self, clicks, path, matrix) -> None:
+        """New data: the clicked points and the traced ``EdgePath`` (or ``None``), in mesh
+        coordinates, drawn where the object's ``matrix`` (``matrix_world``) places them."""
+        matrix = np.asarray(matrix, dtype=np.float64)
+        clicks = np.asarray(clicks, dtype=np.float64).reshape(-1, 3)
+        self._clicks = world_points(clicks, matrix).astype(np.float32)
         if path is None:
             self._ridge = self._flat = None
         else:
-            self._ridge, self._flat = path_segments(path.points, path.arc_lengths, path.flat_spans)
+            self._ridge, self._flat = path_segments(
+                world_points(path.points, matrix), path.arc_lengths, path.flat_spans
+            )
         self._batches = None
 
-    def _build(self, shader) -> list:
+    def _build(self, lines, points) -> list:
         batches = []
         for pairs, color in ((self._ridge, PATH_COLOR), (self._flat, FLAT_COLOR)):
             if pairs is not None and len(pairs):
-                batches.append(("LINES", batch_for_shader(shader, "LINES", {"pos": pairs}), color))
+                batches.append(("LINES", batch_for_shader(lines, "LINES", {"pos": pairs}), color))
         if self._clicks is not None and len(self._clicks):
             batches.append(
-                ("POINTS", batch_for_shader(shader, "POINTS", {"pos": self._clicks}), CLICK_COLOR)
+                ("POINTS", batch_for_shader(points, "POINTS", {"pos": self._clicks}), CLICK_COLOR)
             )
         return batches
 
     def _draw(self) -> None:
-        if bpy.context.region_data is None or self._clicks is None:
+        region = bpy.context.region
+        if bpy.context.region_data is None or region is None or self._clicks is None:
             return
-        shader = gpu.shader.from_builtin("UNIFORM_COLOR")
+        # Line width and point size as shader uniforms (Metal and Vulkan ignore
+        # line_width_set); points fall back to UNIFORM_COLOR on 4.2, as in the drag overlay.
+        lines = gpu.shader.from_builtin("POLYLINE_UNIFORM_COLOR")
+        points, sized = point_shader()
+        if self._batches is None:
+            self._batches = self._build(lines, points)
         gpu.state.blend_set("ALPHA")
         gpu.state.depth_test_set("NONE")
-        shader.bind()
-        if self._batches is None:
-            self._batches = self._build(shader)
-        gpu.state.line_width_set(LINE_WIDTH)
-        gpu.state.point_size_set(CLICK_SIZE)
-        for _, batch, color in self._batches:
+        if not sized:
+            gpu.state.point_size_set(CLICK_SIZE)
+        for kind, batch, color in self._batches:
+            shader = lines if kind == "LINES" else points
+            shader.bind()
+            if kind == "LINES":
+                shader.uniform_float("viewportSize", (region.width, region.height))
+                shader.uniform_float("lineWidth", LINE_WIDTH)
+            elif sized:
+                shader.uniform_float("size", CLICK_SIZE)
             shader.uniform_float("color", color)
             batch.draw(shader)
-        gpu.state.line_width_set(1.0)
-        gpu.state.point_size_set(1.0)
+        if not sized:
+            gpu.state.point_size_set(1.0)
         gpu.state.blend_set("NONE")

@@ -14,7 +14,7 @@ from bpy.props import (
 )
 
 from ..bridge import measuring, records
-from ..bridge.mesh_data import check_measurable, evaluated_geometry
+from ..bridge.mesh_data import check_measurable, evaluated_geometry, uniform_scale
 from ..properties import PATCH_ITEMS, RULE_ITEMS
 from ..vg_addon import GoniometerError
 
@@ -33,9 +33,47 @@ def _stale_warning(obj) -> str:
     if not stale:
         return ""
     return (
-        f"Measurement(s) {', '.join(stale)} of '{obj.name}' are stale: the mesh or its transform "
+        f"Measurement(s) {', '.join(stale)} of '{obj.name}' are stale: the mesh or its modifiers "
         "changed since they were taken. Their numbers are kept; they are no longer painted."
     )
+
+
+def poll_measurable(cls, context) -> bool:
+    """``poll()`` of operators that need a measurable active mesh; the reason it is not goes
+    to the button's tooltip."""
+    try:
+        check_measurable(context.active_object)
+    except GoniometerError as error:
+        cls.poll_message_set(str(error))
+        return False
+    return True
+
+
+def poll_measured(cls, context) -> bool:
+    """``poll()`` of operators that need a measurable active mesh with measurements."""
+    if not poll_measurable(cls, context):
+        return False
+    if not len(context.active_object.vg.measurements):
+        cls.poll_message_set(f"'{context.active_object.name}' has no measurements yet.")
+        return False
+    return True
+
+
+def non_uniform_scale_note(obj) -> str:
+    """A warning for an object whose scale is not uniform, else ''."""
+    if obj is None or uniform_scale(np.array(obj.matrix_world, dtype=np.float64)) is not None:
+        return ""
+    return (
+        f"'{obj.name}' has a non-uniform scale: angles are measured on the mesh as stored "
+        "(its file's shape), not as scaled in the viewport. Apply the scale (Ctrl A) if it is "
+        "meant to change the shape."
+    )
+
+
+SPACE_ITEMS = (
+    ("WORLD", "World", "World space, where the object is now (the 3D cursor's coordinates)"),
+    ("MESH", "Mesh", "The mesh's own coordinates (object space: those of its file and the CSV)"),
+)
 
 
 class MeasureProperties:
@@ -44,15 +82,21 @@ class MeasureProperties:
 
     location: FloatVectorProperty(
         name="Location",
-        description="Centre to measure at, world space (snaps to the nearest vertex); "
-        "default: the 3D cursor",
+        description="Centre to measure at (snaps to the nearest vertex), in the coordinates "
+        "chosen by Space; default: the 3D cursor",
         size=3,
         subtype="TRANSLATION",
         unit="LENGTH",
     )
+    space: EnumProperty(
+        name="Space",
+        items=SPACE_ITEMS,
+        default="WORLD",
+        description="The coordinates Location is given in",
+    )
     radius: FloatProperty(
         name="Radius",
-        description="Patch radius, world space; default: the panel's radius",
+        description="Patch radius, in the mesh's own units; default: the panel's radius",
         soft_min=0.0,  # not min: a negative radius is refused, not quietly made 0
         precision=4,
         subtype="DISTANCE",
@@ -78,11 +122,16 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
     bl_label = "Measure at 3D Cursor"
     bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
 
+    @classmethod
+    def poll(cls, context):
+        return poll_measurable(cls, context)
+
     def execute(self, context):
         settings = context.scene.vg_settings
         given = self.properties.is_property_set
         if not given("location"):
             self.location = context.scene.cursor.location
+            self.space = "WORLD"
         if not given("radius"):
             self.radius = settings.radius
         if not given("seg_param"):
@@ -103,6 +152,7 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
                 self.patch,
                 depsgraph=context.evaluated_depsgraph_get(),
                 note=self.note,
+                space=self.space.lower(),
                 rule=self.rule,
                 stability=self.stability,
             )
@@ -116,9 +166,9 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
             f"{item.angle:.2f}°{spread}, {item.convexity} edge (fit error {item.fit_error:.3g}, "
             f"{item.n_vertices} vertices)",
         )
-
-        if warning := _stale_warning(obj):
-            self.report({"WARNING"}, warning)
+        for warning in (_stale_warning(obj), non_uniform_scale_note(obj)):
+            if warning:
+                self.report({"WARNING"}, warning)
         return {"FINISHED"}
 
 
@@ -154,6 +204,10 @@ class VG_OT_next_break(bpy.types.Operator):
     bl_label = "Next Break"
     bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
 
+    @classmethod
+    def poll(cls, context):
+        return poll_measurable(cls, context)
+
     def execute(self, context):
         obj = _active_measurable(self, context)
         if obj is None:
@@ -173,6 +227,10 @@ class VG_OT_delete_measurement(bpy.types.Operator):
     index: IntProperty(
         name="Index", description="Position in the list; -1: the selected one", default=-1, min=-1
     )
+
+    @classmethod
+    def poll(cls, context):
+        return poll_measured(cls, context)
 
     def execute(self, context):
         obj = context.active_object
@@ -199,6 +257,10 @@ class VG_OT_clear_measurements(bpy.types.Operator):
     bl_idname = "vg.clear_measurements"
     bl_label = "Clear Measurements"
     bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+
+    @classmethod
+    def poll(cls, context):
+        return poll_measured(cls, context)
 
     def invoke(self, context, event):
         return context.window_manager.invoke_confirm(self, event)
@@ -230,6 +292,10 @@ class VG_OT_repaint(bpy.types.Operator):
     bl_idname = "vg.repaint"
     bl_label = "Update Colours"
     bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+
+    @classmethod
+    def poll(cls, context):
+        return poll_measured(cls, context)
 
     def execute(self, context):
         obj = _active_measurable(self, context)

@@ -6,13 +6,19 @@ from __future__ import annotations
 from pathlib import Path
 
 import bpy
-from bpy.props import FloatProperty, FloatVectorProperty, IntProperty, StringProperty
+from bpy.props import (
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    IntProperty,
+    StringProperty,
+)
 from bpy_extras.io_utils import ExportHelper
 
 from ..bridge import measuring
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio, sweep_plot
-from .measure import typed_value
+from .measure import SPACE_ITEMS, poll_measurable, typed_value
 
 
 class VG_OT_radius_sweep(bpy.types.Operator, ExportHelper):
@@ -27,10 +33,17 @@ class VG_OT_radius_sweep(bpy.types.Operator, ExportHelper):
     filter_glob: StringProperty(default="*.csv", options={"HIDDEN"})
     location: FloatVectorProperty(
         name="Location",
-        description="Centre to measure at, world space; default: the 3D cursor",
+        description="Centre to measure at, in the coordinates chosen by Space; default: the 3D "
+        "cursor",
         size=3,
         subtype="TRANSLATION",
         unit="LENGTH",
+    )
+    space: EnumProperty(
+        name="Space",
+        items=SPACE_ITEMS,
+        default="WORLD",
+        description="The coordinates Location is given in",
     )
     start: FloatProperty(name="From", description="First radius; default: the panel's", min=0.0)
     stop: FloatProperty(name="To", description="Last radius; default: the panel's", min=0.0)
@@ -38,14 +51,14 @@ class VG_OT_radius_sweep(bpy.types.Operator, ExportHelper):
 
     @classmethod
     def poll(cls, context):
-        obj = context.active_object
-        return obj is not None and obj.type == "MESH"
+        return poll_measurable(cls, context)
 
     def execute(self, context):
         settings = context.scene.vg_settings
         given = self.properties.is_property_set
         if not given("location"):
             self.location = context.scene.cursor.location
+            self.space = "WORLD"
         for name, setting in (("start", "sweep_start"), ("stop", "sweep_stop")):
             if not given(name):
                 setattr(self, name, getattr(settings, setting))
@@ -66,6 +79,7 @@ class VG_OT_radius_sweep(bpy.types.Operator, ExportHelper):
                 settings.patch,
                 depsgraph=context.evaluated_depsgraph_get(),
                 rule=settings.rule,
+                space=self.space.lower(),
             )
             image = str(Path(path).with_suffix(".png"))
             csvio.write_sweep_csv(path, obj.name, points)

@@ -19,9 +19,13 @@ run() {  # run LABEL PYTHON PYTEST-ARGS...
     echo "== $label" >&2
     "$python" -m pytest -p no:cacheprovider "$@" || status=1
 }
-run "core and extension, bpy 5.2 LTS (Python 3.13, NumPy 2)" .venv/bin/python tests --ignore=tests/gui "$@"
-run "core and extension, bpy 4.2 LTS (Python 3.11, NumPy 1.26)" .venv-bpy42/bin/python tests --ignore=tests/gui "$@"
-run "extension, bpy 4.5 LTS (Python 3.11, NumPy 1.26)" .venv-bpy45/bin/python tests/blender "$@"
+# The core in processes of its own (no bpy loaded), on both NumPy lines; then the extension on
+# every Blender line.
+run "core, Python 3.13, NumPy 2" .venv/bin/python tests/core "$@"
+run "core, Python 3.11, NumPy 1.26" .venv-bpy42/bin/python tests/core "$@"
+run "extension, bpy 5.2 LTS (Python 3.13, NumPy 2)" .venv/bin/python tests/blender "$@"
 run "extension, bpy 5.3 (Python 3.13, NumPy 2)" .venv-bpy53/bin/python tests/blender "$@"
+run "extension, bpy 4.5 LTS (Python 3.11, NumPy 1.26)" .venv-bpy45/bin/python tests/blender "$@"
+run "extension, bpy 4.2 LTS (Python 3.11, NumPy 1.26)" .venv-bpy42/bin/python tests/blender "$@"
 run "real Blender 4.3 and 5.2: GUI and blender -b" .venv/bin/python tests/gui "$@"
 exit $status

@@ -1,5 +1,5 @@
-"""Sidebar panels and the measurement list: drawing only."""
+"""Sidebar panels and lists that only draw, and the viewport labels' draw handler."""
 
-from . import lists, panels
+from . import labels, lists, panels
 
 classes = (*lists.classes, *panels.classes)

@@ -1,24 +1,24 @@
-"""The measurement and edge-profile lists (UILists: they only draw)."""
+"""The measurement list (a UIList: it only draws)."""
 
 import bpy
 
-# Shares of a row at the default sidebar width: the angle first and widest, then the number and
-# break, then the two side colours. Labels in a plain row share the width equally, which cut
-# every angle to "6…"; a split gives each its own share.
-ANGLE_SHARE = 0.46
-NUMBER_SHARE = 0.62  # of what the angle leaves
+# Shares of a row at the default sidebar width (about 170 pixels for the list at UI scale 1): the
+# angle first and widest (room for a warning icon, "179.99°" and a word such as "concave"), then
+# the number, then the two side colours (which also tell the break). Labels in a plain row share
+# the width equally, which cut every angle to "6…"; a split gives each its own share.
+ANGLE_SHARE = 0.6
+NUMBER_SHARE = 0.6  # of what the angle leaves
 
 
 def row_texts(item) -> tuple[str, str]:
-    """The two texts of a list row: the angle (2 decimals) and ``"#number B break"``.
+    """The two texts of a list row: the angle (2 decimals) and ``"#number"``.
 
-    A stale measurement keeps both (the angle gets a warning icon); every other number is in the
-    Selected Measurement panel.
+    A stale measurement keeps both (the angle gets a warning icon); the break is told by the
+    row's colour pair, and every number is in the Selected Measurement panel.
     """
     # A concave or unclear edge is named: its angle is not the solid's interior angle.
     kind = "" if item.convexity in ("convex", "not recorded") else f" {item.convexity}"
-    edge = f" E{item.edge_number}" if item.edge_number else ""
-    return f"{item.angle:.2f}°{kind}", f"#{item.number} B{item.break_number}{edge}"
+    return f"{item.angle:.2f}°{kind}", f"#{item.number}"
 
 
 class VG_UL_measurements(bpy.types.UIList):
@@ -40,20 +40,4 @@ class VG_UL_measurements(bpy.types.UIList):
         swatches.prop(item, "color_minus", text="")
 
 
-class VG_UL_edges(bpy.types.UIList):
-    """One row per edge profile: number, break, stations, mean ± SD, pooled angle, colours."""
-
-    def draw_item(self, context, layout, data, item, icon, active_data, active_property, index):
-        if self.layout_type == "GRID":
-            layout.alignment = "CENTER"
-            layout.label(text=str(item.number))
-            return
-        row = layout.row(align=True)
-        row.label(text=f"E{item.number}")
-        row.label(text=f"B{item.break_number}")
-        row.label(text=f"{item.n_stations} st")
-        row.label(text=f"{item.mean:.1f}±{item.std:.1f}°")
-        row.label(text=f"pooled {item.pooled_angle:.1f}°")
-
-
-classes = (VG_UL_measurements, VG_UL_edges)
+classes = (VG_UL_measurements,)

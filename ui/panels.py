@@ -4,6 +4,7 @@ import textwrap
 
 import bpy
 
+from ..operators.measure import non_uniform_scale_note
 from ..properties import exact_numbers
 from ..vg_addon.method.winding import winding_message
 
@@ -49,6 +50,11 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
         if obj is None:
             layout.label(text="Select a mesh object to measure", icon="INFO")
             return
+        if non_uniform_scale_note(obj):
+            box = layout.box()
+            box.label(text="Non-uniform scale: not measured", icon="INFO")
+            box.label(text="Angles are those of the mesh as stored;")
+            box.label(text="apply the scale (Ctrl A) to change its shape")
         if message := winding_message(obj.name, obj.vg.winding):
             box = layout.box()
             for number, line in enumerate(textwrap.wrap(message, 42)):
@@ -70,6 +76,11 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
         side.operator("vg.clear_measurements", text="", icon="TRASH")
         side.separator()
         side.operator("vg.repaint", text="", icon="FILE_REFRESH")
+        row = layout.row(align=True)
+        row.prop(settings, "show_labels", icon="FONT_DATA")
+        sub = row.row(align=True)
+        sub.active = settings.show_labels
+        sub.prop(settings, "labels_active_break", text="Current Break")
 
 
 class VIEW3D_PT_vg_selected(_GoniometerPanel, bpy.types.Panel):
@@ -148,6 +159,13 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
         for axis, value in zip("XYZ", vector, strict=True):
             text = "missing" if value is None else exact_text(value)
             rows.append((label if axis == "X" else "", f"{axis}  {text}"))
+    if numbers.get("space") == "mesh":
+        # Where the measured vertex is now, the object's transform applied (float32, as shown).
+        for axis, value in zip("XYZ", item.center_world, strict=True):
+            rows.append(("Centre (world)" if axis == "X" else "", f"{axis}  {value:.9g}"))
+        rows.append(("Coordinates", "mesh (the object's own)"))
+    else:
+        rows.append(("Coordinates", "world (recorded by an older version)"))
     rows.append(("Snap distance", number("snap_distance")))
     stability = numbers.get("stability") or {}
     for label, key in (
@@ -262,10 +280,28 @@ class VIEW3D_PT_vg_sweep(_GoniometerPanel, bpy.types.Panel):
         layout.operator("vg.radius_sweep", text="Sweep at 3D Cursor", icon="GRAPH")
 
 
+class VIEW3D_PT_vg_map(_GoniometerPanel, bpy.types.Panel):
+    """Render the measurement map: the coloured sides with numbered labels, from chosen views."""
+
+    bl_label = "Measurement Map"
+    bl_parent_id = "VIEW3D_PT_vg_measure"
+    bl_options = {"DEFAULT_CLOSED"}  # noqa: RUF012 (Blender wants a set)
+
+    def draw(self, context):
+        settings = context.scene.vg_settings
+        layout = self.layout
+        layout.prop(settings, "map_views", expand=True)
+        layout.prop(settings, "map_directory", text="")
+        op = layout.operator("vg.render_map", text="Render Map", icon="RENDER_STILL")
+        op.views = settings.map_views
+        op.directory = settings.map_directory
+
+
 classes = (
     VIEW3D_PT_vg_measure,
     VIEW3D_PT_vg_selected,
     VIEW3D_PT_vg_edges,
     VIEW3D_PT_vg_csv,
     VIEW3D_PT_vg_sweep,
+    VIEW3D_PT_vg_map,
 )

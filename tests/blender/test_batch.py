@@ -87,12 +87,19 @@ def png_size(path) -> tuple[int, int]:
     return struct.unpack(">II", data[16:24])
 
 
+def exact_in_float32(shape):
+    return dataclasses.replace(shape, points=shape.points.astype(np.float32).astype(np.float64))
+
+
 @pytest.fixture(scope="module")
 def meshes(tmp_path_factory) -> dict:
     """Wedges of 90° (as PLY, OBJ and STL) and 60° (PLY), with their true angles."""
     folder = tmp_path_factory.mktemp("meshes")
-    w90 = wedge(90.0, n=24, irregular=True, seed=3)
-    w60 = wedge(60.0, n=24, irregular=True, seed=4)
+    # Coordinates that float32 holds exactly: every format then gives Blender the same mesh,
+    # and the batch measures it as the extension does (float64 files that float32 would round
+    # are measured at the file's precision: test_batch_precision.py).
+    w90 = exact_in_float32(wedge(90.0, n=24, irregular=True, seed=3))
+    w60 = exact_in_float32(wedge(60.0, n=24, irregular=True, seed=4))
     return {
         "ply": meshio.write_ply(folder / "w90.ply", w90.points, w90.triangles),
         "obj": write_obj(folder / "w90_obj.obj", w90.points, w90.triangles),
@@ -145,15 +152,11 @@ def test_points_given_with_at_on_ply_obj_and_stl(meshes, tmp_path):
         assert abs(r.angle - 90.0) < 0.01
         assert (r.radius, r.seg_param, r.patch) == (RADIUS, 2.0, "euclidean")
         assert r.units == "BU" and r.extension_version and r.blender_version
-    # The same surface in three file formats. PLY and OBJ carry the float64 coordinates, which
-    # float32 would round: both are measured at the file's precision, bit for bit alike. STL
-    # holds float32 coordinates: measured as Blender stores them, so equal to rounding only.
-    assert {r.precision for r in rows} == {r.precision for r in results["obj"]} == {"float64"}
-    assert [r.angle for r in results["obj"]] == [r.angle for r in rows]
-    assert [r.normal_plus for r in results["obj"]] == [r.normal_plus for r in rows]
-    assert {r.precision for r in results["stl"]} == {"float32"}
-    for stl, ply in zip(results["stl"], rows, strict=True):
-        assert abs(stl.angle - ply.angle) < 1e-6
+    # The same surface in three file formats: the same float32 vertices and faces in Blender,
+    # hence the same numbers, bit for bit.
+    for kind in ("obj", "stl"):
+        assert [r.angle for r in results[kind]] == [r.angle for r in rows]
+        assert [r.normal_plus for r in results[kind]] == [r.normal_plus for r in rows]
 
 
 def test_points_csv_plain_our_export_and_meshlab_replicate_the_same_angles(meshes, tmp_path):
@@ -285,13 +288,27 @@ def test_an_unreadable_mesh_fails_alone_with_exit_2(meshes, tmp_path):
     assert "unreadable mesh" in result.stderr
 
 
-def test_render_writes_a_png_per_mesh(meshes, tmp_path):
+def test_render_writes_the_measurement_map_per_mesh(meshes, tmp_path):
     renders = tmp_path / "renders"
     result = ok(batch(meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS, "--out",
                       tmp_path / "out.csv", "--render", renders, "--render-size", 48, 32,
                       "--render-samples", 1))  # fmt: skip
-    assert png_size(renders / "w90.png") == (48, 32)
-    assert "wrote 1 render(s)" in result.stderr
+    views = ("front", "back", "right", "left", "top", "bottom")
+    for view in views:
+        assert png_size(renders / f"w90_map_{view}.png") == (48, 32)
+    assert png_size(renders / "w90_map.png") == (3 * 48, 2 * 32)  # the contact sheet
+    assert sorted(p.name for p in renders.iterdir()) == sorted(
+        ["w90_map.png", *(f"w90_map_{view}.png" for view in views)]
+    )
+    assert "wrote 1 measurement map(s)" in result.stderr
+
+
+def test_render_views_flake(meshes, tmp_path):
+    renders = tmp_path / "renders"
+    ok(batch(meshes["ply"], *("--at", *CREASE[1]), "--radius", RADIUS, "--out",
+             tmp_path / "out.csv", "--render", renders, "--render-views", "flake",
+             "--render-size", 48, 32, "--render-samples", 1))  # fmt: skip
+    assert png_size(renders / "w90_map.png") == (2 * 48, 32)
 
 
 # --------------------------------------------------------------------------- against the extension
@@ -323,16 +340,16 @@ def test_batch_angle_equals_measure_xyz_on_blenders_own_ply_import(vg, tmp_path)
     assert obj.vg.measurements[0].n_vertices == row.n_vertices
 
 
-def test_blend_input_world_space_and_saved_measurements(vg, tmp_path):
-    """An object of a .blend, moved, turned and scaled: the batch measures it in world space
-    exactly as measure_xyz does, and the saved .blend lists the measurements, painted."""
+def test_blend_input_mesh_coordinates_and_saved_measurements(vg, tmp_path):
+    """An object of a .blend, moved, turned and scaled: the batch measures it in its mesh
+    coordinates exactly as measure_xyz does, and the saved .blend lists the measurements,
+    painted."""
     shape = wedge(75.0, n=30, irregular=True, seed=5)
     obj = mesh_object("Bone", shape.points, shape.triangles, location=(10.0, -2.0, 3.0),
                       rotation=(0.3, -0.2, 1.1), scale=(2.0, 2.0, 2.0))  # fmt: skip
     source = tmp_path / "study.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(source))
-    centre = np.array(obj.matrix_world) @ np.array([0.1, 0.0, 0.0, 1.0])
-    point = [str(np.float32(v)) for v in centre[:3]]  # as a user would type them
+    point = ["0.1", "0.0", "0.0"]  # mesh coordinates, as in a CSV of this mesh
 
     out, saved = tmp_path / "out.csv", tmp_path / "saved.blend"
     ok(batch(source, "--object", "Bone", "--at", *point, "--radius", "0.6", "--out", out,
@@ -340,7 +357,7 @@ def test_blend_input_world_space_and_saved_measurements(vg, tmp_path):
     row = rows_of(out)[0]
     assert abs(row.angle - 75.0) < 0.01
 
-    bpy.ops.vg.measure_xyz(location=[float(v) for v in point], radius=0.6)
+    bpy.ops.vg.measure_xyz(location=[float(v) for v in point], space="MESH", radius=0.6)
     mine = exact(obj.vg.measurements[0])
     assert (mine["angle"], mine["fit"]) == (row.angle, row.fit)
     assert tuple(mine["center"]) == (row.x, row.y, row.z)
@@ -356,6 +373,32 @@ def test_blend_input_world_space_and_saved_measurements(vg, tmp_path):
     bpy.ops.vg.repaint()
     assert not stored.vg.measurements[0].stale
     np.testing.assert_array_equal(colours(stored), painted)
+
+
+def test_an_old_world_space_csv_on_a_moved_blend_object(vg, tmp_path):
+    """An export of a version that wrote world coordinates (no Coordinates column), re-measured
+    by the batch on the .blend object where it stands: the same vertex, the radius in mesh
+    units, the same angle as measuring there in mesh coordinates."""
+    shape = wedge(75.0, n=30, irregular=True, seed=5)
+    obj = mesh_object("Bone", shape.points, shape.triangles, location=(10.0, -2.0, 3.0),
+                      rotation=(0.3, -0.2, 1.1), scale=(2.0, 2.0, 2.0))  # fmt: skip
+    source = tmp_path / "study.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(source))
+    vertex = int(np.argmin(np.linalg.norm(shape.points - [0.1, 0.0, 0.0], axis=1)))
+    matrix = np.array(obj.matrix_world, dtype=np.float64)
+    local = np.float32(shape.points[vertex]).astype(np.float64)
+    centre = matrix[:3, :3] @ local + matrix[:3, 3]
+    header = [c for c in csvio.EXPORT_COLUMNS if c != "Coordinates"]
+    values = {"Mesh Name": "Bone", "Radius": "1.2", "SegParam": "2.0", "Patch Mode": "euclidean"}
+    values.update({axis: repr(float(v)) for axis, v in zip("xyz", centre, strict=True)})
+    old = tmp_path / "old.csv"
+    old.write_text(",".join(header) + "\n" + ",".join(values.get(c, "") for c in header) + "\n")
+    out = tmp_path / "out.csv"
+    ok(batch(source, "--object", "Bone", "--points", old, "--out", out))
+    row = rows_of(out)[0]
+    assert (row.x, row.y, row.z) == tuple(local) and row.radius == 0.6
+    bpy.ops.vg.measure_xyz(location=tuple(local), space="MESH", radius=0.6)
+    assert exact(obj.vg.measurements[0])["angle"] == row.angle
 
 
 def test_blend_input_errors_exit_2(tmp_path):
@@ -415,7 +458,8 @@ def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
     assert rows[0].units.startswith("BU (1 BU = 0.001 m")
     assert len({r.break_number for r in rows}) == len(sites)  # one colour pair per site
     assert "true angle" in result.stdout and f"Output folder: {out}" in result.stdout
-    assert png_size(out / "bone_fragment.png") == (800, 600)
+    assert png_size(out / "bone_fragment_map_front.png") == (800, 600)
+    assert png_size(out / "bone_fragment_map.png") == (3 * 800, 2 * 600)  # the contact sheet
     assert (out / "bone_fragment.blend").stat().st_size > 0
     # The whole oblique outer rim, profiled: every station within 1° of the exact local angle
     # (180° minus the angle between the cylinder's and the oblique plane's outward normals).

@@ -12,6 +12,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import bpy
 import pytest
 from unprivileged import as_user
 
@@ -23,15 +24,22 @@ SCRIPT = ROOT / "vg_batch.py"
 AT = ("--at", "0.05", "0", "0", "--radius", "0.3")
 
 
-def batch(*args, cwd=None) -> subprocess.CompletedProcess:
+def batch(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, str(SCRIPT), *(str(a) for a in args)],
         capture_output=True,
         text=True,
         timeout=600,
         cwd=cwd,
+        env=None if env is None else {**os.environ, **env},
         check=False,
     )
+
+
+def ocio_set() -> dict:
+    """The OCIO variable set, as in many studios: Blender then logs a line on start-up."""
+    config = Path(bpy.utils.resource_path("LOCAL")) / "datafiles/colormanagement/config.ocio"
+    return {"OCIO": str(config)}
 
 
 @pytest.fixture
@@ -85,7 +93,7 @@ def test_save_blend_onto_an_input_or_onto_the_out_csv_is_refused(scan, tmp_path)
 
 
 def test_out_dash_writes_the_csv_to_standard_output_once(scan, tmp_path):
-    result = batch(scan, *AT, "--out", "-", cwd=tmp_path)
+    result = batch(scan, *AT, "--out", "-", cwd=tmp_path, env=ocio_set())
     assert result.returncode == 0, result.stderr
     rows = csvio.parse_measurements_csv(result.stdout)
     assert len(rows) == 1 and abs(rows[0].angle - 90.0) < 0.01
@@ -97,7 +105,8 @@ def test_out_dash_writes_the_csv_to_standard_output_once(scan, tmp_path):
 def test_out_dash_with_jobs(scan, tmp_path):
     other = wedge(60.0, n=24, irregular=True, seed=4)
     meshio.write_ply(tmp_path / "other.ply", other.points, other.triangles)
-    result = batch(scan, tmp_path / "other.ply", *AT, "--jobs", "2", "--out", "-", cwd=tmp_path)
+    result = batch(scan, tmp_path / "other.ply", *AT, "--jobs", "2", "--out", "-", cwd=tmp_path,
+                   env=ocio_set())  # fmt: skip
     assert result.returncode == 0, result.stderr
     rows = csvio.parse_measurements_csv(result.stdout)
     assert [row.mesh_name for row in rows] == ["scan", "other"]
@@ -123,7 +132,8 @@ def test_out_into_a_folder_that_is_a_file_is_refused(scan, tmp_path):
 
 def test_a_render_that_fails_late_gives_a_nonzero_exit_and_keeps_the_csv(scan, tmp_path):
     renders, out = tmp_path / "renders", tmp_path / "o.csv"
-    (renders / "scan.png").mkdir(parents=True)  # Cycles cannot write its picture there
+    # The map cannot write its contact sheet there.
+    (renders / "scan_map.png").mkdir(parents=True)
     result = batch(scan, *AT, "--out", out, "--render", renders, "--render-size", 16, 16,
                    "--render-samples", 1)  # fmt: skip
     assert result.returncode == 2, result.stderr
@@ -149,7 +159,14 @@ def test_a_blend_that_fails_late_gives_a_nonzero_exit_and_keeps_the_csv(scan, tm
 
 
 def arguments(**given) -> argparse.Namespace:
-    values = {"inputs": [], "points": None, "out": None, "save_blend": None, "render": None}
+    values = {
+        "inputs": [],
+        "points": None,
+        "out": None,
+        "save_blend": None,
+        "render": None,
+        "sweep": None,
+    }
     return argparse.Namespace(**(values | given))
 
 
@@ -198,3 +215,17 @@ def test_a_break_number_blender_cannot_store_refuses_the_points_csv(scan, tmp_pa
     refused(batch(scan, "--points", points, "--radius", "0.3", "--out", out),
             f"row 3: Break # must be a whole number from 1 to 2147483647 (got '{cell}')")  # fmt: skip
     assert not out.exists()
+
+
+def test_sweep_outputs_are_checked_like_the_others(scan, tmp_path):
+    sweep = ("--sweep", "0.2", "0.4", "3")
+    refused(
+        batch(scan, *AT, *sweep, "--out", "-", cwd=tmp_path), "--sweep writes", "must be a file"
+    )
+    # <out>_sweep.csv would be the input scan: refused before anything is written.
+    victim = tmp_path / "o_sweep.csv"
+    victim.write_text("x,y,z\n0.05,0,0\n")
+    refused(batch(scan, "--points", victim, "--radius", "0.3", *sweep, "--out", tmp_path / "o.csv"),
+            "--sweep's CSV", "is the points CSV")  # fmt: skip
+    assert victim.read_text() == "x,y,z\n0.05,0,0\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["o_sweep.csv", "scan.ply"]

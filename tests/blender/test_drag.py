@@ -14,7 +14,7 @@ import bpy
 import numpy as np
 import pytest
 from bpy_extras import view3d_utils
-from bpy_helpers import exact, mesh_object, snapshot
+from bpy_helpers import exact, local_points, mesh_object, snapshot
 from mathutils import Matrix, Vector
 
 N = 31  # grid vertices per side
@@ -77,8 +77,15 @@ def view(drag):
             rv3d=rv3d,
             obj=obj,
             points=world_points,
+            local=local_points(obj).astype(np.float64),
+            matrix=world,
             right=np.array(camera.col[0]),
         )
+
+
+def to_local(view, point) -> np.ndarray:
+    """Mesh coordinates of a world point of the view's object."""
+    return np.linalg.inv(view.matrix) @ np.append(np.asarray(point, dtype=np.float64), 1.0)
 
 
 def pixel(view, point):
@@ -124,7 +131,9 @@ def record_fields(item) -> dict:
 def pixel_size(drag, view, point) -> float:
     """World size of one pixel on the view plane through ``point``."""
     x, y = pixel(view, point)
-    return drag.view_plane_radius(view.region, view.rv3d, (x + 1.0, y), point)
+    return drag.view_plane_radius(
+        view.region, view.rv3d, (x + 1.0, y), to_local(view, point)[:3], view.matrix
+    )
 
 
 def test_ray_cast_from_region_pixels_hits_the_projected_vertices(drag, view):
@@ -136,9 +145,10 @@ def test_ray_cast_from_region_pixels_hits_the_projected_vertices(drag, view):
         point = view.points[vertex]
         coord = pixel(view, point)
         hit = drag.ray_cast_object(view.obj, depsgraph, view.region, view.rv3d, coord)
-        assert hit is not None
-        assert np.linalg.norm(hit - point) < min(pixel_size(drag, view, point), spacing / 10)
-        nearest = np.argmin(np.linalg.norm(view.points - hit, axis=1))
+        assert hit is not None  # in mesh coordinates, where it is measured
+        local = view.local[vertex]
+        assert np.linalg.norm(hit - local) < min(pixel_size(drag, view, point), spacing / 10)
+        nearest = np.argmin(np.linalg.norm(view.local - hit, axis=1))
         assert nearest == vertex
     assert drag.ray_cast_object(view.obj, depsgraph, view.region, view.rv3d, (3, 3)) is None
 
@@ -149,8 +159,23 @@ def test_radius_is_measured_on_the_view_plane(drag, view):
     assert 0 < tolerance < 0.05
     for radius in (0.05, 0.4, 1.3):
         coord = pixel(view, center + radius * view.right)
-        measured = drag.view_plane_radius(view.region, view.rv3d, coord, center)
+        measured = drag.view_plane_radius(
+            view.region, view.rv3d, coord, to_local(view, center)[:3], view.matrix
+        )
         assert measured == pytest.approx(radius, abs=tolerance)
+
+
+def test_radius_is_in_mesh_units_on_a_scaled_object(drag, view):
+    view.obj.scale = (2.0, 2.0, 2.0)
+    bpy.context.view_layer.update()
+    matrix = np.array(view.obj.matrix_world, dtype=np.float64)
+    center = view.local[ridge_vertex(view)]
+    center_world = matrix[:3, :3] @ center + matrix[:3, 3]
+    x, y = pixel(view, center_world)
+    one_pixel = drag.view_plane_radius(view.region, view.rv3d, (x + 1.0, y), center, matrix)
+    coord = pixel(view, center_world + 0.8 * view.right)  # 0.8 in the world: 0.4 on the mesh
+    measured = drag.view_plane_radius(view.region, view.rv3d, coord, center, matrix)
+    assert measured == pytest.approx(0.4, abs=one_pixel)
 
 
 # -- the drag session, driven by translated events --------------------------------------------
@@ -159,7 +184,7 @@ def test_radius_is_measured_on_the_view_plane(drag, view):
 def test_drag_and_release_records_exactly_what_measure_xyz_records(drag, view):
     center_vertex = ridge_vertex(view)
     session = start(drag, view, center_vertex)
-    assert np.array_equal(session.machine.center, view.points[center_vertex])  # snapped
+    assert np.array_equal(session.machine.center, view.local[center_vertex])  # snapped
     handle = session.overlay.handle
     assert session.overlay.active
     far = pixel(view, view.points[center_vertex] + 0.7 * view.right)
@@ -180,7 +205,8 @@ def test_drag_and_release_records_exactly_what_measure_xyz_records(drag, view):
     assert record_fields(dragged) == record_fields(typed)
     numbers = exact(dragged)
     assert numbers["angle"] == record.measurement.angle  # the preview measured the same thing
-    assert numbers["center"] == list(view.points[center_vertex])
+    assert numbers["center"] == list(view.local[center_vertex])
+    assert values["space"] == "MESH"
     assert dragged.n_vertices == session.machine.n_vertices
     assert abs(numbers["angle"] - 90.0) < 1e-3
 
@@ -254,7 +280,7 @@ def test_small_drag_previews_too_few_and_records_nothing(drag, view):
 
 def test_press_that_misses_the_mesh_says_why(drag, view):
     with pytest.raises(ValueError, match="Missed the mesh"):
-        drag.DragSession.start(bpy.context, (3, 3))
+        drag.DragSession.start(bpy.context, (view.region.width - 5, 5))  # a corner of the view
 
 
 def test_non_mesh_active_object_is_refused(drag, view):
@@ -336,6 +362,9 @@ def test_release_over_a_region_drawn_over_the_view_records_nothing(drag, view):
             assert status == drag.DONE, (region.type, events)
             assert drag.record_properties(session) is None, (region.type, events)
             assert "Left the 3D view" in session.machine.message
+        # A press there (where Blender passes it through to the view) does not start a drag.
+        with pytest.raises(ValueError, match="not over the sidebar, toolbar or header"):
+            drag.DragSession.start(bpy.context, coord)
     assert snapshot(view.obj) == before
 
 

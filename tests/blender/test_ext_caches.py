@@ -5,6 +5,7 @@ object's own vertices for the sides, and the old fingerprint format for migratio
 """
 
 import hashlib
+import json
 
 import bpy
 import numpy as np
@@ -24,8 +25,8 @@ def triangles_of(obj) -> np.ndarray:
 
 def painted_from_scratch(vg, obj) -> np.ndarray:
     """The colours the records should give: each current measurement re-measured on a Surface
-    built here, painted later over earlier."""
-    surface = Surface(world(local_points(obj), obj), triangles_of(obj).astype(np.int64))
+    built here (mesh coordinates), painted later over earlier."""
+    surface = Surface(local_points(obj).astype(np.float64), triangles_of(obj).astype(np.int64))
     sides = []
     for item in obj.vg.measurements:
         if item.stale:
@@ -50,11 +51,23 @@ def test_repeat_clicks_reuse_the_geometry(vg):
     # Painting (our own write) left the kept geometry current: the very same object comes back.
     assert mesh_data.evaluated_geometry(obj) is first
     assert not vg.bridge.watch._pending  # and woke no staleness check
+    # A move changes no measurement (mesh coordinates): the same geometry, the new transform,
+    # no staleness check.
     obj.location.z += 0.5
     bpy.context.view_layer.update()
     moved = mesh_data.evaluated_geometry(obj)
-    assert moved is not first
-    assert np.array_equal(moved.points, world(local_points(obj), obj))
+    assert moved.fingerprint == first.fingerprint and moved.points is first.points
+    assert np.array_equal(moved.matrix, np.array(obj.matrix_world, dtype=np.float64))
+    assert not vg.bridge.watch._pending
+    # An edit of the mesh is read again.
+    co = local_points(obj).copy()
+    co[:, 2] *= 1.01
+    obj.data.vertices.foreach_set("co", co.ravel())
+    obj.data.update()
+    bpy.context.view_layer.update()
+    edited = mesh_data.evaluated_geometry(obj)
+    assert edited.fingerprint != first.fingerprint
+    assert np.array_equal(edited.points, local_points(obj))
 
 
 def test_an_edit_between_two_scripted_clicks_is_seen(vg):
@@ -79,8 +92,11 @@ def test_undo_restores_a_geometry_that_is_read_again(vg):
     obj = wedge_object(80.0)
     bpy.ops.ed.undo_push(message="start")
     bpy.ops.vg.measure_xyz("EXEC_DEFAULT", True, location=(0.1, 0, 0), radius=0.3)
-    bpy.ops.transform.translate(value=(0, 0, 0.25))
-    bpy.ops.ed.undo_push(message="moved")
+    co = local_points(obj).copy()
+    co[:, 2] *= 1.01  # an edit of the mesh (a move would change no measurement)
+    obj.data.vertices.foreach_set("co", co.ravel())
+    obj.data.update()
+    bpy.ops.ed.undo_push(message="edited")
     bpy.context.view_layer.update()
     obj = bpy.data.objects["Wedge"]
     bpy.ops.vg.repaint()
@@ -167,11 +183,20 @@ def old_fingerprint(obj) -> str:
 
 
 def test_old_fingerprints_are_migrated_not_marked_stale(vg, tmp_path):
+    """Files written before issue 10 hold BLAKE2b fingerprints, and (before issue 12) world-space
+    records: on load, the records whose mesh and transform still match are brought into mesh
+    coordinates with the current fingerprint, not marked stale."""
     obj = wedge_object(80.0, location=(0.5, 0, 0))
     for x in (0.3, 0.6, 0.9):
         measure_at(x)
     legacy = old_fingerprint(obj)
     items = obj.vg.measurements
+    for item in items:  # written back as the world-space record an old version kept
+        numbers = json.loads(item.exact)
+        del numbers["space"]
+        for key in ("center", "requested"):
+            numbers[key] = world(numbers[key], obj).tolist()
+        item.exact = json.dumps(numbers)
     items[0].fingerprint = legacy
     items[1].fingerprint = legacy
     items[2].fingerprint = "0123456789abcdef0123456789abcdef"  # an old file, another geometry
@@ -180,11 +205,12 @@ def test_old_fingerprints_are_migrated_not_marked_stale(vg, tmp_path):
     bpy.ops.wm.open_mainfile(filepath=str(path))
     obj = bpy.data.objects["Wedge"]
     bpy.context.view_layer.update()
-    assert vg.bridge.watch.refresh(obj)  # the third is stale now: repainted
+    vg.bridge.watch.refresh(obj)
     items = obj.vg.measurements
     assert [item.stale for item in items] == [False, False, True]
     current = vg.bridge.mesh_data.evaluated_geometry(obj).fingerprint
     assert [item.fingerprint for item in items][:2] == [current, current]
+    assert [json.loads(item.exact).get("space") for item in items] == ["mesh", "mesh", None]
     assert items[2].fingerprint == "0123456789abcdef0123456789abcdef"
     np.testing.assert_array_equal(colours(obj), painted_from_scratch(vg, obj))
 

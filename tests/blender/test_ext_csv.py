@@ -1,15 +1,20 @@
 """CSV export and import (replication): the MeshLab header, bit-identical angles, all or nothing."""
 
 import csv
+import math
 import os
 import tomllib
 
 import bpy
+import numpy as np
 import pytest
-from bpy_helpers import exact, snapshot, wedge_object
+from bpy_helpers import exact, local_points, mesh_object, snapshot, wedge_object, world
 from conftest import ROOT
 
-from vg_addon.formats import csvio
+from vg_addon import Surface
+from vg_addon.formats import csvio, meshio
+
+DATA = ROOT.parent / "shared" / "data"
 
 with open(ROOT / "blender_manifest.toml", "rb") as _handle:
     MANIFEST = tomllib.load(_handle)
@@ -102,11 +107,85 @@ def test_export_all_objects(vg, tmp_path):
 
 def test_export_marks_stale_measurements(vg, tmp_path):
     obj = measured_wedge()
-    obj.location.z += 1.0
+    co = local_points(obj).copy()
+    co[:, 2] += 0.01  # an edit of the mesh, not a move of the object
+    obj.data.vertices.foreach_set("co", co.ravel())
+    obj.data.update()
     bpy.context.view_layer.update()
     path = tmp_path / "stale.csv"
     bpy.ops.vg.export_csv(filepath=str(path))
     assert [row.stale for row in csvio.read_measurements_csv(path)] == [True] * 3
+
+
+def test_export_is_in_mesh_coordinates_and_replicates_on_the_file_with_the_core(vg, tmp_path):
+    """A scan imported Y-up (a rotation on the object), moved and scaled: the CSV carries the
+    file's coordinates, and the core re-measures it on the file itself, bit for bit."""
+    # Scanners write float32 coordinates, which Blender keeps exactly; HalfAnnulus.ply has
+    # decimal text, so the scan file here is its float32 version.
+    reference = meshio.read_mesh(DATA / "HalfAnnulus.ply")
+    scan = meshio.write_ply(
+        tmp_path / "HalfAnnulus.ply",
+        reference.points.astype(np.float32).astype(np.float64),
+        reference.triangles,
+    )
+    mesh = meshio.read_mesh(scan)
+    obj = mesh_object(
+        "HalfAnnulus",
+        mesh.points,
+        mesh.triangles,
+        location=(2.0, -5.0, 1.0),
+        rotation=(math.pi / 2, 0.0, 0.3),
+        scale=(0.01, 0.01, 0.01),
+    )
+    picks = [100, 2000, 4000]
+    for vertex in picks:  # the 3D cursor on a vertex, in world space
+        cursor = world(mesh.points[vertex : vertex + 1], obj)[0]
+        bpy.ops.vg.measure_xyz(location=cursor.tolist(), radius=0.3, seg_param=2.0)
+    obj.location.x += 3.0  # moved again after measuring
+    bpy.context.view_layer.update()
+    path = tmp_path / "half_annulus.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    rows = csvio.read_measurements_csv(path)
+    assert {row.coordinates for row in rows} == {"mesh"}
+    assert not any(row.stale for row in rows)
+    assert [[r.x, r.y, r.z] for r in rows] == mesh.points[picks].tolist()
+    assert [r.radius for r in rows] == [0.3] * 3  # mesh units, not the object's 0.003
+    assert {r.units for r in rows} == {
+        "mesh units (1 unit = 0.01 m in the scene, object scale 0.01)"
+    }
+    surface = Surface(mesh.points, mesh.triangles)  # the file, float64 as written
+    for row, exported in zip(csvio.read_replication_csv(path), rows, strict=True):
+        m = surface.measure((row.x, row.y, row.z), row.radius, row.lam, row.patch)
+        assert m.center_index == picks[exported.number - 1]
+        assert (m.n_vertices, m.angle, m.fit_error) == (
+            exported.n_vertices,
+            exported.angle,
+            exported.fit,
+        )
+
+
+def test_an_old_world_space_csv_is_read_as_world_space(vg, tmp_path):
+    """An export of a version that wrote world coordinates (no Coordinates column) replicates
+    on the object where it stands."""
+    obj = wedge_object(100.0, location=(1.0, 2.0, 3.0), rotation=(0.0, 0.0, math.pi / 2))
+    bpy.ops.vg.measure_xyz(location=(0.1, 0.0, 0.0), space="MESH", radius=0.5)
+    item = obj.vg.measurements[0]
+    centre_world = world(np.array([exact(item)["center"]]), obj)[0]
+    header = ",".join(h for h in csvio.EXPORT_COLUMNS if h != "Coordinates")
+    old = tmp_path / "old.csv"
+    old.write_text(
+        f"{header}\nWedge,2024-01-01T00:00:00+00:00,1,1,,,100.0,10,0.5,"
+        + ",".join(repr(float(v)) for v in centre_world)
+        + ",0.0,2.0,euclidean"
+        + "," * (len(header.split(",")) - 15)
+        + "\n",
+        encoding="utf-8",
+    )
+    assert csvio.read_replication_csv(old)[0].coordinates == "world"
+    bpy.ops.vg.import_csv(filepath=str(old))
+    replica = exact(obj.vg.measurements[1])
+    assert replica["center"] == exact(item)["center"]
+    assert replica["angle"] == exact(item)["angle"]
 
 
 def write(path, text):
@@ -220,7 +299,8 @@ def test_ignore_mesh_names(vg, tmp_path):
 
 def test_export_with_nothing_to_export(vg, tmp_path):
     wedge_object(100.0)
-    with pytest.raises(RuntimeError, match="'Wedge' has no measurements to export"):
+    assert not bpy.ops.vg.export_csv.poll()  # greyed out, the reason in the tooltip
+    with pytest.raises(RuntimeError, match="No object in this scene has measurements"):
         bpy.ops.vg.export_csv(filepath=str(tmp_path / "x.csv"))
     with pytest.raises(RuntimeError, match="No object in this scene has measurements"):
         bpy.ops.vg.export_csv(filepath=str(tmp_path / "x.csv"), all_objects=True)

@@ -1,6 +1,7 @@
 """vg.measure_edge against the core: one break of stations, bit-identical to Surface.measure_along
 and replayable with vg.measure_xyz; its record, plot, CSV rows, re-import, undo and delete."""
 
+import csv
 import json
 
 import bpy
@@ -27,10 +28,12 @@ def measure_edge(*args, points=POINTS, spacing=0.5, radius=0.3, **options):
 
 
 def test_stations_are_the_core_profile_bit_for_bit_and_one_break(vg):
+    """Measured in mesh coordinates (the object moved and rotated changes nothing): the core's
+    profile on the mesh's own coordinates, bit for bit."""
     obj, shape = ramp_object(location=(0.25, -1.0, 0.5), rotation=(0.3, 0.0, 0.2))
-    points = world(np.array(POINTS), obj)
-    bpy.ops.vg.measure_xyz(location=tuple(points[0]), radius=0.3)  # break 1 is taken
-    assert measure_edge(points=points.tolist()) == {"FINISHED"}
+    points = np.array(POINTS)
+    bpy.ops.vg.measure_xyz(location=tuple(points[0]), radius=0.3, space="MESH")  # break 1
+    assert measure_edge(points=points.tolist(), space="MESH") == {"FINISHED"}
     profile = core_surface(obj).measure_along(points, 0.5, 0.3)
     stations = [item for item in obj.vg.measurements if item.edge_number == 1]
     assert len(stations) == profile.n_stations == len(obj.vg.measurements) - 1
@@ -48,19 +51,26 @@ def test_stations_are_the_core_profile_bit_for_bit_and_one_break(vg):
     assert numbers["angles"] == profile.angles.tolist()
     assert numbers["points"] == points.tolist()
     # Each station is within 1° of the exact local angle of the ramp.
-    local = np.array([exact(i)["center"] for i in stations]) - np.array(obj.matrix_world)[:3, 3]
-    local = local @ np.array(obj.matrix_world)[:3, :3]  # rotation only: back to object space
-    exact_angles = shape.angle_at(local)
+    exact_angles = shape.angle_at(np.array([exact(i)["center"] for i in stations]))
     assert np.abs(np.array([exact(i)["angle"] for i in stations]) - exact_angles).max() < 1.0
+    # The same clicks in world space (the default, like vg.measure_xyz's) snap to the same
+    # vertices: the same stations, bit for bit.
+    first = [(exact(i)["angle"], exact(i)["center"]) for i in stations]
+    assert measure_edge(points=world(points, obj).tolist()) == {"FINISHED"}
+    again = [exact(item) for item in obj.vg.measurements if item.edge_number == 2]
+    assert [(n["angle"], n["center"]) for n in again] == first
 
 
 def test_stations_replay_with_measure_xyz(vg):
-    obj, _ = ramp_object()
+    obj, _ = ramp_object(location=(0.5, 0.25, -1.0), rotation=(0.0, 0.4, 0.1))
     measure_edge(spacing=0.75, radius=0.35, seg_param=1.5)
     stations = [exact(item) for item in obj.vg.measurements]
     for numbers in stations:
         bpy.ops.vg.measure_xyz(
-            location=numbers["center"], radius=numbers["radius"], seg_param=numbers["lam"]
+            location=numbers["center"],
+            radius=numbers["radius"],
+            seg_param=numbers["lam"],
+            space="MESH",
         )
     replayed = [exact(item) for item in obj.vg.measurements[len(stations) :]]
     for a, b in zip(stations, replayed, strict=True):
@@ -178,13 +188,14 @@ def test_edge_session_event_translation(vg):
     assert points.tolist() == (np.array(POINTS) / 3.0).tolist()
 
 
-def test_local_points_are_measured_in_world_space(vg):
-    obj, _ = ramp_object(scale=(2.0, 2.0, 2.0))
+def test_world_points_on_a_scaled_object_are_measured_in_mesh_coordinates(vg):
+    obj, _ = ramp_object(location=(1.0, 0.0, 0.0), scale=(2.0, 2.0, 2.0))
     points = world(np.array(POINTS), obj)
-    measure_edge(points=points.tolist(), spacing=1.0, radius=0.6)
-    assert all(
-        exact(i)["center"] in world(local_points(obj), obj).tolist() for i in obj.vg.measurements
-    )
+    measure_edge(points=points.tolist(), spacing=0.5, radius=0.3)  # mesh units
+    local = local_points(obj).astype(np.float64).tolist()
+    assert all(exact(i)["center"] in local for i in obj.vg.measurements)
+    assert {exact(i)["radius"] for i in obj.vg.measurements} == {0.3}
+    np.testing.assert_allclose(exact(obj.vg.edges[0])["points"], POINTS, atol=1e-12)
 
 
 def test_each_side_of_a_curved_edge_is_painted_in_one_colour(vg):
@@ -240,6 +251,26 @@ def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):
         (b["angle"], b["arc_length"]) for b in before
     ]
     assert [exact(e)["points"] for e in copy.vg.edges] == [exact(e)["points"] for e in obj.vg.edges]
+    # An edge file of an earlier version: world-space points, no Coordinates column. Read as
+    # world space and brought onto the moved object's mesh: the same stations.
+    moved, _ = ramp_object("Moved", location=(1.0, 2.0, 3.0), rotation=(0.2, 0.0, 0.3))
+    with open(edge_file, newline="", encoding="utf-8") as handle:
+        table = list(csv.DictReader(handle))
+    for row in table:
+        row.pop("Coordinates")
+        # Cells starting with "-" are written behind an apostrophe, which the reader removes.
+        clicks = world(np.array(csvio.parse_points(row["Points"].removeprefix("'"))), moved)
+        text = csvio.format_points(clicks)
+        row["Points"] = "'" + text if text.startswith("-") else text
+    old_file = tmp_path / "old_edges.csv"
+    with open(old_file, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(table[0]))
+        writer.writeheader()
+        writer.writerows(table)
+    assert bpy.ops.vg.import_csv(filepath=str(old_file), ignore_mesh_names=True) == {"FINISHED"}
+    assert [(exact(a)["angle"], exact(a)["center"]) for a in moved.vg.measurements] == [
+        (b["angle"], b["center"]) for b in before
+    ]
     # Another object's name without Ignore Names: refused, nothing recorded.
     other, _ = ramp_object("Other")
     with pytest.raises(RuntimeError, match="names the mesh 'Ramp'"):

@@ -1,4 +1,5 @@
-"""bpy.ops.vg.measure_xyz against the core: same world-space inputs, bit-identical numbers."""
+"""bpy.ops.vg.measure_xyz against the core: the same inputs in mesh coordinates give
+bit-identical numbers, wherever the object is placed."""
 
 import bpy
 import numpy as np
@@ -26,16 +27,16 @@ def triangles_of(obj) -> np.ndarray:
 
 
 def core_surface(obj) -> Surface:
-    """The core's Surface of the object's own mesh, in world space, built here independently."""
-    tris = triangles_of(obj)
-    if np.linalg.det(np.array(obj.matrix_world)[:3, :3]) < 0:
-        tris = tris[:, ::-1]
-    return Surface(world(local_points(obj), obj), tris)
+    """The core's Surface of the object's own mesh, in mesh coordinates, built here
+    independently."""
+    return Surface(local_points(obj).astype(np.float64), triangles_of(obj))
 
 
-def assert_same(item, m):
-    """The recorded item holds exactly the core measurement ``m``."""
+def assert_same(item, m, *, requested=True):
+    """The recorded item holds exactly the core measurement ``m`` (but for the requested
+    centre and the snap distance, when ``requested`` is False)."""
     numbers = exact(item)
+    assert numbers["space"] == "mesh"
     assert numbers["angle"] == m.angle
     assert numbers["fit"] == m.fit_error
     assert numbers["fit_plus"] == m.fit_error_plus
@@ -43,10 +44,11 @@ def assert_same(item, m):
     assert numbers["radius"] == m.radius
     assert numbers["lam"] == m.lam
     assert numbers["center"] == m.center.tolist()
-    assert numbers["requested"] == m.requested_center.tolist()
+    if requested:
+        assert numbers["requested"] == m.requested_center.tolist()
+        assert numbers["snap_distance"] == m.snap_distance
     assert numbers["normal_plus"] == m.normal_plus.tolist()
     assert numbers["normal_minus"] == m.normal_minus.tolist()
-    assert numbers["snap_distance"] == m.snap_distance
     assert (item.n_vertices, item.n_plus, item.n_minus) == (m.n_vertices, m.n_plus, m.n_minus)
     assert item.patch == m.patch
     assert not item.stale
@@ -128,6 +130,20 @@ def test_colour_attribute_paints_the_sides_and_spares_the_users_colours(vg):
     np.testing.assert_array_equal(after, before)
 
 
+def test_the_users_active_colour_attribute_is_switched_only_once(vg):
+    obj = wedge_object(80.0)
+    obj.data.color_attributes.new("Scan colour", "BYTE_COLOR", "CORNER")
+    obj.data.color_attributes.active_color = obj.data.color_attributes["Scan colour"]
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.4)  # the first: show the sides
+    assert obj.data.color_attributes.active_color_name == COLOUR_ATTRIBUTE
+    obj.data.color_attributes.active_color = obj.data.color_attributes["Scan colour"]
+    bpy.ops.vg.measure_xyz(location=(0.3, 0.0, 0.0), radius=0.3)
+    bpy.ops.vg.repaint()
+    bpy.ops.vg.delete_measurement()
+    assert obj.data.color_attributes.active_color_name == "Scan colour"
+    assert colours(obj) is not None  # still painted, just not forced into view
+
+
 def test_viewports_show_attribute_colours(vg):
     wedge_object(90.0)
     bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
@@ -144,19 +160,48 @@ def test_viewports_show_attribute_colours(vg):
     assert all(space.shading.color_type == "VERTEX" for space in spaces)
 
 
-def test_non_uniform_scale_rotation_and_translation_are_honoured(vg):
-    obj = wedge_object(
-        60.0, location=(3.0, -1.0, 2.0), rotation=(0.3, 0.2, 1.1), scale=(2.0, 0.5, 1.3)
-    )
-    centre = world(np.zeros((1, 3)), obj)[0]
-    bpy.ops.vg.measure_xyz(location=centre.tolist(), radius=0.6)
+@pytest.mark.parametrize(
+    "scale", [(1.0, 1.0, 1.0), (2.5, 2.5, 2.5), (2.0, 0.5, 1.3)], ids=["unit", "uniform", "skewed"]
+)
+def test_measured_in_mesh_coordinates_under_any_transform(vg, scale):
+    obj = wedge_object(60.0, location=(3.0, -1.0, 2.0), rotation=(0.3, 0.2, 1.1), scale=scale)
+    vertex = int(np.argmin(np.linalg.norm(local_points(obj), axis=1)))  # on the crease
+    cursor = world(local_points(obj)[vertex : vertex + 1], obj)[0]
+    bpy.ops.vg.measure_xyz(location=cursor.tolist(), radius=0.6)  # world space, the default
     item = obj.vg.measurements[0]
-    typed = [float(str(np.float32(v))) for v in centre]
-    m = core_surface(obj).measure(typed, 0.6)
-    assert_same(item, m)
-    # The non-uniform scale changes the angle: measuring the object-space mesh would be wrong.
-    unscaled = Surface(local_points(obj), triangles_of(obj)).measure([0, 0, 0], 0.6)
-    assert abs(unscaled.angle - m.angle) > 1.0
+    m = core_surface(obj).measure(local_points(obj)[vertex].astype(np.float64), 0.6)
+    assert_same(item, m, requested=False)
+    assert abs(m.angle - 60.0) < 1e-4  # the wedge as built, whatever the object's scale
+    assert exact(item)["center"] == local_points(obj)[vertex].astype(np.float64).tolist()
+    np.testing.assert_allclose(item.center_world, cursor, atol=1e-5)
+
+
+def test_location_in_mesh_coordinates_is_taken_as_given(vg):
+    obj = wedge_object(75.0, location=(1.0, 2.0, 3.0), rotation=(0.0, 0.4, 0.0))
+    location = (0.013, -0.021, 0.004)
+    bpy.ops.vg.measure_xyz(location=location, space="MESH", radius=0.5)
+    typed = [float(str(np.float32(v))) for v in location]
+    assert_same(obj.vg.measurements[0], core_surface(obj).measure(typed, 0.5))
+
+
+def test_moving_rotating_and_scaling_keep_measurements_current(vg):
+    obj = wedge_object(100.0, location=(0.5, 0.0, 0.0))
+    bpy.ops.vg.measure_xyz(location=(0.5, 0.0, 0.0), radius=0.5)
+    before = (exact(obj.vg.measurements[0]), colours(obj).copy())
+    obj.location = (4.0, -3.0, 1.0)
+    obj.rotation_euler = (0.7, -0.2, 2.0)
+    obj.scale = (0.001, 0.001, 0.001)  # e.g. a scan in mm shown in metres
+    bpy.context.view_layer.update()
+    bpy.ops.vg.repaint()
+    item = obj.vg.measurements[0]
+    assert not item.stale
+    assert (exact(item), colours(obj).tolist()) == (before[0], before[1].tolist())
+    # Measuring again at the same vertex, now far away in world space, gives the same numbers.
+    centre_world = world(np.array([exact(item)["center"]]), obj)[0]
+    bpy.ops.vg.measure_xyz(location=centre_world.tolist(), radius=0.5)
+    again = obj.vg.measurements[1]
+    assert exact(again)["angle"] == exact(item)["angle"]
+    assert exact(again)["center"] == exact(item)["center"]
 
 
 def test_mirrored_object_keeps_outward_normals(vg):
@@ -179,7 +224,7 @@ def evaluated_surface(obj) -> Surface:
     tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
     mesh.loop_triangles.foreach_get("vertices", tris)
     obj_eval.to_mesh_clear()
-    return Surface(world(co.reshape(-1, 3), obj), tris.reshape(-1, 3))
+    return Surface(co.reshape(-1, 3).astype(np.float64), tris.reshape(-1, 3))
 
 
 def test_deforming_modifier_is_applied(vg):
@@ -189,7 +234,7 @@ def test_deforming_modifier_is_applied(vg):
     bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
     item = obj.vg.measurements[0]
     surface = evaluated_surface(obj)
-    assert not np.array_equal(surface.points, world(local_points(obj), obj))
+    assert not np.array_equal(surface.points, local_points(obj))
     m = surface.measure([0, 0, 0], 0.5)
     assert_same(item, m)
     np.testing.assert_array_equal(
@@ -211,7 +256,7 @@ def test_subdivision_modifier_is_applied(vg):
     assert plain.stale  # the evaluated mesh changed under it
     # Every original vertex inside the patch is painted with one of the pair's colours.
     rgba = colours(obj)
-    offsets = world(local_points(obj), obj) - m.center
+    offsets = local_points(obj) - m.center
     inside = np.einsum("ij,ij->i", offsets, offsets) <= 0.5 * 0.5
     grey = np.asarray(vg.vg_addon.palette.neutral_linear(), dtype=np.float32)
     assert not (rgba[inside] == grey).all(axis=1).any()
@@ -230,11 +275,16 @@ def test_measure_on_object_keeps_float64_inputs_exactly(vg):
 
     shape = wedge(88.0, n=30, irregular=True)
     obj = mesh_object("Exact", shape.points, shape.triangles, location=(0.1, 0.2, 0.3))
-    location = world(np.zeros((1, 3)), obj)[0] + 1e-9  # on the edge, between vertices
+    location = np.zeros(3) + 1e-9  # on the edge, between vertices, in mesh coordinates
     item = vg.bridge.measuring.measure_on_object(obj, location, 0.123456789, 1.5, note="hi")
     m = core_surface(obj).measure(location, 0.123456789, 1.5)
     assert_same(item, m)
     assert item.note == "hi"
+    # The same point in world space: a pure translation moves it back exactly.
+    in_world = location + np.array([0.1, 0.2, 0.3], dtype=np.float32).astype(np.float64)
+    item = vg.bridge.measuring.measure_on_object(obj, in_world, 0.123456789, 1.5, space="world")
+    assert exact(item)["center"] == m.center.tolist()
+    assert exact(item)["angle"] == m.angle
 
 
 # Reference meshes ---------------------------------------------------------------------------

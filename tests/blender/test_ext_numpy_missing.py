@@ -11,7 +11,7 @@ import subprocess
 import sys
 import textwrap
 
-from conftest import MODULE, REPO
+from conftest import MODULE, REPO, ROOT
 
 HIDE_NUMPY = textwrap.dedent(
     """
@@ -93,3 +93,24 @@ def test_enabling_without_numpy_explains_the_fix(extension_zip, tmp_path):
     frames = [line for line in result.stderr.splitlines() if line.strip().startswith('File "')]
     assert not [f for f in frames if "virtual_goniometer" in f or "bl_ext" in f], output
     assert any("sudo apt install python3-numpy" in line for line in report["lines"])
+
+
+def test_batch_without_numpy_says_why_and_exits_2(tmp_path):
+    harness = tmp_path / "harness"
+    harness.mkdir()
+    (harness / "sitecustomize.py").write_text(HIDE_NUMPY, encoding="utf-8")
+    mesh = tmp_path / "tri.obj"
+    mesh.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", encoding="ascii")
+    out = tmp_path / "out.csv"
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "vg_batch.py"), str(mesh), "--at", "0", "0", "0",
+         "--radius", "1", "--out", str(out)],
+        capture_output=True, text=True, timeout=300, check=False,
+        env={**os.environ, "PYTHONPATH": str(harness)},
+    )  # fmt: skip
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert "vg_batch: error: Virtual Goniometer needs NumPy" in result.stderr
+    assert "sudo apt install python3-numpy" in result.stderr
+    frames = [line for line in result.stderr.splitlines() if line.strip().startswith('File "')]
+    assert not [f for f in frames if str(ROOT) in f], result.stderr
+    assert not out.exists()

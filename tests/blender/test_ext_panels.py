@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import bpy
+import numpy as np
 import pytest
 from bpy_helpers import exact, wedge_object
 from conftest import ROOT
@@ -32,7 +33,11 @@ def measured(obj=None, at=OFFSET):
 
 
 def mark_stale(obj):
-    obj.location.x += 1.0
+    """Edit the mesh (a move would not do: measurements are in mesh coordinates)."""
+    co = np.empty(len(obj.data.vertices) * 3, dtype=np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    obj.data.vertices.foreach_set("co", co * np.float32(1.01))
+    obj.data.update()
     bpy.context.view_layer.update()
     bpy.ops.vg.repaint()
     assert all(item.stale for item in obj.vg.measurements)
@@ -43,10 +48,10 @@ def test_list_row_starts_with_the_angle_and_stale_rows_keep_their_number(vg, lis
     bpy.ops.vg.next_break()
     _, second = measured(obj)
     stored = exact(second)["angle"]
-    assert lists.row_texts(second) == (f"{stored:.2f}°", "#2 B2")
+    assert lists.row_texts(second) == (f"{stored:.2f}°", "#2")
     assert abs(float(lists.row_texts(second)[0][:-1]) - stored) <= 0.005
     mark_stale(obj)
-    assert [lists.row_texts(i)[1] for i in obj.vg.measurements] == ["#1 B1", "#2 B2"]
+    assert [lists.row_texts(i)[1] for i in obj.vg.measurements] == ["#1", "#2"]
 
 
 def selected_value(rows, label, axis=None):
@@ -152,3 +157,20 @@ def test_batch_blend_continues_after_its_breaks(vg, tmp_path):
     bpy.context.view_layer.objects.active = obj
     bpy.ops.vg.next_break()
     assert obj.vg.break_number == max(used) + 2
+
+
+def test_list_row_texts_fit_the_default_sidebar_at_ui_scale_1(vg, lists):
+    # Real font metrics (blf, Blender's UI font at the widget size); the list's row at the default
+    # sidebar width is about 170 pixels, an icon 20, a label's padding about 10. Worst cases: the
+    # widest angle with the longest edge word, a stale row's icon with the widest angle, and a
+    # three-digit number.
+    import blf
+
+    points = bpy.context.preferences.ui_styles[0].widget.points
+    blf.size(0, points)
+    row, icon, padding = 170.0, 20.0, 10.0
+    angle_room = lists.ANGLE_SHARE * row - padding
+    number_room = (1 - lists.ANGLE_SHARE) * lists.NUMBER_SHARE * row - padding
+    assert blf.dimensions(0, "179.99° concave")[0] <= angle_room
+    assert blf.dimensions(0, "179.99°")[0] + icon <= angle_room
+    assert blf.dimensions(0, "#999")[0] <= number_room

@@ -19,10 +19,13 @@ from vg_addon.workflow.batchplan import (
 )
 
 
-def row(n, mesh=None, radius=None, lam=None, patch=None, label=None, break_number=None):
+def row(
+    n, mesh=None, radius=None, lam=None, patch=None, label=None, break_number=None,
+    coordinates="mesh",
+):  # fmt: skip
     return ReplicationRow(
         row_number=n, mesh_name=mesh, x=float(n), y=0.0, z=0.0, radius=radius, lam=lam,
-        patch=patch, label=label, break_number=break_number,
+        patch=patch, label=label, break_number=break_number, coordinates=coordinates,
     )  # fmt: skip
 
 
@@ -113,6 +116,15 @@ def test_plan_rows_uses_each_rows_values_and_the_defaults_for_the_rest():
         0.7, 2.5, "euclidean", "", None,
     )  # fmt: skip
     assert [(t.index, t.number, t.source_row) for t in (first, second)] == [(0, 1, 2), (1, 2, 3)]
+
+
+def test_plan_rows_keep_each_rows_coordinate_space():
+    rows = [row(2, radius=0.3, coordinates="world"), row(3, radius=0.3)]
+    world, mesh = plan_rows([("bone",)], rows)
+    assert (world.coordinates, mesh.coordinates) == ("world", "mesh")
+    assert plan_points(1, [(0.0, 0.0, 0.0)], radius=1.0, lam=2.0, patch="euclidean")[
+        0
+    ].coordinates == ("mesh")
 
 
 def test_plan_rows_needs_a_radius_for_every_row():

@@ -40,6 +40,7 @@ OUR_EXTRA_COLUMNS = [
     "Arc Length",
     "Spacing",
     "Units",
+    "Coordinates",
     "Precision",
     "Stale",
     "Extension Version",
@@ -433,6 +434,42 @@ def test_our_export_is_recognised():
     assert rows[0].patch == "geodesic"
     assert rows[0].label == "note"
     assert rows[0].number == 1
+    assert rows[0].coordinates == "mesh"
+
+
+def legacy_export(rows) -> str:
+    """An export as versions before the Coordinates column wrote it (world coordinates)."""
+    records = list(csv.reader(io.StringIO(csvio.format_measurements_csv(rows))))
+    drop = records[0].index("Coordinates")
+    out = io.StringIO()
+    csv.writer(out, lineterminator="\n").writerows(
+        [cell for i, cell in enumerate(record) if i != drop] for record in records
+    )
+    return out.getvalue()
+
+
+def test_an_export_without_the_coordinates_column_is_read_as_world_space():
+    old = legacy_export([good_row()])
+    assert "Coordinates" not in old.split("\n")[0]
+    replicated = csvio.read_replication_csv(old)
+    assert replicated[0].source_format == "extension"
+    assert replicated[0].coordinates == "world"
+    full = csvio.read_measurements_csv(old)
+    assert full[0].coordinates == "world"
+    assert full[0].x == good_row().x
+
+
+def test_meshlab_and_points_files_are_mesh_coordinates():
+    assert {r.coordinates for r in csvio.read_replication_csv(MESHLAB_FILE)} == {"mesh"}
+    assert csvio.read_replication_csv("x,y,z\n1,2,3\n")[0].coordinates == "mesh"
+    assert csvio.read_replication_csv("x,y,z,coordinates\n1,2,3,World\n")[0].coordinates == (
+        "world"
+    )
+
+
+def test_unknown_coordinates_are_a_problem_with_their_row():
+    with pytest.raises(GoniometerError, match=r"row 3: unknown coordinates 'local'"):
+        csvio.read_replication_csv("x,y,z,Coordinates\n1,2,3,mesh\n1,2,3,local\n")
 
 
 def test_plain_points_file_with_aliases_bom_and_odd_case(tmp_path):

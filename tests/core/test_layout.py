@@ -101,6 +101,6 @@ def test_the_method_package_holds_the_method_only():
 
 def test_vg_batch_is_a_thin_entry():
     text = (ROOT / "vg_batch.py").read_text(encoding="utf-8")
-    assert len(text.splitlines()) < 120
+    assert len(text.splitlines()) < 150
     for line, target in imports(ROOT / "vg_batch.py"):
         assert target not in LAYERS, f"vg_batch.py line {line} imports {target} directly"

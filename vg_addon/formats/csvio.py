@@ -90,6 +90,7 @@ _SCHEMA = (
     ("arc_length", "float", ("Arc Length",)),
     ("spacing", "float", ("Spacing",)),
     ("units", "text", ("Units",)),
+    ("coordinates", "text", ("Coordinates",)),
     ("precision", "text", ("Precision",)),
     ("stale", "bool", ("Stale",)),
     ("extension_version", "text", ("Extension Version",)),
@@ -127,8 +128,17 @@ RULE_COLUMNS = (
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
 EXPORT_COLUMNS = tuple(column for _, _, columns in _SCHEMA for column in columns)
 
+#: The values of the ``Coordinates`` column: the mesh's own coordinates (object space, those of
+#: the file the scan came from) and, in exports of versions before it existed, world space.
+MESH_COORDINATES = "mesh"
+WORLD_COORDINATES = "world"
+COORDINATE_SPACES = (MESH_COORDINATES, WORLD_COORDINATES)
+
+# What a missing column of the LATER_COLUMNS means (others: an empty cell).
+_LEGACY_DEFAULTS = {"Coordinates": WORLD_COORDINATES}
+
 #: Columns added after the first exports: a file without them still reads (their cells empty).
-LATER_COLUMNS = ("Precision", *RULE_COLUMNS, "Edge #", "Arc Length", "Spacing")
+LATER_COLUMNS = ("Precision", *RULE_COLUMNS, "Edge #", "Arc Length", "Spacing", "Coordinates")
 
 # The edge summary file: one row per measured edge profile (see EdgeRow).
 _EDGE_SCHEMA = (
@@ -153,6 +163,7 @@ _EDGE_SCHEMA = (
     ("points", "text", ("Points",)),
     ("flat_spans", "text", ("Flat Spans",)),
     ("units", "text", ("Units",)),
+    ("coordinates", "text", ("Coordinates",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
     ("error", "text", ("error",)),
@@ -160,6 +171,9 @@ _EDGE_SCHEMA = (
 
 #: Every column of an edge summary file.
 EDGE_COLUMNS = tuple(column for _, _, columns in _EDGE_SCHEMA for column in columns)
+
+#: Columns added to the edge summary file after its first version.
+LATER_EDGE_COLUMNS = ("Coordinates",)
 
 #: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
 SOURCE_FORMATS = ("extension", "meshlab", "points")
@@ -248,6 +262,10 @@ class MeasurementRow:
         The edge's station spacing.
     units : str
         What one coordinate unit is.
+    coordinates : str
+        ``"mesh"``: x, y, z, the requested centre, the radius and the normals are in the mesh's
+        own coordinates (those of its file); ``"world"``: in Blender world space (exports of
+        versions before this column existed).
     precision : str
         The coordinates measured: ``"float32"`` (a Blender mesh, as Blender stores it) or
         ``"float64"`` (a mesh file's double-precision coordinates, measured as the file holds
@@ -299,6 +317,7 @@ class MeasurementRow:
     arc_length: float | None = None
     spacing: float | None = None
     units: str = ""
+    coordinates: str = MESH_COORDINATES
     precision: str = ""
     stale: bool = False
     extension_version: str = ""
@@ -338,6 +357,9 @@ class EdgeRow:
         One plane pair fitted to all stations' sides (the whole-edge angle), and its fit error.
     points : str
         The clicked points that define the path, ``"x y z; x y z; ..."`` (start, via, end).
+    coordinates : str
+        ``"mesh"``: the points, lengths and radius are in the mesh's own coordinates;
+        ``"world"``: in Blender world space (files written before this column existed).
     flat_spans : str
         Arc-length intervals where the path crossed no ridge, ``"a-b; ..."``; empty if none.
     """
@@ -363,6 +385,7 @@ class EdgeRow:
     points: str = ""
     flat_spans: str = ""
     units: str = ""
+    coordinates: str = MESH_COORDINATES
     extension_version: str = ""
     blender_version: str = ""
     error: str = ""
@@ -421,6 +444,10 @@ class ReplicationRow:
         ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
         columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
         else with x, y, z columns).
+    coordinates : str
+        ``"mesh"`` (the mesh's own coordinates: MeshLab's files, points files, exports with
+        ``Coordinates`` = mesh) or ``"world"`` (Blender world space: exports of this extension
+        written before the ``Coordinates`` column existed, or with ``Coordinates`` = world).
     rule : str or None
         The rule to replicate with: the ``Rule`` cell of an export; ``"paper"`` for MeshLab and
         earlier add-on files and for exports written before the ``Rule`` column existed (they
@@ -443,6 +470,7 @@ class ReplicationRow:
     arc_length: float | None = None
     spacing: float | None = None
     source_format: str = "points"
+    coordinates: str = MESH_COORDINATES
     rule: str | None = None
 
 
@@ -972,6 +1000,7 @@ _REPLICATION_ALIASES = {
     "label": ("label", "user data", "note", "notes"),
     "number": ("measurement #", "measurement number", "measurement", "number"),
     "break_number": ("break #", "break number", "break"),
+    "coordinates": ("coordinates", "coordinate space"),
     "rule": ("rule",),
     "edge_number": ("edge #", "edge number", "edge"),
     "arc_length": ("arc length", "arc"),
@@ -1124,6 +1153,17 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                     f"row {number}: unknown patch mode {cell('patch').strip()!r} "
                     f"(use {' or '.join(PATCH_MODES)})"
                 )
+        coordinates = _parse_optional_text(cell("coordinates"))
+        if coordinates is None:
+            # This extension wrote world coordinates until it wrote the column; every other
+            # tool writes the mesh's own.
+            coordinates = WORLD_COORDINATES if fmt == "extension" else MESH_COORDINATES
+        coordinates = coordinates.casefold()
+        if coordinates not in COORDINATE_SPACES:
+            problems.append(
+                f"row {number}: unknown coordinates {cell('coordinates').strip()!r} "
+                f"(use {' or '.join(COORDINATE_SPACES)})"
+            )
         rule = _parse_optional_text(cell("rule"))
         if rule is not None:
             rule = rule.casefold()
@@ -1153,6 +1193,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 arc_length=values["arc_length"],
                 spacing=values["spacing"],
                 source_format=fmt,
+                coordinates=coordinates,
                 rule=rule,
             )
         )
@@ -1189,8 +1230,10 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
     ``SegParam``/``Seg Param``/``lambda``/``λ``/``Segmentation Parameter``;
     ``Patch Mode``/``patch``; ``label``/``User Data``/``note`` (``label`` wins over
     ``User Data``); ``Measurement #``; ``Break #``; ``Rule`` (``oriented`` or ``paper``);
-    ``error``. Only x, y and z are required. Rows of MeshLab and earlier add-on files, and of
-    exports without a ``Rule`` column, replicate with the paper's rule (see
+    ``Coordinates`` (``mesh`` or ``world``; absent or blank: ``world`` in an export of this
+    extension, which wrote world coordinates before it had the column, ``mesh`` in every other
+    file); ``error``. Only x, y and z are required. Rows of MeshLab and earlier add-on files, and
+    of exports without a ``Rule`` column, replicate with the paper's rule (see
     :attr:`ReplicationRow.rule`).
     A UTF-8 byte-order mark is ignored; cells are read without surrounding whitespace, and the
     apostrophe the writer puts before formula-like text is removed.
@@ -1242,7 +1285,9 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
 
 def parse_edges_csv(text: str, source: str = "The CSV text") -> list[EdgeRow]:
     """Parse an edge summary file written by :func:`format_edges_csv` back into rows."""
-    return _parse_table(text, source, _EDGE_SCHEMA, EdgeRow, (), "an edge summary file")
+    return _parse_table(
+        text, source, _EDGE_SCHEMA, EdgeRow, LATER_EDGE_COLUMNS, "an edge summary file"
+    )
 
 
 def is_edges_csv(path_or_text) -> bool:
@@ -1285,7 +1330,9 @@ def _parse_table(text, source, schema, row_type, optional, what):
 
         def cell(column: str, cells=cells) -> str:
             index = columns.get(column)
-            return cells[index] if index is not None and index < len(cells) else ""
+            if index is None:
+                return _LEGACY_DEFAULTS.get(column, "")
+            return cells[index] if index < len(cells) else ""
 
         def number_of(column: str, number=number) -> float | None:
             raw = cell(column)

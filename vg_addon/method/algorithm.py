@@ -44,7 +44,8 @@ MAX_MAGNITUDE = 1e150
 many points, overflow float64 (from about 1e154). A scan in any real unit is far below this."""
 
 MIN_RADIUS = 1e-152
-"""Smallest patch radius: squared distances below about 1e-154 lose precision (subnormal)."""
+"""Smallest radius to measure with: squared distances below about 1e-154 lose precision
+(subnormal). Finding a patch works with any positive radius."""
 
 
 def canonical_order(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
@@ -200,6 +201,11 @@ def measure_patch(
     Returns a dict of the measured fields of :class:`~vg_addon.result.Measurement`; ``labels`` follow
     the order of ``points``. Callers normally use :func:`goniometer` or ``Surface.measure``.
     """
+    if not MIN_RADIUS <= radius <= MAX_MAGNITUDE:
+        raise GoniometerError(
+            f"The radius must be from {MIN_RADIUS:g} to {MAX_MAGNITUDE:g} to measure, where "
+            f"squared distances stay representable; got {radius!r}. Scale the mesh to a real unit."
+        )
     n_points = points.shape[0]
     if n_points < 2 * MIN_SIDE_VERTICES:
         raise GoniometerError(
@@ -293,11 +299,6 @@ def as_radius(radius) -> float:
         raise GoniometerError(f"The radius must be a number; got {radius!r}.") from None
     if not np.isfinite(value) or value <= 0:
         raise GoniometerError(f"The radius must be a finite number greater than 0; got {value!r}.")
-    if not MIN_RADIUS <= value <= MAX_MAGNITUDE:
-        raise GoniometerError(
-            f"The radius must be from {MIN_RADIUS:g} to {MAX_MAGNITUDE:g}, where squared "
-            f"distances stay representable; got {value!r}. Scale the mesh to a real unit."
-        )
     return value
 
 

@@ -62,6 +62,7 @@ def vertex_normals(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarra
     extent = float(np.max(points.max(axis=0) - origin))
     scaled = (points - origin) / extent if extent > 0 else points - origin
     weighted = face_normals(scaled, triangles)
+    del scaled  # a copy of the points: free it before the sums need their own memory
     corners = [np.ascontiguousarray(triangles[:, k]) for k in range(3)]
     summed = np.zeros((n, 3), dtype=np.float64)
     for axis in range(3):

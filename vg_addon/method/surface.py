@@ -98,6 +98,8 @@ class Surface:
             )
         if full_index is not None and self.valid_ids.size == n:
             self.index = full_index  # the same points: the normals' index serves the queries
+        elif self.valid_ids.size == n:
+            self.index = GridIndex(self.points)  # every vertex: no copy of the points needed
         else:
             self.index = GridIndex(self.points[self.valid_ids], ids=self.valid_ids)
         self.ranks = canonical_ranks(self.points, self.normals)

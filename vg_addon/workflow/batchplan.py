@@ -56,6 +56,10 @@ class Task:
         The mesh name as the input gave it (for rows that match no mesh).
     error : str
         Why this task cannot be measured at all; empty for a task to measure.
+    coordinates : str
+        ``"mesh"``: ``center`` and ``radius`` are in the mesh's own coordinates (every input
+        but a world-space row, see :attr:`ReplicationRow.coordinates`); ``"world"``: in Blender
+        world space, to be converted by the object's transform.
     rule : str
         ``"oriented"`` or ``"paper"``: a CSV row's own rule (MeshLab and earlier add-on rows
         carry the paper's), else the run's.
@@ -73,6 +77,7 @@ class Task:
     source_row: int | None = None
     mesh_name: str = ""
     error: str = ""
+    coordinates: str = "mesh"
     rule: str = "oriented"
 
 
@@ -298,6 +303,7 @@ def plan_rows(
                 source_row=row.row_number,
                 mesh_name=row.mesh_name or "",
                 error=error,
+                coordinates=row.coordinates,
                 rule=row.rule or rule,
             )
         )

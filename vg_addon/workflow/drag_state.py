@@ -19,7 +19,7 @@ from enum import StrEnum
 import numpy as np
 
 from ..errors import GoniometerError
-from ..method.algorithm import MIN_SIDE_VERTICES
+from ..method.algorithm import MIN_RADIUS, MIN_SIDE_VERTICES
 
 MIN_PATCH_VERTICES = 2 * MIN_SIDE_VERTICES
 """The fewest patch vertices that can be measured (three per side)."""
@@ -272,7 +272,8 @@ class DragMachine:
     def _set_radius(self, radius: float) -> None:
         self.radius = float(radius)
         self.measurement = None
-        if not np.isfinite(self.radius) or self.radius <= 0.0:
+        # Below the smallest radius the core accepts a patch holds at most its centre vertex.
+        if not np.isfinite(self.radius) or self.radius < MIN_RADIUS:
             self.indices = np.empty(0, dtype=np.int64)
         else:
             try:

@@ -1,0 +1,82 @@
+"""What a label says and where it stands: each current measurement's number, angle and centre
+in world space, read from the records (for the viewport labels and the measurement map)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..properties import exact_numbers
+from ..vg_addon.workflow.labels import label_text
+from . import records
+from .mesh_data import world_points
+
+
+@dataclass(frozen=True)
+class Label:
+    """One measurement's label.
+
+    Attributes
+    ----------
+    number, break_number : int
+    text : str
+        E.g. ``"3: 91.25°"``.
+    position : ndarray, shape (3,)
+        The measured centre in world space, where the object is now.
+    outward : ndarray, shape (3,)
+        Unit direction away from the surface at the centre, world space (the mean of the two
+        sides' normals), for placing the text off the surface.
+    radius : float
+        The patch radius in world units (mesh radius times the object's mean scale).
+    active : bool
+        The list's selected measurement.
+    """
+
+    number: int
+    break_number: int
+    text: str
+    position: np.ndarray
+    outward: np.ndarray
+    radius: float
+    active: bool
+
+
+def labels_of(obj, *, active_break_only: bool = False) -> list[Label]:
+    """Labels of ``obj``'s measurements that are current (stale ones get none), in list order.
+
+    ``active_break_only`` keeps those of the break the next measurement goes to.
+    """
+    data = getattr(obj, "vg", None)
+    if data is None or not len(data.measurements):
+        return []
+    matrix = np.array(obj.matrix_world, dtype=np.float64)
+    linear = matrix[:3, :3]
+    try:
+        normal_matrix = np.linalg.inv(linear).T
+    except np.linalg.LinAlgError:
+        return []
+    scale = float(np.cbrt(abs(np.linalg.det(linear))))
+    labels = []
+    for index, item in enumerate(data.measurements):
+        if item.stale or (active_break_only and item.break_number != data.break_number):
+            continue
+        numbers = exact_numbers(item)
+        if numbers.get("space") != records.MESH or "center" not in numbers:
+            continue
+        outward = normal_matrix @ (
+            np.asarray(numbers["normal_plus"]) + np.asarray(numbers["normal_minus"])
+        )
+        length = np.linalg.norm(outward)
+        labels.append(
+            Label(
+                number=item.number,
+                break_number=item.break_number,
+                text=label_text(item.number, numbers["angle"]),
+                position=world_points(np.asarray(numbers["center"])[None, :], matrix)[0],
+                outward=outward / length if length > 0 else outward,
+                radius=float(numbers["radius"]) * scale,
+                active=index == data.active_index,
+            )
+        )
+    return labels

@@ -1,0 +1,438 @@
+"""The measurement map: the object rendered from chosen views with its coloured sides and a
+numbered label beside each current measurement, one PNG per view and one contact sheet.
+
+It is what a user prints and keeps beside the CSV (the paper's analysts made one from
+screenshots). The operator ``vg.render_map`` and the batch's ``--render`` both make it here.
+
+Rendering is Cycles on the CPU: the headless ``bpy`` module has no GPU context, and Workbench
+and EEVEE need one (Workbench there renders garbage on a machine without a GPU). The scene is a
+throwaway one: a copy of the evaluated mesh (so the user's materials are never touched) with a
+material showing the "VG Sides" colours, orthographic cameras, a sun and a grey sky, and the
+labels as text objects with their own flat materials, on a plane in front of the mesh so the
+mesh never hides them. A label is only drawn in a view that sees its centre (a ray from the
+camera reaches it), and labels too close to a more important one on the picture are left out.
+Everything made for the render is removed afterwards, whatever happens.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from pathlib import Path
+
+import bpy
+import numpy as np
+from mathutils import Matrix, Vector
+
+from ..vg_addon import GoniometerError
+from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, place_labels
+from .colors import ATTRIBUTE_NAME
+from .label_data import labels_of
+from .mesh_data import read_positions, world_points
+
+MAP_VIEWS = ("SIX", "FLAKE")
+TEXT_FRACTION = 0.035  # label height, as a fraction of the picture's width
+GLYPH_EM = 0.6  # the width of a label's character (at most, about), in label heights
+OUTLINE = 0.07  # the black ring around label text, in label heights
+MARGIN = 1.25  # the frame around the object, room for labels at its edges
+
+
+def safe_file_name(name: str) -> str:
+    """``name`` with every character that is not safe in a file name replaced by ``_``."""
+    return "".join(c if c.isalnum() or c in "-_.+" else "_" for c in name) or "mesh"
+
+
+def view_list(obj, views: str, depsgraph) -> tuple:
+    """The ``(name, look, up)`` views of a map of ``obj``: ``"SIX"`` or ``"FLAKE"``."""
+    if views == "SIX":
+        return SIX_VIEWS
+    if views == "FLAKE":
+        mesh = obj.evaluated_get(depsgraph).to_mesh()
+        try:
+            local = read_positions(mesh)
+        finally:
+            obj.evaluated_get(depsgraph).to_mesh_clear()
+        return flake_views(world_points(local, np.array(obj.matrix_world, dtype=np.float64)))
+    raise GoniometerError(f"Unknown map views {views!r}: use one of {', '.join(MAP_VIEWS)}.")
+
+
+class MapJob:
+    """One measurement map being made, a view at a time (so an operator can show progress and
+    stop between views).
+
+    Use :meth:`render_next` until :attr:`done`, then :meth:`finish`; call :meth:`close` on
+    every way out (it removes the throwaway scene), and :meth:`abort` to remove the pictures
+    written so far when the map is not completed.
+    """
+
+    def __init__(self, obj, directory, *, views="SIX", size=(800, 600), samples=16):
+        if obj is None or obj.type != "MESH":
+            raise GoniometerError("Select the measured mesh object to make its map.")
+        width, height = (int(v) for v in size)
+        if width < 16 or height < 16 or samples < 1:
+            raise GoniometerError(
+                f"A map needs pictures of at least 16 x 16 pixels and 1 sample (got "
+                f"{width} x {height}, {samples})."
+            )
+        self.obj = obj
+        self.directory = Path(directory)
+        self.size = (width, height)
+        self.samples = int(samples)
+        self.depsgraph = bpy.context.evaluated_depsgraph_get()
+        self.views = view_list(obj, views, self.depsgraph)
+        self.labels = labels_of(obj)
+        self.written: list[Path] = []
+        self.sheet: Path | None = None
+        self._made: list = []
+        self._scene = None
+        self._label_objects: list = []
+        self.directory.mkdir(parents=True, exist_ok=True)
+        try:
+            self._build_scene()
+        except BaseException:
+            self.close()
+            raise
+
+    @property
+    def done(self) -> bool:
+        """Whether every view has been rendered."""
+        return len(self.written) == len(self.views)
+
+    def picture_path(self, view_name: str) -> Path:
+        return (
+            self.directory / f"{safe_file_name(self.obj.name)}_map_{safe_file_name(view_name)}.png"
+        )
+
+    # -- the throwaway scene ------------------------------------------------------------------
+
+    def _keep(self, block):
+        self._made.append(block)
+        return block
+
+    def _build_scene(self) -> None:
+        scene = self._scene = self._keep(bpy.data.scenes.new("VG Map"))
+        mesh = self._keep(
+            bpy.data.meshes.new_from_object(
+                self.obj.evaluated_get(self.depsgraph),
+                preserve_all_data_layers=True,
+                depsgraph=self.depsgraph,
+            )
+        )
+        mesh.materials.clear()
+        mesh.materials.append(self._sides_material())
+        copy = self._keep(bpy.data.objects.new("VG Map mesh", mesh))
+        copy.matrix_world = self.obj.matrix_world
+        scene.collection.objects.link(copy)
+        corners = np.array([list(self.obj.matrix_world @ Vector(c)) for c in self.obj.bound_box])
+        self._corners = corners
+        self._size = float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0))) or 1.0
+
+        camera_data = self._keep(bpy.data.cameras.new("VG Map camera"))
+        camera_data.type = "ORTHO"
+        self._camera = self._keep(bpy.data.objects.new("VG Map camera", camera_data))
+        scene.collection.objects.link(self._camera)
+        scene.camera = self._camera
+
+        sun_data = self._keep(bpy.data.lights.new("VG Map sun", "SUN"))
+        sun_data.energy = 2.5
+        sun_data.angle = 0.3
+        self._sun = self._keep(bpy.data.objects.new("VG Map sun", sun_data))
+        scene.collection.objects.link(self._sun)
+
+        world = self._keep(bpy.data.worlds.new("VG Map sky"))
+        if world.node_tree is None:
+            world.use_nodes = True
+        background = world.node_tree.nodes.get("Background")
+        if background is not None:
+            background.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)
+            background.inputs["Strength"].default_value = 0.9
+        scene.world = world
+
+        scene.render.engine = "CYCLES"
+        scene.cycles.device = "CPU"
+        scene.cycles.samples = self.samples
+        scene.cycles.use_denoising = False
+        scene.cycles.use_adaptive_sampling = False
+        scene.render.resolution_x, scene.render.resolution_y = self.size
+        scene.render.resolution_percentage = 100
+        scene.render.image_settings.file_format = "PNG"
+        scene.render.film_transparent = False
+        scene.view_settings.view_transform = "Standard"
+        self._white = self._flat_material("VG Map label", (1.0, 1.0, 1.0, 1.0))
+        self._black = self._flat_material("VG Map outline", (0.0, 0.0, 0.0, 1.0))
+
+    def _sides_material(self):
+        material = self._keep(bpy.data.materials.new("VG Map sides"))
+        if material.node_tree is None:  # Blender < 5: nodes are off by default
+            material.use_nodes = True
+        nodes = material.node_tree.nodes
+        shader = next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
+        shader.inputs["Roughness"].default_value = 0.7
+        colour = nodes.new("ShaderNodeVertexColor")
+        colour.layer_name = ATTRIBUTE_NAME
+        material.node_tree.links.new(colour.outputs["Color"], shader.inputs["Base Color"])
+        return material
+
+    def _flat_material(self, name, rgba):
+        """A material that shows ``rgba`` whatever the light (an emission)."""
+        material = self._keep(bpy.data.materials.new(name))
+        if material.node_tree is None:
+            material.use_nodes = True
+        nodes = material.node_tree.nodes
+        nodes.clear()
+        emission = nodes.new("ShaderNodeEmission")
+        emission.inputs["Color"].default_value = rgba
+        emission.inputs["Strength"].default_value = 1.0
+        output = nodes.new("ShaderNodeOutputMaterial")
+        material.node_tree.links.new(emission.outputs["Emission"], output.inputs["Surface"])
+        return material
+
+    # -- one view -------------------------------------------------------------------------------
+
+    def _frame(self, look, up):
+        """Camera axes, placement and ortho scale that frame the object seen along ``look``."""
+        back = -np.asarray(look, dtype=np.float64)
+        up = np.asarray(up, dtype=np.float64)
+        right = np.cross(up, back)
+        along = [self._corners @ axis for axis in (right, up, back)]
+        extent = [float(a.max() - a.min()) for a in along]
+        width, height = self.size
+        aspect = width / height
+        scale = MARGIN * max(extent[0], extent[1] * aspect, self._size * 1e-3)
+        centre = (
+            right * (along[0].max() + along[0].min()) / 2
+            + up * (along[1].max() + along[1].min()) / 2
+        )
+        front = float(along[2].max())
+        return right, up, back, centre, front, scale
+
+    def render_next(self) -> Path:
+        """Render the next view into its PNG; returns its path."""
+        if self.done:
+            raise GoniometerError("Every view of this map is rendered already.")
+        name, look, up = self.views[len(self.written)]
+        right, up, back, centre, front, scale = self._frame(look, up)
+        rotation = Matrix(np.column_stack([right, up, back]).tolist()).to_4x4()
+        camera = self._camera
+        camera.matrix_world = Matrix.Translation(Vector(centre + back * (front + self._size))) @ (
+            rotation
+        )
+        camera.data.ortho_scale = scale
+        camera.data.clip_start = self._size * 1e-3
+        camera.data.clip_end = 3.0 * self._size
+        key = -np.asarray(look) + 0.5 * right + 0.6 * up
+        self._sun.rotation_euler = Vector(-key).to_track_quat("-Z", "Y").to_euler()
+        self._place_labels(name, right, up, back, centre, front, scale, rotation)
+        path = self.picture_path(name)
+        scene = self._scene
+        scene.render.filepath = str(path.resolve())
+        bpy.ops.render.render(write_still=True, scene=scene.name)
+        if not path.is_file():
+            raise GoniometerError(f"Cycles wrote no picture to {path}.")
+        self.written.append(path)
+        return path
+
+    def _visible(self, label, look) -> bool:
+        """Whether the camera looking along ``look`` sees ``label``'s centre: a ray along
+        ``look`` through the centre, or through one of four points a quarter radius around it
+        (a centre on a break edge is often right on the outline), first meets the object
+        within half a radius of the centre."""
+        obj_eval = self.obj.evaluated_get(self.depsgraph)
+        to_local = np.linalg.inv(np.array(self.obj.matrix_world, dtype=np.float64))
+        look = np.asarray(look, dtype=np.float64)
+        side = np.cross(look, [0.0, 0.0, 1.0] if abs(look[2]) < 0.9 else [1.0, 0.0, 0.0])
+        side /= np.linalg.norm(side)
+        other = np.cross(look, side)
+        step = 0.25 * label.radius
+        local_direction = Vector(to_local[:3, :3] @ look)
+        reach = max(0.5 * label.radius, self._size * 1e-3)
+        for offset in (0.0 * side, step * side, -step * side, step * other, -step * other):
+            origin = label.position + offset - look * 2.0 * self._size
+            local_origin = Vector(to_local[:3, :3] @ origin + to_local[:3, 3])
+            hit, location, _normal, _face = obj_eval.ray_cast(local_origin, local_direction)
+            if not hit:
+                continue
+            world_hit = np.array(self.obj.matrix_world @ location, dtype=np.float64)
+            if float(np.linalg.norm(world_hit - label.position)) <= reach:
+                return True
+        return False
+
+    def _place_labels(self, view_name, right, up, back, centre, front, scale, rotation) -> None:
+        for block in self._label_objects:
+            self._remove(block)
+        self._label_objects = []
+        width, height = self.size
+        pixel = scale / width  # world size of one pixel
+        text_height = TEXT_FRACTION * width * pixel
+        look = -back
+        shown = [label for label in self.labels if self._visible(label, look)]
+        positions = np.array(
+            [
+                [
+                    ((label.position - centre) @ right) / pixel,
+                    ((label.position - centre) @ up) / pixel,
+                ]
+                for label in shown
+            ]
+        ).reshape(-1, 2)
+        priority = [(len(shown) if label.active else 0) + i for i, label in enumerate(shown)]
+        plane = front + 0.05 * self._size  # in front of the mesh, behind the camera
+        text_px = TEXT_FRACTION * width
+        widths = [GLYPH_EM * len(label.text) * text_px for label in shown]
+        gap = 0.45 * text_px
+        for index, side in place_labels(positions, widths, text_px, priority, gap=gap):
+            label = shown[index]
+            on_plane = label.position + back * (plane - label.position @ back)
+            self._marker(on_plane, rotation, 0.22 * text_height)
+            at = on_plane + side * right * gap * pixel
+            self._text(label.text, at, rotation, text_height, "LEFT" if side > 0 else "RIGHT")
+        # The caption: object and view, in the top-left corner.
+        corner = centre + back * plane
+        corner = (
+            corner
+            - right * (scale / 2 - text_height)
+            + up * (scale * height / width / 2 - 1.2 * text_height)
+        )
+        self._text(f"{self.obj.name} · {view_name}", corner, rotation, text_height)
+
+    def _text(self, text, at, rotation, height, align="LEFT") -> None:
+        """White text ringed in black, its left (or right) middle at ``at``, facing the camera:
+        eight black copies shifted around a white one, so it reads on light and dark alike."""
+        right, up, back = (np.array(rotation.col[i][:3]) for i in range(3))
+        shift = OUTLINE * height
+        copies = [
+            (self._black, right * dx * shift + up * dy * shift - back * 0.02 * height)
+            for dx, dy in ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
+        ]
+        curve = self._keep(bpy.data.curves.new("VG Map label", "FONT"))
+        curve.body = text
+        curve.size = height
+        curve.align_x = align
+        curve.align_y = "CENTER"
+        curve.materials.append(self._black)
+        white = self._keep(curve.copy())
+        white.materials[0] = self._white
+        for data, offset in [*((curve, o) for _, o in copies), (white, np.zeros(3))]:
+            label = self._keep(bpy.data.objects.new("VG Map label", data))
+            label.matrix_world = Matrix.Translation(Vector(np.asarray(at) + offset)) @ rotation
+            self._scene.collection.objects.link(label)
+            self._label_objects.append(label)
+        self._label_objects.extend([curve, white])
+
+    def _marker(self, at, rotation, radius) -> None:
+        """A white dot ringed in black at a measurement's centre."""
+        angles = np.linspace(0.0, 2.0 * np.pi, 25)[:-1]
+        for material, scale, depth in ((self._black, 1.6, -0.002), (self._white, 1.0, 0.0)):
+            ring = np.column_stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)])
+            verts = [(0.0, 0.0, 0.0), *(radius * scale * ring).tolist()]
+            faces = [(0, 1 + i, 1 + (i + 1) % len(angles)) for i in range(len(angles))]
+            mesh = self._keep(bpy.data.meshes.new("VG Map marker"))
+            mesh.from_pydata(verts, [], faces)
+            mesh.materials.append(material)
+            dot = self._keep(bpy.data.objects.new("VG Map marker", mesh))
+            back = np.array(rotation.col[2][:3])
+            dot.matrix_world = (
+                Matrix.Translation(Vector(np.asarray(at) + back * depth * radius * 10)) @ rotation
+            )
+            self._scene.collection.objects.link(dot)
+            self._label_objects.extend([dot, mesh])
+
+    # -- the end ----------------------------------------------------------------------------------
+
+    def finish(self) -> Path:
+        """Write the contact sheet of every view; returns its path."""
+        if not self.done:
+            raise GoniometerError("The map is not complete: render every view first.")
+        self.sheet = self.directory / f"{safe_file_name(self.obj.name)}_map.png"
+        write_contact_sheet(self.written, self.sheet, columns=3 if len(self.written) > 2 else 2)
+        return self.sheet
+
+    def abort(self) -> None:
+        """Remove the pictures this job wrote (a cancelled map leaves nothing half-done)."""
+        for path in [*self.written, *([self.sheet] if self.sheet else [])]:
+            with contextlib.suppress(OSError):
+                path.unlink()
+        self.written, self.sheet = [], None
+
+    def _remove(self, block) -> None:
+        with contextlib.suppress(ReferenceError, RuntimeError):
+            collection = {
+                bpy.types.Object: bpy.data.objects,
+                bpy.types.Mesh: bpy.data.meshes,
+                bpy.types.TextCurve: bpy.data.curves,
+                bpy.types.Camera: bpy.data.cameras,
+                bpy.types.SunLight: bpy.data.lights,
+                bpy.types.World: bpy.data.worlds,
+                bpy.types.Material: bpy.data.materials,
+                bpy.types.Scene: bpy.data.scenes,
+            }.get(type(block))
+            if collection is not None:
+                collection.remove(block)
+
+    def close(self) -> None:
+        """Remove everything made for the render (safe to call more than once)."""
+        made, self._made, self._label_objects = self._made, [], []
+        # Objects first, then their data, the scene last but one: each removal is allowed.
+        order = sorted(
+            made,
+            key=lambda b: (
+                0 if isinstance(b, bpy.types.Object) else 2 if isinstance(b, bpy.types.Scene) else 1
+            ),
+        )
+        for block in order:
+            self._remove(block)
+
+
+def write_contact_sheet(paths, out: Path, *, columns: int = 3) -> Path:
+    """Tile the PNGs ``paths`` (all the same size) into one PNG, ``columns`` wide, row by row
+    from the top left."""
+    images = []
+    try:
+        for path in paths:
+            images.append(bpy.data.images.load(str(path), check_existing=False))
+        width, height = images[0].size
+        rows = -(-len(images) // columns)
+        sheet = np.ones((rows * height, columns * width, 4), dtype=np.float32)
+        for index, image in enumerate(images):
+            if tuple(image.size) != (width, height):
+                raise GoniometerError("The map's pictures differ in size: cannot tile them.")
+            pixels = np.empty(width * height * 4, dtype=np.float32)
+            image.pixels.foreach_get(pixels)
+            row, column = divmod(index, columns)
+            top = (rows - 1 - row) * height  # Blender's pixels start at the bottom row
+            sheet[top : top + height, column * width : (column + 1) * width] = pixels.reshape(
+                height, width, 4
+            )
+        result = bpy.data.images.new("VG Map sheet", columns * width, rows * height, alpha=False)
+        images.append(result)
+        result.pixels.foreach_set(sheet.ravel())
+        result.filepath_raw = str(out)
+        result.file_format = "PNG"
+        result.save()
+    finally:
+        for image in images:
+            with contextlib.suppress(ReferenceError, RuntimeError):
+                bpy.data.images.remove(image)
+    return out
+
+
+def render_map(obj, directory, *, views="SIX", size=(800, 600), samples=16, progress=None):
+    """Render the measurement map of ``obj`` into ``directory``: one PNG per view and a contact
+    sheet. Returns ``(view paths, sheet path)``.
+
+    ``progress(done, total)`` is called before each view; returning False cancels: the
+    pictures written so far are removed and a GoniometerError says so.
+    """
+    job = MapJob(obj, directory, views=views, size=size, samples=samples)
+    try:
+        while not job.done:
+            if progress is not None and progress(len(job.written), len(job.views)) is False:
+                job.abort()
+                raise GoniometerError("The map was cancelled: no picture was kept.")
+            job.render_next()
+        job.finish()
+    except BaseException:
+        job.abort()
+        raise
+    finally:
+        job.close()
+    return job.written, job.sheet
