@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 import subprocess
 import sys
 
@@ -79,8 +80,11 @@ def blender_root(suite: str) -> None:
 def gui(request, extension_zip):
     """A GUI Blender of one Debian suite, extension installed, the wedge scene set up."""
     blender_root(request.param)
+    failed_before = request.session.testsfailed
     session = GuiBlender(request.param, extension_zip, POINTS)
     try:
         yield session
     finally:
         session.close()
+        if request.session.testsfailed == failed_before:  # keep screenshots and logs of failures
+            shutil.rmtree(session.tmp, ignore_errors=True)
