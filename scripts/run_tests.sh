@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Set everything up and run every check: lint, the core on NumPy 2 and on NumPy 1.26, the extension
-# on every Blender line (bpy 5.2 LTS, 5.3, 4.5 LTS, 4.2 LTS). Extra arguments go to every pytest run
-# (e.g. -x, -k name).
+# on every Blender line (bpy 5.2 LTS, 5.3, 4.5 LTS, 4.2 LTS), then real Blender binaries (Debian's
+# 4.3 and 5.2, provisioned by scripts/provision_blender.sh): the GUI driven with real mouse and key
+# events, and `blender -b` batch runs (tests/gui; they skip, saying why, where the roots cannot be
+# made). Extra arguments go to every pytest run (e.g. -x, -k name).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh all
@@ -25,4 +27,5 @@ run "extension, bpy 5.2 LTS (Python 3.13, NumPy 2)" .venv/bin/python tests/blend
 run "extension, bpy 5.3 (Python 3.13, NumPy 2)" .venv-bpy53/bin/python tests/blender "$@"
 run "extension, bpy 4.5 LTS (Python 3.11, NumPy 1.26)" .venv-bpy45/bin/python tests/blender "$@"
 run "extension, bpy 4.2 LTS (Python 3.11, NumPy 1.26)" .venv-bpy42/bin/python tests/blender "$@"
+run "real Blender 4.3 and 5.2: GUI and blender -b" .venv/bin/python tests/gui "$@"
 exit $status

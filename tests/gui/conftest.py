@@ -1,0 +1,90 @@
+"""Fixtures of the GUI lane: the extension zip, the Blender roots, one GUI Blender per root.
+
+A root that cannot be made here (not root, no debootstrap, no network to the Debian mirror, the
+package not installable) skips that root's tests with the provisioning script's own reason.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+import pytest
+from driver import REPO, GuiBlender
+
+SUITES = ("trixie", "unstable")  # Debian's Blender 4.3 and 5.2
+
+_S, _C = math.sin(math.radians(50.0)), math.cos(math.radians(50.0))  # the wedge's half angle
+
+
+def face_point(x: float, t: float, side: int) -> list[float]:
+    """The point at distance ``t`` from the crease on the wedge face ``side`` (+1: y > 0)."""
+    return [x, side * t * _S, -t * _C]
+
+
+#: 3D points (world space) the harness projects to the screen for the test.
+POINTS = {
+    "crease": [0.15, 0.0, 0.0],
+    "crease_left": [-0.45, 0.0, 0.0],
+    "plus_in": face_point(0.15, 0.1, +1),
+    "minus_in": face_point(0.15, 0.1, -1),
+    "plus_out": face_point(0.15, 0.8, +1),
+    "minus_out": face_point(0.15, 0.8, -1),
+}
+
+
+@pytest.fixture(scope="session")
+def extension_zip(tmp_path_factory):
+    out = tmp_path_factory.mktemp("dist")
+    result = subprocess.run(
+        [sys.executable, str(REPO / "scripts" / "build_extension.py"), "--output-dir", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    return out / result.stdout.strip().splitlines()[-1].rsplit("/", 1)[-1]
+
+
+_provisioned: dict[str, str | None] = {}
+
+
+def blender_root(suite: str) -> None:
+    """Make (or reuse) the root of ``suite``; skip, saying why, where it cannot be made."""
+    if suite not in _provisioned:
+        if os.geteuid() != 0:
+            _provisioned[suite] = (
+                "the GUI lane needs root (debootstrap, chroot, mounts); run the tests as root"
+            )
+        else:
+            result = subprocess.run(
+                ["bash", str(REPO / "scripts" / "provision_blender.sh"), suite],
+                capture_output=True,
+                text=True,
+                check=False,
+                timeout=1800,
+            )
+            _provisioned[suite] = (
+                None
+                if result.returncode == 0
+                else f"scripts/provision_blender.sh {suite} failed:\n{result.stderr[-2000:]}"
+            )
+    if _provisioned[suite] is not None:
+        pytest.skip(f"no real Blender from Debian {suite}: {_provisioned[suite]}")
+
+
+@pytest.fixture(scope="module", params=SUITES)
+def gui(request, extension_zip):
+    """A GUI Blender of one Debian suite, extension installed, the wedge scene set up."""
+    blender_root(request.param)
+    failed_before = request.session.testsfailed
+    session = GuiBlender(request.param, extension_zip, POINTS)
+    try:
+        yield session
+    finally:
+        session.close()
+        if request.session.testsfailed == failed_before:  # keep screenshots and logs of failures
+            shutil.rmtree(session.tmp, ignore_errors=True)

@@ -1,0 +1,335 @@
+"""Drive a real Blender under Xvfb inside a Blender root (scripts/provision_blender.sh).
+
+Everything runs inside the root through one long-lived shell (scripts/blender_root.sh, so the
+mounts live in a private mount namespace and vanish with it): Xvfb, the GUI Blender started with
+``harness_startup.py``, xdotool for the mouse and keys, xwd for screenshots. The test reads what
+Blender shows through the JSON state the startup script writes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import select
+import shlex
+import shutil
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[2]
+ROOT_SCRIPT = REPO / "scripts" / "blender_root.sh"
+SCREEN = (1280, 1800)  # tall: the whole sidebar shows without scrolling
+GUEST_REPO, GUEST_TMP = "/vg/repo", "/vg/tmp"
+END = "__vg_end__"
+
+
+class RootShell:
+    """A bash inside a Blender root; :meth:`run` runs one command line and returns its output."""
+
+    def __init__(self, suite: str, host_tmp: Path, log: Path):
+        # Background jobs (Xvfb, Blender) end with the shell, which ends when this side closes
+        # its input (also when the test process is killed).
+        loop = (
+            "trap 'kill $(jobs -p) 2>/dev/null' EXIT; "
+            f'while IFS= read -r line; do eval "$line" </dev/null 2>&1; echo "{END} $?"; done'
+        )
+        self._log = open(log, "ab")  # noqa: SIM115 (closed in close())
+        self.process = subprocess.Popen(
+            [
+                str(ROOT_SCRIPT),
+                suite,
+                "--ro-bind",
+                str(REPO),
+                GUEST_REPO,
+                "--bind",
+                str(host_tmp),
+                GUEST_TMP,
+                "--",
+                "bash",
+                "-c",
+                loop,
+            ],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=self._log,
+        )
+        self._buffer = b""
+
+    def run(self, command: str, timeout: float = 60.0) -> tuple[int, str]:
+        """Run ``command`` (a bash line, output merged); return ``(status, output)``."""
+        self.process.stdin.write(command.replace("\n", " ").encode() + b"\n")
+        self.process.stdin.flush()
+        deadline = time.monotonic() + timeout
+        marker = END.encode() + b" "
+        while marker not in self._buffer:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise TimeoutError(f"no answer within {timeout} s from: {command}")
+            ready, _, _ = select.select([self.process.stdout], [], [], left)
+            if ready:
+                chunk = os.read(self.process.stdout.fileno(), 65536)
+                if not chunk:
+                    raise RuntimeError(f"the root shell ended while running: {command}")
+                self._buffer += chunk
+        output, _, rest = self._buffer.partition(marker)
+        status_line, _, self._buffer = rest.partition(b"\n")
+        return int(status_line), output.decode(errors="replace")
+
+    def check(self, command: str, timeout: float = 60.0) -> str:
+        status, output = self.run(command, timeout)
+        if status:
+            raise RuntimeError(f"exit status {status} from: {command}\n{output[-3000:]}")
+        return output
+
+    def close(self) -> None:
+        with contextlib.suppress(BrokenPipeError, OSError):
+            self.process.stdin.close()
+        try:
+            self.process.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+        self._log.close()
+
+
+class GuiBlender:
+    """One real Blender window under Xvfb, with the extension installed from ``zip_path``."""
+
+    def __init__(
+        self, suite: str, zip_path: Path, points: dict[str, list[float]], scene: str = "wedge"
+    ):
+        self.suite = suite
+        self.scene = scene
+        self.tmp = Path(tempfile.mkdtemp(prefix=f"vg-gui-{suite}-"))
+        os.chmod(self.tmp, 0o755)
+        shutil.copy(zip_path, self.tmp / "extension.zip")
+        (self.tmp / "points.json").write_text(json.dumps(points))
+        self.shell = RootShell(suite, self.tmp, self.tmp / "shell.log")
+        self.display = None
+        self.state_path = self.tmp / "state.json"
+        try:
+            self._start()
+        except BaseException:
+            self.close()
+            raise
+
+    # -- start and stop ---------------------------------------------------------------------
+    def _start(self) -> None:
+        run = self.shell.check
+        run(f"mkdir -p {GUEST_TMP}/home && export HOME={GUEST_TMP}/home && cd {GUEST_TMP}")
+        self.version = run("blender --version | head -n 1").strip()
+        run(
+            "blender --command extension install-file -r user_default -e "
+            f"{GUEST_TMP}/extension.zip",
+            timeout=180,
+        )
+        # The splash would cover the viewport: a user closes it once, the harness turns it off.
+        # Developer extras let F3 find operators by name, as they do for many users.
+        run(
+            "blender -b --python-expr 'import bpy; view = bpy.context.preferences.view; "
+            "view.show_splash = False; view.show_developer_ui = True; "
+            "bpy.ops.wm.save_userpref()'",
+            timeout=180,
+        )
+        width, height = SCREEN
+        run(
+            f"Xvfb -displayfd 1 -screen 0 {width}x{height}x24 -nolisten tcp "
+            f">{GUEST_TMP}/display 2>{GUEST_TMP}/xvfb.log & echo $! >{GUEST_TMP}/xvfb.pid"
+        )
+        deadline, display = time.monotonic() + 30, self.tmp / "display"
+        while not (display.exists() and display.read_text().strip()):
+            if time.monotonic() > deadline:
+                raise RuntimeError("Xvfb did not start: " + (self.tmp / "xvfb.log").read_text())
+            time.sleep(0.1)
+        self.display = ":" + display.read_text().strip()
+        run(
+            f"DISPLAY={self.display} VG_GUI_SCENE={self.scene} VG_GUI_STATE={GUEST_TMP}/state.json "
+            f"VG_GUI_POINTS={GUEST_TMP}/points.json blender -p 0 0 {width} {height} "
+            f"--python {GUEST_REPO}/tests/gui/harness_startup.py "
+            f">{GUEST_TMP}/blender.log 2>&1 & echo $! >{GUEST_TMP}/blender.pid"
+        )
+        self.wait_for(lambda s: s.get("ready"), 120, "Blender's window and the test scene")
+
+    def close(self) -> None:
+        for name in ("blender", "xvfb"):
+            pid_file = self.tmp / f"{name}.pid"
+            if pid_file.exists() and pid_file.read_text().strip():
+                with contextlib.suppress(Exception):
+                    self.shell.run(f"kill {pid_file.read_text().strip()}; sleep 0.5", timeout=10)
+        self.shell.close()
+
+    def log(self) -> str:
+        path = self.tmp / "blender.log"
+        return path.read_text(errors="replace")[-4000:] if path.exists() else ""
+
+    # -- reading Blender's state -------------------------------------------------------------
+    def state(self) -> dict:
+        for _ in range(50):
+            with contextlib.suppress(FileNotFoundError, ValueError):
+                return json.loads(self.state_path.read_text())
+            time.sleep(0.02)
+        raise RuntimeError("no state from the GUI Blender; its log:\n" + self.log())
+
+    def wait_for(self, predicate, timeout: float, what: str) -> dict:
+        deadline = time.monotonic() + timeout
+        while True:
+            with contextlib.suppress(FileNotFoundError, ValueError):
+                state = json.loads(self.state_path.read_text())
+                if state.get("errors"):
+                    raise RuntimeError("the harness failed:\n" + state["errors"][-1])
+                if predicate(state):
+                    return state
+            if time.monotonic() > deadline:
+                with contextlib.suppress(Exception):
+                    self.save_png("timeout", self.tmp / "timeout.png")
+                raise TimeoutError(
+                    f"waited {timeout} s for {what} (screen: {self.tmp}/timeout.png); "
+                    f"Blender's log:\n{self.log()}"
+                )
+            time.sleep(0.05)
+
+    def settle(self, ticks: int = 3) -> dict:
+        """Wait until the harness has reported ``ticks`` more times (events processed)."""
+        seq = self.state()["seq"]
+        return self.wait_for(lambda s: s["seq"] >= seq + ticks, 30, "the harness to report")
+
+    def measurements(self, obj: str) -> list[dict]:
+        return self.state()["objects"][obj]["measurements"]
+
+    # -- real input events -------------------------------------------------------------------
+    def xdotool(self, *args) -> None:
+        self.shell.check(f"DISPLAY={self.display} xdotool " + " ".join(map(shlex.quote, args)))
+
+    def move(self, xy) -> None:
+        """Move the pointer and let Blender see it (keys go where Blender last saw it)."""
+        self.xdotool("mousemove", str(round(xy[0])), str(round(xy[1])))
+        self.settle(1)
+
+    def click(self, xy, button: int = 1, modifier: str | None = None) -> None:
+        """Press and release ``button`` at ``xy``, holding ``modifier`` (e.g. ``"shift"``)."""
+        self.move(xy)
+        if modifier:
+            self.xdotool("keydown", modifier)
+            self.settle(1)
+        self.xdotool("mousedown", str(button))
+        self.settle(1)
+        self.xdotool("mouseup", str(button))
+        if modifier:
+            self.settle(1)
+            self.xdotool("keyup", modifier)
+        self.settle()
+
+    def focus_window_at(self, xy) -> None:
+        """Give the X input focus to the window at ``xy`` (with no window manager, a window
+        Blender opens, e.g. the file browser, is not focused by clicking it in Blender 5.2)."""
+        self.move(xy)
+        self.shell.check(
+            f"eval $(DISPLAY={self.display} xdotool getmouselocation --shell) && "
+            f"DISPLAY={self.display} xdotool windowfocus --sync $WINDOW"
+        )
+        self.settle()
+
+    def key(self, *keys: str) -> None:
+        self.xdotool("key", "--delay", "60", *keys)
+        self.settle()
+
+    def type_text(self, text: str) -> None:
+        self.xdotool("type", "--delay", "60", text)
+        self.settle()
+
+    def copies(self, xy, key: str = "ctrl+c") -> str | None:
+        """What ``key`` over ``xy`` copies to the clipboard (None: nothing, not a button)."""
+        self.move(xy)
+        seq = self.state()["seq"]
+        self.xdotool("key", key)
+        state = self.settle(2)
+        return next((text for s, text in state["clipboard"] if s >= seq), None)
+
+    def find_button(
+        self,
+        region: str,
+        copied: str,
+        step: int = 8,
+        key: str = "ctrl+c",
+        upward: bool = False,
+        rows: range | None = None,
+    ) -> tuple[float, float]:
+        """Screen position of the button in ``region`` whose copy to the clipboard contains
+        ``copied``: Ctrl+C over an operator button copies its Python call, Ctrl+Shift+C over a
+        property its data path. Buttons are hovered top to bottom (or bottom to top; only ``rows``
+        when given), as a user would."""
+        left, top, width, height = self.state()["regions"][region]
+        rows = range(top + 4, top + height - 4, step) if rows is None else rows
+        for x in (left + width // 2, left + width // 4, left + 3 * width // 4):
+            for y in reversed(rows) if upward else rows:
+                self.move((x, y))
+                seq = self.state()["seq"]
+                self.xdotool("key", key)
+                state = self.settle(2)
+                if any(s >= seq and copied in text for s, text in state["clipboard"]):
+                    return x, y
+        raise LookupError(f"no button copying {copied!r} in the {region} region")
+
+    # -- pictures ----------------------------------------------------------------------------
+    def screenshot(self, name: str = "shot") -> np.ndarray:
+        """The whole X screen as an (height, width, 3) uint8 array (also kept as ``name``.ppm)."""
+        path = f"{GUEST_TMP}/{name}.ppm"
+        self.shell.check(
+            f"xwd -root -silent -display {self.display} | xwdtopnm >{path} 2>/dev/null"
+        )
+        return read_ppm(self.tmp / f"{name}.ppm")
+
+    def wait_for_change(self, before: np.ndarray, box, timeout: float, what: str) -> None:
+        """Wait until a fifth of the pixels in ``box`` (left, top, width, height) differ from
+        the screenshot ``before`` (e.g. a popup opened there)."""
+        left, top, width, height = (int(v) for v in box)
+        deadline = time.monotonic() + timeout
+        while True:
+            now = self.screenshot("change")
+            cut = (slice(max(top, 0), top + height), slice(max(left, 0), left + width))
+            changed = np.any(now[cut] != before[cut], axis=2).mean()
+            if changed > 0.2:
+                return
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"waited {timeout} s for {what} to show")
+            time.sleep(0.2)
+
+    def save_png(self, name: str, destination: Path, crop=None) -> None:
+        """Screenshot as PNG (optionally cropped to ``(left, top, width, height)``)."""
+        path = f"{GUEST_TMP}/{name}.png"
+        cut = ""
+        if crop is not None:
+            left, top, width, height = (int(v) for v in crop)
+            cut = f"| pnmcut -left {left} -top {top} -width {width} -height {height} "
+        self.shell.check(
+            f"xwd -root -silent -display {self.display} | xwdtopnm 2>/dev/null {cut}"
+            f"| pnmtopng -compression 9 >{path} 2>/dev/null"
+        )
+        shutil.copy(self.tmp / f"{name}.png", destination)
+
+
+def read_ppm(path: Path) -> np.ndarray:
+    """A binary PPM (P6, maxval 255) as an (height, width, 3) uint8 array."""
+    data = path.read_bytes()
+    fields, position = [], 0
+    while len(fields) < 4:
+        while data[position : position + 1].isspace():
+            position += 1
+        if data[position : position + 1] == b"#":
+            position = data.index(b"\n", position)
+            continue
+        end = position
+        while not data[end : end + 1].isspace():
+            end += 1
+        fields.append(data[position:end])
+        position = end
+    magic, width, height, maxval = fields[0], int(fields[1]), int(fields[2]), int(fields[3])
+    if magic != b"P6" or maxval != 255:
+        raise ValueError(f"{path}: not an 8-bit binary PPM")
+    pixels = np.frombuffer(data, dtype=np.uint8, count=width * height * 3, offset=position + 1)
+    return pixels.reshape(height, width, 3)

@@ -1,0 +1,186 @@
+"""Startup script of the GUI Blender in the GUI test lane (``blender --python`` this file).
+
+It only sets the scene up and reports; the test drives Blender with real X events (xdotool).
+On its first timer tick it builds the wedge scene (:mod:`scene`; ``VG_GUI_SCENE=fragment``: the
+bone fragment of the README's pictures, its break sites written to ``$VG_GUI_POINTS``); then, ten times a second, it
+writes what the test needs to read to ``$VG_GUI_STATE`` (JSON, replaced atomically): the
+measurements of every mesh object with their exact numbers, the active tool, the 3D view's
+regions in X screen pixels, the sidebar's tab, the 3D cursor, the running drag (found by
+looking, read-only, at the live ``DragSession`` objects), what a Ctrl+Shift+C copied, and the
+regions of an open file browser, the
+screen positions of the 3D points listed in ``$VG_GUI_POINTS``.
+"""
+
+from __future__ import annotations
+
+import gc
+import json
+import os
+import sys
+import traceback
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import scene
+
+STATE = os.environ["VG_GUI_STATE"]
+POINTS = os.environ.get("VG_GUI_POINTS", "")
+_status = {"seq": 0, "ready": False, "errors": [], "clipboard": []}
+
+
+def _view3d(window):
+    for area in window.screen.areas:
+        if area.type == "VIEW_3D":
+            return area
+    return None
+
+
+def _to_screen(window, wx: float, wy: float) -> list[float]:
+    """Blender window coordinates (origin bottom left) to X screen pixels (origin top left)."""
+    return [window.x + wx, window.y + window.height - 1 - wy]
+
+
+def _regions(window, area) -> dict:
+    rects = {}
+    for region in area.regions:
+        if region.width <= 1 or region.height <= 1:
+            continue
+        left, top = _to_screen(window, region.x, region.y + region.height - 1)
+        rects[region.type] = [left, top, region.width, region.height]
+    return rects
+
+
+def _file_browser() -> dict | None:
+    """The regions of an open file browser (its own window, or an area of the main one)."""
+    for window in bpy.context.window_manager.windows:
+        for area in window.screen.areas:
+            if area.type == "FILE_BROWSER":
+                return _regions(window, area)
+    return None
+
+
+def _projections(window, area) -> dict:
+    if not POINTS or not os.path.exists(POINTS):
+        return {}
+    from bpy_extras import view3d_utils
+
+    with open(POINTS) as handle:
+        points = json.load(handle)
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    region_3d = area.spaces.active.region_3d
+    out = {}
+    for name, xyz in points.items():
+        xy = view3d_utils.location_3d_to_region_2d(region, region_3d, xyz)
+        out[name] = None if xy is None else _to_screen(window, region.x + xy.x, region.y + xy.y)
+    return out
+
+
+def _drag(window, area):
+    """The running drag: its machine's numbers and its circle's centre and radius on screen."""
+    from bpy_extras import view3d_utils
+    from mathutils import Vector
+
+    drag = scene.extension().operators.drag
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    region_3d = area.spaces.active.region_3d
+    for obj in gc.get_objects():
+        if isinstance(obj, drag.DragSession):
+            machine = obj.machine
+            if machine.phase.name == "DRAGGING":
+                centre = Vector(machine.center)
+                right = region_3d.view_rotation @ Vector((1.0, 0.0, 0.0))
+                ends = [
+                    view3d_utils.location_3d_to_region_2d(region, region_3d, point)
+                    for point in (centre, centre + machine.radius * right)
+                ]
+                return {
+                    "center_screen": _to_screen(window, region.x + ends[0].x, region.y + ends[0].y),
+                    "radius_px": (ends[1] - ends[0]).length,
+                    "phase": machine.phase.name,
+                    "radius": machine.radius,
+                    "lam": machine.lam,
+                    "typed": machine.typed,
+                    "n_vertices": machine.n_vertices,
+                }
+    return None
+
+
+def _objects(scene_) -> dict:
+    objects = {}
+    for obj in scene_.objects:
+        if obj.type != "MESH":
+            continue
+        objects[obj.name] = {
+            "break_number": obj.vg.break_number,
+            "measurements": [
+                {
+                    "number": item.number,
+                    "break_number": item.break_number,
+                    "exact": json.loads(item.exact) if item.exact else {},
+                    "patch": item.patch,
+                    "n_vertices": item.n_vertices,
+                    "stale": item.stale,
+                    "colors": item.colors,
+                }
+                for item in obj.vg.measurements
+            ],
+        }
+    return objects
+
+
+def _setup(window) -> None:
+    area = _view3d(window)
+    with bpy.context.temp_override(window=window, area=area):
+        if os.environ.get("VG_GUI_SCENE") == "fragment":
+            _obj, sites = scene.build_fragment()
+            scene.frame_fragment(area.spaces.active)
+            with open(POINTS, "w") as handle:
+                json.dump({site.label: list(site.point) for site in sites}, handle)
+        else:
+            scene.build_wedge()
+            scene.frame_view(area.spaces.active)
+
+
+def _tick():
+    try:
+        window = bpy.context.window_manager.windows[0]
+        if not _status["ready"]:
+            _setup(window)
+            _status["ready"] = True
+        wm = bpy.context.window_manager
+        if wm.clipboard:
+            _status["clipboard"].append([_status["seq"], wm.clipboard])
+            wm.clipboard = ""
+        area = _view3d(window)
+        sidebar = next((r for r in area.regions if r.type == "UI"), None)
+        tool = window.workspace.tools.from_space_view3d_mode("OBJECT", create=False)
+        _status["seq"] += 1
+        state = {
+            "seq": _status["seq"],
+            "ready": True,
+            "version": list(bpy.app.version),
+            "window": [window.x, window.y, window.width, window.height],
+            "regions": _regions(window, area),
+            "file_browser": _file_browser(),
+            "sidebar_category": sidebar.active_panel_category if sidebar else None,
+            "tool": tool.idname if tool else None,
+            "cursor": list(window.scene.cursor.location),
+            "active": getattr(window.view_layer.objects.active, "name", None),
+            "objects": _objects(window.scene),
+            "drag": _drag(window, area),
+            "points": _projections(window, area),
+            "clipboard": _status["clipboard"][-20:],
+            "errors": _status["errors"][-5:],
+        }
+    except Exception:
+        _status["errors"].append(traceback.format_exc())
+        state = {"seq": _status["seq"], "ready": False, "errors": _status["errors"][-5:]}
+    partial = STATE + ".part"
+    with open(partial, "w") as handle:
+        json.dump(state, handle)
+    os.replace(partial, STATE)
+    return 0.1
+
+
+bpy.app.timers.register(_tick, first_interval=0.5, persistent=True)
