@@ -245,8 +245,19 @@ def test_measure_at_cursor_after_shift_right_click(gui):
     assert abs(exact["angle"] - WEDGE_ANGLE) < 1e-6
 
 
-def test_csv_export_through_the_file_browser(gui):
+def test_csv_export_through_the_file_browser(gui, request):
     """Open the CSV panel, press Export, name the file in the file browser, export."""
+    if gui.suite == "unstable":
+        # Blender 5.2 opens the file browser in a window of its own that, under Xvfb with no
+        # window manager, ignores the synthetic clicks sent to it (even once focused); 4.3 takes
+        # them. Strict: the day the harness or Blender gets it right, this xfail fails.
+        request.applymarker(
+            pytest.mark.xfail(
+                strict=True,
+                reason="5.2's file-browser window ignores xdotool clicks under Xvfb without a "
+                "window manager (export itself is tested by vg.export_csv on every line)",
+            )
+        )
     items = gui.measurements(OBJ)
     # The CSV panel is closed; it is one of the closed panels below the Selected panel, whose
     # last field is the note. Their headers are found by their disclosure triangles.
