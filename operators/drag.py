@@ -45,7 +45,8 @@ _DIGITS = {
     "PERIOD": ".",
     "NUMPAD_PERIOD": ".",
 }
-_NAVIGATION = {
+# Events that move the view: passed through to Blender while a tool is running.
+NAVIGATION_EVENTS = {
     "MIDDLEMOUSE",
     "WHEELUPMOUSE",
     "WHEELDOWNMOUSE",
@@ -85,7 +86,7 @@ def translate_event(event_type: str, value: str, *, ctrl=False, shift=False, alt
         return ("release", None) if value == "RELEASE" else ("ignore", None)
     if event_type in ("WHEELUPMOUSE", "WHEELDOWNMOUSE") and ctrl:
         return "lam", (1 if event_type == "WHEELUPMOUSE" else -1)
-    if event_type in _NAVIGATION:
+    if event_type in NAVIGATION_EVENTS:
         return "pass", None
     if event_type == "WINDOW_DEACTIVATE":
         return "cancel", "The window lost focus: nothing was recorded."

@@ -24,23 +24,12 @@ from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
 from ..properties import PATCH_ITEMS
 from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.edge_state import EdgeMachine, EdgePhase
-from .drag import format_length, object_alive, ray_cast_object
+from .drag import NAVIGATION_EVENTS, format_length, object_alive, ray_cast_object
 from .edge_overlay import EdgeOverlay
 from .measure import SPACE_ITEMS, poll_measurable, typed_value
 
-_NAVIGATION = {
-    "MIDDLEMOUSE",
-    "WHEELUPMOUSE",
-    "WHEELDOWNMOUSE",
-    "WHEELINMOUSE",
-    "WHEELOUTMOUSE",
-    "TRACKPADPAN",
-    "TRACKPADZOOM",
-    "NDOF_MOTION",
-    "MOUSEROTATE",
-    "MOUSESMARTZOOM",
-    "MOUSEMOVE",
-}
+# The drag tool's view navigation, and plain mouse moves (a click session has no drag).
+_NAVIGATION = NAVIGATION_EVENTS | {"MOUSEMOVE"}
 
 HINTS = (
     (("MOUSE_LMB",), "Click start, via points, end"),
