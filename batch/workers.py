@@ -20,7 +20,6 @@ import signal
 import subprocess
 import sys
 import threading
-import time
 from collections import deque
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -173,6 +172,8 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
+        for thread in threads:  # they end once their worker has: none may outlive the run
+            thread.join(timeout=STOP_SECONDS)
         raise
 
 
@@ -183,20 +184,32 @@ def _quit(folders, status: int) -> None:
     os._exit(status)
 
 
-def watch_parent(folder: str, parent_session: str) -> None:
+def watch_parent(folder: str, parent_session: str):
     """In a worker: when the parent process is gone, remove the run's temporary folder (with
     this worker's Blender session folder inside it) and the parent's Blender session folder,
     and exit at once: a parent killed with SIGKILL cannot clean up after itself. SIGTERM (the
-    parent stopping its workers) ends the worker the same way, without a traceback."""
+    parent stopping its workers) ends the worker the same way, without a traceback.
+
+    Returns a function that stops the watching; call it before the worker exits normally (a
+    thread still running at exit makes some bpy versions, e.g. 4.5, hang in their shutdown).
+    """
     parent = os.getppid()
     signal.signal(signal.SIGTERM, lambda signum, frame: _quit([bpy.app.tempdir], 143))
+    stop = threading.Event()
 
     def watch():
-        while os.getppid() == parent:
-            time.sleep(PARENT_POLL_SECONDS)
-        _quit([folder, parent_session], 1)
+        while not stop.wait(PARENT_POLL_SECONDS):
+            if os.getppid() != parent:
+                _quit([folder, parent_session], 1)
 
-    threading.Thread(target=watch, name="vg-parent-watch", daemon=True).start()
+    watcher = threading.Thread(target=watch, name="vg-parent-watch", daemon=True)
+    watcher.start()
+
+    def stop_watching():
+        stop.set()
+        watcher.join()
+
+    return stop_watching
 
 
 def worker_main(plan_path: str) -> int:
@@ -206,7 +219,14 @@ def worker_main(plan_path: str) -> int:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with open(plan_path, encoding="utf-8") as handle:
         plan = json.load(handle)
-    watch_parent(plan["folder"], plan.get("parent_session", ""))
+    stop_watching = watch_parent(plan["folder"], plan.get("parent_session", ""))
+    try:
+        return _measure_from_stdin(plan)
+    finally:
+        stop_watching()
+
+
+def _measure_from_stdin(plan: dict) -> int:
     bpy.ops.wm.read_homefile(use_empty=True)
     extension.activate()
     set_units(bpy.context.scene, plan["options"]["units"])
