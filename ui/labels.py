@@ -56,12 +56,25 @@ def _draw() -> None:
     blf.size(FONT_ID, size)
     widths = [blf.dimensions(FONT_ID, label.text)[0] for label, _ in placed]
     gap = 0.6 * size
-    shown = place_labels(positions, widths, size, priority, gap=gap)
+    shown = place_labels(
+        positions, widths, size, priority, gap=gap, right_edge=_visible_right(context, region)
+    )
     _dots(positions[[index for index, _ in shown]], 0.5 * size)
     for index, side in shown:
         label, (x, y) = placed[index]
         x = x + gap if side > 0 else x - gap - widths[index]
         _outlined(label.text, x, y - 0.35 * size, ACTIVE_COLOR if label.active else TEXT_COLOR)
+
+
+def _visible_right(context, region) -> float:
+    """Where the view stops being visible on the right: the region's edge, or the left edge of
+    a sidebar drawn over it (Region Overlap)."""
+    right = float(region.width)
+    area = context.area
+    for other in area.regions if area is not None else ():
+        if other.type == "UI" and other.width > 1 and other.x > region.x:
+            right = min(right, float(other.x - region.x))
+    return right
 
 
 def _dots(positions: np.ndarray, diameter: float) -> None:

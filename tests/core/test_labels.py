@@ -103,3 +103,16 @@ def test_flake_views_refuse_degenerate_meshes():
 
 def test_label_text():
     assert label_text(3, 91.2549) == "3: 91.25°"
+
+
+def test_a_label_that_would_cross_the_right_edge_goes_left():
+    anchors = [[95.0, 50.0], [10.0, 10.0]]
+    widths = [40.0, 40.0]
+    free = place_labels(anchors, widths, 12.0, [1, 0])
+    assert dict(free) == {0: 1, 1: 1}  # without an edge, both to the right
+    bounded = dict(place_labels(anchors, widths, 12.0, [1, 0], right_edge=100.0))
+    assert bounded == {0: -1, 1: 1}  # the one near the edge flips; the other stays
+    # Every shown box lies inside the edge when it can.
+    for index, side in bounded.items():
+        box = label_box(np.array(anchors[index]), widths[index], 12.0, side, 6.0)
+        assert box[2] <= 100.0

@@ -31,7 +31,9 @@ def _overlaps(boxes: np.ndarray, box: np.ndarray) -> bool:
     )
 
 
-def place_labels(anchors, widths, height: float, priority, *, gap: float | None = None) -> list:
+def place_labels(
+    anchors, widths, height: float, priority, *, gap: float | None = None, right_edge=None
+) -> list:
     """Which labels to show and on which side of their anchor, so that no two overlap.
 
     Greedily, by priority: a label goes to the right of its anchor if its text box is clear of
@@ -49,6 +51,9 @@ def place_labels(anchors, widths, height: float, priority, *, gap: float | None 
         Higher first (e.g. the selected measurement, then the newest); ties keep input order.
     gap : float, optional
         Between anchor and text; default half the height.
+    right_edge : float, optional
+        Where the visible picture ends on the right (pixels): a label whose text would cross it
+        tries the left side first.
 
     Returns
     -------
@@ -72,7 +77,13 @@ def place_labels(anchors, widths, height: float, priority, *, gap: float | None 
     for index in np.argsort(-priority, kind="stable"):
         anchor = anchors[index]
         mark = np.array([anchor[0] - dot, anchor[1] - dot, anchor[0] + dot, anchor[1] + dot])
-        for side in (1, -1):
+        sides = (1, -1)
+        if (
+            right_edge is not None
+            and label_box(anchor, widths[index], height, 1, gap)[2] > right_edge
+        ):
+            sides = (-1, 1)
+        for side in sides:
             box = label_box(anchor, widths[index], height, side, gap)
             padded = box + np.array([-pad, -pad, pad, pad])
             if not taken.size or not (_overlaps(taken, padded) or _overlaps(taken, mark)):
