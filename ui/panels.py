@@ -130,7 +130,7 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
         return exact_text(numbers[key]) + suffix if key in numbers else "missing"
 
     rows = [
-        ("Measurement", f"{item.number}, break {item.break_number}"),
+        ("Number", f"{item.number}, break {item.break_number}"),
     ]
     if item.edge_number:
         rows.append(
@@ -138,7 +138,8 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
         )
     rows += [
         ("Angle", number("angle", "°")),
-        ("Edge", f"{item.convexity}: {ANGLE_MEANING.get(item.convexity, '')}"),
+        ("Edge", item.convexity),
+        ("", ANGLE_MEANING.get(item.convexity, "")),
         ("Rule", item.rule),
         ("Stability", item.stability_text),
         ("Fit error", number("fit")),

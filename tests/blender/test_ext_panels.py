@@ -94,7 +94,7 @@ def test_selected_panel_shows_every_number_exactly_as_stored(vg, panels):
     # The centre is a vertex of the moved wedge: far more digits than a rounded field shows.
     assert len(selected_value(rows, "Centre", "X")) > 8
     assert selected_value(rows, "Lengths in") == "BU (1 BU = 0.001 m)"
-    assert selected_value(rows, "Measurement") == f"{item.number}, break {item.break_number}"
+    assert selected_value(rows, "Number") == f"{item.number}, break {item.break_number}"
     assert selected_value(rows, "Vertices") == (
         f"{item.n_vertices} ({item.n_plus} +, {item.n_minus} −)"
     )
