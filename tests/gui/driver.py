@@ -129,10 +129,14 @@ class GuiBlender:
             timeout=180,
         )
         # The splash would cover the viewport: a user closes it once, the harness turns it off.
-        # Developer extras let F3 find operators by name, as they do for many users.
+        # Developer extras let F3 find operators by name, as they do for many users. The file
+        # browser opens as a maximized area of the main window (Preferences > Interface >
+        # Temporary Editors), not a window of its own: with no window manager under Xvfb, 5.2's
+        # new window ignores synthetic clicks.
         run(
             "blender -b --python-expr 'import bpy; view = bpy.context.preferences.view; "
             "view.show_splash = False; view.show_developer_ui = True; "
+            'view.filebrowser_display_type = "SCREEN"; '
             "bpy.ops.wm.save_userpref()'",
             timeout=180,
         )
@@ -222,16 +226,6 @@ class GuiBlender:
         if modifier:
             self.settle(1)
             self.xdotool("keyup", modifier)
-        self.settle()
-
-    def focus_window_at(self, xy) -> None:
-        """Give the X input focus to the window at ``xy`` (with no window manager, a window
-        Blender opens, e.g. the file browser, is not focused by clicking it in Blender 5.2)."""
-        self.move(xy)
-        self.shell.check(
-            f"eval $(DISPLAY={self.display} xdotool getmouselocation --shell) && "
-            f"DISPLAY={self.display} xdotool windowfocus --sync $WINDOW"
-        )
         self.settle()
 
     def key(self, *keys: str) -> None:

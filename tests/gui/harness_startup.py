@@ -152,8 +152,9 @@ def _tick():
         if wm.clipboard:
             _status["clipboard"].append([_status["seq"], wm.clipboard])
             wm.clipboard = ""
+        # None while a maximized file browser stands in for the window's screen.
         area = _view3d(window)
-        sidebar = next((r for r in area.regions if r.type == "UI"), None)
+        sidebar = next((r for r in area.regions if r.type == "UI"), None) if area else None
         tool = window.workspace.tools.from_space_view3d_mode("OBJECT", create=False)
         _status["seq"] += 1
         state = {
@@ -161,15 +162,15 @@ def _tick():
             "ready": True,
             "version": list(bpy.app.version),
             "window": [window.x, window.y, window.width, window.height],
-            "regions": _regions(window, area),
+            "regions": _regions(window, area) if area else {},
             "file_browser": _file_browser(),
             "sidebar_category": sidebar.active_panel_category if sidebar else None,
             "tool": tool.idname if tool else None,
             "cursor": list(window.scene.cursor.location),
             "active": getattr(window.view_layer.objects.active, "name", None),
             "objects": _objects(window.scene),
-            "drag": _drag(window, area),
-            "points": _projections(window, area),
+            "drag": _drag(window, area) if area else None,
+            "points": _projections(window, area) if area else {},
             "clipboard": _status["clipboard"][-20:],
             "errors": _status["errors"][-5:],
         }
