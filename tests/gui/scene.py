@@ -25,16 +25,15 @@ def extension():
     return importlib.import_module(EXTENSION)
 
 
-def build_wedge():
-    """Replace the startup scene's objects by the wedge, active and selected; return it."""
-    synthetic = importlib.import_module(EXTENSION + ".vg_addon.synthetic_meshes")
-    shape = synthetic.wedge(WEDGE_ANGLE, n=40, irregular=True, seed=3)
+def replace_meshes_with(name: str, points, triangles):
+    """Remove the scene's mesh objects and add one made of ``points`` and ``triangles``,
+    active and selected; return it."""
     for obj in list(bpy.data.objects):
         if obj.type == "MESH":
             bpy.data.objects.remove(obj)
-    points = np.asarray(shape.points, dtype=np.float32)
-    triangles = np.asarray(shape.triangles, dtype=np.int32)
-    mesh = bpy.data.meshes.new(OBJECT_NAME)
+    points = np.asarray(points, dtype=np.float32)
+    triangles = np.asarray(triangles, dtype=np.int32)
+    mesh = bpy.data.meshes.new(name)
     mesh.vertices.add(points.shape[0])
     mesh.vertices.foreach_set("co", points.ravel())
     mesh.loops.add(triangles.size)
@@ -42,11 +41,19 @@ def build_wedge():
     mesh.polygons.add(triangles.shape[0])
     mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
     mesh.update(calc_edges=True)
-    obj = bpy.data.objects.new(OBJECT_NAME, mesh)
-    scene = bpy.context.scene
-    scene.collection.objects.link(obj)
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
     bpy.context.view_layer.objects.active = obj
     obj.select_set(True)
+    return obj
+
+
+def build_wedge():
+    """Replace the startup scene's objects by the wedge, active and selected; return it."""
+    synthetic = importlib.import_module(EXTENSION + ".vg_addon.synthetic_meshes")
+    shape = synthetic.wedge(WEDGE_ANGLE, n=40, irregular=True, seed=3)
+    obj = replace_meshes_with(OBJECT_NAME, shape.points, shape.triangles)
+    scene = bpy.context.scene
     scene.vg_settings.radius = PANEL_RADIUS
     bpy.context.view_layer.update()
     return obj
@@ -76,24 +83,8 @@ def build_fragment():
     """A synthetic long-bone fragment (mm), for the README's pictures; return it and its sites."""
     synthetic = importlib.import_module(EXTENSION + ".vg_addon.synthetic_meshes")
     fragment = synthetic.bone_fragment(spacing=0.4)
-    for obj in list(bpy.data.objects):
-        if obj.type == "MESH":
-            bpy.data.objects.remove(obj)
-    points = np.asarray(fragment.points, dtype=np.float32)
-    triangles = np.asarray(fragment.triangles, dtype=np.int32)
-    mesh = bpy.data.meshes.new(FRAGMENT_NAME)
-    mesh.vertices.add(points.shape[0])
-    mesh.vertices.foreach_set("co", points.ravel())
-    mesh.loops.add(triangles.size)
-    mesh.loops.foreach_set("vertex_index", triangles.ravel())
-    mesh.polygons.add(triangles.shape[0])
-    mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
-    mesh.update(calc_edges=True)
-    obj = bpy.data.objects.new(FRAGMENT_NAME, mesh)
+    obj = replace_meshes_with(FRAGMENT_NAME, fragment.points, fragment.triangles)
     scene = bpy.context.scene
-    scene.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
-    obj.select_set(True)
     scene.unit_settings.system = "METRIC"
     scene.unit_settings.scale_length = 0.001
     scene.unit_settings.length_unit = "MILLIMETERS"
