@@ -193,19 +193,18 @@ def measure_on_object(
 
 # Per measurement, what changes whenever it is replaced by another one; read for the whole list
 # at once (foreach_get) to recognise the measurements already painted without reading them.
-_SIGNATURE = ("number", "break_number", "n_vertices", "n_plus", "n_minus")
+_SIGNATURE = ("number", "break_number", "n_vertices", "n_plus", "n_minus", "stale")
 
 
-def _signatures(items) -> list[tuple]:
-    columns = []
-    for name in _SIGNATURE:
-        values = np.empty(len(items), dtype=np.int64)
-        items.foreach_get(name, values)
-        columns.append(values.tolist())
+def _signatures(items) -> np.ndarray:
+    """One row of :data:`_SIGNATURE` values per record, int64 ``(n, 6)``."""
+    rows = np.empty((len(_SIGNATURE), len(items)), dtype=np.int64)
     stale = np.empty(len(items), dtype=bool)
+    for row, name in zip(rows[:-1], _SIGNATURE[:-1], strict=True):
+        items.foreach_get(name, row)
     items.foreach_get("stale", stale)
-    columns.append(stale.tolist())
-    return list(zip(*columns, strict=True))
+    rows[-1] = stale
+    return rows.T.copy()
 
 
 def repaint(
@@ -250,9 +249,19 @@ def repaint(
     if not trusted and legacy.has_world_records(obj):
         # Only a file load or an undo brings world-space records, and neither is trusted.
         legacy.migrate(obj, geometry, surface_for(obj, geometry))
-    known = state.known if trusted else {}
-    keys, sides, stale, remembered = [], {}, [], {}
-    for position, signature in enumerate(_signatures(items)):
+    rows = _signatures(items)
+    keys, sides, stale, remembered, start = [], {}, [], {}, 0
+    if trusted:
+        remembered = state.known
+        before = state.rows.shape[0]
+        if before <= rows.shape[0] and np.array_equal(state.rows, rows[:before]):
+            # Records only added since (the usual click): the earlier ones are as painted.
+            keys, stale, start = list(state.painted), list(state.stale), before
+    known = remembered
+    if start == 0:
+        remembered = {}
+    for position in range(start, rows.shape[0]):
+        signature = tuple(rows[position].tolist())
         entry = known.get(signature)
         if entry is None:
             item = items[position]
@@ -265,7 +274,8 @@ def repaint(
                     is_stale, key = True, None
             if item.stale != is_stale:
                 item.stale = is_stale
-            signature = (*signature[:-1], is_stale)
+            rows[position, -1] = is_stale
+            signature = (*signature[:-1], int(is_stale))
             entry = (key, sides.get(key))
         remembered[signature] = entry
         key, kept = entry
@@ -280,9 +290,10 @@ def repaint(
             state.add(key, sides[key])
         painting.set_state(obj, state)
     state.known, state.generation = remembered, painting.generation()
+    state.rows, state.stale = rows, stale
     with own_write(mesh, depsgraph):
         colors.write_attribute(mesh, state.colours)
-    return stale
+    return list(stale)
 
 
 def migrate_fingerprints(obj, geometry: Geometry) -> int:

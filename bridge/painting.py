@@ -83,6 +83,9 @@ class PaintState:
     # trusted only in the generation it was made in (see ``generation``).
     known: dict = field(default_factory=dict)
     generation: int = -1
+    # The records' signatures as last painted (int64, one row each) and the stale numbers.
+    rows: np.ndarray = field(default_factory=lambda: np.zeros((0, 6), dtype=np.int64))
+    stale: list = field(default_factory=list)
 
     @classmethod
     def blank(cls, fingerprint: str, n: int) -> PaintState:
@@ -137,6 +140,10 @@ class PaintState:
         """Bring the painting to ``keys`` (in painting order) by removing and adding entries;
         False (nothing changed) if only a full repaint can, i.e. an entry kept would have to
         move. ``sides_of(key)`` gives the Sides of a key to add."""
+        if keys[: len(self.painted)] == self.painted:  # only additions (the usual click)
+            for key in keys[len(self.painted) :]:
+                self.add(key, sides_of(key))
+            return True
         wanted = set(keys)
         kept = [key for key in self.painted if key in wanted]
         if kept != keys[: len(kept)] or len(self.painted) - len(kept) > _MAX_REMOVALS:

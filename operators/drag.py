@@ -14,12 +14,13 @@ import contextlib
 import bpy
 import numpy as np
 from bpy_extras import view3d_utils
-from mathutils import Vector
+from mathutils import Matrix, Vector
 
 from ..bridge.mesh_data import (
     check_measurable,
     evaluated_geometry,
     mesh_points,
+    ray_tree_for,
     surface_for,
     uniform_scale,
     world_points,
@@ -124,18 +125,18 @@ def ray_cast_object(obj, depsgraph, region, region_data, coord):
     """Point where the view ray through region pixel ``coord`` first hits ``obj``, in mesh
     coordinates (object space, where it is measured).
 
-    Only ``obj`` is tested (its evaluated mesh); ``None`` when the ray misses.
+    Only ``obj`` is tested (its evaluated mesh, through its kept ray-cast tree); ``None`` when
+    the ray misses.
     """
     coord = Vector(coord)
     origin = view3d_utils.region_2d_to_origin_3d(region, region_data, coord)
     direction = view3d_utils.region_2d_to_vector_3d(region, region_data, coord)
-    obj_eval = obj.evaluated_get(depsgraph)
-    to_world = obj_eval.matrix_world
-    to_local = to_world.inverted_safe()
-    local_origin = to_local @ origin
-    local_direction = to_local.to_3x3() @ direction
-    hit, location, _normal, _face = obj_eval.ray_cast(local_origin, local_direction)
-    return np.array(location, dtype=np.float64) if hit else None
+    geometry = evaluated_geometry(obj, depsgraph)
+    to_local = Matrix(geometry.matrix.tolist()).inverted_safe()
+    location = ray_tree_for(obj, geometry, depsgraph).ray_cast(
+        to_local @ origin, to_local.to_3x3() @ direction
+    )[0]
+    return None if location is None else np.array(location, dtype=np.float64)
 
 
 def view_plane_radius(region, region_data, coord, center, matrix) -> float:

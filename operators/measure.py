@@ -29,9 +29,14 @@ def typed_value(value: float) -> float:
 
 
 def _stale_warning(obj) -> str:
-    stale = [str(item.number) for item in obj.vg.measurements if item.stale]
-    if not stale:
+    items = obj.vg.measurements
+    flags = np.zeros(len(items), dtype=bool)
+    items.foreach_get("stale", flags)  # no Python loop over every stored measurement
+    if not flags.any():
         return ""
+    numbers = np.zeros(len(items), dtype=np.int64)
+    items.foreach_get("number", numbers)
+    stale = [str(number) for number in numbers[flags]]
     return (
         f"Measurement(s) {', '.join(stale)} of '{obj.name}' are stale: the mesh or its modifiers "
         "changed since they were taken. Their numbers are kept; they are no longer painted."

@@ -8,7 +8,8 @@ own); times are the minimum (and median) of repeats, since the machine may be sh
 
 Per size: the first click (mesh read, Surface build, measure, record, paint, undo step) and the
 process's peak memory; a repeat click (``vg.measure_xyz`` with its undo step) with 1 and with
-1,000 measurements stored; drag press (evaluate, cached Surface, ray cast, snap) and release
+1,000 measurements stored, without and with the stability figure (the panel's default); drag
+press (evaluate, kept Surface, ray cast on the kept tree, snap) and release
 (measure, then ``vg.measure_xyz``); delete, undo and clear at 1,000 measurements; the first
 geodesic measurement. At 1M also: the core's time per 2,000-vertex measurement, the batch's
 measurements per second (mesh import excluded) and the import of a 1M-vertex binary PLY.
@@ -128,17 +129,26 @@ def run_size(label: str, stored: int, repeats: int) -> dict:
     bpy.ops.ed.undo_push(message="start")
     out["rss_before_first_click_mb"] = rss_mb()
 
-    def click():
+    def click(stability=False):
         c = next(next_center)
         result = bpy.ops.vg.measure_xyz(
-            "EXEC_DEFAULT", True, location=tuple(c), radius=radius, seg_param=2.0
+            "EXEC_DEFAULT",
+            True,
+            location=tuple(c),
+            radius=radius,
+            seg_param=2.0,
+            stability=stability,
         )
         assert result == {"FINISHED"}, result
+
+    def stable_click():
+        click(stability=True)
 
     out["first_click_ms"] = timed(click) * 1e3
     out["peak_rss_mb"] = peak_rss_mb()
     out["patch_vertices"] = int(obj.vg.measurements[-1].n_vertices)
     out["repeat_click_1"] = stats([timed(click) for _ in range(repeats)])
+    out["stable_click_1"] = stats([timed(stable_click) for _ in range(repeats)])
 
     depsgraph = bpy.context.evaluated_depsgraph_get()
 
@@ -146,10 +156,11 @@ def run_size(label: str, stored: int, repeats: int) -> dict:
         mesh_data.check_measurable(obj)
         dg = bpy.context.evaluated_depsgraph_get()
         surface = mesh_data.surface_for(obj, mesh_data.evaluated_geometry(obj, dg))
-        obj_eval = obj.evaluated_get(dg)
+        geometry = mesh_data.evaluated_geometry(obj, dg)
         c = next(next_center)
-        hit, location, _n, _f = obj_eval.ray_cast(c + np.array([0, 0, 1.0]), (0, 0, -1.0))
-        surface.index.nearest(np.array(location if hit else c), np.inf)
+        tree = mesh_data.ray_tree_for(obj, geometry, dg)  # what the drag tool casts on
+        location = tree.ray_cast(c + np.array([0, 0, 1.0]), (0, 0, -1.0))[0]
+        surface.index.nearest(np.array(c if location is None else location), np.inf)
         return surface
 
     def release():
@@ -157,7 +168,7 @@ def run_size(label: str, stored: int, repeats: int) -> dict:
         c = next(next_center)
         surface.measure(c, radius)
         result = bpy.ops.vg.measure_xyz(
-            "EXEC_DEFAULT", True, location=tuple(c), radius=radius, seg_param=2.0
+            "EXEC_DEFAULT", True, location=tuple(c), radius=radius, seg_param=2.0, stability=False
         )
         assert result == {"FINISHED"}, result
 
@@ -181,6 +192,7 @@ def run_size(label: str, stored: int, repeats: int) -> dict:
     out["stored"] = len(obj.vg.measurements)
     bpy.ops.ed.undo_push(message="filled")
     out[f"repeat_click_{stored}"] = stats([timed(click) for _ in range(repeats)])
+    out[f"stable_click_{stored}"] = stats([timed(stable_click) for _ in range(repeats)])
     out[f"press_{stored}"], out[f"release_{stored}"] = drags(repeats)
 
     deletes, undos = [], []
@@ -313,6 +325,8 @@ def table(results: list[dict]) -> None:
     row("repeat click, 1 stored (median)", "repeat_click_1", sub="median")
     row(f"repeat click, {stored} stored (min)", f"repeat_click_{stored}")
     row(f"repeat click, {stored} stored (median)", f"repeat_click_{stored}", sub="median")
+    row("click with the stability figure, 1 stored", "stable_click_1")
+    row(f"click with the stability figure, {stored} stored", f"stable_click_{stored}")
     row("drag press, 1 stored", "press_1")
     row("drag release, 1 stored", "release_1")
     row(f"drag press, {stored} stored", f"press_{stored}")

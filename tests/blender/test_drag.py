@@ -153,6 +153,55 @@ def test_ray_cast_from_region_pixels_hits_the_projected_vertices(drag, view):
     assert drag.ray_cast_object(view.obj, depsgraph, view.region, view.rv3d, (3, 3)) is None
 
 
+def test_ray_tree_survives_measuring_and_follows_edits(drag, view, vg):
+    """The press after a measurement must not wait for a new ray-cast tree (the colour write
+    makes Blender rebuild its own), yet an edited mesh must be hit where it now is. Oracle:
+    Blender's own ray cast on the evaluated object."""
+    mesh_data = importlib.import_module(f"{vg.__name__}.bridge.mesh_data")
+    obj = view.obj
+    vertex = ridge_vertex(view)
+    coord = pixel(view, view.points[vertex])
+
+    def blender_hit():
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        obj_eval = obj.evaluated_get(depsgraph)
+        to_local_matrix = obj_eval.matrix_world.inverted_safe()
+        origin = view3d_utils.region_2d_to_origin_3d(view.region, view.rv3d, Vector(coord))
+        direction = view3d_utils.region_2d_to_vector_3d(view.region, view.rv3d, Vector(coord))
+        hit, location, _n, _f = obj_eval.ray_cast(
+            to_local_matrix @ origin, to_local_matrix.to_3x3() @ direction
+        )
+        assert hit
+        return np.array(location)
+
+    def tree():
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        return mesh_data.ray_tree_for(obj, mesh_data.evaluated_geometry(obj, depsgraph))
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    first = drag.ray_cast_object(obj, depsgraph, view.region, view.rv3d, coord)
+    assert np.array_equal(first, blender_hit())
+    kept = tree()
+    bpy.context.view_layer.objects.active = obj
+    result = bpy.ops.vg.measure_xyz(
+        "EXEC_DEFAULT", location=tuple(view.points[vertex]), radius=0.5, stability=False
+    )
+    assert result == {"FINISHED"}
+    assert tree() is kept  # painting the sides kept it
+    # Lift the whole mesh by 0.25 along its own z (towards the camera): the ray must hit the
+    # moved surface, not the kept tree's.
+    positions = np.empty(len(obj.data.vertices) * 3, dtype=np.float32)
+    obj.data.vertices.foreach_get("co", positions)
+    positions[2::3] += 0.25
+    obj.data.vertices.foreach_set("co", positions)
+    obj.data.update()
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    moved = drag.ray_cast_object(obj, depsgraph, view.region, view.rv3d, coord)
+    assert tree() is not kept
+    assert np.array_equal(moved, blender_hit())
+    assert moved[2] == pytest.approx(first[2] + 0.25, abs=1e-3)
+
+
 def test_radius_is_measured_on_the_view_plane(drag, view):
     center = view.points[ridge_vertex(view)]
     tolerance = pixel_size(drag, view, center)
