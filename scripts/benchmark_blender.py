@@ -10,7 +10,8 @@ Per size: the first click (mesh read, Surface build, measure, record, paint, und
 process's peak memory; a repeat click (``vg.measure_xyz`` with its undo step) with 1 and with
 1,000 measurements stored, without and with the stability figure (the panel's default); drag
 press (evaluate, kept Surface, ray cast on the kept tree, snap) and release
-(measure, then ``vg.measure_xyz``); delete, undo and clear at 1,000 measurements; the first
+(measure, then ``vg.measure_xyz``); delete, undo, the click after an undo and clear at 1,000
+measurements; the first
 geodesic measurement. At 1M also: the core's time per 2,000-vertex measurement, the batch's
 measurements per second (mesh import excluded) and the import of a 1M-vertex binary PLY.
 """
@@ -195,7 +196,7 @@ def run_size(label: str, stored: int, repeats: int) -> dict:
     out[f"stable_click_{stored}"] = stats([timed(stable_click) for _ in range(repeats)])
     out[f"press_{stored}"], out[f"release_{stored}"] = drags(repeats)
 
-    deletes, undos = [], []
+    deletes, undos, after_undo = [], [], []
     for k in range(repeats):
         index = (k * 37) % len(obj.vg.measurements)
         deletes.append(
@@ -203,8 +204,13 @@ def run_size(label: str, stored: int, repeats: int) -> dict:
         )
         undos.append(timed(bpy.ops.ed.undo))
         obj = bpy.data.objects["Scan"]
+        # An undo may restore any mesh and any records: the next click reads them again.
+        after_undo.append(timed(click))
+        bpy.ops.ed.undo()
+        obj = bpy.data.objects["Scan"]
     out[f"delete_{stored}"] = stats(deletes)
     out[f"undo_{stored}"] = stats(undos)
+    out[f"after_undo_{stored}"] = stats(after_undo)
     bpy.context.view_layer.objects.active = obj
     out[f"clear_{stored}"] = stats(
         [timed(lambda: bpy.ops.vg.clear_measurements("EXEC_DEFAULT", True))]
@@ -333,6 +339,7 @@ def table(results: list[dict]) -> None:
     row(f"drag release, {stored} stored", f"release_{stored}")
     row(f"delete one, {stored} stored", f"delete_{stored}")
     row(f"undo of a delete, {stored} stored", f"undo_{stored}")
+    row(f"click after an undo, {stored} stored", f"after_undo_{stored}")
     row(f"clear {stored}", f"clear_{stored}")
     row("first geodesic measurement", "first_geodesic_ms")
     row("core, per 2,000-vertex measurement", "core_per_measurement")

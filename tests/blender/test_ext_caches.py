@@ -225,3 +225,28 @@ def test_fingerprint_follows_faces_not_only_positions(vg):
     bpy.ops.object.mode_set(mode="OBJECT")
     bpy.ops.vg.repaint()
     assert obj.vg.measurements[0].stale
+
+
+def test_a_reread_geometry_is_compared_bit_for_bit(vg):
+    """After an invalidation the mesh is compared with the kept one instead of hashed again;
+    a change the fingerprint sees (here 0.0 to -0.0, equal as numbers) must still give a new
+    fingerprint. Oracle: the fingerprint computed here from the mesh's own arrays."""
+    mesh_data = vg.bridge.mesh_data
+    obj = wedge_object(80.0)
+    measure_at(0.1)
+    kept = mesh_data.evaluated_geometry(obj)
+    mesh_data.invalidate(obj)
+    assert mesh_data.evaluated_geometry(obj) is kept  # unchanged: the kept geometry itself
+    co = local_points(obj).copy()
+    zero = np.flatnonzero(co.ravel() == 0.0)[0]
+    assert not np.signbit(co.ravel()[zero])
+    co.ravel()[zero] = -0.0
+    obj.data.vertices.foreach_set("co", co.ravel())
+    obj.data.update()
+    bpy.context.view_layer.update()
+    changed = mesh_data.evaluated_geometry(obj)
+    corners, faces = mesh_data.read_corners(obj.data)
+    assert changed.fingerprint == mesh_data.fingerprint(co, corners, faces)
+    assert changed.fingerprint != kept.fingerprint
+    bpy.ops.vg.repaint()
+    assert obj.vg.measurements[0].stale
