@@ -9,11 +9,10 @@ own); times are the minimum (and median) of repeats, since the machine may be sh
 Per size: the first click (mesh read, Surface build, measure, record, paint, undo step) and the
 process's peak memory; a repeat click (``vg.measure_xyz`` with its undo step) with 1 and with
 1,000 measurements stored, without and with the stability figure (the panel's default); drag
-press (evaluate, kept Surface, ray cast on the kept tree, snap) and release
-(measure, then ``vg.measure_xyz``); delete, undo, the click after an undo and clear at 1,000
-measurements; the first
-geodesic measurement. At 1M also: the core's time per 2,000-vertex measurement, the batch's
-measurements per second (mesh import excluded) and the import of a 1M-vertex binary PLY.
+press (evaluate, kept Surface, ray cast on the kept tree, snap) and release (measure, then
+``vg.measure_xyz``); delete, undo, the click after an undo and clear at 1,000 measurements; the
+first geodesic measurement. At 1M also: the core's time per 2,000-vertex measurement, the
+batch's measurements per second (mesh import excluded) and the import of a 1M-vertex binary PLY.
 """
 
 from __future__ import annotations
