@@ -159,6 +159,12 @@ class VG_Measurement(PropertyGroup):
     edge_number: IntProperty(
         name="Edge #", description="The edge profile this measurement is a station of (0: none)"
     )
+    content_id: IntProperty(
+        name="Content id",
+        description="A digest of the exact numbers, patch mode and fingerprint (0: not yet "
+        "stamped): recognises a record restored by undo without reading it",
+        options={"HIDDEN"},
+    )
 
     # Read-only views of the exact numbers, for drawing.
     arc_length: FloatProperty(

@@ -266,6 +266,7 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
             numbers = exact_numbers(item)
             numbers["plus_left"] = bool(left)
             item.exact = json.dumps(numbers)
+            records.stamp(item)
             item.colors = "/".join(records.station_colours(item.break_number, left))
         edge.plot = make_plot(obj, edge).name
         numbers_made.append(edge.number)

@@ -29,11 +29,21 @@ from . import records
 from .mesh_data import Geometry, mesh_points, uniform_scale, world_points
 
 
-def has_world_records(obj) -> bool:
-    """Whether any measurement of ``obj`` is still recorded in world space."""
-    return any(
-        (numbers := exact_numbers(item)) and "space" not in numbers for item in obj.vg.measurements
-    )
+def has_world_records(obj, signatures=None, known=()) -> bool:
+    """Whether any measurement of ``obj`` is still recorded in world space.
+
+    ``signatures`` (one row per record) and ``known`` (signatures of records already read, as
+    ``measuring.repaint`` keeps them) skip the records already read, which it has judged.
+    """
+    items = obj.vg.measurements
+    positions = range(len(items))
+    if signatures is not None:
+        positions = [i for i, row in enumerate(signatures.tolist()) if tuple(row) not in known]
+    for position in positions:
+        numbers = exact_numbers(items[position])
+        if numbers and "space" not in numbers:
+            return True
+    return False
 
 
 def migrate(obj, geometry: Geometry, surface) -> list[int]:
@@ -82,6 +92,7 @@ def migrate(obj, geometry: Geometry, surface) -> list[int]:
         )
         item.fingerprint = geometry.fingerprint
         item.stale = False
+        records.stamp(item)
         migrated.append(item.number)
     return migrated
 

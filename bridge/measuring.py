@@ -193,17 +193,19 @@ def measure_on_object(
 
 # Per measurement, what changes whenever it is replaced by another one; read for the whole list
 # at once (foreach_get) to recognise the measurements already painted without reading them.
-_SIGNATURE = ("number", "break_number", "n_vertices", "n_plus", "n_minus", "stale")
+_SIGNATURE = ("number", "break_number", "n_vertices", "n_plus", "n_minus", "content_id", "stale")
+_STALE = len(_SIGNATURE) - 1
+_CONTENT = _SIGNATURE.index("content_id")
 
 
 def _signatures(items) -> np.ndarray:
-    """One row of :data:`_SIGNATURE` values per record, int64 ``(n, 6)``."""
-    rows = np.empty((len(_SIGNATURE), len(items)), dtype=np.int64)
+    """One row of :data:`_SIGNATURE` values per record, int32 ``(n, 7)``."""
+    rows = np.empty((len(_SIGNATURE), len(items)), dtype=np.int32)  # IntProperty's own type
     stale = np.empty(len(items), dtype=bool)
-    for row, name in zip(rows[:-1], _SIGNATURE[:-1], strict=True):
+    for row, name in zip(rows[:_STALE], _SIGNATURE[:_STALE], strict=True):
         items.foreach_get(name, row)
     items.foreach_get("stale", stale)
-    rows[-1] = stale
+    rows[_STALE] = stale
     return rows.T.copy()
 
 
@@ -246,18 +248,23 @@ def repaint(
         and colors.has_attribute(mesh)
     )
     trusted = usable and not verify and state.generation == painting.generation()
-    if not trusted and legacy.has_world_records(obj):
-        # Only a file load or an undo brings world-space records, and neither is trusted.
-        legacy.migrate(obj, geometry, surface_for(obj, geometry))
     rows = _signatures(items)
     keys, sides, stale, remembered, start = [], {}, [], {}, 0
+    known = state.known if usable and not verify else {}
     if trusted:
-        remembered = state.known
+        remembered = known
         before = state.rows.shape[0]
         if before <= rows.shape[0] and np.array_equal(state.rows, rows[:before]):
             # Records only added since (the usual click): the earlier ones are as painted.
             keys, stale, start = list(state.painted), list(state.stale), before
-    known = remembered
+    elif known:
+        # After an undo or redo, a record is recognised only by its content id (the same
+        # exact numbers, patch mode and fingerprint); unstamped ones are read again.
+        known = {signature: entry for signature, entry in known.items() if signature[_CONTENT]}
+    if not trusted and legacy.has_world_records(obj, rows, known):
+        # Only a file load or an undo brings world-space records, and neither is trusted.
+        legacy.migrate(obj, geometry, surface_for(obj, geometry))
+        rows = _signatures(items)
     if start == 0:
         remembered = {}
     for position in range(start, rows.shape[0]):
@@ -274,8 +281,11 @@ def repaint(
                     is_stale, key = True, None
             if item.stale != is_stale:
                 item.stale = is_stale
-            rows[position, -1] = is_stale
-            signature = (*signature[:-1], int(is_stale))
+            content = records.content_id(item)
+            if signature[_CONTENT] != content:  # an older version's record, or a script's edit
+                item.content_id = content
+            rows[position, _CONTENT], rows[position, _STALE] = content, is_stale
+            signature = (*signature[:_CONTENT], content, int(is_stale))
             entry = (key, sides.get(key))
         remembered[signature] = entry
         key, kept = entry
@@ -304,6 +314,7 @@ def migrate_fingerprints(obj, geometry: Geometry) -> int:
     for item in obj.vg.measurements:
         if item.fingerprint != geometry.fingerprint and geometry.matches(item.fingerprint):
             item.fingerprint = geometry.fingerprint
+            records.stamp(item)
             migrated += 1
     return migrated
 

@@ -80,11 +80,12 @@ class PaintState:
     painted: list = field(default_factory=list)  # keys, in painting order
     sides: list = field(default_factory=list)  # their Sides, aligned with ``painted``
     # The records as last painted: signature -> (key, Sides), or (None, None) for a stale one;
-    # trusted only in the generation it was made in (see ``generation``).
+    # trusted in the generation it was made in (see ``generation``), and in later ones for
+    # records with a content id.
     known: dict = field(default_factory=dict)
     generation: int = -1
-    # The records' signatures as last painted (int64, one row each) and the stale numbers.
-    rows: np.ndarray = field(default_factory=lambda: np.zeros((0, 6), dtype=np.int64))
+    # The records' signatures as last painted (one row each) and the stale numbers.
+    rows: np.ndarray = field(default_factory=lambda: np.zeros((0, 7), dtype=np.int32))
     stale: list = field(default_factory=list)
 
     @classmethod

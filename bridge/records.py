@@ -3,6 +3,7 @@ a CSV row."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import tomllib
 from functools import cache
@@ -142,8 +143,22 @@ def add_measurement(
     item.colors = "/".join(station_colours(item.break_number, numbers.get("plus_left", True)))
     item.fingerprint = geometry_fingerprint
     item.stale = False
+    stamp(item)
     data.active_index = len(data.measurements) - 1
     return item
+
+
+def content_id(item) -> int:
+    """A digest, from 1 to 2**31 - 1, of what painting ``item`` depends on besides its
+    break: its exact numbers, patch mode and geometry fingerprint."""
+    digest = hashlib.sha256(f"{item.fingerprint}\0{item.patch}\0{item.exact}".encode())
+    return int.from_bytes(digest.digest()[:4], "little") % (2**31 - 1) + 1
+
+
+def stamp(item) -> None:
+    """Record ``item``'s :func:`content_id`; call after changing its exact numbers, patch mode
+    or fingerprint."""
+    item.content_id = content_id(item)
 
 
 def next_free_break(obj) -> int:

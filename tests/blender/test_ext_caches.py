@@ -197,6 +197,7 @@ def test_old_fingerprints_are_migrated_not_marked_stale(vg, tmp_path):
         for key in ("center", "requested"):
             numbers[key] = world(numbers[key], obj).tolist()
         item.exact = json.dumps(numbers)
+        item.content_id = 0  # old versions wrote none
     items[0].fingerprint = legacy
     items[1].fingerprint = legacy
     items[2].fingerprint = "0123456789abcdef0123456789abcdef"  # an old file, another geometry
