@@ -19,8 +19,8 @@ from ..vg_addon import palette
 
 # Patch vertices whose sides are kept, in all (5 bytes each): bounds the memory, not the count.
 _KEPT_VERTICES = 20_000_000
-# Beyond this many removed measurements, painting everything again is cheaper.
-_MAX_REMOVALS = 8
+# Beyond this many removed or inserted measurements, painting everything again is cheaper.
+_MAX_CHANGES = 8
 
 
 @dataclass(frozen=True)
@@ -137,23 +137,41 @@ class PaintState:
         later = self.owner > position + 1
         self.owner[later] -= 1
 
+    def insert(self, position: int, key: tuple, sides: Sides) -> None:
+        """Paint ``sides`` as the entry at ``position``: over the entries before it, under the
+        ones after it (e.g. a deleted measurement brought back by undo)."""
+        self.owner[self.owner > position] += 1  # the later entries move up one place
+        self.painted.insert(position, key)
+        self.sides.insert(position, sides)
+        free = self.owner[sides.vertices] <= position  # earlier entries' or nobody's
+        self._paint(sides, sides.vertices[free], sides.plus[free], position + 1)
+
     def update_to(self, keys: list, sides_of) -> bool:
-        """Bring the painting to ``keys`` (in painting order) by removing and adding entries;
-        False (nothing changed) if only a full repaint can, i.e. an entry kept would have to
-        move. ``sides_of(key)`` gives the Sides of a key to add."""
+        """Bring the painting to ``keys`` (in painting order) by removing, inserting and adding
+        entries; False (nothing changed) if only a full repaint can, i.e. an entry kept would
+        have to move, or there are many to remove or insert. ``sides_of(key)`` gives the Sides
+        of a key to add."""
         if keys[: len(self.painted)] == self.painted:  # only additions (the usual click)
             for key in keys[len(self.painted) :]:
                 self.add(key, sides_of(key))
             return True
         wanted = set(keys)
         kept = [key for key in self.painted if key in wanted]
-        if kept != keys[: len(kept)] or len(self.painted) - len(kept) > _MAX_REMOVALS:
+        present = set(kept)
+        missing = [position for position, key in enumerate(keys) if key not in present]
+        last_kept = max((p for p, key in enumerate(keys) if key in present), default=-1)
+        inserts = sum(position < last_kept for position in missing)  # the others are added
+        changes = len(self.painted) - len(kept) + inserts
+        if [key for key in keys if key in present] != kept or changes > _MAX_CHANGES:
             return False
         for position in range(len(self.painted) - 1, -1, -1):
             if self.painted[position] not in wanted:
                 self.remove(position)
-        for key in keys[len(kept) :]:
-            self.add(key, sides_of(key))
+        for position in missing:  # in increasing order: each lands at its place in ``keys``
+            if position == len(self.painted):
+                self.add(keys[position], sides_of(keys[position]))
+            else:
+                self.insert(position, keys[position], sides_of(keys[position]))
         return True
 
 

@@ -129,13 +129,23 @@ def test_incremental_painting_equals_painting_from_scratch(vg, seed):
     a random order; after each, the colours are what the records give from scratch."""
     rng = np.random.default_rng(seed)
     obj = wedge_object(70.0, n=50)
+    bpy.ops.ed.undo_push(message="start")
     for step in range(40):
-        action = rng.choice(["measure", "measure", "measure", "delete", "break"])
+        action = rng.choice(["measure", "measure", "measure", "delete", "break", "undo"])
         if action == "measure" or not len(obj.vg.measurements):
-            measure_at(float(rng.uniform(-0.8, 0.8)), radius=float(rng.uniform(0.15, 0.5)))
+            x, radius = float(rng.uniform(-0.8, 0.8)), float(rng.uniform(0.15, 0.5))
+            result = bpy.ops.vg.measure_xyz(
+                "EXEC_DEFAULT", True, location=(x, 0.0, 0.0), radius=radius
+            )
+            assert result == {"FINISHED"}
         elif action == "delete":
             index = int(rng.integers(len(obj.vg.measurements)))
-            assert bpy.ops.vg.delete_measurement(index=index) == {"FINISHED"}
+            result = bpy.ops.vg.delete_measurement("EXEC_DEFAULT", True, index=index)
+            assert result == {"FINISHED"}
+        elif action == "undo":  # brings back a deleted measurement, or removes a new one
+            bpy.ops.ed.undo()
+            obj = bpy.data.objects["Wedge"]
+            bpy.context.view_layer.objects.active = obj
         else:
             bpy.ops.vg.next_break()
         if step == 20:  # an edit: everything so far goes stale and grey
@@ -144,8 +154,8 @@ def test_incremental_painting_equals_painting_from_scratch(vg, seed):
             obj.data.vertices.foreach_set("co", co.ravel())
             obj.data.update()
             bpy.ops.vg.repaint()
+            assert all(item.stale for item in obj.vg.measurements)
         np.testing.assert_array_equal(colours(obj), painted_from_scratch(vg, obj), f"step {step}")
-    assert any(item.stale for item in obj.vg.measurements) or step < 20
 
 
 def test_clicks_do_not_measure_the_stored_measurements_again(vg, monkeypatch):
@@ -251,3 +261,41 @@ def test_a_reread_geometry_is_compared_bit_for_bit(vg):
     assert changed.fingerprint != kept.fingerprint
     bpy.ops.vg.repaint()
     assert obj.vg.measurements[0].stale
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_paint_state_updates_equal_painting_from_scratch(vg, seed):
+    """Removals, insertions (a delete undone) and additions, in random mixes: the colours and
+    owners are those of painting the wanted entries from blank, in order."""
+    painting = vg.bridge.painting
+    rng = np.random.default_rng(seed)
+    n = 400
+    pool = {}
+    for k in range(30):  # overlapping patches of random vertices, random sides and breaks
+        vertices = np.unique(rng.integers(0, n, int(rng.integers(5, 120)))).astype(np.int32)
+        pool[k] = painting.Sides(
+            vertices, rng.random(vertices.size) < 0.5, int(rng.integers(1, 6)), np.zeros(3), 1.0
+        )
+    keys = rng.permutation(len(pool))[:10].tolist()
+    state = painting.PaintState.blank("f", n)
+    assert state.update_to(keys, pool.__getitem__)
+    incremental = 0
+    for _ in range(60):
+        target = [key for key in keys if rng.random() > 0.15]  # some removed
+        for _ in range(int(rng.integers(0, 4))):  # some inserted anywhere, or added at the end
+            new = int(rng.integers(len(pool)))
+            if new not in target:
+                target.insert(int(rng.integers(0, len(target) + 1)), new)
+        if state.update_to(target, pool.__getitem__):
+            incremental += 1
+        else:
+            state = painting.PaintState.blank("f", n)
+            assert state.update_to(target, pool.__getitem__)
+        scratch = painting.PaintState.blank("f", n)
+        for key in target:
+            scratch.add(key, pool[key])
+        np.testing.assert_array_equal(state.colours, scratch.colours)
+        np.testing.assert_array_equal(state.owner, scratch.owner)
+        assert state.painted == target
+        keys = target
+    assert incremental > 30  # the incremental path, not only full repaints, was tested
