@@ -56,8 +56,9 @@ class Geometry:
     ----------
     local : ndarray of float32, shape (n, 3)
         Vertex coordinates in object space, as Blender stores them.
-    triangles : ndarray of int64, shape (m, 3)
-        Triangulated faces, as the mesh winds them.
+    triangles : ndarray of int32, shape (m, 3)
+        Triangulated faces, as the mesh winds them (for a mesh of triangles, a view of
+        ``corners``: no copy).
     matrix : ndarray of float64, shape (4, 4)
         The evaluated object's ``matrix_world`` (not part of the measurement).
     points : ndarray of float64, shape (n, 3)
@@ -82,14 +83,14 @@ class Geometry:
     def legacy_fingerprint(self) -> str:
         """The mesh-space fingerprint of this geometry in the format before issue 10 (BLAKE2b
         of the positions and the loop triangles as Blender gives them)."""
-        return legacy_fingerprint(self.local, self.triangles.astype(np.int32))
+        return legacy_fingerprint(self.local, self.triangles)
 
     @cached_property
     def world_fingerprints(self) -> frozenset[str]:
         """The fingerprints world-space records (files written before issue 12) hold for this
         geometry at its current transform: BLAKE2b of positions, loop triangles and the matrix
         (before issue 10), and SHA-256 of positions, face corners and the matrix (issue 10)."""
-        old = legacy_fingerprint(self.local, self.triangles.astype(np.int32), self.matrix)
+        old = legacy_fingerprint(self.local, self.triangles, self.matrix)
         if self.corners is None:
             return frozenset((old,))
         return frozenset((old, fingerprint(self.local, self.corners, self.faces, self.matrix)))
@@ -328,7 +329,7 @@ def _read_geometry(obj, obj_eval, kept: Geometry | None) -> Geometry:
         raise GoniometerError(
             f"'{obj.name}' has vertices with infinite or NaN coordinates (check its modifiers)."
         )
-    return Geometry(local, triangles.astype(np.int64), matrix, points, key, corners, faces)
+    return Geometry(local, triangles, matrix, points, key, corners, faces)
 
 
 def _same_bits(kept: Geometry, local: np.ndarray, corners: np.ndarray, faces) -> bool:
