@@ -92,13 +92,21 @@ class GridIndex:
         self.cell_size = cell_size
         self.dims = (np.floor(extent / cell_size).astype(np.int64) + 1).astype(np.int64)
         self._top = tuple(int(d) - 1 for d in self.dims)
-        ijk = self._cells(points)
-        keys = (ijk[:, 0] * self.dims[1] + ijk[:, 1]) * self.dims[2] + ijk[:, 2]
+        # The key (i * dims[1] + j) * dims[2] + k of each point's cell, one axis at a time:
+        # what _cells gives, without (n, 3) temporaries.
+        keys = np.zeros(points.shape[0], dtype=np.int64)
+        for axis in range(3):
+            scaled = points[:, axis] - self.origin[axis]
+            scaled /= self.cell_size
+            cell = np.floor(scaled, out=scaled).astype(np.int64)
+            del scaled
+            keys *= self.dims[axis]
+            keys += np.clip(cell, 0, self._top[axis], out=cell)
         order = np.argsort(keys, kind="stable")
         self.keys = keys[order]
+        del keys
         self.points = np.ascontiguousarray(points[order])
-        ids = np.arange(points.shape[0], dtype=np.int64) if ids is None else np.asarray(ids)
-        self.ids = ids[order]
+        self.ids = order if ids is None else np.asarray(ids)[order]
 
     def _cells(self, coordinates: np.ndarray) -> np.ndarray:
         scaled = coordinates - self.origin
