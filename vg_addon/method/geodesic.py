@@ -6,6 +6,10 @@ import numpy as np
 
 from .ranges import expand_ranges
 
+_CHUNK = 1 << 18  # corners per block
+_NEXT = np.array([1, 2, 0])  # the corner after corner k of a face, and the one before it
+_PREVIOUS = np.array([2, 0, 1])
+
 
 class EdgeGraph:
     """The edges of a triangle mesh around any patch, from a vertex-to-corner table built once.
@@ -28,12 +32,22 @@ class EdgeGraph:
         # depend on it (the relaxation below reaches the same least fixed point in any order).
         order = np.argsort(corners)
         ids = np.int32 if n < 2**31 else np.int64
-        # The next and the previous vertex of each corner's face, in row order.
+        # The next and the previous vertex of each corner's face, in row order (block by block:
+        # no whole-mesh temporaries beside the order itself).
         self.ends = np.empty((order.size, 2), dtype=ids)
-        for column, turn in ((0, [1, 2, 0]), (1, [2, 0, 1])):
-            self.ends[:, column] = triangles[:, turn].reshape(-1)[order]
+        for first in range(0, order.size, _CHUNK):
+            corner = order[first : first + _CHUNK]
+            face = corner // 3 * 3
+            turn = corner - face
+            rows = slice(first, first + corner.size)
+            self.ends[rows, 0] = corners[face + _NEXT[turn]]
+            self.ends[rows, 1] = corners[face + _PREVIOUS[turn]]
+        del order
         self.starts = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(np.bincount(corners, minlength=n), out=self.starts[1:])
+        step = 16 * _CHUNK  # bincount copies int32 indices: in blocks, each copy stays small
+        for first in range(0, corners.size, step):
+            self.starts[1:] += np.bincount(corners[first : first + step], minlength=n)
+        np.cumsum(self.starts, out=self.starts)
         self._local = np.full(n, -1, dtype=np.int64)
 
     def _patch_edges(self, vertices: np.ndarray):
@@ -48,15 +62,13 @@ class EdgeGraph:
         finally:
             local[vertices] = -1
         # Each edge once each way, sorted by source: (source, target) as one sortable key.
-        size = np.int64(vertices.size)
-        keys = np.repeat(np.arange(size), 2 * counts)
-        keys *= size
-        keys += v
+        keys = np.repeat(np.arange(vertices.size, dtype=np.int64) << 32, 2 * counts)
+        keys |= v
         keys = np.sort(keys[v >= 0])
         first = np.ones(keys.size, dtype=bool)
         first[1:] = keys[1:] != keys[:-1]
         keys = keys[first]
-        u, v = keys // size, keys % size
+        u, v = keys >> 32, keys & 0xFFFFFFFF
         ends = vertices[v]
         # Each edge's length from its lower-numbered end, as np.linalg.norm(points[low] -
         # points[high], axis=1) gives it for the whole mesh's edges: sqrt((x^2 + y^2) + z^2).

@@ -121,7 +121,8 @@ def _signed_volume(points: np.ndarray, triangles: np.ndarray) -> float:
     """Six times the signed volume, in units of the used vertices' extent around their mean."""
     used = np.zeros(points.shape[0], dtype=bool)
     used[triangles.ravel()] = True
-    corners = points[used]
+    # All used: the same rows, in the same (C) layout, so the same sums, without a copy.
+    corners = points if used.all() and points.flags.c_contiguous else points[used]
     origin = corners.mean(axis=0)
     scale = max(float(np.abs(corners[:, k] - origin[k]).max()) for k in range(3)) or 1.0
     del corners
