@@ -46,7 +46,9 @@ def estimate_spacing(points: np.ndarray) -> float:
     while True:
         ijk = np.floor((points - origin) / cell).astype(np.int64)
         side = int(ijk.max()) + 1
-        occupied = np.unique((ijk[:, 0] * side + ijk[:, 1]) * side + ijk[:, 2]).size
+        keys = np.sort((ijk[:, 0] * side + ijk[:, 1]) * side + ijk[:, 2])
+        # np.unique(keys).size, without NumPy 2's hashing (slow on such structured keys)
+        occupied = 1 + int(np.count_nonzero(keys[1:] != keys[:-1]))
         if occupied <= n / 4 or cell >= extent:
             return cell * float(np.sqrt(occupied / n))
         cell *= 2.0
