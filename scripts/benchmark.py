@@ -3,7 +3,9 @@
 Run: ``.venv/bin/python scripts/benchmark.py`` (after ``bash scripts/setup.sh``), or with any
 Python that has NumPy. Prints: spatial-index build for a 1M-vertex mesh, patch query time,
 measurement time for 1k/10k/100k-vertex patches, measurements per second on the 1M-vertex mesh,
-and WithinSS on 100k values.
+and WithinSS on 100k values; then the core's figures for a click on a 1M-vertex scan-like ridge
+(Surface build with int64 and int32 triangles, winding, first and later geodesic measurement,
+Euclidean measurement of a 2,000-vertex patch).
 """
 
 from __future__ import annotations
@@ -17,6 +19,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmark_drag import ridge_mesh  # scripts/ is on sys.path when run as a script
 
 from vg_addon import GridIndex, Surface, withinss_split
 from vg_addon.synthetic_meshes import wedge
@@ -88,6 +92,40 @@ def main(argv=None) -> None:
     print(
         f"WithinSS, 100k values:                   {best_of(lambda: withinss_split(values), 10) * 1e3:8.2f} ms"
     )
+    core_figures(int(np.sqrt(args.vertices)))
+
+
+def core_figures(side: int, repeats: int = 3) -> None:
+    """What the first click on a scan costs, and each measurement after it (best of ``repeats``)."""
+    points, triangles = ridge_mesh(side)
+    print(f"\ncore figures: ridge of {len(points):,} vertices, {len(triangles):,} triangles")
+    radius = (2.0 / (side - 1)) * np.sqrt(2000 / np.pi)  # about 2,000 vertices
+    centers = [(x, 0.0, 0.0) for x in np.random.default_rng(0).uniform(-0.8, 0.8, 200)]
+    figures = {}
+    for _ in range(repeats):
+        for label, given in (("int64", triangles), ("int32", triangles.astype(np.int32))):
+            start = time.perf_counter()
+            surface = Surface(points, given)
+            built = time.perf_counter()
+            _ = surface.winding
+            wound = time.perf_counter()
+            surface.measure(centers[0], radius, patch="geodesic")
+            first = time.perf_counter()
+            surface.measure(centers[1], radius, patch="geodesic")
+            later = time.perf_counter()
+            for center in centers:
+                surface.measure(center, radius)
+            done = time.perf_counter()
+            for name, seconds in (
+                (f"Surface build ({label} triangles)", built - start),
+                (f"winding, first use ({label})", wound - built),
+                (f"first geodesic measurement ({label})", first - wound),
+                (f"later geodesic measurement ({label})", later - first),
+                (f"Euclidean measurement, 2k vertices ({label})", (done - later) / len(centers)),
+            ):
+                figures[name] = min(figures.get(name, np.inf), seconds)
+    for name, seconds in figures.items():
+        print(f"{name + ':':48s} {seconds * 1e3:9.2f} ms")
 
 
 if __name__ == "__main__":

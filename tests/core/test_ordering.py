@@ -34,3 +34,16 @@ def test_surface_patch_is_in_lexicographic_order():
     assert np.array_equal(
         np.lexsort((q[:, 2], q[:, 1], q[:, 0], p[:, 2], p[:, 1], p[:, 0])), np.arange(m.n_vertices)
     )
+
+
+def test_ranks_break_exact_ties_by_index_on_large_inputs():
+    """Large enough for the unstable (SIMD) sort by x to shuffle equal x: the ranks do not
+    depend on it."""
+    rng = np.random.default_rng(7)
+    points = rng.integers(0, 3, size=(20_000, 3)).astype(float)
+    normals = rng.integers(0, 2, size=(20_000, 3)).astype(float)
+    ranks = canonical_ranks(points, normals)
+    expected = np.lexsort(
+        (np.arange(20_000), *normals[:, ::-1].T, points[:, 2], points[:, 1], points[:, 0])
+    )
+    assert np.array_equal(np.argsort(ranks), expected)

@@ -172,3 +172,93 @@ def test_point_cloud_normals_face_outward_on_a_hollow_shaft():
     assert (agree > 0.5).mean() > 0.99
     for site in fragment.sites:
         assert cloud.measure(site.point, 1.0).angle == pytest.approx(site.angle, abs=2.5)
+
+
+def _restricted_dijkstra(points, triangles, vertices, source, radius):
+    """Textbook Dijkstra on the edges between ``vertices``; inf where farther than ``radius``.
+
+    Each edge's length is ``np.linalg.norm(points[low] - points[high], axis=1)`` over the edge
+    list (low < high), the definition the patches use (the norm of a single 3-vector rounds
+    differently)."""
+    inside = set(vertices.tolist())
+    edges = {
+        (min(u, v), max(u, v))
+        for a, b, c in np.asarray(triangles).tolist()
+        for u, v in ((a, b), (b, c), (c, a))
+        if u in inside and v in inside
+    }
+    low, high = np.array(sorted(edges), dtype=np.int64).reshape(-1, 2).T
+    lengths = np.linalg.norm(points[low] - points[high], axis=1)
+    neighbours = {}
+    for u, v, w in zip(low.tolist(), high.tolist(), lengths.tolist(), strict=True):
+        neighbours.setdefault(u, []).append((v, w))
+        neighbours.setdefault(v, []).append((u, w))
+    distance = {source: 0.0}
+    queue = [(0.0, source)]
+    while queue:
+        d, u = heapq.heappop(queue)
+        if d > distance[u]:
+            continue
+        for v, w in neighbours.get(u, ()):
+            candidate = d + w
+            if candidate <= radius and candidate < distance.get(v, np.inf):
+                distance[v] = candidate
+                heapq.heappush(queue, (candidate, v))
+    return np.array([distance.get(v, np.inf) for v in vertices.tolist()])
+
+
+@pytest.mark.parametrize("case", ["wedge", "int32", "open", "collapsed", "non-manifold"])
+def test_geodesic_distances_equal_dijkstra_bit_for_bit(case, monkeypatch):
+    """Every distance, not just the patch: the per-patch edge list gives the same edges, with
+    the same lengths, as a graph over the whole mesh."""
+    from vg_addon.method import geodesic
+    from vg_addon.method.geodesic import EdgeGraph
+
+    monkeypatch.setattr(geodesic, "_CHUNK", 7)  # the table is built in many blocks
+
+    mesh = wedge(70, n=30, irregular=True, seed=5)
+    points, triangles = mesh.points, mesh.triangles
+    if case == "int32":
+        triangles = triangles.astype(np.int32)
+    elif case == "open":  # holes: some faces missing
+        triangles = triangles[np.random.default_rng(0).random(len(triangles)) > 0.2]
+    elif case == "collapsed":
+        triangles = triangles.copy()
+        triangles[::7, 1] = triangles[::7, 0]
+    elif case == "non-manifold":  # a fin on existing edges, and a face repeated
+        extra = len(points)
+        points = np.vstack([points, points[:40] + np.array([0.0, 0.0, 0.05])])
+        fins = np.column_stack([triangles[:40, 0], triangles[:40, 1], extra + np.arange(40)])
+        triangles = np.vstack([triangles, fins, triangles[:10]])
+    graph = EdgeGraph(points, triangles)
+    index = GridIndex(points)
+    for center, radius in (([0.0, 0.0, 0.0], 0.4), ([0.3, 0.2, -0.1], 0.25), ([-0.5, 0, 0], 1e-3)):
+        source, _ = index.nearest(np.array(center), 1.0)
+        vertices, _ = index.ball(points[source], radius)
+        got = graph.distances(vertices, source, radius)
+        expected = _restricted_dijkstra(points, triangles, vertices, source, radius)
+        assert got.tobytes() == expected.tobytes()
+
+
+def test_int32_triangles_are_used_without_a_copy_and_measure_the_same():
+    mesh = wedge(80, n=40, irregular=True, seed=3)
+    given = mesh.triangles.astype(np.int32)
+    narrow = Surface(mesh.points, given)
+    wide = Surface(mesh.points, mesh.triangles)
+    assert narrow.triangles is given
+    assert wide.triangles.dtype == np.int64
+    assert narrow.normals.tobytes() == wide.normals.tobytes()
+    for patch in ("euclidean", "geodesic"):
+        a = narrow.measure([0.1, 0.0, 0.0], 0.4, patch=patch)
+        b = wide.measure([0.1, 0.0, 0.0], 0.4, patch=patch)
+        assert (a.angle, a.fit_error, a.threshold) == (b.angle, b.fit_error, b.threshold)
+        assert a.indices.dtype == np.int64
+        assert a.indices.tobytes() == b.indices.tobytes()
+
+
+def test_corner_edges_are_checked():
+    mesh = wedge(80, n=10)
+    with pytest.raises(GoniometerError, match="corner edges"):
+        Surface(mesh.points, mesh.triangles, corner_edges=np.arange(5))
+    with pytest.raises(GoniometerError, match="negative"):
+        Surface(mesh.points, mesh.triangles, corner_edges=-np.ones(mesh.triangles.shape, dtype=int))

@@ -64,3 +64,92 @@ def test_inward_bone_reads_the_same_angles_with_swapped_labels():
         assert b.angle == pytest.approx(a.angle, abs=1e-9)
         swap = {"convex": "concave", "concave": "convex", "unclear": "unclear"}
         assert b.convexity == swap[a.convexity]
+
+
+def reference_winding(points, triangles):
+    """The first implementation (three sorts of every edge), kept as the oracle."""
+    n = np.int64(points.shape[0])
+    triangles = np.asarray(triangles, dtype=np.int64)
+    start = triangles.ravel()
+    end = triangles[:, [1, 2, 0]].ravel()
+    keep = start != end
+    start, end = start[keep], end[keep]
+    low, high = np.minimum(start, end), np.maximum(start, end)
+    _, uses = np.unique(low * n + high, return_counts=True)
+    if not (uses == 2).all():
+        return "open"
+    directed = np.sort(start * n + end)
+    if (np.diff(directed) == 0).any() or not np.array_equal(directed, np.sort(end * n + start)):
+        return "mixed"
+    used = np.unique(triangles)
+    origin = points[used].mean(axis=0)
+    scale = float(np.abs(points[used] - origin).max()) or 1.0
+    a, b, c = ((points[triangles[:, k]] - origin) / scale for k in range(3))
+    volume = float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum())
+    if volume == 0.0:
+        return "open"
+    return "outward" if volume > 0 else "inward"
+
+
+def edge_ids(triangles, n):
+    """Each corner's undirected edge id, as Blender's ``.corner_edge`` numbers them (any
+    numbering will do: here sparse, with ids no corner uses, like loose edges)."""
+    start = np.asarray(triangles, dtype=np.int64).ravel()
+    end = np.asarray(triangles, dtype=np.int64)[:, [1, 2, 0]].ravel()
+    _, ids = np.unique(np.minimum(start, end) * n + np.maximum(start, end), return_inverse=True)
+    return 3 * ids.reshape(-1) + 1
+
+
+def perturbed(rng, case):
+    """Closed tetrahedra, then one change that makes the mesh open, mixed or inward."""
+    pieces = int(rng.integers(1, 5))
+    points = np.vstack([TETRA_POINTS * rng.uniform(0.5, 2.0) + 5.0 * i for i in range(pieces)])
+    faces = np.vstack([TETRA + 4 * i for i in range(pieces)])
+    pick = int(rng.integers(len(faces)))
+    if case == "inward":
+        faces = faces[:, ::-1]
+    elif case == "open":
+        faces = np.delete(faces, pick, axis=0)
+    elif case == "mixed":
+        faces[pick] = faces[pick, ::-1]
+    elif case == "collapsed":  # a corner repeated: that face adds one edge, used both ways
+        faces[pick, int(rng.integers(3))] = faces[pick, int(rng.integers(3))]
+    elif case == "non-manifold":  # a face repeated, one way or the other
+        extra = faces[pick] if rng.random() < 0.5 else faces[pick, ::-1]
+        faces = np.vstack([faces, extra])
+    faces = faces[rng.permutation(len(faces))]
+    faces = np.roll(faces, int(rng.integers(3)), axis=1)
+    return points, faces
+
+
+CASES = ["outward", "inward", "open", "mixed", "collapsed", "non-manifold"]
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_classification_equals_the_reference(case, monkeypatch):
+    from vg_addon.method import winding
+
+    monkeypatch.setattr(winding, "_CHUNK", 3)  # many blocks: their seams are exercised
+    rng = np.random.default_rng(CASES.index(case))
+    for _ in range(60):
+        points, faces = perturbed(rng, case)
+        expected = reference_winding(points, faces)
+        for given in (faces, faces.astype(np.int32)):
+            assert mesh_winding(points, given) == expected
+            assert mesh_winding(points, given, edge_ids(given, len(points))) == expected
+
+
+@pytest.mark.parametrize("name", ["bone", "wedge", "reference"])
+def test_classification_equals_the_reference_on_larger_meshes(name, shared_data):
+    if name == "bone":
+        mesh = bone_fragment(spacing=1.0)
+    elif name == "wedge":
+        mesh = wedge(60, n=30)
+    else:
+        mesh = read_mesh(shared_data / "IntersectingSpheres.ply")
+    points, faces = mesh.points, mesh.triangles
+    for given in (faces, faces[:, ::-1], np.vstack([faces[:1, ::-1], faces[1:]])):
+        expected = reference_winding(points, given)
+        assert mesh_winding(points, given) == expected
+        assert mesh_winding(points, given, edge_ids(given, len(points))) == expected
+        assert Surface(points, given, corner_edges=edge_ids(given, len(points))).winding == expected

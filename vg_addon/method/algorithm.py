@@ -67,10 +67,16 @@ def _smallest_eigenvector(matrix: np.ndarray) -> tuple[float, np.ndarray, np.nda
     return float(values[0]), vector, values
 
 
-def _plane(points: np.ndarray) -> tuple[np.ndarray, float, bool]:
+def _column_means(array: np.ndarray) -> np.ndarray:
+    """``array.mean(axis=0)``, without its wrapper's overhead: the same sums (row after row, per
+    column), divided by the same count."""
+    return np.add.reduce(array, axis=0) / array.shape[0]
+
+
+def _plane(points: np.ndarray, mean: np.ndarray | None = None) -> tuple[np.ndarray, float, bool]:
     """PCA plane fit: unit normal, mean squared distance to the plane, and whether the points
-    span a plane at all (``False``: they lie on a line)."""
-    centred = points - points.mean(axis=0)
+    span a plane at all (``False``: they lie on a line). ``mean``: the points' mean, if known."""
+    centred = points - (_column_means(points) if mean is None else mean)
     covariance = centred.T @ centred / points.shape[0]
     error, normal, values = _smallest_eigenvector(covariance)
     spans = bool(values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny))
@@ -93,29 +99,34 @@ def _row_beside(line_points: np.ndarray, others: np.ndarray) -> np.ndarray:
     return beside
 
 
-def _fit_side(points, normals, mask, side: str) -> tuple[np.ndarray, float, int]:
-    """The plane of one side, its fit error and how many vertices it borrowed from the other.
+def _fit_side(points, joined, mask, side: str) -> tuple[np.ndarray, float, int, np.ndarray]:
+    """The plane of one side, its fit error, how many vertices it borrowed from the other, and
+    the mean of its own vertices.
 
-    A side that is a single row of vertices (a coarse mesh across a near-flat edge) has no plane
-    of its own; the row of the other side nearest it (the vertices on the edge, which lie on both
-    faces) completes it.
+    ``joined`` is the points and normals side by side, shape (k, 6): one gather and one sum give
+    a side's vertices and the means of its points and normals. A side that is a single row of
+    vertices (a coarse mesh across a near-flat edge) has no plane of its own; the row of the
+    other side nearest it (the vertices on the edge, which lie on both faces) completes it.
     """
-    normal, error, spans = _plane(points[mask])
+    rows = joined[mask]
+    means = _column_means(rows)
+    own, centroid = rows[:, :3], means[:3]
+    normal, error, spans = _plane(own, centroid)
     borrowed = 0
     if not spans:
-        beside = _row_beside(points[mask], points[~mask])
+        beside = _row_beside(own, points[~mask])
         borrowed = int(beside.sum())
         if borrowed:
-            normal, error, spans = _plane(np.vstack([points[mask], points[~mask][beside]]))
+            normal, error, spans = _plane(np.vstack([own, points[~mask][beside]]))
         if not spans:
             raise GoniometerError(
                 f"The vertices on the {side} side lie on a line, even with the row of vertices "
                 "beside it, so no plane can be fitted: use a larger radius (each side needs at "
                 "least two rows of vertices off the edge) or move the centre onto the break edge."
             )
-    if np.dot(normal, normals[mask].mean(axis=0)) < 0:
+    if np.dot(normal, means[3:]) < 0:
         normal = -normal
-    return normal, error, borrowed
+    return normal, error, borrowed, centroid
 
 
 def _check_finite(name: str, array: np.ndarray) -> None:
@@ -147,12 +158,16 @@ def _correlation(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.dot(a, b)) / scale if scale > 0 else 0.0
 
 
-def _split_and_fit(points, normals, projection) -> dict:
-    """Steps 9-13 of Algorithm 1: the WithinSS split of ``projection`` and a plane per side."""
+def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray]:
+    """Steps 9-13 of Algorithm 1: the WithinSS split of ``projection`` and a plane per side.
+
+    Returns the measured fields, and the step from the "−" side's centroid to the "+" side's
+    (their own vertices).
+    """
     threshold, _ = withinss_split(projection, min_size=MIN_SIDE_VERTICES)
     labels = projection >= threshold
-    normal_plus, error_plus, shared_plus = _fit_side(points, normals, labels, "+")
-    normal_minus, error_minus, shared_minus = _fit_side(points, normals, ~labels, "-")
+    normal_plus, error_plus, shared_plus, mean_plus = _fit_side(points, joined, labels, "+")
+    normal_minus, error_minus, shared_minus, mean_minus = _fit_side(points, joined, ~labels, "-")
     cosine = float(np.clip(np.dot(normal_plus, normal_minus), -1.0, 1.0))
     angle = 180.0 - float(np.degrees(np.arccos(cosine)))
     if angle < FLAT_TOLERANCE_DEG:
@@ -165,7 +180,7 @@ def _split_and_fit(points, normals, projection) -> dict:
             f"No break edge found: the two sides fit planes within {180.0 - angle:.2f}° of each other, "
             "so the patch is flat. Move the centre onto the break edge, or use a larger radius."
         )
-    return {
+    fields = {
         "angle": angle,
         "fit_error": error_plus + error_minus,
         "fit_error_plus": error_plus,
@@ -178,13 +193,13 @@ def _split_and_fit(points, normals, projection) -> dict:
         "n_minus": int((~labels).sum()),
         "n_shared": shared_plus + shared_minus,
     }
+    return fields, mean_plus - mean_minus
 
 
-def _planes_form_ridge(points, fields) -> bool:
+def _planes_form_ridge(fields, step) -> bool:
     """Whether the fitted planes meet in a ridge (convex) rather than a valley, relative to their
-    normals: moving from the "−" side's centroid to the "+" side's, the normal turns the same way."""
-    labels = fields["labels"]
-    step = points[labels].mean(axis=0) - points[~labels].mean(axis=0)
+    normals: moving from the "−" side's centroid to the "+" side's (``step``), the normal turns the
+    same way."""
     return float(np.dot(step, fields["normal_plus"] - fields["normal_minus"])) > 0
 
 
@@ -213,8 +228,10 @@ def measure_patch(
             f"({MIN_SIDE_VERTICES} per side): use a larger radius."
         )
     _, tangent, normal_eigenvalues = _smallest_eigenvector(normals.T @ normals)
-    mean_normal = normals.mean(axis=0)
-    cross = np.cross(tangent, mean_normal)
+    mean_normal = _column_means(normals)
+    # np.cross's arithmetic on Python floats (the same IEEE operations, without its overhead).
+    (t0, t1, t2), (m0, m1, m2) = tangent.tolist(), mean_normal.tolist()
+    cross = np.array([t1 * m2 - t2 * m1, t2 * m0 - t0 * m2, t0 * m1 - t1 * m0])
     cross_norm = float(np.linalg.norm(cross))
     if normal_eigenvalues[1] <= 1e-12 * normal_eigenvalues[2] or cross_norm <= 1e-12:
         raise GoniometerError(
@@ -222,36 +239,36 @@ def measure_patch(
             "cancel out): move the centre onto a break edge or use a larger radius."
         )
     binormal = cross / cross_norm
-    correlation = _correlation(normals @ binormal, (points - center) @ binormal)
+    offsets = points - center
+    correlation = _correlation(normals @ binormal, offsets @ binormal)
     orientation = -1 if rule == "oriented" and correlation < 0 else 1
     # The "+1" projection is the paper's expression, evaluated exactly as before, so ridges (and
     # every measurement under the paper's rule) stay bit-identical.
-    paper_projection = (normals + (lam / radius) * (points - center)) @ binormal
-    flipped_projection = (normals - (lam / radius) * (points - center)) @ binormal
-    first, second = (
-        (paper_projection, flipped_projection)
-        if orientation > 0
-        else (flipped_projection, paper_projection)
-    )
+    offsets *= lam / radius
+
+    def projection(sign: int) -> np.ndarray:
+        return ((normals + offsets) if sign > 0 else (normals - offsets)) @ binormal
+
+    joined = np.concatenate((points, normals), axis=1)
     weak = abs(correlation) < WEAK_CORRELATION
     if not (rule == "oriented" and weak and lam > 0):
-        fields = _split_and_fit(points, normals, first)
+        fields, step = _split_and_fit(points, joined, projection(orientation))
         other_angle = None
     else:
         # The sign is weakly determined: measure with both and keep the better plane fit.
         readings = []
-        for sign, projection in ((orientation, first), (-orientation, second)):
+        for sign in (orientation, -orientation):
             try:
-                readings.append((sign, _split_and_fit(points, normals, projection)))
+                readings.append((sign, *_split_and_fit(points, joined, projection(sign))))
             except GoniometerError as error:
                 refusal = error
         if not readings:
             raise refusal
-        orientation, fields = min(readings, key=lambda reading: reading[1]["fit_error"])
+        orientation, fields, step = min(readings, key=lambda reading: reading[1]["fit_error"])
         other_angle = next(
-            (r["angle"] for sign, r in readings if sign != orientation), fields["angle"]
+            (r["angle"] for sign, r, _ in readings if sign != orientation), fields["angle"]
         )
-    if weak or _planes_form_ridge(points, fields) != (correlation >= 0):
+    if weak or _planes_form_ridge(fields, step) != (correlation >= 0):
         convexity = "unclear"
     else:
         convexity = "convex" if correlation >= 0 else "concave"

@@ -144,7 +144,9 @@ def ridge_graph(surface) -> RidgeGraph:
                 "Tracing a break edge follows mesh edges, and this surface is a point cloud with "
                 "no faces: give the triangles, or measure the edge point by point."
             )
-        graph = RidgeGraph(surface.points, surface.triangles, surface.valid)
+        # int64: the edge keys below are products of two vertex indices.
+        triangles = surface.triangles.astype(np.int64, copy=False)
+        graph = RidgeGraph(surface.points, triangles, surface.valid)
         _graphs[surface] = graph
     return graph
 

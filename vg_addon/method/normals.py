@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .ranges import expand_ranges
-from .spatial import GridIndex
+from .spatial import GridIndex, bounds
 
 _CHUNK = 1 << 18  # triangles per block: the temporaries stay small and in cache
 
@@ -58,20 +58,34 @@ def vertex_normals(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarra
     n = points.shape[0]
     # In units of the mesh's extent (min and max do not depend on vertex order), so that a scan
     # in kilometres or in nanometres neither overflows nor underflows the cross products.
-    origin = points.min(axis=0)
-    extent = float(np.max(points.max(axis=0) - origin))
-    scaled = (points - origin) / extent if extent > 0 else points - origin
+    origin, top = bounds(points)
+    extent = float(np.max(top - origin))
+    scaled = points - origin
+    if extent > 0:
+        scaled /= extent
     weighted = face_normals(scaled, triangles)
     del scaled  # a copy of the points: free it before the sums need their own memory
-    corners = [np.ascontiguousarray(triangles[:, k]) for k in range(3)]
-    summed = np.zeros((n, 3), dtype=np.float64)
-    for axis in range(3):
-        for corner in corners:
-            summed[:, axis] += np.bincount(corner, weights=weighted[axis], minlength=n)
-    lengths = np.linalg.norm(summed, axis=1)
+    # Per axis, the sum of corner 0's contributions, plus corner 1's, plus corner 2's, in that
+    # order (the order fixes the rounding); one corner column at a time keeps one index copy.
+    summed = [None, None, None]
+    for k in range(3):
+        corner = np.ascontiguousarray(triangles[:, k], dtype=np.intp)
+        for axis in range(3):
+            part = np.bincount(corner, weights=weighted[axis], minlength=n)
+            if k == 0:
+                summed[axis] = part
+            else:
+                summed[axis] += part
+    del weighted, corner, part
+    # sqrt((x^2 + y^2) + z^2): what np.linalg.norm(axis=1) computes, on contiguous columns.
+    lengths = summed[0] * summed[0]
+    lengths += summed[1] * summed[1]
+    lengths += summed[2] * summed[2]
+    np.sqrt(lengths, out=lengths)
     valid = lengths > 1e-150
-    normals = np.zeros_like(summed)
-    normals[valid] = summed[valid] / lengths[valid, None]
+    normals = np.zeros((n, 3), dtype=np.float64)
+    for axis in range(3):
+        np.divide(summed[axis], lengths, out=normals[:, axis], where=valid)
     return normals, valid
 
 

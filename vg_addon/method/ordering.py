@@ -23,10 +23,12 @@ def canonical_ranks(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
     Notes
     -----
     Sorted by x first (one key); only runs of equal x (rare on scans, common on grids) are
-    sorted by the remaining five keys.
+    sorted by the remaining five keys, then by vertex index.
     """
     n = points.shape[0]
-    order = np.argsort(points[:, 0], kind="stable")
+    # Any order among equal x will do (faster than a stable sort): the runs of equal x are
+    # sorted again below, with the vertex index as the last key.
+    order = np.argsort(points[:, 0])
     x = points[order, 0]
     tied = np.zeros(n, dtype=bool)
     equal = x[1:] == x[:-1]
@@ -36,7 +38,7 @@ def canonical_ranks(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
         members = order[tied]
         run = np.cumsum(~np.concatenate(([False], equal)))[tied]  # run number, ascending in x
         p, q = points[members], normals[members]
-        within = np.lexsort((q[:, 2], q[:, 1], q[:, 0], p[:, 2], p[:, 1], run))
+        within = np.lexsort((members, q[:, 2], q[:, 1], q[:, 0], p[:, 2], p[:, 1], run))
         order[tied] = members[within]
     ranks = np.empty(n, dtype=np.int32 if n < 2**31 else np.int64)
     ranks[order] = np.arange(n, dtype=ranks.dtype)

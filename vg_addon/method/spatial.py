@@ -12,6 +12,21 @@ from .ranges import expand_ranges
 _MAX_CELLS_PER_AXIS = 1 << 20
 
 
+def bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``points.min(axis=0)`` and ``points.max(axis=0)`` of finite (n, 3) points, faster.
+
+    One column at a time is several times faster than the row-wise reduction; the values are the
+    same, except possibly the sign of a zero, so a zero bound is taken from the row-wise one.
+    """
+    low = np.array([points[:, axis].min() for axis in range(3)])
+    high = np.array([points[:, axis].max() for axis in range(3)])
+    if not low.all():
+        low = points.min(axis=0)
+    if not high.all():
+        high = points.max(axis=0)
+    return low, high
+
+
 def estimate_spacing(points: np.ndarray) -> float:
     """Typical distance between neighbouring points of a sampled surface (or volume).
 
@@ -23,15 +38,17 @@ def estimate_spacing(points: np.ndarray) -> float:
         stride = points.shape[0] // 100_000
         return estimate_spacing(points[_sample_by_position(points, stride)]) / np.sqrt(stride)
     n = points.shape[0]
-    origin = points.min(axis=0)
-    extent = float((points.max(axis=0) - origin).max())
+    origin, top = bounds(points)
+    extent = float((top - origin).max())
     if n < 2 or extent == 0.0:
         return max(extent, 1.0)
     cell = extent / 128.0
     while True:
         ijk = np.floor((points - origin) / cell).astype(np.int64)
         side = int(ijk.max()) + 1
-        occupied = np.unique((ijk[:, 0] * side + ijk[:, 1]) * side + ijk[:, 2]).size
+        keys = np.sort((ijk[:, 0] * side + ijk[:, 1]) * side + ijk[:, 2])
+        # np.unique(keys).size, without NumPy 2's hashing (slow on such structured keys)
+        occupied = 1 + int(np.count_nonzero(keys[1:] != keys[:-1]))
         if occupied <= n / 4 or cell >= extent:
             return cell * float(np.sqrt(occupied / n))
         cell *= 2.0
@@ -69,25 +86,35 @@ class GridIndex:
         points = np.asarray(points, dtype=np.float64)
         if points.ndim != 2 or points.shape[1] != 3 or points.shape[0] == 0:
             raise GoniometerError("A spatial index needs a non-empty (n, 3) array of points.")
-        self.origin = points.min(axis=0)
-        extent = points.max(axis=0) - self.origin
+        self.origin, top = bounds(points)
+        extent = top - self.origin
         if cell_size is None:
             cell_size = 2.0 * estimate_spacing(points)
         cell_size = max(float(cell_size), float(extent.max()) / _MAX_CELLS_PER_AXIS, 1e-300)
         self.cell_size = cell_size
         self.dims = (np.floor(extent / cell_size).astype(np.int64) + 1).astype(np.int64)
         self._top = tuple(int(d) - 1 for d in self.dims)
-        ijk = self._cells(points)
-        keys = (ijk[:, 0] * self.dims[1] + ijk[:, 1]) * self.dims[2] + ijk[:, 2]
+        # The key (i * dims[1] + j) * dims[2] + k of each point's cell, one axis at a time:
+        # what _cells gives, without (n, 3) temporaries.
+        keys = np.zeros(points.shape[0], dtype=np.int64)
+        for axis in range(3):
+            scaled = points[:, axis] - self.origin[axis]
+            scaled /= self.cell_size
+            cell = np.floor(scaled, out=scaled).astype(np.int64)
+            del scaled
+            keys *= self.dims[axis]
+            keys += np.clip(cell, 0, self._top[axis], out=cell)
         order = np.argsort(keys, kind="stable")
         self.keys = keys[order]
+        del keys
         self.points = np.ascontiguousarray(points[order])
-        ids = np.arange(points.shape[0], dtype=np.int64) if ids is None else np.asarray(ids)
-        self.ids = ids[order]
+        self.ids = order if ids is None else np.asarray(ids)[order]
 
     def _cells(self, coordinates: np.ndarray) -> np.ndarray:
-        ijk = np.floor((coordinates - self.origin) / self.cell_size).astype(np.int64)
-        return np.clip(ijk, 0, self.dims - 1)
+        scaled = coordinates - self.origin
+        scaled /= self.cell_size
+        ijk = np.floor(scaled, out=scaled).astype(np.int64)
+        return np.clip(ijk, 0, self.dims - 1, out=ijk)
 
     def _candidates(self, center, radius: float) -> np.ndarray:
         """Positions (into the sorted arrays) of the points in the cells the ball's box overlaps."""
@@ -114,7 +141,8 @@ class GridIndex:
         """Ids of the points within ``radius`` of ``center`` (boundary included), and their distances."""
         center = np.asarray(center, dtype=np.float64)
         positions = self._candidates(center, radius)
-        offsets = self.points[positions] - center
+        offsets = np.take(self.points, positions, axis=0)  # faster than fancy indexing
+        offsets -= center
         squared = np.einsum("ij,ij->i", offsets, offsets)
         inside = squared <= radius * radius
         return self.ids[positions[inside]], np.sqrt(squared[inside])
@@ -129,7 +157,8 @@ class GridIndex:
         while True:
             positions = self._candidates(center, radius)
             if positions.size:
-                offsets = self.points[positions] - center
+                offsets = np.take(self.points, positions, axis=0)
+                offsets -= center
                 squared = np.einsum("ij,ij->i", offsets, offsets)
                 inside = squared <= radius * radius
                 if inside.any():

@@ -39,19 +39,34 @@ def _as_triangles(triangles, n_points: int) -> np.ndarray:
         raise GoniometerError(
             f"The triangles must be integer vertex indices; got {given.dtype} values."
         )
-    array = np.ascontiguousarray(given, dtype=np.int64)
+    # int32 indices are kept as they are (every index fits; no copy of the largest array).
+    dtype = np.int32 if given.dtype == np.int32 else np.int64
+    array = np.ascontiguousarray(given, dtype=dtype)
     if array.size == 0:
         return array.reshape(0, 3)
     if array.ndim != 2 or array.shape[1] != 3:
         raise GoniometerError(
             f"The triangles must be an (m, 3) array of vertex indices; got shape {array.shape}."
         )
-    if array.min() < 0 or array.max() >= n_points:
+    low, high = int(array.min()), int(array.max())
+    if low < 0 or high >= n_points:
         raise GoniometerError(
-            f"A triangle refers to vertex {int(array.max() if array.max() >= n_points else array.min())},"
+            f"A triangle refers to vertex {high if high >= n_points else low},"
             f" but the mesh has vertices 0 to {n_points - 1}: the face list does not match the points."
         )
     return array
+
+
+def _as_corner_edges(corner_edges, n_triangles: int) -> np.ndarray:
+    given = np.asarray(corner_edges)
+    if given.size != 3 * n_triangles or not np.issubdtype(given.dtype, np.integer):
+        raise GoniometerError(
+            f"The corner edges must be one integer edge id per corner ({3 * n_triangles} for "
+            f"{n_triangles} triangles); got {given.size} {given.dtype} values."
+        )
+    if given.size and given.min() < 0:
+        raise GoniometerError("The corner edges must be edge ids from 0 up; got a negative one.")
+    return given.reshape(-1)
 
 
 class Surface:
@@ -63,9 +78,14 @@ class Surface:
         Vertex coordinates (converted to float64).
     triangles : array_like of int, shape (m, 3), optional
         Faces, wound counter-clockwise seen from outside. Needed for the geodesic patch mode.
+        int32 indices are used without a copy (other integer types are converted to int64).
     normals : array_like, shape (n, 3), optional
         Outward vertex normals. Default: area-weighted normals from ``triangles``, or for a point
         cloud, local-PCA normals oriented outward.
+    corner_edges : array_like of int, shape (m, 3) or (3 m,), optional
+        Each corner's edge id, aligned with ``triangles`` (Blender's ``.corner_edge`` of an
+        all-triangle mesh): lets :attr:`winding` count edge uses instead of sorting the edges.
+        See :func:`~vg_addon.method.winding.mesh_winding`.
 
     Notes
     -----
@@ -73,7 +93,7 @@ class Surface:
     of every patch; ``valid`` marks the vertices that take part.
     """
 
-    def __init__(self, points, triangles=None, normals=None):
+    def __init__(self, points, triangles=None, normals=None, corner_edges=None):
         self.points = as_points("points", points)
         n = self.points.shape[0]
         self.triangles = None if triangles is None else _as_triangles(triangles, n)
@@ -81,6 +101,9 @@ class Surface:
             self.triangles = None
         self._graph = None
         self._winding = None
+        self._corner_edges = None
+        if self.triangles is not None and corner_edges is not None:
+            self._corner_edges = _as_corner_edges(corner_edges, self.triangles.shape[0])
         full_index = None
         if normals is not None:
             self.normals = as_normals(normals, n)
@@ -103,6 +126,9 @@ class Surface:
         else:
             self.index = GridIndex(self.points[self.valid_ids], ids=self.valid_ids)
         self.ranks = canonical_ranks(self.points, self.normals)
+        # The vertex of each rank: a patch in canonical order is by_rank[sort(ranks[patch])].
+        self._by_rank = np.empty(n, dtype=self.ranks.dtype)
+        self._by_rank[self.ranks] = np.arange(n, dtype=self.ranks.dtype)
 
     @property
     def n_points(self) -> int:
@@ -114,7 +140,7 @@ class Surface:
         """``"outward"``, ``"inward"``, ``"mixed"`` or ``"open"`` (see ``winding.WINDINGS``);
         computed on first use. On an ``"inward"`` surface convex edges are labelled concave."""
         if self._winding is None:
-            self._winding = mesh_winding(self.points, self.triangles)
+            self._winding = mesh_winding(self.points, self.triangles, self._corner_edges)
         return self._winding
 
     def snap(self, center, radius: float) -> tuple[int, float]:
@@ -212,10 +238,10 @@ class Surface:
                 f"{2 * MIN_SIDE_VERTICES} are needed: use a larger radius."
             )
         # The canonical order (see algorithm.canonical_order), from the ranks sorted at build.
-        indices = indices[np.argsort(self.ranks[indices], kind="stable")]
+        indices = self._by_rank[np.sort(self.ranks[indices])].astype(np.int64)
         fields = measure_patch(
-            self.points[indices],
-            self.normals[indices],
+            np.take(self.points, indices, axis=0),
+            np.take(self.normals, indices, axis=0),
             self.points[center_index],
             radius,
             lam,

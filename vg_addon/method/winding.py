@@ -17,14 +17,23 @@ WINDINGS = ("outward", "inward", "mixed", "open")
 which side is outside cannot be decided."""
 
 
-def mesh_winding(points: np.ndarray, triangles: np.ndarray | None) -> str:
+_CHUNK = 1 << 18  # triangles per block: the temporaries stay small
+
+
+def mesh_winding(
+    points: np.ndarray, triangles: np.ndarray | None, corner_edges: np.ndarray | None = None
+) -> str:
     """Classify the winding of a triangle mesh (see :data:`WINDINGS`).
 
     Parameters
     ----------
     points : ndarray, shape (n, 3)
-    triangles : ndarray of int64, shape (m, 3), or None
-        ``None`` (a point cloud) is ``"open"``.
+    triangles : ndarray of int, shape (m, 3), or None
+        ``None`` (a point cloud) is ``"open"``. Fewer than 2**31 vertices.
+    corner_edges : ndarray of int, shape (m, 3) or (3 m,), optional
+        For each corner, the id of the undirected edge from it to the next corner of its
+        triangle, aligned with ``triangles.ravel()`` (Blender's ``.corner_edge`` of an
+        all-triangle mesh), one id per pair of vertices. Spares sorting the edges.
 
     Returns
     -------
@@ -33,26 +42,106 @@ def mesh_winding(points: np.ndarray, triangles: np.ndarray | None) -> str:
     """
     if triangles is None or len(triangles) == 0:
         return "open"
-    n = np.int64(points.shape[0])
-    start = triangles.ravel()
-    end = triangles[:, [1, 2, 0]].ravel()
-    keep = start != end  # a collapsed corner adds no edge
-    start, end = start[keep], end[keep]
-    low, high = np.minimum(start, end), np.maximum(start, end)
-    _, uses = np.unique(low * n + high, return_counts=True)
-    if not (uses == 2).all():
-        return "open"
-    directed = np.sort(start * n + end)
-    if (np.diff(directed) == 0).any() or not np.array_equal(directed, np.sort(end * n + start)):
+    if corner_edges is None:
+        closed, consistent = _edge_uses(triangles, points.shape[0])
+    else:
+        closed, consistent = _edge_uses_by_id(triangles, corner_edges)
+    if not closed:
+        return "open"  # a boundary, or an edge of more than two faces
+    if not consistent:
         return "mixed"  # each edge is used twice, but twice in the same direction somewhere
-    used = np.unique(triangles)
-    origin = points[used].mean(axis=0)
-    scale = float(np.abs(points[used] - origin).max()) or 1.0
-    a, b, c = ((points[triangles[:, k]] - origin) / scale for k in range(3))
-    volume = float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum())
+    volume = _signed_volume(points, triangles)
     if volume == 0.0:
         return "open"
     return "outward" if volume > 0 else "inward"
+
+
+def _corner_edges(block: np.ndarray):
+    """Start and end vertex of each corner's edge (corner k to corner k + 1) of some triangles."""
+    block = block.astype(np.int64, copy=False)
+    return block.ravel(), block[:, [1, 2, 0]].ravel()
+
+
+def _edge_uses(triangles: np.ndarray, n: int) -> tuple[bool, bool]:
+    """Whether every edge is used by exactly two faces (closed), and once each way (consistent).
+
+    One sort of a key per corner: the undirected edge (low, high) times two, plus one when the
+    corner runs from high to low. Collapsed corners (both ends one vertex) add no edge.
+    """
+    m = triangles.shape[0]
+    keys = np.empty(3 * m, dtype=np.int64)
+    for first in range(0, m, _CHUNK):
+        start, end = _corner_edges(triangles[first : first + _CHUNK])
+        low = np.minimum(start, end)
+        key = low * np.int64(n)
+        key += np.maximum(start, end)
+        key *= 2
+        key += start > end
+        key[start == end] = -1
+        keys[3 * first : 3 * first + key.size] = key
+    keys.sort()
+    keys = keys[np.searchsorted(keys, 0) :]
+    if keys.size % 2:
+        return False, False
+    # Closed: sorted, the keys come in pairs of one edge, each edge in one pair only.
+    consistent = True
+    for first in range(0, keys.size, 2 * _CHUNK):
+        block = keys[first : first + 2 * _CHUNK + 1]  # and the next pair's first key
+        one, other = block[0:-1:2], block[1::2]
+        edge = one >> 1
+        if (edge != other >> 1).any() or (edge[1:] == other[:-1] >> 1).any():
+            return False, False
+        if block.size % 2 and block[-1] >> 1 == other[-1] >> 1:
+            return False, False
+        consistent = consistent and bool((other - one == 1).all())
+    return True, consistent
+
+
+def _edge_uses_by_id(triangles: np.ndarray, corner_edges: np.ndarray) -> tuple[bool, bool]:
+    """:func:`_edge_uses` from each corner's edge id: counts instead of a sort."""
+    ids = np.asarray(corner_edges).ravel()
+    m = triangles.shape[0]
+    if ids.size != 3 * m:
+        raise ValueError(f"{ids.size} corner edges for {m} triangles: expected {3 * m}.")
+    size = int(ids.max()) + 1
+    uses = np.zeros(size, dtype=np.int64)
+    forward = np.zeros(size, dtype=np.int64)
+    step = 8 * _CHUNK  # large blocks: each bincount walks all the edge counts
+    for first in range(0, m, step):
+        start, end = _corner_edges(triangles[first : first + step])
+        block = ids[3 * first : 3 * first + start.size]
+        uses += np.bincount(block[start != end], minlength=size)
+        forward += np.bincount(block[start < end], minlength=size)
+    if not ((uses == 0) | (uses == 2)).all():
+        return False, False
+    return True, bool((2 * forward == uses).all())
+
+
+def _signed_volume(points: np.ndarray, triangles: np.ndarray) -> float:
+    """Six times the signed volume, in units of the used vertices' extent around their mean."""
+    used = np.zeros(points.shape[0], dtype=bool)
+    used[triangles.ravel()] = True
+    # All used: the same rows, in the same (C) layout, so the same sums, without a copy.
+    corners = points if used.all() and points.flags.c_contiguous else points[used]
+    origin = corners.mean(axis=0)
+    scale = max(float(np.abs(corners[:, k] - origin[k]).max()) for k in range(3)) or 1.0
+    del corners
+    # Per face, then one sum over all faces (its rounding depends on the whole array). The cross
+    # product written out is np.cross's arithmetic, element for element, without its overhead.
+    m = triangles.shape[0]
+    volumes = np.empty(m, dtype=np.float64)
+    for first in range(0, m, _CHUNK):
+        block = triangles[first : first + _CHUNK]
+        a, b, c = (np.take(points, block[:, k], axis=0) for k in range(3))
+        for corner in (a, b, c):
+            corner -= origin
+            corner /= scale
+        cross = np.empty_like(a)
+        np.subtract(b[:, 1] * c[:, 2], b[:, 2] * c[:, 1], out=cross[:, 0])
+        np.subtract(b[:, 2] * c[:, 0], b[:, 0] * c[:, 2], out=cross[:, 1])
+        np.subtract(b[:, 0] * c[:, 1], b[:, 1] * c[:, 0], out=cross[:, 2])
+        volumes[first : first + block.shape[0]] = np.einsum("ij,ij->i", a, cross)
+    return float(volumes.sum())
 
 
 def winding_message(name: str, winding: str) -> str:
