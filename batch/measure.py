@@ -146,7 +146,13 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         # Measure a block, then record it: alternating one measurement with one record costs
         # about a tenth more (measured), the records' writes evicting the measuring's data.
         block = tasks[first : first + _BLOCK]
-        measured = [_measure_task(surface, geometry, task, options) for task in block]
+        measured = []
+        for task in block:
+            measured.append(_measure_task(surface, geometry, task, options))
+            now = time.perf_counter()  # once a second however slow the block (a task each)
+            if progress is not None and now - last_report >= 1.0:
+                progress(first + len(measured))
+                last_report = now
         for task, m in zip(block, measured, strict=True):
             if isinstance(m, GoniometerError):
                 result.rows.append((task.index, error_row(task, obj.name, str(m), units)))
@@ -160,10 +166,6 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             result.rows.append((task.index, row))
             measuring.keep_sides(obj, geometry, item, m)
             result.measured += 1
-        now = time.perf_counter()
-        if progress is not None and now - last_report >= 1.0:
-            progress(first + len(block))
-            last_report = now
     result.measure_seconds = time.perf_counter() - start
     if options.get("sweep"):
         sweep_sites(result, surface, obj.name, tasks, options, geometry.matrix)

@@ -8,7 +8,9 @@ geometry; if a stale flag no longer matches, the object is repainted, so the col
 sides of a mesh that has changed. Moving, rotating or scaling the object changes no measurement
 (they are in mesh coordinates) and triggers nothing. The check runs from a timer, not inside the
 depsgraph handler (writing data there would re-trigger it), and not in Edit Mode (leaving Edit
-Mode triggers it again). Undo and redo drop every kept geometry.
+Mode triggers it again). Undo and redo drop every kept geometry. A frame change that moves an
+animated mesh (shape keys, armatures, animated modifiers) sends no depsgraph update, only the
+frame-change handlers: it is handled as an edit.
 
 The timer writes only what follows from the mesh the user edited (the stale flags and the "VG
 Sides" colours), never the viewport shading or the active colour attribute: undoing the edit
@@ -133,6 +135,7 @@ def migrate(obj) -> list[int]:
 
 _HANDLERS = (
     ("depsgraph_update_post", on_depsgraph_update),
+    ("frame_change_post", on_depsgraph_update),  # animation: no depsgraph update is sent
     ("undo_post", on_undo_or_redo),
     ("redo_post", on_undo_or_redo),
     ("load_post", on_load),

@@ -12,6 +12,7 @@ import struct
 import subprocess
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import bpy
 import numpy as np
@@ -624,3 +625,32 @@ def test_edge_arguments_are_checked(tmp_path):
     assert "drop --jobs and --shard" in result.stderr
     result = ok(batch("--demo", "--edge", 0, 0, 0, 1, 0, 0), 2)
     assert "--demo takes no --edge" in result.stderr
+
+
+def test_progress_is_reported_each_second_while_measuring(vg, monkeypatch):
+    """``progress(done)`` comes at most once a second, but at least once a second of measuring
+    however slow each measurement is: with a clock that advances a second per reading, after
+    every task, in order (failed ones included). Oracle: the task count, one by one."""
+    measure = importlib.import_module(f"{vg.__name__}.batch.measure")
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    batchplan = importlib.import_module(f"{vg.__name__}.vg_addon.workflow.batchplan")
+    shape = wedge(80.0, n=20, irregular=True, seed=2)
+    mesh_object("Wedge", shape.points, shape.triangles)
+    tasks = [
+        batchplan.Task(
+            index=k,
+            mesh=0,
+            center=(float(x), 0.0, 0.0),
+            radius=0.3 if k % 7 else 1e-9,  # every seventh fails: too few vertices
+            lam=2.0,
+            patch="euclidean",
+            number=k + 1,
+        )
+        for k, x in enumerate(np.linspace(-0.6, 0.6, 70))
+    ]
+    clock = iter(range(10**6))
+    monkeypatch.setattr(measure, "time", SimpleNamespace(perf_counter=lambda: float(next(clock))))
+    reported = []
+    result = measure.measure_mesh(0, sources.MeshSource("Wedge"), tasks, {}, reported.append)
+    assert result.failed == 10 and result.measured == 60
+    assert reported == list(range(1, len(tasks) + 1))

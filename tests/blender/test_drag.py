@@ -204,6 +204,39 @@ def test_ray_tree_survives_measuring_and_follows_edits(drag, view, vg):
     assert moved[2] == pytest.approx(first[2] + 0.25, abs=1e-3)
 
 
+def test_ray_cast_follows_a_mesh_moved_by_a_frame_change(drag, view, vg):
+    """An animated shape key lifts the mesh between two frames; a frame change sends no
+    depsgraph update, yet the press must hit the mesh where it now is, not the kept ray-cast
+    tree of the earlier frame. Oracle: Blender's own ray cast on the evaluated object."""
+    obj = view.obj
+    coord = pixel(view, view.points[ridge_vertex(view)])
+    obj.shape_key_add(name="Basis")
+    key = obj.shape_key_add(name="Lifted")
+    lifted = local_points(obj).copy()
+    lifted[:, 2] += 0.25  # along the mesh's own z, towards the camera
+    key.data.foreach_set("co", lifted.ravel())
+    for frame, value in ((1, 0.0), (10, 1.0)):
+        key.value = value
+        key.keyframe_insert("value", frame=frame)
+    scene = bpy.context.scene
+    scene.frame_set(1)
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    first = drag.ray_cast_object(obj, depsgraph, view.region, view.rv3d, coord)
+    scene.frame_set(10)
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    moved = drag.ray_cast_object(obj, depsgraph, view.region, view.rv3d, coord)
+    obj_eval = obj.evaluated_get(depsgraph)
+    to_local_matrix = obj_eval.matrix_world.inverted_safe()
+    origin = view3d_utils.region_2d_to_origin_3d(view.region, view.rv3d, Vector(coord))
+    direction = view3d_utils.region_2d_to_vector_3d(view.region, view.rv3d, Vector(coord))
+    hit, location, _n, _f = obj_eval.ray_cast(
+        to_local_matrix @ origin, to_local_matrix.to_3x3() @ direction
+    )
+    assert hit
+    np.testing.assert_allclose(moved, np.array(location), rtol=0, atol=1e-5)
+    assert moved[2] == pytest.approx(first[2] + 0.25, abs=1e-3)
+
+
 def test_radius_is_measured_on_the_view_plane(drag, view):
     center = view.points[ridge_vertex(view)]
     tolerance = pixel_size(drag, view, center)

@@ -299,3 +299,43 @@ def test_paint_state_updates_equal_painting_from_scratch(vg, seed):
         assert state.painted == target
         keys = target
     assert incremental > 30  # the incremental path, not only full repaints, was tested
+
+
+def evaluated_points(obj) -> np.ndarray:
+    """The evaluated mesh's vertex coordinates (shape keys and modifiers applied), read here."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    obj_eval.to_mesh_clear()
+    return co.reshape(-1, 3)
+
+
+def test_a_frame_change_that_moves_the_mesh_is_seen(vg):
+    """An animated shape key moves the mesh on a frame change, which sends no depsgraph update
+    (only the frame-change handlers run): the next measurement must still be taken on the mesh
+    as it now is, and the earlier one, taken on the mesh of frame 1, must go stale and grey.
+    Oracle: a Surface of the evaluated mesh's positions, read here."""
+    obj = wedge_object(80.0)
+    obj.shape_key_add(name="Basis")
+    key = obj.shape_key_add(name="Larger")
+    key.data.foreach_set("co", (local_points(obj) * np.float32(1.3)).ravel())
+    for frame, value in ((1, 0.0), (10, 1.0)):
+        key.value = value
+        key.keyframe_insert("value", frame=frame)
+    scene = bpy.context.scene
+    scene.frame_set(1)
+    vg.bridge.watch._pending.clear()
+    measure_at(0.1)
+    scene.frame_set(10)
+    measure_at(-0.1)
+    surface = Surface(evaluated_points(obj).astype(np.float64), triangles_of(obj).astype(np.int64))
+    m = surface.measure([-0.1, 0.0, 0.0], 0.3)
+    second = vg.bridge.records.numbers_of(obj.vg.measurements[1])
+    assert second["center"] == m.center.tolist()
+    assert obj.vg.measurements[1].n_vertices == m.n_vertices
+    vg.bridge.watch._check_pending()  # the staleness check (timers do not run in bpy)
+    assert [item.stale for item in obj.vg.measurements] == [True, False]
+    expected = expected_colours(len(obj.data.vertices), [(m.indices, m.labels, 1)])
+    np.testing.assert_array_equal(colours(obj), expected)
