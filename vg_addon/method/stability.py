@@ -86,6 +86,45 @@ def _side_normals(weights: np.ndarray, features: np.ndarray) -> tuple[np.ndarray
     return normal, spans & (count >= MIN_SIDE_VERTICES)
 
 
+def _best_splits(projection, members, weights, count, row_mean) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's WithinSS split of its members' projections (weighted), as the smallest value of
+    the upper side, and whether the row has a split leaving both sides enough vertices.
+
+    Members come first in sorted order, non-members (+inf) after them; a split after position
+    ``j`` maximises the weighted between-sides sum of squares ``P_j² W / (L_j (W - L_j))``.
+    """
+    masked = np.where(members, projection, np.inf)
+    n_members = members.sum(axis=1)
+    # Only the first (most members) columns can hold a split; the rest are +inf in every row.
+    width = min(masked.shape[1], max(int(n_members.max(initial=0)), 2))
+    ordered_weights = None
+    if weights.dtype == bool:
+        # With 0/1 weights the members tied at a value add equal terms, so the sorted values alone
+        # give the same sums as a permutation would, if every member's projection is finite.
+        ordered = np.sort(masked, axis=1)[:, :width]
+        last = ordered[np.arange(ordered.shape[0]), np.maximum(n_members, 1) - 1]
+        finite = (np.isfinite(ordered[:, 0]) & np.isfinite(last)) | (n_members == 0)
+    if weights.dtype != bool or not finite.all():
+        order = np.argsort(masked, axis=1)[:, :width]
+        ordered = np.take_along_axis(masked, order, axis=1)
+        ordered_weights = np.take_along_axis(weights, order, axis=1)
+    total = count[:, None]
+    inside = np.arange(width)[None, :] < n_members[:, None]
+    centred = np.where(inside, ordered - row_mean, 0.0)
+    if ordered_weights is None:
+        lower = np.minimum(np.arange(1.0, width), total)  # weight below a split after position j
+    else:
+        centred *= ordered_weights
+        lower = np.cumsum(ordered_weights, axis=1, dtype=np.float64)[:, :-1]
+    prefix = np.cumsum(centred, axis=1)[:, :-1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        between = prefix * prefix * total / (lower * (total - lower))
+    allowed = (ordered[:, 1:] > ordered[:, :-1]) & np.isfinite(ordered[:, 1:])
+    allowed &= (lower >= MIN_SIDE_VERTICES) & (total - lower >= MIN_SIDE_VERTICES)
+    best = np.argmax(np.where(allowed, between, -np.inf), axis=1)
+    return ordered[np.arange(ordered.shape[0]), best + 1], allowed.any(axis=1)
+
+
 def batched_angles(
     local, normals, weights, centers, position_scale, rule: str
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -113,7 +152,11 @@ def batched_angles(
         False where Algorithm 1 would refuse the patch (too few vertices, no edge, a side on a
         line, flat or folded planes); those angles mean nothing.
     """
-    weights = np.asarray(weights, dtype=np.float64)
+    weights = np.asarray(weights)
+    # Whole-number weights (0/1 or counts) are gathered and summed in their own narrow type: their
+    # running sums are exact integers, the same in float64 whatever the order.
+    raw = weights if weights.dtype.kind in "biu" else weights.astype(np.float64)
+    weights = weights.astype(np.float64)
     members = weights > 0
     count = weights.sum(axis=1)
     ok = count >= 2 * MIN_SIDE_VERTICES
@@ -121,14 +164,14 @@ def batched_angles(
 
     values, vectors = np.linalg.eigh((weights @ _outer_pairs(normals, normals)).reshape(-1, 3, 3))
     tangent = vectors[:, :, 0]
-    mean_normal = weights @ normals / safe[:, None]
+    weighted_normal = weights @ normals
+    mean_normal = weighted_normal / safe[:, None]
     cross = np.cross(tangent, mean_normal)
     cross_norm = np.linalg.norm(cross, axis=1)
     ok &= (values[:, 1] > 1e-12 * values[:, 2]) & (cross_norm > 1e-12)
     binormal = cross / np.maximum(cross_norm, 1e-300)[:, None]
 
     # Sums over each patch, as matrix products with the pool: no (k, m) temporaries.
-    weighted_normal = weights @ normals
     weighted_local = weights @ local
     center_b = np.einsum("ki,ki->k", centers, binormal)
     sum_q = np.einsum("ki,ki->k", binormal, weighted_normal)
@@ -145,22 +188,8 @@ def batched_angles(
     projection -= (scale * center_b)[:, None]
     row_mean = ((sum_q + scale * sum_u) / safe)[:, None]
 
-    # Weighted WithinSS per row: members first in sorted order, non-members (+inf) after them.
-    masked = np.where(members, projection, np.inf)
-    order = np.argsort(masked, axis=1)
-    ordered = np.take_along_axis(masked, order, axis=1)
-    ordered_weights = np.take_along_axis(weights, order, axis=1)
-    total = count[:, None]
-    inside = np.arange(ordered.shape[1])[None, :] < members.sum(axis=1)[:, None]
-    prefix = np.cumsum(np.where(inside, ordered - row_mean, 0.0) * ordered_weights, axis=1)[:, :-1]
-    lower = np.cumsum(ordered_weights, axis=1)[:, :-1]  # weight below a split after position j
-    with np.errstate(divide="ignore", invalid="ignore"):
-        between = prefix * prefix * total / (lower * (total - lower))
-    allowed = (ordered[:, 1:] > ordered[:, :-1]) & np.isfinite(ordered[:, 1:])
-    allowed &= (lower >= MIN_SIDE_VERTICES) & (total - lower >= MIN_SIDE_VERTICES)
-    ok &= allowed.any(axis=1)
-    best = np.argmax(np.where(allowed, between, -np.inf), axis=1)
-    threshold = ordered[np.arange(ordered.shape[0]), best + 1]
+    threshold, split = _best_splits(projection, members, raw, count, row_mean)
+    ok &= split
     plus = members & (projection >= threshold[:, None])
 
     features = _features(local, normals)
