@@ -401,28 +401,31 @@ def set_watching(watching: bool) -> None:
     _current.clear()
 
 
+def _kept(cache: OrderedDict, key: str, build):
+    """``cache[key]``, built by ``build()`` if absent; the latest :data:`_CACHE_SIZE` kept."""
+    value = cache.get(key)
+    if value is None:
+        value = cache[key] = build()
+        while len(cache) > _CACHE_SIZE:
+            cache.popitem(last=False)
+    else:
+        cache.move_to_end(key)
+    return value
+
+
 def surface_for(obj, geometry: Geometry) -> Surface:
     """The prepared :class:`Surface` of ``geometry``, built once per fingerprint (objects with
     equal meshes share it, wherever they are placed)."""
-    key = geometry.fingerprint
-    surface = _surfaces.get(key)
-    if surface is None:
-        triangles = geometry.triangles if geometry.triangles.size else None
-        surface = Surface(geometry.points, triangles)
-        _surfaces[key] = surface
-        while len(_surfaces) > _CACHE_SIZE:
-            _surfaces.popitem(last=False)
-    else:
-        _surfaces.move_to_end(key)
-    return surface
+    triangles = geometry.triangles if geometry.triangles.size else None
+    return _kept(_surfaces, geometry.fingerprint, lambda: Surface(geometry.points, triangles))
 
 
 def ray_tree_for(obj, geometry: Geometry, depsgraph=None) -> BVHTree:
     """A ray-cast tree of ``obj``'s evaluated mesh, in mesh coordinates, built once per
     fingerprint.
 
-    Rays cast on it hit what ``obj.evaluated_get(depsgraph).ray_cast`` hits (the same C code on
-    the same triangles), but it survives our colour writes: Blender rebuilds the evaluated
+    Rays cast on it hit the triangles ``obj.evaluated_get(depsgraph).ray_cast`` hits (to
+    float32 precision), but it survives our colour writes: Blender rebuilds the evaluated
     mesh's own tree after every change of the mesh, colours included (0.7 s at 1M vertices, on
     the press after each measurement).
 
@@ -432,18 +435,12 @@ def ray_tree_for(obj, geometry: Geometry, depsgraph=None) -> BVHTree:
         ``evaluated_geometry(obj, depsgraph)``, just read: the tree is built from the same
         evaluated mesh.
     """
-    key = geometry.fingerprint
-    tree = _ray_trees.get(key)
-    if tree is None:
-        if depsgraph is None:
-            depsgraph = bpy.context.evaluated_depsgraph_get()
-        tree = BVHTree.FromObject(obj.evaluated_get(depsgraph), depsgraph)
-        _ray_trees[key] = tree
-        while len(_ray_trees) > _CACHE_SIZE:
-            _ray_trees.popitem(last=False)
-    else:
-        _ray_trees.move_to_end(key)
-    return tree
+
+    def build() -> BVHTree:
+        graph = bpy.context.evaluated_depsgraph_get() if depsgraph is None else depsgraph
+        return BVHTree.FromObject(obj.evaluated_get(graph), graph)
+
+    return _kept(_ray_trees, geometry.fingerprint, build)
 
 
 def clear_cache() -> None:

@@ -7,6 +7,8 @@ import json
 import bpy
 import numpy as np
 
+from vg_addon import Surface
+
 COLOUR_ATTRIBUTE = "VG Sides"
 
 
@@ -38,6 +40,21 @@ def local_points(obj) -> np.ndarray:
     co = np.empty(len(obj.data.vertices) * 3, dtype=np.float32)
     obj.data.vertices.foreach_get("co", co)
     return co.reshape(-1, 3)
+
+
+def evaluated_surface(obj) -> Surface:
+    """A core Surface of the object's evaluated mesh (shape keys and modifiers applied), read
+    here: an oracle for what the extension measures on."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    mesh.calc_loop_triangles()
+    tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", tris)
+    obj_eval.to_mesh_clear()
+    return Surface(co.reshape(-1, 3).astype(np.float64), tris.reshape(-1, 3))
 
 
 def world(points, obj) -> np.ndarray:

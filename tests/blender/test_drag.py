@@ -153,6 +153,20 @@ def test_ray_cast_from_region_pixels_hits_the_projected_vertices(drag, view):
     assert drag.ray_cast_object(view.obj, depsgraph, view.region, view.rv3d, (3, 3)) is None
 
 
+def blender_hit(view, coord) -> np.ndarray:
+    """Where Blender's own ray cast on the evaluated object hits it through region pixel
+    ``coord``, in mesh coordinates: the oracle of the kept ray-cast tree."""
+    obj_eval = view.obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    to_local_matrix = obj_eval.matrix_world.inverted_safe()
+    origin = view3d_utils.region_2d_to_origin_3d(view.region, view.rv3d, Vector(coord))
+    direction = view3d_utils.region_2d_to_vector_3d(view.region, view.rv3d, Vector(coord))
+    hit, location, _n, _f = obj_eval.ray_cast(
+        to_local_matrix @ origin, to_local_matrix.to_3x3() @ direction
+    )
+    assert hit
+    return np.array(location)
+
+
 def test_ray_tree_survives_measuring_and_follows_edits(drag, view, vg):
     """The press after a measurement must not wait for a new ray-cast tree (the colour write
     makes Blender rebuild its own), yet an edited mesh must be hit where it now is. Oracle:
@@ -162,18 +176,6 @@ def test_ray_tree_survives_measuring_and_follows_edits(drag, view, vg):
     vertex = ridge_vertex(view)
     coord = pixel(view, view.points[vertex])
 
-    def blender_hit():
-        depsgraph = bpy.context.evaluated_depsgraph_get()
-        obj_eval = obj.evaluated_get(depsgraph)
-        to_local_matrix = obj_eval.matrix_world.inverted_safe()
-        origin = view3d_utils.region_2d_to_origin_3d(view.region, view.rv3d, Vector(coord))
-        direction = view3d_utils.region_2d_to_vector_3d(view.region, view.rv3d, Vector(coord))
-        hit, location, _n, _f = obj_eval.ray_cast(
-            to_local_matrix @ origin, to_local_matrix.to_3x3() @ direction
-        )
-        assert hit
-        return np.array(location)
-
     def tree():
         depsgraph = bpy.context.evaluated_depsgraph_get()
         return mesh_data.ray_tree_for(obj, mesh_data.evaluated_geometry(obj, depsgraph))
@@ -182,7 +184,7 @@ def test_ray_tree_survives_measuring_and_follows_edits(drag, view, vg):
     first = drag.ray_cast_object(obj, depsgraph, view.region, view.rv3d, coord)
     # The same surface point, to float32 ray-cast precision (bpy 5.3's own ray cast can differ
     # from the tree's in the last bits).
-    np.testing.assert_allclose(first, blender_hit(), rtol=0, atol=1e-5)
+    np.testing.assert_allclose(first, blender_hit(view, coord), rtol=0, atol=1e-5)
     kept = tree()
     bpy.context.view_layer.objects.active = obj
     result = bpy.ops.vg.measure_xyz(
@@ -200,7 +202,7 @@ def test_ray_tree_survives_measuring_and_follows_edits(drag, view, vg):
     depsgraph = bpy.context.evaluated_depsgraph_get()
     moved = drag.ray_cast_object(obj, depsgraph, view.region, view.rv3d, coord)
     assert tree() is not kept
-    np.testing.assert_allclose(moved, blender_hit(), rtol=0, atol=1e-5)
+    np.testing.assert_allclose(moved, blender_hit(view, coord), rtol=0, atol=1e-5)
     assert moved[2] == pytest.approx(first[2] + 0.25, abs=1e-3)
 
 
@@ -225,15 +227,7 @@ def test_ray_cast_follows_a_mesh_moved_by_a_frame_change(drag, view, vg):
     scene.frame_set(10)
     depsgraph = bpy.context.evaluated_depsgraph_get()
     moved = drag.ray_cast_object(obj, depsgraph, view.region, view.rv3d, coord)
-    obj_eval = obj.evaluated_get(depsgraph)
-    to_local_matrix = obj_eval.matrix_world.inverted_safe()
-    origin = view3d_utils.region_2d_to_origin_3d(view.region, view.rv3d, Vector(coord))
-    direction = view3d_utils.region_2d_to_vector_3d(view.region, view.rv3d, Vector(coord))
-    hit, location, _n, _f = obj_eval.ray_cast(
-        to_local_matrix @ origin, to_local_matrix.to_3x3() @ direction
-    )
-    assert hit
-    np.testing.assert_allclose(moved, np.array(location), rtol=0, atol=1e-5)
+    np.testing.assert_allclose(moved, blender_hit(view, coord), rtol=0, atol=1e-5)
     assert moved[2] == pytest.approx(first[2] + 0.25, abs=1e-3)
 
 

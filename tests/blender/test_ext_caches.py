@@ -10,7 +10,14 @@ import json
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import colours, expected_colours, local_points, wedge_object, world
+from bpy_helpers import (
+    colours,
+    evaluated_surface,
+    expected_colours,
+    local_points,
+    wedge_object,
+    world,
+)
 
 from vg_addon import Surface
 
@@ -301,17 +308,6 @@ def test_paint_state_updates_equal_painting_from_scratch(vg, seed):
     assert incremental > 30  # the incremental path, not only full repaints, was tested
 
 
-def evaluated_points(obj) -> np.ndarray:
-    """The evaluated mesh's vertex coordinates (shape keys and modifiers applied), read here."""
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    obj_eval = obj.evaluated_get(depsgraph)
-    mesh = obj_eval.to_mesh()
-    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
-    mesh.vertices.foreach_get("co", co)
-    obj_eval.to_mesh_clear()
-    return co.reshape(-1, 3)
-
-
 def test_a_frame_change_that_moves_the_mesh_is_seen(vg):
     """An animated shape key moves the mesh on a frame change, which sends no depsgraph update
     (only the frame-change handlers run): the next measurement must still be taken on the mesh
@@ -330,8 +326,7 @@ def test_a_frame_change_that_moves_the_mesh_is_seen(vg):
     measure_at(0.1)
     scene.frame_set(10)
     measure_at(-0.1)
-    surface = Surface(evaluated_points(obj).astype(np.float64), triangles_of(obj).astype(np.int64))
-    m = surface.measure([-0.1, 0.0, 0.0], 0.3)
+    m = evaluated_surface(obj).measure([-0.1, 0.0, 0.0], 0.3)
     second = vg.bridge.records.numbers_of(obj.vg.measurements[1])
     assert second["center"] == m.center.tolist()
     assert obj.vg.measurements[1].n_vertices == m.n_vertices

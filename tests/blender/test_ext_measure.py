@@ -7,6 +7,7 @@ import pytest
 from bpy_helpers import (
     COLOUR_ATTRIBUTE,
     colours,
+    evaluated_surface,
     exact,
     expected_colours,
     local_points,
@@ -212,19 +213,6 @@ def test_mirrored_object_keeps_outward_normals(vg):
     a, b = plain.vg.measurements[0], mirrored.vg.measurements[0]
     assert abs(a.angle - b.angle) < 1e-9
     assert_same(b, core_surface(mirrored).measure([0, 0, 0], 0.5))
-
-
-def evaluated_surface(obj) -> Surface:
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    obj_eval = obj.evaluated_get(depsgraph)
-    mesh = obj_eval.to_mesh()
-    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
-    mesh.vertices.foreach_get("co", co)
-    mesh.calc_loop_triangles()
-    tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
-    mesh.loop_triangles.foreach_get("vertices", tris)
-    obj_eval.to_mesh_clear()
-    return Surface(co.reshape(-1, 3).astype(np.float64), tris.reshape(-1, 3))
 
 
 def test_deforming_modifier_is_applied(vg):
