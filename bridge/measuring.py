@@ -249,10 +249,9 @@ def repaint(
     )
     trusted = usable and not verify and state.generation == painting.generation()
     rows = _signatures(items)
-    keys, sides, stale, remembered, start = [], {}, [], {}, 0
+    keys, stale, start = [], [], 0
     known = state.known if usable and not verify else {}
     if trusted:
-        remembered = known
         before = state.rows.shape[0]
         if before <= rows.shape[0] and np.array_equal(state.rows, rows[:before]):
             # Records only added since (the usual click): the earlier ones are as painted.
@@ -265,8 +264,8 @@ def repaint(
         # Only a file load or an undo brings world-space records, and neither is trusted.
         legacy.migrate(obj, geometry, surface_for(obj, geometry))
         rows = _signatures(items)
-    if start == 0:
-        remembered = {}
+    # The records as painted now: the ones kept unread join the map they were recognised by.
+    remembered, sides = (known if start else {}), {}
     for position in range(start, rows.shape[0]):
         signature = tuple(rows[position].tolist())
         entry = known.get(signature)

@@ -33,24 +33,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
 
-from benchmark_drag import ridge_mesh  # noqa: E402
+from benchmark_drag import load_extension, ridge_mesh  # noqa: E402
 
 SIZES = {"10k": 10_000, "1M": 1_000_000, "5M": 5_000_000}
 PATCH_VERTICES = 2_000
-
-
-def load_extension():
-    """This checkout as the ``virtual_goniometer`` extension package, registered."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location(
-        "virtual_goniometer", ROOT / "__init__.py", submodule_search_locations=[str(ROOT)]
-    )
-    extension = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = extension
-    spec.loader.exec_module(extension)
-    extension.register()
-    return extension
 
 
 def rss_mb() -> float:

@@ -108,13 +108,8 @@ def view_radius_cost(repeats: int = 200) -> str:
     return f"{(time.perf_counter() - start) / repeats * 1e6:.1f} µs"
 
 
-def extension_costs(points, triangles, center, radius) -> None:
-    """With bpy: the press (mesh evaluation + cached Surface) and release (record) costs."""
-    try:
-        import bpy
-    except ImportError:
-        print("press / release in Blender: not measured: no bpy module in this Python")
-        return
+def load_extension():
+    """This checkout as the ``virtual_goniometer`` extension package, registered (needs bpy)."""
     spec = importlib.util.spec_from_file_location(
         "virtual_goniometer", ROOT / "__init__.py", submodule_search_locations=[str(ROOT)]
     )
@@ -122,6 +117,17 @@ def extension_costs(points, triangles, center, radius) -> None:
     sys.modules[spec.name] = extension
     spec.loader.exec_module(extension)
     extension.register()
+    return extension
+
+
+def extension_costs(points, triangles, center, radius) -> None:
+    """With bpy: the press (mesh evaluation + cached Surface) and release (record) costs."""
+    try:
+        import bpy
+    except ImportError:
+        print("press / release in Blender: not measured: no bpy module in this Python")
+        return
+    extension = load_extension()
     from virtual_goniometer.bridge import measuring, mesh_data
 
     mesh = bpy.data.meshes.new("Benchmark")
