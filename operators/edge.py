@@ -26,7 +26,7 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.edge_state import EdgeMachine, EdgePhase
 from .drag import NAVIGATION_EVENTS, format_length, object_alive, ray_cast_object
 from .edge_overlay import EdgeOverlay
-from .measure import SPACE_ITEMS, poll_measurable, typed_value
+from .measure import SPACE_ITEMS, defaults_from_panel, poll_measurable, typed_value
 
 # The drag tool's view navigation, and plain mouse moves (a click session has no drag).
 _NAVIGATION = NAVIGATION_EVENTS | {"MOUSEMOVE"}
@@ -241,16 +241,16 @@ class VG_OT_measure_edge(bpy.types.Operator):
         return poll_measurable(cls, context)
 
     def execute(self, context):
-        settings = context.scene.vg_settings
-        given = self.properties.is_property_set
-        if not given("spacing"):
-            self.spacing = settings.edge_spacing
-        if not given("radius"):
-            self.radius = settings.radius
-        if not given("seg_param"):
-            self.seg_param = settings.seg_param
-        if not given("patch"):
-            self.patch = settings.patch
+        defaults_from_panel(
+            self,
+            context,
+            {
+                "spacing": "edge_spacing",
+                "radius": "radius",
+                "seg_param": "seg_param",
+                "patch": "patch",
+            },
+        )
         obj = context.active_object
         try:
             edge = edges.measure_edge_on_object(

@@ -43,6 +43,19 @@ def _stale_warning(obj) -> str:
     )
 
 
+def defaults_from_panel(operator, context, settings_of: dict) -> None:
+    """Give each operator property the caller did not set (a key of ``settings_of``) the value
+    of its panel setting (the value); an unset ``location`` is the 3D cursor, in world space."""
+    given = operator.properties.is_property_set
+    settings = context.scene.vg_settings
+    for name, setting in settings_of.items():
+        if not given(name):
+            setattr(operator, name, getattr(settings, setting))
+    if "location" in operator.properties.bl_rna.properties and not given("location"):
+        operator.location = context.scene.cursor.location
+        operator.space = "WORLD"
+
+
 def poll_measurable(cls, context) -> bool:
     """``poll()`` of operators that need a measurable active mesh; the reason it is not goes
     to the button's tooltip."""
@@ -132,21 +145,11 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
         return poll_measurable(cls, context)
 
     def execute(self, context):
-        settings = context.scene.vg_settings
-        given = self.properties.is_property_set
-        if not given("location"):
-            self.location = context.scene.cursor.location
-            self.space = "WORLD"
-        if not given("radius"):
-            self.radius = settings.radius
-        if not given("seg_param"):
-            self.seg_param = settings.seg_param
-        if not given("patch"):
-            self.patch = settings.patch
-        if not given("rule"):
-            self.rule = settings.rule
-        if not given("stability"):
-            self.stability = settings.stability
+        defaults_from_panel(
+            self,
+            context,
+            {name: name for name in ("radius", "seg_param", "patch", "rule", "stability")},
+        )
         obj = context.active_object
         try:
             item = measuring.measure_on_object(

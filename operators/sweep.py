@@ -18,7 +18,7 @@ from bpy_extras.io_utils import ExportHelper
 from ..bridge import measuring
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio, sweep_plot
-from .measure import SPACE_ITEMS, poll_measurable, typed_value
+from .measure import SPACE_ITEMS, defaults_from_panel, poll_measurable, typed_value
 
 
 class VG_OT_radius_sweep(bpy.types.Operator, ExportHelper):
@@ -55,15 +55,9 @@ class VG_OT_radius_sweep(bpy.types.Operator, ExportHelper):
 
     def execute(self, context):
         settings = context.scene.vg_settings
-        given = self.properties.is_property_set
-        if not given("location"):
-            self.location = context.scene.cursor.location
-            self.space = "WORLD"
-        for name, setting in (("start", "sweep_start"), ("stop", "sweep_stop")):
-            if not given(name):
-                setattr(self, name, getattr(settings, setting))
-        if not given("count"):
-            self.count = settings.sweep_count
+        defaults_from_panel(
+            self, context, {"start": "sweep_start", "stop": "sweep_stop", "count": "sweep_count"}
+        )
         path = bpy.path.abspath(self.filepath) if self.filepath else ""
         obj = context.active_object
         try:

@@ -107,3 +107,17 @@ def test_radius_sweep_writes_its_csv_and_png(vg, tmp_path):
     )
     image = bpy.data.images.load(str(path.with_suffix(".png")))
     assert tuple(image.size) == (640, 430)  # Blender itself reads the plot
+
+
+def test_radius_sweep_takes_unset_radii_from_the_panel(vg, tmp_path):
+    wedge_object(70.0)
+    bpy.context.scene.cursor.location = (0.01, 0.0, 0.0)
+    settings = bpy.context.scene.vg_settings
+    settings.sweep_start, settings.sweep_stop, settings.sweep_count = 0.1, 0.5, 5
+    path = tmp_path / "sweep.csv"
+    assert bpy.ops.vg.radius_sweep(filepath=str(path)) == {"FINISHED"}
+    with open(path, newline="", encoding="utf-8") as handle:
+        rows = list(csv.DictReader(handle))
+    radii = np.linspace(np.float32(0.1), np.float32(0.5), 5)  # the panel keeps 32-bit floats
+    np.testing.assert_allclose([float(r["Radius"]) for r in rows], radii, rtol=1e-6)
+    assert all(abs(float(r["Angle"]) - 70.0) < 0.1 for r in rows if r["Angle"])
