@@ -17,6 +17,7 @@ from ..bridge import measuring, records
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, uniform_scale
 from ..properties import PATCH_ITEMS, RULE_ITEMS
 from ..vg_addon import GoniometerError
+from ..vg_addon.method.result import fit_text
 
 
 def typed_value(value: float) -> float:
@@ -171,7 +172,8 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
         self.report(
             {"INFO"},
             f"Measurement {item.number} (break {item.break_number}) on '{obj.name}': "
-            f"{item.angle:.2f}°{spread}, {item.convexity} edge (fit error {item.fit_error:.3g}, "
+            f"{item.angle:.2f}°{spread}, {item.convexity} edge "
+            f"(fit error {fit_text(item.fit_error, item.radius)}, "
             f"{item.n_vertices} vertices)",
         )
         for warning in (_stale_warning(obj), non_uniform_scale_note(obj)):

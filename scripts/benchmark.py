@@ -93,6 +93,7 @@ def main(argv=None) -> None:
         f"WithinSS, 100k values:                   {best_of(lambda: withinss_split(values), 10) * 1e3:8.2f} ms"
     )
     core_figures(int(np.sqrt(args.vertices)))
+    blas_path_comparison(int(np.sqrt(args.vertices)))
 
 
 def core_figures(side: int, repeats: int = 3) -> None:
@@ -126,6 +127,76 @@ def core_figures(side: int, repeats: int = 3) -> None:
                 figures[name] = min(figures.get(name, np.inf), seconds)
     for name, seconds in figures.items():
         print(f"{name + ':':48s} {seconds * 1e3:9.2f} ms")
+
+
+BLAS_COMMIT = "97179f7"
+"""The last commit whose measuring path used BLAS and LAPACK (matrix products, ``eigh``)."""
+
+
+def _blas_core():
+    """The core as it was at :data:`BLAS_COMMIT`, imported under another name from ``git archive``
+    (None, with the reason printed, where git or that commit is not available)."""
+    import importlib
+    import subprocess
+    import tempfile
+
+    root = Path(__file__).resolve().parents[1]
+    folder = Path(tempfile.mkdtemp(prefix="vg-blas-core-"))
+    try:
+        archive = subprocess.run(
+            ["git", "-C", str(root), "archive", BLAS_COMMIT, "vg_addon"],
+            capture_output=True,
+            check=True,
+        ).stdout
+        subprocess.run(["tar", "-x", "-C", str(folder)], input=archive, check=True)
+    except (OSError, subprocess.CalledProcessError) as error:
+        print(f"(no BLAS-path comparison: git archive {BLAS_COMMIT} failed: {error})")
+        return None
+    (folder / "vg_addon").rename(folder / "vg_addon_blas")
+    sys.path.insert(0, str(folder))
+    return importlib.import_module("vg_addon_blas"), importlib.import_module(
+        "vg_addon_blas.method.stability"
+    )
+
+
+def blas_path_comparison(side: int, rounds: int = 5) -> None:
+    """Today's fixed-order arithmetic against the BLAS path of :data:`BLAS_COMMIT`, in one run,
+    the two interleaved round by round (best of ``rounds``): a 2,000-vertex Euclidean measurement
+    on a 1M-vertex ridge, and its stability figure."""
+    from vg_addon.method.stability import estimate_stability
+
+    loaded = _blas_core()
+    if loaded is None:
+        return
+    old_core, old_stability = loaded
+    points, triangles = ridge_mesh(side)
+    radius = (2.0 / (side - 1)) * np.sqrt(2000 / np.pi)
+    centers = [(x, 0.0, 0.0) for x in np.random.default_rng(1).uniform(-0.8, 0.8, 200)]
+    paths = {
+        "fixed order (today)": (Surface(points, triangles), estimate_stability),
+        f"BLAS path ({BLAS_COMMIT})": (
+            old_core.Surface(points, triangles),
+            old_stability.estimate_stability,
+        ),
+    }
+    best = {(name, what): np.inf for name in paths for what in ("measure", "stability")}
+    for _ in range(rounds):
+        for name, (surface, stability) in paths.items():
+            start = time.perf_counter()
+            for center in centers:
+                surface.measure(center, radius)
+            per_measurement = (time.perf_counter() - start) / len(centers)
+            m = surface.measure(centers[0], radius)
+            figure = best_of(lambda s=surface, f=stability, m=m: f(s, m), 5)
+            best[name, "measure"] = min(best[name, "measure"], per_measurement)
+            best[name, "stability"] = min(best[name, "stability"], figure)
+    print(f"\nfixed-order arithmetic against the BLAS path, {len(points):,}-vertex ridge:")
+    for what, label in (("measure", "measurement, 2k vertices"), ("stability", "stability figure")):
+        new, old = (best[name, what] for name in paths)
+        print(
+            f"{label + ':':28s} today {new * 1e3:7.3f} ms, BLAS path {old * 1e3:7.3f} ms, "
+            f"ratio {new / old:5.2f}"
+        )
 
 
 if __name__ == "__main__":

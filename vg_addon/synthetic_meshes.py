@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import GoniometerError
+from .method.fixed_order import dot3, norm3, row_dot
 
 __all__ = [
     "REGION_INNER",
@@ -490,9 +491,7 @@ class BoneFragment:
 
 def _interior_angle(normal_a: np.ndarray, normal_b: np.ndarray) -> float:
     """180 degrees minus the angle between two outward normals."""
-    between = math.atan2(
-        float(np.linalg.norm(np.cross(normal_a, normal_b))), float(np.dot(normal_a, normal_b))
-    )
+    between = math.atan2(norm3(np.cross(normal_a, normal_b)), dot3(normal_a, normal_b))
     return 180.0 - math.degrees(between)
 
 
@@ -674,5 +673,6 @@ def _bumps(points: np.ndarray, seed: int, waves: int = 16) -> np.ndarray:
     directions /= np.linalg.norm(directions, axis=1, keepdims=True)
     wavenumbers = 2.0 * math.pi / rng.uniform(1.5, 6.0, waves)
     phases = rng.uniform(0.0, 2.0 * math.pi, waves)
-    field = np.sin(points @ (directions * wavenumbers[:, None]).T + phases).sum(axis=1)
+    waves_at = np.stack([row_dot(points, d) for d in directions * wavenumbers[:, None]], axis=1)
+    field = np.sin(waves_at + phases).sum(axis=1)
     return field / math.sqrt(waves / 2.0)

@@ -1,13 +1,15 @@
 """Measurements whose exact outputs are pinned in ``data/replay_pins.json``.
 
-The pins were computed by ``python tests/core/replay_cases.py`` at commit 5ffee72 (before the
-issue-10 hot-path changes to ``spatial.py`` and ``surface.py``). Recorded measurements replay by
-re-measuring at their stored centre, radius, λ and patch mode, so these outputs must stay bit for
-bit what that code gave. Each case records the patch (snapped vertex, snap distance, the vertex
-indices in the order Algorithm 1 summed them, their labels) apart from the numbers Algorithm 1
-derived from it, so a change to the algorithm's own arithmetic shows as a change of numbers only.
-The numbers are pinned for the NumPy they were computed with (another NumPy's linear algebra
-and sums may round differently); the patches for every NumPy.
+The pins were computed by ``python tests/core/replay_cases.py`` with the arithmetic of issue 18
+(no BLAS or LAPACK in the measuring path): the same bits under NumPy 1.26 and 2.x, on every CPU,
+BLAS kernel and thread count. Recorded measurements replay by re-measuring at their stored
+centre, radius, λ and patch mode, so these outputs must stay bit for bit what that code gave.
+Each case records the patch (snapped vertex, snap distance, the vertex indices in the order
+Algorithm 1 summed them, their labels) apart from the numbers Algorithm 1 derived from it, so a
+change to the algorithm's own arithmetic shows as a change of numbers only.
+
+``data/replay_pins_5ffee72.json`` holds the same cases as commit 5ffee72 computed them (NumPy
+1.26.4, BLAS and LAPACK): the patches must still be those, and the numbers within 1e-9°.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from vg_addon.formats.meshio import read_mesh  # noqa: E402
 from vg_addon.synthetic_meshes import bone_fragment, wedge  # noqa: E402
 
 PINS = Path(__file__).with_name("data") / "replay_pins.json"
+PINS_5FFEE72 = Path(__file__).with_name("data") / "replay_pins_5ffee72.json"
 SHARED_DATA = ROOT.parent / "shared" / "data"
 
 

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import GoniometerError
+from .fixed_order import acos_degrees, dot3, eigh3, moments, norm3, row_dot, total
 from .result import Measurement
 from .withinss import withinss_split
 
@@ -60,9 +63,9 @@ def canonical_order(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
 
 def _smallest_eigenvector(matrix: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
     """Smallest eigenvalue, its unit eigenvector (sign fixed) and all eigenvalues of a 3x3 SPD matrix."""
-    values, vectors = np.linalg.eigh(matrix)
+    values, vectors = eigh3(matrix)
     vector = vectors[:, 0]
-    if vector[np.argmax(np.abs(vector))] < 0:  # a deterministic sign, independent of LAPACK's
+    if vector[np.argmax(np.abs(vector))] < 0:  # a sign that does not depend on the solver
         vector = -vector
     return float(values[0]), vector, values
 
@@ -77,7 +80,7 @@ def _plane(points: np.ndarray, mean: np.ndarray | None = None) -> tuple[np.ndarr
     """PCA plane fit: unit normal, mean squared distance to the plane, and whether the points
     span a plane at all (``False``: they lie on a line). ``mean``: the points' mean, if known."""
     centred = points - (_column_means(points) if mean is None else mean)
-    covariance = centred.T @ centred / points.shape[0]
+    covariance = moments(centred) / points.shape[0]
     error, normal, values = _smallest_eigenvector(covariance)
     spans = bool(values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny))
     return normal, max(error, 0.0), spans
@@ -87,9 +90,9 @@ def _row_beside(line_points: np.ndarray, others: np.ndarray) -> np.ndarray:
     """Mask of ``others`` on the row nearest to and parallel with the line through
     ``line_points``; all False when the nearest vertices do not form such a row."""
     centred = line_points - line_points.mean(axis=0)
-    direction = np.linalg.eigh(centred.T @ centred)[1][:, 2]
+    direction = eigh3(moments(centred))[1][:, 2]
     offsets = others - line_points.mean(axis=0)
-    across = offsets - np.outer(offsets @ direction, direction)
+    across = offsets - np.outer(row_dot(offsets, direction), direction)
     distance = np.sqrt(np.einsum("ij,ij->i", across, across))
     beside = distance <= SHARED_ROW_FACTOR * distance.min()
     # A row parallel to the line sits at one offset across it; scattered neighbours do not.
@@ -124,7 +127,7 @@ def _fit_side(points, joined, mask, side: str) -> tuple[np.ndarray, float, int, 
                 "beside it, so no plane can be fitted: use a larger radius (each side needs at "
                 "least two rows of vertices off the edge) or move the centre onto the break edge."
             )
-    if np.dot(normal, means[3:]) < 0:
+    if dot3(normal, means[3:]) < 0:
         normal = -normal
     return normal, error, borrowed, centroid
 
@@ -154,8 +157,8 @@ def _correlation(a: np.ndarray, b: np.ndarray) -> float:
     """Pearson correlation of two vectors; 0 when either is constant."""
     a = a - a.mean()
     b = b - b.mean()
-    scale = float(np.sqrt(np.dot(a, a) * np.dot(b, b)))
-    return float(np.dot(a, b)) / scale if scale > 0 else 0.0
+    scale = math.sqrt(total(a * a) * total(b * b))
+    return total(a * b) / scale if scale > 0 else 0.0
 
 
 def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray]:
@@ -168,8 +171,7 @@ def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray]:
     labels = projection >= threshold
     normal_plus, error_plus, shared_plus, mean_plus = _fit_side(points, joined, labels, "+")
     normal_minus, error_minus, shared_minus, mean_minus = _fit_side(points, joined, ~labels, "-")
-    cosine = float(np.clip(np.dot(normal_plus, normal_minus), -1.0, 1.0))
-    angle = 180.0 - float(np.degrees(np.arccos(cosine)))
+    angle = 180.0 - acos_degrees(dot3(normal_plus, normal_minus))
     if angle < FLAT_TOLERANCE_DEG:
         raise GoniometerError(
             f"The two sides fit planes folded onto each other ({angle:.2f}°): the patch is too "
@@ -200,7 +202,7 @@ def _planes_form_ridge(fields, step) -> bool:
     """Whether the fitted planes meet in a ridge (convex) rather than a valley, relative to their
     normals: moving from the "−" side's centroid to the "+" side's (``step``), the normal turns the
     same way."""
-    return float(np.dot(step, fields["normal_plus"] - fields["normal_minus"])) > 0
+    return dot3(step, fields["normal_plus"] - fields["normal_minus"]) > 0
 
 
 def measure_patch(
@@ -227,27 +229,26 @@ def measure_patch(
             f"The patch holds {n_points} vertices; at least {2 * MIN_SIDE_VERTICES} are needed "
             f"({MIN_SIDE_VERTICES} per side): use a larger radius."
         )
-    _, tangent, normal_eigenvalues = _smallest_eigenvector(normals.T @ normals)
+    _, tangent, normal_eigenvalues = _smallest_eigenvector(moments(normals))
     mean_normal = _column_means(normals)
     # np.cross's arithmetic on Python floats (the same IEEE operations, without its overhead).
     (t0, t1, t2), (m0, m1, m2) = tangent.tolist(), mean_normal.tolist()
     cross = np.array([t1 * m2 - t2 * m1, t2 * m0 - t0 * m2, t0 * m1 - t1 * m0])
-    cross_norm = float(np.linalg.norm(cross))
+    cross_norm = norm3(cross)
     if normal_eigenvalues[1] <= 1e-12 * normal_eigenvalues[2] or cross_norm <= 1e-12:
         raise GoniometerError(
             "The normals in the patch do not define a break edge (they are all parallel, or they "
             "cancel out): move the centre onto a break edge or use a larger radius."
         )
     binormal = cross / cross_norm
-    offsets = points - center
-    correlation = _correlation(normals @ binormal, offsets @ binormal)
+    along_normal = row_dot(normals, binormal)  # bᵀN
+    across = row_dot(points - center, binormal)  # bᵀ(X − x̄)
+    correlation = _correlation(along_normal, across)
     orientation = -1 if rule == "oriented" and correlation < 0 else 1
-    # The "+1" projection is the paper's expression, evaluated exactly as before, so ridges (and
-    # every measurement under the paper's rule) stay bit-identical.
-    offsets *= lam / radius
 
     def projection(sign: int) -> np.ndarray:
-        return ((normals + offsets) if sign > 0 else (normals - offsets)) @ binormal
+        """p = bᵀN + sign (λ/r) bᵀ(X − x̄); sign +1 is the paper's projection."""
+        return along_normal + (sign * lam / radius) * across
 
     joined = np.concatenate((points, normals), axis=1)
     weak = abs(correlation) < WEAK_CORRELATION
@@ -274,7 +275,7 @@ def measure_patch(
         convexity = "convex" if correlation >= 0 else "concave"
     fields.update(
         tangent=tangent,
-        mean_normal=mean_normal / np.linalg.norm(mean_normal),
+        mean_normal=mean_normal / norm3(mean_normal),
         binormal=binormal,
         n_vertices=n_points,
         rule=rule,

@@ -34,6 +34,7 @@ import numpy as np
 
 from ..errors import GoniometerError, bounded_list
 from .algorithm import as_center, as_radius
+from .fixed_order import acos_degrees, dot3, eigh3, in_frame, moments, norm3
 from .normals import face_normals
 from .ranges import expand_ranges
 from .result import Measurement
@@ -519,17 +520,17 @@ class EdgeSummary:
 
 def _frame(m: Measurement, direction: np.ndarray) -> np.ndarray:
     """Rows: along the edge (oriented like ``direction``), across it, and the mean normal."""
-    tangent = m.tangent if m.tangent @ direction >= 0 else -m.tangent
-    normal = m.mean_normal - (m.mean_normal @ tangent) * tangent
-    normal /= np.linalg.norm(normal)
+    tangent = m.tangent if dot3(m.tangent, direction) >= 0 else -m.tangent
+    normal = m.mean_normal - dot3(m.mean_normal, tangent) * tangent
+    normal /= norm3(normal)
     return np.array([tangent, np.cross(normal, tangent), normal])
 
 
 def _plane(points: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, float]:
     centred = points - points.mean(axis=0)
-    values, vectors = np.linalg.eigh(centred.T @ centred / points.shape[0])
+    values, vectors = eigh3(moments(centred) / points.shape[0])
     normal = vectors[:, 0]
-    if normal @ normals.sum(axis=0) < 0:
+    if dot3(normal, normals.sum(axis=0)) < 0:
         normal = -normal
     return normal, max(float(values[0]), 0.0)
 
@@ -550,8 +551,8 @@ def summarize(surface, stations) -> EdgeSummary:
         ahead, behind = centers[min(k + 1, len(stations) - 1)], centers[max(k - 1, 0)]
         direction = ahead - behind if len(stations) > 1 else m.tangent
         frame = _frame(m, direction)
-        local = (surface.points[m.indices] - m.center) @ frame.T
-        normals = surface.normals[m.indices] @ frame.T
+        local = in_frame(surface.points[m.indices] - m.center, frame)
+        normals = in_frame(surface.normals[m.indices], frame)
         plus_is_left = bool(local[m.labels, 1].mean() >= local[~m.labels, 1].mean())
         plus_left.append(plus_is_left)
         for mask, is_plus in ((m.labels, True), (~m.labels, False)):
@@ -562,7 +563,7 @@ def summarize(surface, stations) -> EdgeSummary:
         _plane(np.concatenate(sides[key][0]), np.concatenate(sides[key][1]))
         for key in (True, False)
     )
-    pooled = 180.0 - float(np.degrees(np.arccos(np.clip(left @ right, -1.0, 1.0))))
+    pooled = 180.0 - acos_degrees(dot3(left, right))
     return EdgeSummary(
         n_stations=len(stations),
         mean=float(angles.mean()),

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .fixed_order import dot3, eigh3_batched
 from .ranges import expand_ranges
 from .spatial import GridIndex, bounds
 
@@ -170,7 +171,7 @@ def pca_normals(points: np.ndarray, index: GridIndex, radius: float | None = Non
     covariance = (
         moments / np.maximum(counts, 1)[:, None, None] - means[:, :, None] * means[:, None, :]
     )
-    values, vectors = np.linalg.eigh(covariance)
+    values, vectors = eigh3_batched(covariance)
     normals = vectors[:, :, 0]
     valid = (counts >= 3) & (values[:, 1] > 1e-12 * np.maximum(values[:, 2], 1e-300))
     normals[~valid] = 0.0
@@ -254,7 +255,7 @@ def orient_normals(
         pick = int(np.argmax(np.einsum("ij,ij->i", away, away)))
         seed = free[pick]
         decided_before = flips != 0  # finished pieces have no links left to undecided points
-        flips[seed] = 1.0 if normals[seed] @ away[pick] >= 0 else -1.0
+        flips[seed] = 1.0 if dot3(normals[seed], away[pick]) >= 0 else -1.0
         for tier in tiers:
             spread(np.flatnonzero((flips != 0) & ~decided_before), tier)
     rest = np.flatnonzero(flips == 0)

@@ -2,9 +2,29 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
+
+ROUNDING_FIT = 1e-12
+"""A fit error below this many times the squared radius is rounding, not a measured distance:
+the plane fits' eigenvalues are exact to about 1e-16 r², and sums of a few thousand terms lose a
+few more bits."""
+
+
+def fit_text(fit_error: float, radius: float) -> str:
+    """The fit error for people: its value to three digits, or ``< bound`` at rounding level.
+
+    The digits of a rounding-level fit error depend on the order of operations, so printing them
+    would say nothing and differ between builds; the bound is ``ROUNDING_FIT · r²`` rounded up to
+    one digit.
+    """
+    bound = ROUNDING_FIT * radius * radius
+    if fit_error >= bound:
+        return f"{fit_error:.3g}"
+    exponent = math.floor(math.log10(bound))
+    return f"< {math.ceil(bound / 10.0**exponent - 1e-9):d}e{exponent:+03d}"
 
 
 @dataclass(frozen=True)
@@ -159,7 +179,7 @@ class Measurement:
         """One line for reports: angle, fit error, radius, λ and vertex counts."""
         spread = "" if self.stability is None else f" {self.stability.text()}"
         return (
-            f"{self.angle:.2f}°{spread} {self.convexity} (fit {self.fit_error:.3g}, "
+            f"{self.angle:.2f}°{spread} {self.convexity} (fit {fit_text(self.fit_error, self.radius)}, "
             f"r={self.radius:g}, λ={self.lam:g}, {self.n_vertices} vertices: "
             f"{self.n_plus}+/{self.n_minus}-)"
         )

@@ -3,8 +3,9 @@ and λ that make two drag measurements of one edge differ, and under a bootstrap
 
 All perturbed measurements run at once on one pool of vertices (the ball that holds every
 perturbed patch; for the bootstrap, the patch itself): Algorithm 1 batched over the rows of a
-``(runs, vertices)`` weight matrix (0/1 for a patch, counts for a resample), every sum a matrix
-product and the WithinSS split a row-wise sort and prefix sums. No Python loop runs over vertices.
+``(runs, vertices)`` weight matrix (0/1 for a patch, counts for a resample), every sum an exact
+matrix product and the WithinSS split a row-wise sort and prefix sums. No Python loop runs over
+vertices.
 """
 
 from __future__ import annotations
@@ -14,6 +15,14 @@ import math
 import numpy as np
 
 from .algorithm import FLAT_TOLERANCE_DEG, MIN_SIDE_VERTICES
+from .fixed_order import (
+    acos_degrees_array,
+    combine,
+    eigh3_batched,
+    exact_integer_sums,
+    rows_dot,
+    split_exactly,
+)
 from .result import Measurement, Stability
 
 CENTER_EDGE_LENGTHS = 2.0
@@ -58,53 +67,106 @@ def _moved_centers(surface, m: Measurement) -> np.ndarray:
     return ids[order[:MAX_CENTERS]]
 
 
+_PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+"""The six distinct entries of a symmetric 3×3 matrix, row by row."""
+
+# Columns of the per-vertex features whose weighted sums Algorithm 1 needs (see _features).
+_NN, _N, _L, _NL, _LL = slice(0, 6), slice(6, 9), slice(9, 12), slice(12, 21), slice(21, 27)
+_SIDE = np.r_[9:12, 21:27, 6:9]  # a side's plane: coordinates, their products, normals
+
+
 def _features(local: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """Per vertex: coordinates, their outer product (flattened) and the normal, ``(n, 15)``.
-
-    One matrix product of a weight matrix with these gives every sum a plane fit needs.
-    """
-    return np.hstack([local, _outer_pairs(local, local), normals])
-
-
-def _outer_pairs(first: np.ndarray, second: np.ndarray) -> np.ndarray:
-    """Row-wise outer products ``first_i second_iᵀ``, flattened: ``(n, 9)``."""
-    return (first[:, :, None] * second[:, None, :]).reshape(-1, 9)
+    """Per vertex, ``(m, 27)``: the distinct products of the normal's components, the normal, the
+    coordinates, the products of normal and coordinate components, and the distinct products of
+    the coordinates' components. Weighted sums of these are every sum Algorithm 1 takes."""
+    columns = [normals[:, i] * normals[:, j] for i, j in _PAIRS]
+    columns += [normals[:, i] for i in range(3)] + [local[:, i] for i in range(3)]
+    columns += [normals[:, i] * local[:, j] for i in range(3) for j in range(3)]
+    columns += [local[:, i] * local[:, j] for i, j in _PAIRS]
+    return np.stack(columns, axis=1)
 
 
-def _side_normals(weights: np.ndarray, features: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Plane normals (oriented by the side's mean normal) of weighted vertex sets, and whether
-    each set spans a plane with at least the minimum number of vertices."""
-    count = weights.sum(axis=1)
-    sums = weights @ features / np.maximum(count, 1.0)[:, None]
-    mean = sums[:, :3]
-    covariance = sums[:, 3:12].reshape(-1, 3, 3) - mean[:, :, None] * mean[:, None, :]
-    values, vectors = np.linalg.eigh(covariance)
+def _symmetric(distinct: np.ndarray) -> np.ndarray:
+    """``(k, 3, 3)`` symmetric matrices from their six distinct entries, ``(k, 6)``."""
+    out = np.empty((distinct.shape[0], 3, 3))
+    for column, (i, j) in enumerate(_PAIRS):
+        out[:, i, j] = out[:, j, i] = distinct[:, column]
+    return out
+
+
+def _side_covariances(sums: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Covariance matrices of weighted vertex sets, and their weighted mean normals.
+
+    ``sums`` are the sets' weighted sums of the side features (coordinates, their six distinct
+    products, normals), ``(k, 12)``; ``count`` their total weights."""
+    scaled = sums / np.maximum(count, 1.0)[:, None]
+    mean = scaled[:, :3]
+    return _symmetric(scaled[:, 3:9]) - mean[:, :, None] * mean[:, None, :], scaled[:, 9:12]
+
+
+def _side_normals(values, vectors, mean_normals, count) -> tuple[np.ndarray, np.ndarray]:
+    """Plane normals (oriented by the side's mean normal) from the covariances' eigen-pairs, and
+    whether each set spans a plane with at least the minimum number of vertices."""
     normal = vectors[:, :, 0]
     spans = values[:, 1] > _RANK_TOLERANCE * np.maximum(values[:, 2], np.finfo(float).tiny)
-    flip = np.einsum("ki,ki->k", normal, sums[:, 12:]) < 0
+    flip = rows_dot(normal, mean_normals) < 0
     normal[flip] = -normal[flip]
     return normal, spans & (count >= MIN_SIDE_VERTICES)
 
 
-def _best_splits(projection, members, weights, count, row_mean) -> tuple[np.ndarray, np.ndarray]:
+_PROJECTION_ROWS = 16
+"""Rows of the projection computed together: a block stays in the CPU's cache between its terms."""
+
+
+def _projection(binormal, scale, normals, local, offset) -> np.ndarray:
+    """``p = bᵀN + s bᵀX − offset`` for every row and pool vertex, ``(k, m)``: six products
+    added in a fixed order (a matrix product would leave the order to BLAS)."""
+    factors = np.hstack([binormal, binormal * scale[:, None]])
+    columns = np.vstack([normals.T, local.T])  # contiguous rows
+    out = np.empty((factors.shape[0], columns.shape[1]))
+    term = np.empty((_PROJECTION_ROWS, columns.shape[1]))
+    for start in range(0, out.shape[0], _PROJECTION_ROWS):
+        block = out[start : start + _PROJECTION_ROWS]
+        block_factors, block_term = factors[start : start + _PROJECTION_ROWS], term[: len(block)]
+        np.multiply(block_factors[:, :1], columns[0], out=block)
+        for i in range(1, 6):
+            np.multiply(block_factors[:, i : i + 1], columns[i], out=block_term)
+            block += block_term
+        block -= offset[start : start + _PROJECTION_ROWS, None]
+    return out
+
+
+def _best_splits(
+    projection, members, weights, count, row_mean, draws=None
+) -> tuple[np.ndarray, np.ndarray]:
     """Each row's WithinSS split of its members' projections (weighted), as the smallest value of
     the upper side, and whether the row has a split leaving both sides enough vertices.
 
     Members come first in sorted order, non-members (+inf) after them; a split after position
     ``j`` maximises the weighted between-sides sum of squares ``P_j² W / (L_j (W - L_j))``.
+    ``draws``: for a bootstrap, the positions drawn in each row, ``(k, n)`` (their counts are
+    ``weights``).
     """
-    masked = np.where(members, projection, np.inf)
-    n_members = members.sum(axis=1)
+    if draws is None:
+        masked = np.where(members, projection, np.inf)
+        n_members = members.sum(axis=1)
+    else:
+        # A vertex drawn c times is c equal values: the weighted split is the plain split of the
+        # drawn values, which a sort of values alone orders the same on every CPU.
+        masked = np.take_along_axis(projection, draws, axis=1)
+        n_members = np.full(draws.shape[0], draws.shape[1])
     # Only the first (most members) columns can hold a split; the rest are +inf in every row.
     width = min(masked.shape[1], max(int(n_members.max(initial=0)), 2))
     ordered_weights = None
-    if weights.dtype == bool:
-        # With 0/1 weights the members tied at a value add equal terms, so the sorted values alone
-        # give the same sums as a permutation would, if every member's projection is finite.
-        ordered = np.sort(masked, axis=1)[:, :width]
-        last = ordered[np.arange(ordered.shape[0]), np.maximum(n_members, 1) - 1]
-        finite = (np.isfinite(ordered[:, 0]) & np.isfinite(last)) | (n_members == 0)
-    if weights.dtype != bool or not finite.all():
+    # Members tied at a value add equal terms, so the sorted values alone give the same sums as
+    # any order of them would, if every member's projection is finite.
+    ordered = np.sort(masked, axis=1)[:, :width]
+    last = ordered[np.arange(ordered.shape[0]), np.maximum(n_members, 1) - 1]
+    finite = (np.isfinite(ordered[:, 0]) & np.isfinite(last)) | (n_members == 0)
+    if not finite.all():  # (never on finite coordinates; kept for safety)
+        masked = np.where(members, projection, np.inf)
+        n_members = members.sum(axis=1)
+        width = min(masked.shape[1], max(int(n_members.max(initial=0)), 2))
         order = np.argsort(masked, axis=1)[:, :width]
         ordered = np.take_along_axis(masked, order, axis=1)
         ordered_weights = np.take_along_axis(weights, order, axis=1)
@@ -114,8 +176,20 @@ def _best_splits(projection, members, weights, count, row_mean) -> tuple[np.ndar
     if ordered_weights is None:
         lower = np.minimum(np.arange(1.0, width), total)  # weight below a split after position j
     else:
-        centred *= ordered_weights
-        lower = np.cumsum(ordered_weights, axis=1, dtype=np.float64)[:, :-1]
+        # The sort leaves tied values in an order of its own (it differs between CPUs); their
+        # weights are summed first, exactly, and enter once per distinct value, at its last place.
+        running = np.cumsum(ordered_weights, axis=1, dtype=np.float64)
+        tied = ordered[:, 1:] == ordered[:, :-1]
+        tied &= inside[:, 1:]
+        if tied.any():
+            run_end = np.ones(ordered.shape, dtype=bool)
+            run_end[:, :-1] = ~tied
+            before = np.zeros_like(running)
+            before[:, 1:] = np.maximum.accumulate(np.where(run_end, running, 0.0), axis=1)[:, :-1]
+            centred *= np.where(run_end, running - before, 0.0)
+        else:
+            centred *= ordered_weights
+        lower = running[:, :-1]
     prefix = np.cumsum(centred, axis=1)[:, :-1]
     with np.errstate(divide="ignore", invalid="ignore"):
         between = prefix * prefix * total / (lower * (total - lower))
@@ -138,7 +212,7 @@ def batched_angles(
         Unit normals of the pool.
     weights : ndarray, shape (k, m)
         Row ``j`` is patch ``j``: how many times each vertex is in it (0 or 1 for a patch, a
-        bootstrap count for a resample).
+        bootstrap count for a resample); whole numbers.
     centers : ndarray, shape (k, 3)
         Each patch's centre ``x̄`` in the same local coordinates.
     position_scale : ndarray, shape (k,)
@@ -152,52 +226,100 @@ def batched_angles(
         False where Algorithm 1 would refuse the patch (too few vertices, no edge, a side on a
         line, flat or folded planes); those angles mean nothing.
     """
+    (result,) = _run_together(
+        _algorithm_steps(local, normals, weights, centers, position_scale, rule)
+    )
+    return result
+
+
+def _run_together(*batches) -> list:
+    """Run :func:`_algorithm_steps` generators in step, each of their 3×3 eigen-problems solved
+    in one call for all of them (the solver's cost is mostly per call, not per matrix)."""
+    requests = [next(batch) for batch in batches]
+    while True:
+        ends = np.cumsum([len(request) for request in requests])[:-1]
+        values, vectors = eigh3_batched(np.concatenate(requests))
+        answers = zip(np.split(values, ends), np.split(vectors, ends), strict=True)
+        requests, results = [], []
+        for batch, answer in zip(batches, answers, strict=True):
+            try:
+                requests.append(batch.send(answer))
+            except StopIteration as finished:
+                results.append(finished.value)
+        if results:
+            return results
+
+
+def _algorithm_steps(
+    local, normals, weights, centers, position_scale, rule: str, split=None, draws=None
+):
+    """:func:`batched_angles` as a generator: it yields the 3×3 matrices whose eigen-pairs it
+    needs and is sent them back (see :func:`_run_together`); it returns the angles and flags.
+    ``split``: :func:`split_exactly` of the pool's features, if already made (for at least as
+    many terms as a row of ``weights`` adds up to); ``draws``: see :func:`_best_splits`."""
     weights = np.asarray(weights)
     # Whole-number weights (0/1 or counts) are gathered and summed in their own narrow type: their
     # running sums are exact integers, the same in float64 whatever the order.
     raw = weights if weights.dtype.kind in "biu" else weights.astype(np.float64)
     weights = weights.astype(np.float64)
+    if not np.array_equal(weights, np.round(weights)):
+        raise ValueError("batched_angles needs whole-number weights (memberships or counts)")
     members = weights > 0
     count = weights.sum(axis=1)
     ok = count >= 2 * MIN_SIDE_VERTICES
     safe = np.maximum(count, 1.0)
 
-    values, vectors = np.linalg.eigh((weights @ _outer_pairs(normals, normals)).reshape(-1, 3, 3))
+    # Every sum over a patch is a product of the whole-number weights with the pool's features,
+    # made exact (see fixed_order.exact_integer_sums): no order, kernel or thread changes it.
+    if split is None:
+        split = split_exactly(_features(local, normals), int(count.max(initial=1.0)))
+    parts = exact_integer_sums(weights, split)
+    sums = combine(parts, split)
+    values, vectors = yield _symmetric(sums[:, _NN])
     tangent = vectors[:, :, 0]
-    weighted_normal = weights @ normals
+    weighted_normal = sums[:, _N]
     mean_normal = weighted_normal / safe[:, None]
     cross = np.cross(tangent, mean_normal)
-    cross_norm = np.linalg.norm(cross, axis=1)
+    cross_norm = np.sqrt(rows_dot(cross, cross))
     ok &= (values[:, 1] > 1e-12 * values[:, 2]) & (cross_norm > 1e-12)
     binormal = cross / np.maximum(cross_norm, 1e-300)[:, None]
 
-    # Sums over each patch, as matrix products with the pool: no (k, m) temporaries.
-    weighted_local = weights @ local
-    center_b = np.einsum("ki,ki->k", centers, binormal)
-    sum_q = np.einsum("ki,ki->k", binormal, weighted_normal)
-    sum_u = np.einsum("ki,ki->k", binormal, weighted_local) - count * center_b
+    center_b = rows_dot(centers, binormal)
+    sum_q = rows_dot(binormal, weighted_normal)
+    sum_u = rows_dot(binormal, sums[:, _L]) - count * center_b
     if rule == "oriented":
-        cross_moments = (weights @ _outer_pairs(normals, local)).reshape(-1, 3, 3)
-        sum_qu = np.einsum("ki,kij,kj->k", binormal, cross_moments, binormal) - center_b * sum_q
+        cross_moments = sums[:, _NL].reshape(-1, 3, 3)
+        terms = binormal[:, :, None] * cross_moments * binormal[:, None, :]
+        sum_qu = np.add.reduce(terms.reshape(-1, 9), axis=1) - center_b * sum_q
         sign = np.where(sum_qu - sum_q * sum_u / safe < 0, -1.0, 1.0)
     else:
         sign = np.ones(weights.shape[0])
     scale = sign * position_scale
-    # p = bᵀN + s (λ/r) bᵀ(X - x̄), for every row at once.
-    projection = np.hstack([binormal, scale[:, None] * binormal]) @ np.hstack([normals, local]).T
-    projection -= (scale * center_b)[:, None]
+    projection = _projection(binormal, scale, normals, local, scale * center_b)
     row_mean = ((sum_q + scale * sum_u) / safe)[:, None]
 
-    threshold, split = _best_splits(projection, members, raw, count, row_mean)
-    ok &= split
+    threshold, split_found = _best_splits(projection, members, raw, count, row_mean, draws)
+    ok &= split_found
     plus = members & (projection >= threshold[:, None])
 
-    features = _features(local, normals)
-    normal_plus, plane_plus = _side_normals(np.where(plus, weights, 0.0), features)
-    normal_minus, plane_minus = _side_normals(np.where(plus, 0.0, weights), features)
-    ok &= plane_plus & plane_minus
-    cosine = np.clip(np.einsum("ki,ki->k", normal_plus, normal_minus), -1.0, 1.0)
-    angle = 180.0 - np.degrees(np.arccos(cosine))
+    # The "+" sides' sums by an exact product; the "−" sides' are the rest of the patch's, exactly.
+    high, low, scale, bits = split
+    side_split = (high[:, _SIDE], low[:, _SIDE], scale[_SIDE], bits)
+    plus_weights = np.where(plus, weights, 0.0)
+    plus_high, plus_low = exact_integer_sums(plus_weights, side_split)
+    side_parts = (
+        np.concatenate([plus_high, parts[0][:, _SIDE] - plus_high]),
+        np.concatenate([plus_low, parts[1][:, _SIDE] - plus_low]),
+    )
+    plus_count = plus_weights.sum(axis=1)
+    side_count = np.concatenate([plus_count, count - plus_count])
+    covariances, side_mean_normals = _side_covariances(combine(side_parts, side_split), side_count)
+    values, vectors = yield covariances
+    normals_both, planes = _side_normals(values, vectors, side_mean_normals, side_count)
+    k = weights.shape[0]
+    normal_plus, normal_minus = normals_both[:k], normals_both[k:]
+    ok &= planes[:k] & planes[k:]
+    angle = 180.0 - acos_degrees_array(rows_dot(normal_plus, normal_minus))
     ok &= (angle >= FLAT_TOLERANCE_DEG) & (angle <= 180.0 - FLAT_TOLERANCE_DEG)
     return angle, ok
 
@@ -209,18 +331,35 @@ def bootstrap_angles(surface, m: Measurement, n_resamples: int = N_BOOTSTRAP):
     Returns the angles and which resamples Algorithm 1 would measure (see
     :func:`batched_angles`).
     """
+    (result,) = _run_together(_bootstrap_steps(surface, m, n_resamples))
+    return result
+
+
+def _bootstrap_steps(surface, m: Measurement, n_resamples: int, pool=None):
+    """The bootstrap's batch; ``pool``: the perturbed runs' ``(ids, local, normals, split)``,
+    which hold the patch, to share their features."""
     size = m.indices.size
     rng = np.random.default_rng(BOOTSTRAP_SEED)
-    draws = rng.integers(0, size, size=(n_resamples, size)) + size * np.arange(n_resamples)[:, None]
-    counts = np.bincount(draws.ravel(), minlength=n_resamples * size).reshape(n_resamples, size)
-    local = (surface.points[m.indices] - m.center) / m.radius
-    return batched_angles(
+    draws = rng.integers(0, size, size=(n_resamples, size))
+    flat = (draws + size * np.arange(n_resamples)[:, None]).ravel()
+    counts = np.bincount(flat, minlength=n_resamples * size).reshape(n_resamples, size)
+    if pool is None:
+        local = (surface.points[m.indices] - m.center) / m.radius
+        normals, split = surface.normals[m.indices], None
+    else:
+        ids, pool_local, pool_normals, pool_split = pool
+        at = np.searchsorted(ids, m.indices)
+        local, normals = pool_local[at], pool_normals[at]
+        split = (pool_split[0][at], pool_split[1][at], *pool_split[2:])
+    return _algorithm_steps(
         local,
-        surface.normals[m.indices],
+        normals,
         counts,
         np.zeros((n_resamples, 3)),
         np.full(n_resamples, m.lam),
         m.rule,
+        split,
+        draws,
     )
 
 
@@ -261,22 +400,36 @@ def perturbations(surface, m: Measurement) -> tuple[np.ndarray, np.ndarray, np.n
 
 def perturbed_angles(surface, m: Measurement, center_ids, radii, lams):
     """The angles of the perturbed runs, batched, and which of them Algorithm 1 would measure."""
-    reach = float(np.linalg.norm(surface.points[center_ids] - m.center, axis=1).max())
-    pool, _ = surface.index.ball(m.center, float(radii.max()) + reach)
-    pool = np.sort(pool)
-    points = surface.points[pool]
+    (result,) = _run_together(_perturbed_steps(surface, m, center_ids, radii, lams))
+    return result
+
+
+def _perturbed_steps(surface, m: Measurement, center_ids, radii, lams, pool=None):
+    """The perturbed runs' batch, on ``pool`` (see :func:`_pool`) if given."""
+    ids, local, normals, split = _pool(surface, m, center_ids, radii) if pool is None else pool
     if m.patch == "geodesic":
-        members = np.zeros((center_ids.size, pool.size), dtype=bool)
+        members = np.zeros((center_ids.size, ids.size), dtype=bool)
         for row, (center, radius) in enumerate(zip(center_ids, radii, strict=True)):
-            members[row, np.searchsorted(pool, surface.patch(center, radius, "geodesic"))] = True
+            members[row, np.searchsorted(ids, surface.patch(center, radius, "geodesic"))] = True
     else:
-        offsets = points[None, :, :] - surface.points[center_ids][:, None, :]
+        offsets = surface.points[ids][None, :, :] - surface.points[center_ids][:, None, :]
         members = np.einsum("kmi,kmi->km", offsets, offsets) <= (radii * radii)[:, None]
-    local = (points - m.center) / m.radius
     centers = (surface.points[center_ids] - m.center) / m.radius
-    return batched_angles(
-        local, surface.normals[pool], members, centers, lams * m.radius / radii, m.rule
+    return _algorithm_steps(
+        local, normals, members, centers, lams * m.radius / radii, m.rule, split
     )
+
+
+def _pool(surface, m: Measurement, center_ids, radii):
+    """The vertices every perturbed patch (and the measurement's own) is drawn from: sorted
+    ids, coordinates relative to the centre in units of the radius, normals, and the split of
+    their features for exact sums of up to all of them."""
+    reach = float(np.linalg.norm(surface.points[center_ids] - m.center, axis=1).max())
+    ids, _ = surface.index.ball(m.center, float(radii.max()) + reach)
+    ids = np.sort(ids)
+    local = (surface.points[ids] - m.center) / m.radius
+    normals = surface.normals[ids]
+    return ids, local, normals, split_exactly(_features(local, normals), ids.size)
 
 
 def estimate_stability(surface, m: Measurement) -> Stability:
@@ -294,12 +447,15 @@ def estimate_stability(surface, m: Measurement) -> Stability:
     Stability
     """
     center_ids, radii, lams, families = perturbations(surface, m)
-    angles, measured = perturbed_angles(surface, m, center_ids, radii, lams)
+    pool = _pool(surface, m, center_ids, radii)
+    (angles, measured), (resampled, kept) = _run_together(
+        _perturbed_steps(surface, m, center_ids, radii, lams, pool),
+        _bootstrap_steps(surface, m, N_BOOTSTRAP, pool),
+    )
     parts = {
         name: _largest_change(angles[rows], measured[rows], m.angle)
         for name, rows in families.items()
     }
-    resampled, kept = bootstrap_angles(surface, m)
     low, high = np.percentile(resampled[kept], [2.5, 97.5]) if kept.any() else (0.0, 0.0)
     parts["bootstrap"] = float(high - low) / 2.0
     parts["orientation"] = m.orientation_difference

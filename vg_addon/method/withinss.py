@@ -59,5 +59,5 @@ def withinss_split(values, min_size: int = 1) -> tuple[float, float]:
         )
     between = np.where(valid, between, -np.inf)
     best = int(np.argmax(between))
-    total_ss = float(np.dot(centred, centred))
+    total_ss = float(np.add.reduce(centred * centred))  # pairwise: not BLAS's machine-chosen order
     return float(p[best + 1]), max(total_ss - float(between[best]), 0.0)

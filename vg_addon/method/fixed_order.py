@@ -1,0 +1,313 @@
+"""Arithmetic whose rounding does not depend on the machine: no BLAS, no LAPACK, no SIMD dispatch.
+
+NumPy hands matrix products (``@``, ``np.dot``) to BLAS and ``np.linalg.eigh`` to LAPACK, whose
+kernels are picked at run time for the CPU (``OPENBLAS_CORETYPE``) and split work over threads:
+each choice sums in another order, with or without fused multiply-adds, so the last bits of a
+measurement depended on the machine. NumPy's transcendental ufuncs (``np.arccos``) also have
+CPU-specific SIMD versions. Everything here is made of operations whose result IEEE 754 fixes:
+element-wise ``+ − × ÷`` and ``sqrt``, NumPy's pairwise sums of contiguous data (plain C, the same
+on every CPU), the C library's ``acos`` through :mod:`math`, and matrix products whose every
+partial sum is an exact integer (:func:`exact_weighted_sums`), so their order cannot matter.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+_MAX_SWEEPS = 32
+"""Cyclic Jacobi on a 3×3 matrix converges quadratically: 4 to 6 sweeps in practice."""
+
+
+def row_dot(rows: np.ndarray, vector) -> np.ndarray:
+    """``rows @ vector`` for an ``(n, 3)`` array, as ``x·v0 + y·v1 + z·v2`` in that order."""
+    v0, v1, v2 = (float(value) for value in vector)
+    return rows[:, 0] * v0 + rows[:, 1] * v1 + rows[:, 2] * v2
+
+
+def rows_dot(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Row-wise dot products of two ``(k, 3)`` arrays, summed in a fixed order."""
+    return first[:, 0] * second[:, 0] + first[:, 1] * second[:, 1] + first[:, 2] * second[:, 2]
+
+
+def in_frame(rows: np.ndarray, frame: np.ndarray) -> np.ndarray:
+    """``rows @ frame.T``: each ``(n, 3)`` row's coordinates along the three rows of ``frame``."""
+    return np.stack([row_dot(rows, axis) for axis in frame], axis=1)
+
+
+def dot3(a, b) -> float:
+    """The dot product of two 3-vectors, in a fixed order, as a Python float."""
+    (a0, a1, a2), (b0, b1, b2) = (float(x) for x in a), (float(x) for x in b)
+    return a0 * b0 + a1 * b1 + a2 * b2
+
+
+def norm3(a) -> float:
+    """The length of a 3-vector."""
+    return math.sqrt(dot3(a, a))
+
+
+def total(values: np.ndarray) -> float:
+    """Sum of a 1-D array by NumPy's pairwise summation (fixed order for a given length)."""
+    return float(np.add.reduce(np.ascontiguousarray(values, dtype=np.float64)))
+
+
+def moments(rows: np.ndarray) -> np.ndarray:
+    """``rows.T @ rows`` for an ``(n, 3)`` array: the symmetric 3×3 matrix ``Σ r_i r_iᵀ``.
+
+    Each of the six distinct entries is NumPy's pairwise sum of a contiguous row of products.
+    """
+    columns = rows.T.copy()
+    products = np.empty((6, rows.shape[0]))
+    for k, (i, j) in enumerate(_UPPER):
+        np.multiply(columns[i], columns[j], out=products[k])
+    sums = np.add.reduce(products, axis=1)
+    out = np.empty((3, 3))
+    for k, (i, j) in enumerate(_UPPER):
+        out[i, j] = out[j, i] = sums[k]
+    return out
+
+
+_UPPER = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+
+
+def solve3(matrix, rhs: np.ndarray) -> np.ndarray | None:
+    """Solve ``matrix @ x_i = rhs_i`` for every row ``rhs_i`` of an ``(n, 3)`` array.
+
+    Gaussian elimination with partial pivoting on Python floats (LAPACK's ``dgesv`` picks its
+    kernel by CPU), applied to all right-hand sides in a fixed order. Returns None when the
+    matrix is singular or not finite (a pivot of 0, or below 1e-300 of the largest entry).
+    """
+    a = [list(row) for row in np.asarray(matrix, dtype=np.float64).tolist()]
+    largest = max(abs(value) for row in a for value in row)
+    if not math.isfinite(largest) or largest == 0.0:
+        return None
+    b = [np.asarray(rhs, dtype=np.float64)[:, k].copy() for k in range(3)]
+    for column in range(3):
+        pivot = max(range(column, 3), key=lambda row: abs(a[row][column]))
+        if abs(a[pivot][column]) <= 1e-300 * largest:
+            return None
+        a[column], a[pivot] = a[pivot], a[column]
+        b[column], b[pivot] = b[pivot], b[column]
+        for row in range(column + 1, 3):
+            factor = a[row][column] / a[column][column]
+            for k in range(column, 3):
+                a[row][k] -= factor * a[column][k]
+            b[row] = b[row] - factor * b[column]
+    x = [None, None, None]
+    for row in (2, 1, 0):
+        value = b[row]
+        for k in range(row + 1, 3):
+            value = value - a[row][k] * x[k]
+        x[row] = value / a[row][row]
+    return np.stack(x, axis=1)
+
+
+def acos_degrees(cosine: float) -> float:
+    """``degrees(arccos(cosine))`` by the C library's ``acos``, the argument clipped to [−1, 1]."""
+    return math.degrees(math.acos(min(1.0, max(-1.0, cosine))))
+
+
+def acos_degrees_array(cosines: np.ndarray) -> np.ndarray:
+    """:func:`acos_degrees` of each value (NumPy's ``arccos`` has CPU-specific SIMD versions)."""
+    clipped = np.clip(cosines, -1.0, 1.0).tolist()
+    return np.degrees(np.array([math.acos(c) for c in clipped], dtype=np.float64))
+
+
+def _rotation(app: float, aqq: float, apq: float) -> tuple[float, float, float]:
+    """The Jacobi rotation ``(t, c, s)`` that zeroes ``apq`` (Numerical Recipes' form). Where
+    ``theta²`` overflows, ``t`` is 0: ``apq`` is then below 1e-150 of ``aqq − app`` and is
+    dropped."""
+    theta = (aqq - app) / (apq + apq)
+    t = math.copysign(1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0)), theta)
+    c = 1.0 / math.sqrt(t * t + 1.0)
+    return t, c, t * c
+
+
+def eigh3(matrix) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues (ascending) and unit eigenvectors (columns) of a symmetric 3×3 matrix.
+
+    Cyclic Jacobi rotations on Python floats: every operation is IEEE ``+ − × ÷`` or a correctly
+    rounded ``sqrt``, so the result is the same on every machine. Jacobi's eigenvalues and vectors
+    are as accurate as LAPACK's (to a few units in the last place of the matrix's norm).
+
+    Parameters
+    ----------
+    matrix : array_like, shape (3, 3)
+        Symmetric; only its upper triangle is read.
+
+    Returns
+    -------
+    values : ndarray, shape (3,)
+    vectors : ndarray, shape (3, 3)
+        ``vectors[:, k]`` belongs to ``values[k]``.
+    """
+    (a0, a01, a02), (_, a1, a12), (_, _, a2) = np.asarray(matrix, dtype=np.float64).tolist()
+    # Columns of the eigenvector matrix, rotated along with the matrix.
+    v0, v1, v2 = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
+    for sweep in range(_MAX_SWEEPS):
+        if a01 == 0.0 and a02 == 0.0 and a12 == 0.0:
+            break
+        first = sweep == 0
+        if a01 != 0.0:  # p, q, r = 0, 1, 2
+            if not first and _negligible(a0, a1, a01):
+                a01 = 0.0
+            else:
+                t, c, s = _rotation(a0, a1, a01)
+                shift = t * a01
+                a0, a1, a01 = a0 - shift, a1 + shift, 0.0
+                a02, a12 = c * a02 - s * a12, s * a02 + c * a12
+                v0, v1 = _rotate(v0, v1, c, s)
+        if a02 != 0.0:  # p, q, r = 0, 2, 1
+            if not first and _negligible(a0, a2, a02):
+                a02 = 0.0
+            else:
+                t, c, s = _rotation(a0, a2, a02)
+                shift = t * a02
+                a0, a2, a02 = a0 - shift, a2 + shift, 0.0
+                a01, a12 = c * a01 - s * a12, s * a01 + c * a12
+                v0, v2 = _rotate(v0, v2, c, s)
+        if a12 != 0.0:  # p, q, r = 1, 2, 0
+            if not first and _negligible(a1, a2, a12):
+                a12 = 0.0
+            else:
+                t, c, s = _rotation(a1, a2, a12)
+                shift = t * a12
+                a1, a2, a12 = a1 - shift, a2 + shift, 0.0
+                a01, a02 = c * a01 - s * a02, s * a01 + c * a02
+                v1, v2 = _rotate(v1, v2, c, s)
+    diagonal, columns = (a0, a1, a2), (v0, v1, v2)
+    order = sorted(range(3), key=diagonal.__getitem__)
+    values = np.array([diagonal[k] for k in order])
+    vectors = np.array([columns[k] for k in order]).T
+    return values, vectors
+
+
+def _negligible(app: float, aqq: float, apq: float) -> bool:
+    """Whether ``apq`` is below the last bit of both diagonal entries (zeroed, not rotated)."""
+    g = 100.0 * abs(apq)
+    return abs(app) + g == abs(app) and abs(aqq) + g == abs(aqq)
+
+
+def _rotate(vp, vq, c: float, s: float) -> tuple:
+    """Columns ``p`` and ``q`` of the eigenvector matrix after a rotation."""
+    return (
+        (c * vp[0] - s * vq[0], c * vp[1] - s * vq[1], c * vp[2] - s * vq[2]),
+        (s * vp[0] + c * vq[0], s * vp[1] + c * vq[1], s * vp[2] + c * vq[2]),
+    )
+
+
+def eigh3_batched(matrices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`eigh3` of each of ``k`` symmetric 3×3 matrices, vectorised over ``k``.
+
+    Parameters
+    ----------
+    matrices : ndarray, shape (k, 3, 3)
+
+    Returns
+    -------
+    values : ndarray, shape (k, 3)
+        Ascending.
+    vectors : ndarray, shape (k, 3, 3)
+        ``vectors[j, :, i]`` belongs to ``values[j, i]``.
+    """
+    m = np.asarray(matrices, dtype=np.float64)
+    k = m.shape[0]
+    a = [m[:, 0, 0].copy(), m[:, 1, 1].copy(), m[:, 2, 2].copy()]
+    off = {(0, 1): m[:, 0, 1].copy(), (0, 2): m[:, 0, 2].copy(), (1, 2): m[:, 1, 2].copy()}
+    v = np.zeros((k, 3, 3))  # v[:, p] is column p of the eigenvector matrix, for speed
+    v[:, 0, 0] = v[:, 1, 1] = v[:, 2, 2] = 1.0
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        for sweep in range(_MAX_SWEEPS):
+            if not (off[0, 1].any() or off[0, 2].any() or off[1, 2].any()):
+                break
+            for p, q, r in ((0, 1, 2), (0, 2, 1), (1, 2, 0)):
+                apq = off[p, q]
+                off[p, q] = np.zeros(k)
+                if sweep:  # below the last bit of both diagonal entries: zeroed, not rotated
+                    g = 100.0 * np.abs(apq)
+                    abs_p, abs_q = np.abs(a[p]), np.abs(a[q])
+                    apq = np.where((abs_p + g == abs_p) & (abs_q + g == abs_q), 0.0, apq)
+                active = apq != 0.0
+                if not active.any():
+                    continue
+                theta = (a[q] - a[p]) / (apq + apq)
+                t = np.copysign(1.0 / (np.abs(theta) + np.sqrt(theta * theta + 1.0)), theta)
+                t = np.where(active, t, 0.0)
+                c = 1.0 / np.sqrt(t * t + 1.0)
+                s = t * c
+                shift = t * apq
+                a[p] = a[p] - shift
+                a[q] = a[q] + shift
+                rp, rq = (min(r, p), max(r, p)), (min(r, q), max(r, q))
+                arp, arq = off[rp], off[rq]
+                off[rp] = c * arp - s * arq
+                off[rq] = s * arp + c * arq
+                vp, vq = v[:, p], v[:, q]
+                c2, s2 = c[:, None], s[:, None]
+                v[:, p], v[:, q] = c2 * vp - s2 * vq, s2 * vp + c2 * vq
+    values = np.stack(a, axis=1)
+    order = np.argsort(values, axis=1, kind="stable")
+    rows = np.arange(k)[:, None]
+    return values[rows, order], v[rows, order].transpose(0, 2, 1)
+
+
+def split_exactly(features: np.ndarray, max_terms: int) -> tuple:
+    """Split each column of ``features`` into two integer-valued parts for exact weighted sums.
+
+    ``features[:, c] ≈ (high[:, c] + low[:, c] · 2^-bits) · 2^-shift[c]``, where ``high`` and
+    ``low`` hold whole numbers small enough that any sum of at most ``max_terms`` of them, each
+    times a whole number, is exact in float64 (below 2^53). What is left out is below
+    ``2^-(2·bits)`` of the column's largest value (bits ≥ 16 even for a billion terms): far below
+    anything a measurement can resolve.
+
+    Returns
+    -------
+    high, low : ndarray, shape (n, f)
+    scale : ndarray, shape (f,)
+        The factor ``2^-shift`` of each column.
+    bits : int
+        The low part's further factor is ``2^-bits``.
+    """
+    bits = 52 - max(int(max_terms), 1).bit_length()
+    largest = np.max(np.abs(features), axis=0, initial=0.0)
+    _, exponent = np.frexp(largest)  # largest < 2^exponent
+    shift = bits - exponent
+    scaled = np.ldexp(features, shift[None, :])
+    high = np.round(scaled)
+    low = np.round(np.ldexp(scaled - high, bits))
+    return high, low, np.ldexp(1.0, -shift), bits
+
+
+def exact_integer_sums(weights: np.ndarray, split) -> tuple[np.ndarray, np.ndarray]:
+    """The two whole-number parts of ``weights @ features``: exact, so bit-identical everywhere.
+
+    Parameters
+    ----------
+    weights : ndarray, shape (k, n)
+        Whole numbers (0/1 memberships or bootstrap counts) as float64; the sum of each row must be
+        at most the ``max_terms`` the split was made for.
+    split : tuple
+        :func:`split_exactly` of the ``(n, f)`` features.
+
+    Returns
+    -------
+    high, low : ndarray, shape (k, f)
+        Every partial sum of these matrix products is a whole number below 2^53, so BLAS's
+        order, blocking, fused multiply-adds and threads cannot change them. Being exact, they
+        can also be subtracted exactly (the sums over a set's complement). :func:`combine` turns
+        them into the sums.
+    """
+    return weights @ split[0], weights @ split[1]
+
+
+def combine(parts: tuple[np.ndarray, np.ndarray], split) -> np.ndarray:
+    """The weighted sums from their exact parts (see :func:`exact_integer_sums`), rounded once."""
+    high, low = parts
+    return (high + np.ldexp(low, -split[3])) * split[2]
+
+
+def exact_weighted_sums(weights: np.ndarray, split) -> np.ndarray:
+    """``weights @ features`` for whole-number weights, bit-identical on every machine (see
+    :func:`exact_integer_sums`)."""
+    return combine(exact_integer_sums(weights, split), split)
