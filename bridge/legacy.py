@@ -26,7 +26,7 @@ import numpy as np
 from ..properties import exact_numbers
 from ..vg_addon import GoniometerError
 from . import records
-from .mesh_data import Geometry, mesh_points, uniform_scale, world_points
+from .mesh_data import Geometry, mesh_points, uniform_scale
 
 
 def has_world_records(obj, signatures=None, known=()) -> bool:
@@ -100,10 +100,11 @@ def migrate(obj, geometry: Geometry, surface) -> list[int]:
 def _remeasure(geometry: Geometry, surface, numbers: dict, patch: str, scale: float):
     """The measurement a world-space record makes in mesh coordinates, at the same vertex."""
     world_centre = np.array(numbers["center"], dtype=np.float64)
-    # The recorded centre was a vertex's world position, computed exactly this way.
-    hits = np.flatnonzero(
-        (world_points(geometry.local, geometry.matrix) == world_centre).all(axis=1)
-    )
+    # The recorded centre was a vertex's world position, computed exactly this way (a matrix
+    # product, as world-space records were made; world_points now sums in a fixed order).
+    matrix = np.asarray(geometry.matrix, dtype=np.float64)
+    recorded_way = geometry.local @ matrix[:3, :3].T + matrix[:3, 3]
+    hits = np.flatnonzero((recorded_way == world_centre).all(axis=1))
     if not hits.size:
         raise GoniometerError("the recorded centre is no vertex of the mesh")
     vertex = int(hits[0])

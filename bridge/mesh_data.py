@@ -26,6 +26,7 @@ import numpy as np
 from mathutils.bvhtree import BVHTree
 
 from ..vg_addon import GoniometerError, Surface
+from ..vg_addon.method.fixed_order import in_frame, moments, solve3
 
 # A Surface of a million-vertex scan takes a few hundred MB; keep only the latest few.
 _CACHE_SIZE = 3
@@ -111,7 +112,8 @@ def world_points(local: np.ndarray, matrix: np.ndarray) -> np.ndarray:
     """
     local = np.asarray(local, dtype=np.float64)
     matrix = np.asarray(matrix, dtype=np.float64)
-    return local @ matrix[:3, :3].T + matrix[:3, 3]
+    rows = in_frame(local.reshape(-1, 3), matrix[:3, :3]) + matrix[:3, 3]
+    return rows.reshape(local.shape)
 
 
 def mesh_points(world: np.ndarray, matrix: np.ndarray) -> np.ndarray:
@@ -124,14 +126,15 @@ def mesh_points(world: np.ndarray, matrix: np.ndarray) -> np.ndarray:
         The transform cannot be inverted (a scale of 0 on some axis).
     """
     matrix = np.asarray(matrix, dtype=np.float64)
-    linear = matrix[:3, :3]
-    if not np.isfinite(matrix).all() or abs(np.linalg.det(linear)) <= 1e-300:
+    world = np.asarray(world, dtype=np.float64)
+    rows = (world - matrix[:3, 3]).reshape(-1, 3)
+    local = solve3(matrix[:3, :3], rows) if np.isfinite(matrix).all() else None
+    if local is None:
         raise GoniometerError(
             "The object's transform flattens it (a scale of 0 on some axis): a point in world "
             "space has no place on its mesh. Give it a non-zero scale."
         )
-    world = np.asarray(world, dtype=np.float64)
-    return np.linalg.solve(linear, (world - matrix[:3, 3]).T).T
+    return local.reshape(world.shape)
 
 
 def uniform_scale(matrix: np.ndarray, rtol: float = 1e-6) -> float | None:
@@ -143,7 +146,7 @@ def uniform_scale(matrix: np.ndarray, rtol: float = 1e-6) -> float | None:
     transforms in (so a scale of 3 under a rotation is 3, not 2.99999996).
     """
     linear = np.asarray(matrix, dtype=np.float64)[:3, :3]
-    gram = linear.T @ linear
+    gram = moments(linear)  # linearᵀ linear
     scale2 = float(np.trace(gram)) / 3.0
     if not np.isfinite(scale2) or scale2 <= 0.0:
         return None

@@ -161,3 +161,23 @@ def wedge_object(angle, name="Wedge", *, n=40, irregular=True, **transform):
     obj = mesh_object(name, shape.points, shape.triangles, **transform)
     obj["true_angle"] = float(shape.angle)
     return obj
+
+
+def half_annulus_with_edge_vertices():
+    """The project's half annulus (``vg_addon.reference_shapes``; the shape of the reference file
+    ``HalfAnnulus.ply``) in float32 coordinates, as a scanner writes them and Blender keeps them,
+    and three vertices on its edges (top/outer, cut/outer, bottom/inner), where a 0.3 patch holds
+    an edge."""
+    from vg_addon.reference_shapes import BOTTOM, CUT, INNER, OUTER, TOP, half_annulus
+
+    mesh = half_annulus()
+    points = mesh.points.astype(np.float32).astype(np.float64)
+    picks = []
+    for pair in ((TOP, OUTER), (CUT, OUTER), (BOTTOM, INNER)):
+        on_edge = np.flatnonzero(np.isin(mesh.labels, pair))
+        corner = mesh.labels[mesh.triangles]
+        touching = np.isin(corner, pair[0]).any(axis=1) & np.isin(corner, pair[1]).any(axis=1)
+        on_edge = np.intersect1d(on_edge, mesh.triangles[touching])
+        middle = np.median(points[on_edge], axis=0)
+        picks.append(int(on_edge[np.argmin(np.linalg.norm(points[on_edge] - middle, axis=1))]))
+    return points, mesh.triangles, picks

@@ -8,13 +8,19 @@ import tomllib
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import exact, local_points, mesh_object, snapshot, wedge_object, world
+from bpy_helpers import (
+    exact,
+    half_annulus_with_edge_vertices,
+    local_points,
+    mesh_object,
+    snapshot,
+    wedge_object,
+    world,
+)
 from conftest import ROOT
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
-
-DATA = ROOT.parent / "shared" / "data"
 
 with open(ROOT / "blender_manifest.toml", "rb") as _handle:
     MANIFEST = tomllib.load(_handle)
@@ -120,14 +126,10 @@ def test_export_marks_stale_measurements(vg, tmp_path):
 def test_export_is_in_mesh_coordinates_and_replicates_on_the_file_with_the_core(vg, tmp_path):
     """A scan imported Y-up (a rotation on the object), moved and scaled: the CSV carries the
     file's coordinates, and the core re-measures it on the file itself, bit for bit."""
-    # Scanners write float32 coordinates, which Blender keeps exactly; HalfAnnulus.ply has
-    # decimal text, so the scan file here is its float32 version.
-    reference = meshio.read_mesh(DATA / "HalfAnnulus.ply")
-    scan = meshio.write_ply(
-        tmp_path / "HalfAnnulus.ply",
-        reference.points.astype(np.float32).astype(np.float64),
-        reference.triangles,
-    )
+    # Scanners write float32 coordinates, which Blender keeps exactly: the scan file here holds
+    # the half annulus in float32.
+    points, triangles, picks = half_annulus_with_edge_vertices()
+    scan = meshio.write_ply(tmp_path / "HalfAnnulus.ply", points, triangles)
     mesh = meshio.read_mesh(scan)
     obj = mesh_object(
         "HalfAnnulus",
@@ -137,7 +139,6 @@ def test_export_is_in_mesh_coordinates_and_replicates_on_the_file_with_the_core(
         rotation=(math.pi / 2, 0.0, 0.3),
         scale=(0.01, 0.01, 0.01),
     )
-    picks = [100, 2000, 4000]
     for vertex in picks:  # the 3D cursor on a vertex, in world space
         cursor = world(mesh.points[vertex : vertex + 1], obj)[0]
         bpy.ops.vg.measure_xyz(location=cursor.tolist(), radius=0.3, seg_param=2.0)

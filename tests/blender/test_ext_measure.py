@@ -10,6 +10,7 @@ from bpy_helpers import (
     evaluated_surface,
     exact,
     expected_colours,
+    half_annulus_with_edge_vertices,
     local_points,
     mesh_object,
     wedge_object,
@@ -317,6 +318,28 @@ def test_intersecting_spheres_rim(vg, shared_data):
     # Measured 67.956° here, 2.57° under the exact 70.53° (the rim's bevel; the core on the
     # file's float64 coordinates reads 68.092°, its rim vertex and radius differ a little).
     assert abs(exact(item)["angle"] - 67.956) < 0.05
+
+
+def test_the_projects_half_annulus_and_lens_measure_as_the_core_does(vg):
+    """The reference shapes the project makes (in every clone): the extension records what the
+    core measures on Blender's float32 copy, and the readings are the geometry's (a bevelled
+    right angle; the lens rim near its exact 70.53°)."""
+    from vg_addon.reference_shapes import LENS_RIM_ANGLE, intersecting_spheres
+
+    points, triangles, picks = half_annulus_with_edge_vertices()
+    obj = mesh_object("HalfAnnulus", points, triangles)
+    centre = points[picks[0]]  # top meets outer wall at 90°
+    item = vg.bridge.measuring.measure_on_object(obj, centre, 0.4)
+    assert_same(item, core_surface(obj).measure(centre, 0.4))
+    assert abs(exact(item)["angle"] - 90.0) < 2.5  # the core reads +1.6° on float64 (bevel)
+    lens = intersecting_spheres()
+    obj = mesh_object("Lens", lens.points, lens.triangles)
+    local = local_points(obj).astype(np.float64)
+    centre = local[np.argmax(np.hypot(local[:, 1] - 1.0, local[:, 2] - 1.0))]
+    radius = 0.06 * float(np.ptp(local, axis=0).max())
+    item = vg.bridge.measuring.measure_on_object(obj, centre, radius)
+    assert_same(item, core_surface(obj).measure(centre, radius))
+    assert abs(exact(item)["angle"] - LENS_RIM_ANGLE) < 2.0
 
 
 def test_sample_bone_scan(vg, shared_data):

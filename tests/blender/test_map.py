@@ -7,13 +7,9 @@ import bpy
 import numpy as np
 import pytest
 from bpy_extras.object_utils import world_to_camera_view
-from bpy_helpers import exact, mesh_object, wedge_object
-from conftest import ROOT
+from bpy_helpers import exact, half_annulus_with_edge_vertices, mesh_object, wedge_object
 from mathutils import Vector
 
-from vg_addon.formats import meshio
-
-DATA = ROOT.parent / "shared" / "data"
 SIZE = (200, 150)
 
 
@@ -44,10 +40,10 @@ def colourful(rgba: np.ndarray) -> int:
 
 
 def measured_annulus(vg):
-    mesh = meshio.read_mesh(DATA / "HalfAnnulus.ply")
-    obj = mesh_object("HalfAnnulus", mesh.points, mesh.triangles, location=(1.0, 2.0, 3.0))
-    for vertex in (100, 2000, 4000):
-        vg.bridge.measuring.measure_on_object(obj, mesh.points[vertex], 0.3)
+    points, triangles, picks = half_annulus_with_edge_vertices()
+    obj = mesh_object("HalfAnnulus", points, triangles, location=(1.0, 2.0, 3.0))
+    for vertex in picks:
+        vg.bridge.measuring.measure_on_object(obj, points[vertex], 0.3)
     return obj
 
 

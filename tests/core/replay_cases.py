@@ -27,6 +27,7 @@ if str(ROOT) not in sys.path:
 
 from vg_addon import GoniometerError, Surface  # noqa: E402
 from vg_addon.formats.meshio import read_mesh  # noqa: E402
+from vg_addon.reference_shapes import half_annulus, intersecting_spheres  # noqa: E402
 from vg_addon.synthetic_meshes import bone_fragment, wedge  # noqa: E402
 
 PINS = Path(__file__).with_name("data") / "replay_pins.json"
@@ -51,6 +52,8 @@ def surfaces() -> dict[str, Surface]:
     found["wedge78-cloud"] = Surface(w.points)
     b = bone_fragment(spacing=0.6, roughness=0.05, seed=1)
     found["bone"] = Surface(b.points, b.triangles)
+    for name, shape in (("half-annulus", half_annulus()), ("lens", intersecting_spheres())):
+        found[name] = Surface(shape.points, shape.triangles)  # the project's, in every clone
     for name in ("HalfAnnulus", "IntersectingSpheres", "sample_mesh"):
         path = SHARED_DATA / f"{name}.ply"
         if path.is_file():
