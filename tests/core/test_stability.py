@@ -11,6 +11,7 @@ from vg_addon.method.stability import (
     perturbations,
     perturbed_angles,
 )
+from vg_addon.reference_shapes import half_annulus
 from vg_addon.synthetic_meshes import wedge
 
 
@@ -49,8 +50,12 @@ def test_batched_runs_equal_single_measurements_on_wedges(angle, concave, patch)
     assert check_runs_against_single_measurements(surface, m) >= 10
 
 
-def test_batched_runs_equal_single_measurements_on_the_bone_scan(shared_data):
-    mesh = read_mesh(shared_data / "sample_mesh.ply")
+@pytest.mark.parametrize("source", ["bone scan", "project half annulus"])
+def test_batched_runs_equal_single_measurements_on_the_bone_scan(source, request):
+    if source == "bone scan":
+        mesh = read_mesh(request.getfixturevalue("shared_data") / "sample_mesh.ply")
+    else:  # bevelled creases and curved faces, in every clone
+        mesh = half_annulus()
     surface = Surface(mesh.points, mesh.triangles)
     radius = 0.04 * float(np.ptp(mesh.points, axis=0).max())
     rng = np.random.default_rng(5)

@@ -6,6 +6,7 @@ import pytest
 from vg_addon import Surface
 from vg_addon.formats.meshio import read_mesh
 from vg_addon.method.winding import mesh_winding
+from vg_addon.reference_shapes import half_annulus, intersecting_spheres
 from vg_addon.synthetic_meshes import bone_fragment, wedge
 
 # A unit tetrahedron wound outward by hand: each face's corners run counter-clockwise seen from
@@ -47,9 +48,16 @@ def test_bone_fragment_and_its_inward_copy():
     assert Surface(bone.points, bone.triangles[:, ::-1]).winding == "inward"
 
 
-@pytest.mark.parametrize("name", ["HalfAnnulus", "IntersectingSpheres", "sample_mesh"])
-def test_reference_meshes_are_closed_and_outward(shared_data, name):
-    mesh = read_mesh(shared_data / f"{name}.ply")
+@pytest.mark.parametrize(
+    "name", ["HalfAnnulus", "IntersectingSpheres", "sample_mesh", "project half annulus", "project lens"]
+)
+def test_reference_meshes_are_closed_and_outward(name, request):
+    if name == "project half annulus":
+        mesh = half_annulus()
+    elif name == "project lens":
+        mesh = intersecting_spheres()
+    else:
+        mesh = read_mesh(request.getfixturevalue("shared_data") / f"{name}.ply")
     assert Surface(mesh.points, mesh.triangles).winding == "outward"
     assert mesh_winding(mesh.points, mesh.triangles[:, ::-1]) == "inward"
 
@@ -139,14 +147,16 @@ def test_classification_equals_the_reference(case, monkeypatch):
             assert mesh_winding(points, given, edge_ids(given, len(points))) == expected
 
 
-@pytest.mark.parametrize("name", ["bone", "wedge", "reference"])
-def test_classification_equals_the_reference_on_larger_meshes(name, shared_data):
+@pytest.mark.parametrize("name", ["bone", "wedge", "project lens", "reference"])
+def test_classification_equals_the_reference_on_larger_meshes(name, request):
     if name == "bone":
         mesh = bone_fragment(spacing=1.0)
     elif name == "wedge":
         mesh = wedge(60, n=30)
+    elif name == "project lens":
+        mesh = intersecting_spheres()
     else:
-        mesh = read_mesh(shared_data / "IntersectingSpheres.ply")
+        mesh = read_mesh(request.getfixturevalue("shared_data") / "IntersectingSpheres.ply")
     points, faces = mesh.points, mesh.triangles
     for given in (faces, faces[:, ::-1], np.vstack([faces[:1, ::-1], faces[1:]])):
         expected = reference_winding(points, given)
