@@ -91,7 +91,7 @@ def test_exact_weighted_sums_do_not_depend_on_the_order_of_the_vertices():
                 for w, f in zip(weights[row], features[:, column], strict=True)
             )
             largest = float(np.abs(features[:, column]).max())
-            tolerance = 2e-16 * abs(float(exact)) + 3000 * 4 * largest * 2.0 ** (-2 * split[3])
+            tolerance = 2e-16 * abs(float(exact)) + 3000 * 4 * largest * 2.0 ** (-2 * split.bits)
             assert abs(sums[row, column] - float(exact)) <= tolerance
 
 

@@ -13,6 +13,7 @@ partial sum is an exact integer (:func:`exact_weighted_sums`), so their order ca
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -252,62 +253,95 @@ def eigh3_batched(matrices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return values[rows, order], v[rows, order].transpose(0, 2, 1)
 
 
-def split_exactly(features: np.ndarray, max_terms: int) -> tuple:
-    """Split each column of ``features`` into two integer-valued parts for exact weighted sums.
+@dataclass(frozen=True)
+class ExactSplit:
+    """Features split for exact weighted sums (see :func:`split_exactly`).
+
+    Attributes
+    ----------
+    parts : ndarray, shape (n, 2 f)
+        Per vertex, the ``high`` whole numbers of the ``f`` features, then the ``low`` ones.
+    scale : ndarray, shape (f,)
+        ``2^-shift`` of each feature: ``feature ≈ (high + low · 2^-bits) · scale``.
+    bits : int
+    """
+
+    parts: np.ndarray
+    scale: np.ndarray
+    bits: int
+
+    def rows(self, index) -> ExactSplit:
+        """The split of some vertices (the same scales, so still exact for as many terms)."""
+        return ExactSplit(self.parts[index], self.scale, self.bits)
+
+    def columns(self, index) -> ExactSplit:
+        """The split of some features."""
+        index = np.arange(self.scale.size)[index]
+        return ExactSplit(
+            self.parts[:, np.concatenate([index, index + self.scale.size])],
+            self.scale[index],
+            self.bits,
+        )
+
+    def part_columns(self, index) -> np.ndarray:
+        """Where the high and low parts of some features are in :attr:`parts` (and in the
+        sums of :func:`exact_integer_sums`)."""
+        index = np.arange(self.scale.size)[index]
+        return np.concatenate([index, index + self.scale.size])
+
+
+def split_exactly(features: np.ndarray, max_terms: int) -> ExactSplit:
+    """Split each column of ``features`` into two whole-number parts for exact weighted sums.
 
     ``features[:, c] ≈ (high[:, c] + low[:, c] · 2^-bits) · 2^-shift[c]``, where ``high`` and
     ``low`` hold whole numbers small enough that any sum of at most ``max_terms`` of them, each
     times a whole number, is exact in float64 (below 2^53). What is left out is below
-    ``2^-(2·bits)`` of the column's largest value (bits ≥ 16 even for a billion terms): far below
-    anything a measurement can resolve.
-
-    Returns
-    -------
-    high, low : ndarray, shape (n, f)
-    scale : ndarray, shape (f,)
-        The factor ``2^-shift`` of each column.
-    bits : int
-        The low part's further factor is ``2^-bits``.
+    ``2^-(2·bits)`` of the column's largest value (``bits`` is 52 minus the bits of
+    ``max_terms``: 32 for a million terms): far below anything a measurement can resolve. Every
+    scaling is by a power of two, so exact.
     """
     bits = 52 - max(int(max_terms), 1).bit_length()
     largest = np.max(np.abs(features), axis=0, initial=0.0)
     _, exponent = np.frexp(largest)  # largest < 2^exponent
     shift = bits - exponent
-    scaled = np.ldexp(features, shift[None, :])
-    high = np.round(scaled)
-    low = np.round(np.ldexp(scaled - high, bits))
-    return high, low, np.ldexp(1.0, -shift), bits
+    if shift.max(initial=0) < 1000:  # a product by 2^shift is exact and faster than ldexp
+        scaled = features * np.ldexp(1.0, shift)
+    else:  # columns of values near 1e-300, whose 2^shift is beyond float64
+        scaled = np.ldexp(features, shift)
+    high = np.rint(scaled)
+    low = np.rint((scaled - high) * 2.0**bits)
+    return ExactSplit(np.hstack([high, low]), np.ldexp(1.0, -shift), bits)
 
 
-def exact_integer_sums(weights: np.ndarray, split) -> tuple[np.ndarray, np.ndarray]:
-    """The two whole-number parts of ``weights @ features``: exact, so bit-identical everywhere.
+def exact_integer_sums(weights: np.ndarray, split: ExactSplit) -> np.ndarray:
+    """The whole-number parts of ``weights @ features``: exact, so bit-identical everywhere.
 
     Parameters
     ----------
     weights : ndarray, shape (k, n)
         Whole numbers (0/1 memberships or bootstrap counts) as float64; the sum of each row must be
         at most the ``max_terms`` the split was made for.
-    split : tuple
+    split : ExactSplit
         :func:`split_exactly` of the ``(n, f)`` features.
 
     Returns
     -------
-    high, low : ndarray, shape (k, f)
-        Every partial sum of these matrix products is a whole number below 2^53, so BLAS's
-        order, blocking, fused multiply-adds and threads cannot change them. Being exact, they
-        can also be subtracted exactly (the sums over a set's complement). :func:`combine` turns
-        them into the sums.
+    ndarray, shape (k, 2 f)
+        The sums of the high parts, then of the low parts. Every partial sum of this matrix
+        product is a whole number below 2^53, so BLAS's order, blocking, fused multiply-adds and
+        threads cannot change it. Being exact, sums can also be subtracted exactly (the sums over
+        a set's complement). :func:`combine` turns them into the feature sums.
     """
-    return weights @ split[0], weights @ split[1]
+    return weights @ split.parts
 
 
-def combine(parts: tuple[np.ndarray, np.ndarray], split) -> np.ndarray:
-    """The weighted sums from their exact parts (see :func:`exact_integer_sums`), rounded once."""
-    high, low = parts
-    return (high + np.ldexp(low, -split[3])) * split[2]
+def combine(sums: np.ndarray, split: ExactSplit) -> np.ndarray:
+    """The weighted sums of the features from their exact parts, rounded once."""
+    f = split.scale.size
+    return (sums[:, :f] + sums[:, f:] * 2.0**-split.bits) * split.scale
 
 
-def exact_weighted_sums(weights: np.ndarray, split) -> np.ndarray:
+def exact_weighted_sums(weights: np.ndarray, split: ExactSplit) -> np.ndarray:
     """``weights @ features`` for whole-number weights, bit-identical on every machine (see
     :func:`exact_integer_sums`)."""
     return combine(exact_integer_sums(weights, split), split)

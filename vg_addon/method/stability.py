@@ -119,20 +119,24 @@ _PROJECTION_ROWS = 16
 
 
 def _projection(binormal, scale, normals, local, offset) -> np.ndarray:
-    """``p = bᵀN + s bᵀX − offset`` for every row and pool vertex, ``(k, m)``: six products
-    added in a fixed order (a matrix product would leave the order to BLAS)."""
-    factors = np.hstack([binormal, binormal * scale[:, None]])
-    columns = np.vstack([normals.T, local.T])  # contiguous rows
-    out = np.empty((factors.shape[0], columns.shape[1]))
-    term = np.empty((_PROJECTION_ROWS, columns.shape[1]))
-    for start in range(0, out.shape[0], _PROJECTION_ROWS):
-        block = out[start : start + _PROJECTION_ROWS]
-        block_factors, block_term = factors[start : start + _PROJECTION_ROWS], term[: len(block)]
-        np.multiply(block_factors[:, :1], columns[0], out=block)
-        for i in range(1, 6):
-            np.multiply(block_factors[:, i : i + 1], columns[i], out=block_term)
-            block += block_term
-        block -= offset[start : start + _PROJECTION_ROWS, None]
+    """``p = bᵀ(N + s X) − offset`` for every row and pool vertex, ``(k, m)``, in a fixed order
+    (a matrix product would leave the order to BLAS). Rows that share ``s`` (the same λ/r and
+    sign) share ``N + s X``, so each row costs three products."""
+    out = np.empty((binormal.shape[0], normals.shape[0]))
+    term = np.empty((_PROJECTION_ROWS, normals.shape[0]))
+    values, group = np.unique(scale, return_inverse=True)
+    for g, value in enumerate(values):
+        rows = np.flatnonzero(group == g)
+        columns = (normals + value * local).T.copy()  # contiguous rows: N + s X, per axis
+        for start in range(0, rows.size, _PROJECTION_ROWS):
+            block_rows = rows[start : start + _PROJECTION_ROWS]
+            factors, block_term = binormal[block_rows], term[: block_rows.size]
+            block = np.multiply(factors[:, :1], columns[0])
+            for i in (1, 2):
+                np.multiply(factors[:, i : i + 1], columns[i], out=block_term)
+                block += block_term
+            block -= offset[block_rows, None]
+            out[block_rows] = block
     return out
 
 
@@ -303,14 +307,10 @@ def _algorithm_steps(
     plus = members & (projection >= threshold[:, None])
 
     # The "+" sides' sums by an exact product; the "−" sides' are the rest of the patch's, exactly.
-    high, low, scale, bits = split
-    side_split = (high[:, _SIDE], low[:, _SIDE], scale[_SIDE], bits)
+    side_split = split.columns(_SIDE)
     plus_weights = np.where(plus, weights, 0.0)
-    plus_high, plus_low = exact_integer_sums(plus_weights, side_split)
-    side_parts = (
-        np.concatenate([plus_high, parts[0][:, _SIDE] - plus_high]),
-        np.concatenate([plus_low, parts[1][:, _SIDE] - plus_low]),
-    )
+    plus_parts = exact_integer_sums(plus_weights, side_split)
+    side_parts = np.concatenate([plus_parts, parts[:, split.part_columns(_SIDE)] - plus_parts])
     plus_count = plus_weights.sum(axis=1)
     side_count = np.concatenate([plus_count, count - plus_count])
     covariances, side_mean_normals = _side_covariances(combine(side_parts, side_split), side_count)
@@ -349,8 +349,7 @@ def _bootstrap_steps(surface, m: Measurement, n_resamples: int, pool=None):
     else:
         ids, pool_local, pool_normals, pool_split = pool
         at = np.searchsorted(ids, m.indices)
-        local, normals = pool_local[at], pool_normals[at]
-        split = (pool_split[0][at], pool_split[1][at], *pool_split[2:])
+        local, normals, split = pool_local[at], pool_normals[at], pool_split.rows(at)
     return _algorithm_steps(
         local,
         normals,
