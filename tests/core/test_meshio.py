@@ -11,6 +11,7 @@ import pytest
 
 from vg_addon import GoniometerError
 from vg_addon.formats.meshio import MeshData, read_mesh, write_ply
+from vg_addon.synthetic_meshes import wedge
 
 STRUCT_CODES = {
     "char": "b", "int8": "b", "uchar": "B", "uint8": "B", "short": "h", "int16": "h",
@@ -633,10 +634,263 @@ def test_malformed_stl(tmp_path):
     path.write_bytes(b"not an stl")
     expect_error(path, "not an STL")
     path.write_bytes(b"solid x\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n")
-    expect_error(path, "multiple of three")
+    expect_error(path, "line 2:", "2 vertex lines, not 3")
     path.write_bytes(b"solid x\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0 0\n")
-    expect_error(path, "line 4", "exactly three")
+    expect_error(path, "line 4", "exactly three", "4 numbers")
     path.write_bytes(stl_binary([[[0, 0, 0], [1, np.nan, 0], [0, 1, 0]]]))
     expect_error(path, "not finite")
     path.write_bytes(stl_binary([]))
     expect_error(path, "no vertices")
+
+
+# ------------------------------------- a value too many or too few: each line read by its header
+
+
+def wedge_ply_ascii(tmp_path, name="wedge.ply"):
+    """An exact 60° wedge written as ASCII PLY: its path, its lines, the header's line count,
+    and the vertex and face counts."""
+    mesh = wedge(60.0, n=20)
+    # A vertex of the crease (z = 0) last, as in the issue's file: a value too many then makes
+    # the first face count 0, and the flat reading went on without an error.
+    last = int(np.flatnonzero(mesh.points[:, 2] == 0)[-1])
+    order = np.r_[np.delete(np.arange(len(mesh.points)), last), last]
+    points = mesh.points[order]
+    triangles = np.argsort(order)[mesh.triangles]
+    path = write_ply(tmp_path / name, points, triangles, binary=False)
+    lines = path.read_bytes().split(b"\n")
+    header = lines.index(b"end_header") + 1
+    return path, lines, header, len(points), len(triangles)
+
+
+def test_a_stray_value_on_an_ascii_ply_vertex_line_is_refused_with_its_line(tmp_path):
+    """Issue 25: " 0.25" appended to one vertex line, 200 lines before the end of the vertex
+    block, shifted every later vertex and dropped the last face (42.64° on a 60° wedge)."""
+    path, lines, header, n_vertices, _ = wedge_ply_ascii(tmp_path)
+    assert read_mesh(path).n_vertices == n_vertices
+    stray = header + n_vertices - 200  # 0-based index of the line in the file
+    lines[stray] += b" 0.25"
+    path.write_bytes(b"\n".join(lines))
+    expect_error(path, f"line {stray + 1}:", "4 values", "3")
+
+
+@pytest.mark.parametrize("where", ["first", "middle", "last"])
+def test_an_ascii_ply_face_line_with_an_extra_index_is_refused_with_its_line(tmp_path, where):
+    path, lines, header, n_vertices, n_faces = wedge_ply_ascii(tmp_path)
+    first_face = header + n_vertices
+    at = {"first": first_face, "middle": first_face + n_faces // 2}.get(
+        where, first_face + n_faces - 1
+    )
+    lines[at] += b" 5"
+    path.write_bytes(b"\n".join(lines))
+    expect_error(path, f"line {at + 1}:", "5 values", "'face'")
+
+
+@pytest.mark.parametrize("fault", ["a face line missing", "a face line too many"])
+def test_an_ascii_ply_with_a_line_missing_or_too_many_is_refused(tmp_path, fault):
+    path, lines, header, n_vertices, n_faces = wedge_ply_ascii(tmp_path)
+    end = header + n_vertices + n_faces  # index of the line after the last face (blank)
+    assert lines[end:] == [b""]
+    if fault == "a face line missing":
+        del lines[end - 1]
+        fragments = (f"line {end}:", f"{n_faces - 1} of the {n_faces}", "'face'")
+    else:
+        lines.insert(end, b"3 0 1 2")
+        fragments = (f"line {end + 1}:", "after the last element")
+    path.write_bytes(b"\n".join(lines))
+    expect_error(path, *fragments)
+
+
+def test_an_ascii_ply_vertex_line_missing_is_refused_where_the_faces_begin(tmp_path):
+    """A vertex line too few makes the first face line the last vertex: refused there."""
+    path, lines, header, n_vertices, _ = wedge_ply_ascii(tmp_path)
+    del lines[header + 10]
+    path.write_bytes(b"\n".join(lines))
+    expect_error(path, f"line {header + n_vertices}:", "4 values", "'vertex'")
+
+
+def test_an_ascii_ply_face_index_out_of_range_names_its_line(tmp_path):
+    path, lines, header, n_vertices, _ = wedge_ply_ascii(tmp_path)
+    at = header + n_vertices + 7
+    lines[at] = f"3 0 1 {n_vertices}".encode()
+    path.write_bytes(b"\n".join(lines))
+    expect_error(path, f"line {at + 1}:", f"vertex {n_vertices}", f"{n_vertices} vertices")
+    lines[at] = b"3 0 -1 2"
+    path.write_bytes(b"\n".join(lines))
+    expect_error(path, f"line {at + 1}:", "vertex -1")
+
+
+def test_ascii_ply_blank_lines_crlf_and_comments_are_read(tmp_path):
+    points, faces = grid_polygons("mixed")
+    data = ply_bytes(
+        "ascii",
+        [
+            ("vertex", [(c, "double") for c in "xyz"], points),
+            ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
+        ],
+        comments=("comment one", "comment 3 0 1 2", "obj_info two"),
+    )
+    head, body = data.split(b"end_header\n")
+    lines = body.split(b"\n")
+    lines.insert(5, b"   ")  # a blank line among the vertices
+    body = b"\r\n".join(b"\t" + line + b"  " for line in lines) + b"\n\n \r\n"
+    path = tmp_path / "blank.ply"
+    path.write_bytes(head + b"end_header\n" + body)
+    mesh = read_mesh(path)
+    assert np.array_equal(mesh.points, np.array(points))
+    assert mesh.triangles.tolist() == [list(t) for t in fan(faces)]
+
+
+def test_ascii_ply_lists_in_other_elements_are_checked_line_by_line(tmp_path):
+    """A vertex list property and an extra face list: each line's length follows its counts."""
+    points, faces = grid_polygons("quads")
+    elements = [
+        ("vertex", [("x", "float"), ("tags", "list", "uchar", "int"), ("y", "float"),
+                    ("z", "float")], [(p[0], [1] * (i % 3), p[1], p[2]) for i, p in
+                                      enumerate(points)]),
+        ("face", [("vertex_indices", "list", "uchar", "int"), ("uv", "list", "int", "float")],
+         [(f, [0.5] * k) for k, f in enumerate(faces)]),
+    ]  # fmt: skip
+    path = tmp_path / "lists.ply"
+    data = ply_bytes("ascii", elements)
+    path.write_bytes(data)
+    mesh = read_mesh(path)
+    assert np.array_equal(mesh.points, np.array(points, np.float32))
+    lines = data.split(b"\n")
+    header = lines.index(b"end_header") + 1
+    for at, change, fragment in [
+        (header + 2, b" 7", "'vertex'"),  # one tag too many
+        (header + len(points) + 3, b" 0.5", "'face'"),  # one uv too many
+    ]:
+        changed = [*lines[:at], lines[at] + change, *lines[at + 1 :]]
+        path.write_bytes(b"\n".join(changed))
+        expect_error(path, f"line {at + 1}:", fragment)
+    changed = list(lines)
+    changed[header + len(points)] = b"9 0 1 5 4"  # a count larger than the line holds
+    path.write_bytes(b"\n".join(changed))
+    expect_error(path, f"line {header + len(points) + 1}:", "'face'")
+
+
+@pytest.mark.parametrize("columns", ["1 2 3", "1 2 3 1", "1 2 3 0.5 0.25 1"])
+def test_obj_vertex_lines_with_w_or_colours_are_read(tmp_path, columns):
+    """x y z, x y z w (the OBJ format) and x y z r g b (the colour extension MeshLab and
+    Blender write)."""
+    text = f"v 0 0 0\nv {columns}\nv 0 1 0\nf 1 2 3\n"
+    mesh = read_mesh(write_text(tmp_path / "columns.obj", text))
+    assert mesh.points.tolist() == [[0, 0, 0], [1, 2, 3], [0, 1, 0]]
+
+
+@pytest.mark.parametrize(
+    ("text", "fragments"),
+    [
+        ("v 0 0 0\nv 1 0 0 0.25 0.5\nv 0 1 0\nf 1 2 3\n", ("line 2", "5 numbers")),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0 1 1 1 1\nf 1 2 3\n", ("line 3", "7 numbers")),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\n# x\nf 1 2 4\n", ("line 5", "vertex 4", "3 vertices")),
+        ("v 0 0 0\nf -1 -2 -3\nv 1 0 0\nv 0 1 0\n", ("line 2", "out of range")),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2/1/1/1 3\n", ("line 5", "'2/1/1/1'")),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/ 2 3\n", ("line 4", "'1/'")),
+    ],
+)
+def test_obj_wrong_counts_and_indices_name_the_line(tmp_path, text, fragments):
+    expect_error(write_text(tmp_path / "bad.obj", text), *fragments)
+
+
+def test_ascii_stl_facets_are_read_line_by_line(tmp_path):
+    data = stl_ascii(CUBE_CORNERS[CUBE_TRIANGLES])
+    lines = data.split(b"\n")
+    path = tmp_path / "cube.stl"
+    facet = lines.index(b"  facet normal 0 0 0", 10)  # the third facet's line
+    for change, fragments in [
+        ({facet: b"  facet normal 0 0 0 1"}, (f"line {facet + 1}:", "4 numbers")),
+        ({facet: b"  facet normal 0 0"}, (f"line {facet + 1}:", "2 numbers")),
+        ({facet + 2: lines[facet + 2] + b" 0.25"}, (f"line {facet + 3}:", "4 numbers")),
+    ]:
+        changed = [change.get(k, line) for k, line in enumerate(lines)]
+        path.write_bytes(b"\n".join(changed))
+        expect_error(path, *fragments)
+    # A vertex line moved from one facet to the next: still a multiple of three vertex lines.
+    moved = [
+        *lines[: facet + 2],
+        *lines[facet + 3 : facet + 8],
+        lines[facet + 2],
+        *lines[facet + 8 :],
+    ]
+    path.write_bytes(b"\n".join(moved))
+    expect_error(path, f"line {facet + 1}:", "2 vertex lines")
+
+
+@pytest.mark.parametrize("count", [0, 6, 11, 13, 24])
+def test_binary_stl_whose_header_count_disagrees_with_its_size_is_refused(tmp_path, count):
+    """Issue 25: a count of 0 read as "no vertices", half the count read half the triangles."""
+    data = bytearray(stl_binary(CUBE_CORNERS[CUBE_TRIANGLES]))
+    data[80:84] = struct.pack("<I", count)
+    path = tmp_path / "count.stl"
+    path.write_bytes(bytes(data))
+    expect_error(path, f"declares {count} triangles", "implies 12")
+
+
+def test_binary_stl_trailing_bytes_are_ignored_only_short_of_a_record(tmp_path):
+    whole = stl_binary(CUBE_CORNERS[CUBE_TRIANGLES])
+    path = tmp_path / "padded.stl"
+    for extra in (1, 49):
+        path.write_bytes(whole + b"\0" * extra)
+        assert read_mesh(path).n_triangles == 12
+    for extra in (50, 51, 120):
+        path.write_bytes(whole + b"\0" * extra)
+        expect_error(path, "declares 12 triangles", f"implies {12 + extra // 50}")
+
+
+PLY_XYZ_HEAD = b"ply\nformat ascii 1.0\nelement vertex 3\n" + b"".join(
+    b"property float %s\n" % c for c in (b"x", b"y", b"z")
+)
+
+
+def test_a_ply_header_count_in_non_ascii_digits_is_refused_cleanly(tmp_path):
+    """Latin-1 "²" is a digit to str.isdigit(), not to int(): it raised a bare ValueError."""
+    path = tmp_path / "digit.ply"
+    path.write_bytes(PLY_XYZ_HEAD.replace(b"vertex 3", b"vertex \xb2") + b"end_header\n")
+    expect_error(path, "header line 3", "element <name> <count>")
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_a_ply_vertex_with_two_x_properties_is_refused(tmp_path, fmt):
+    """Two 'x' properties: the first one's type was reported, the last one's values read."""
+    props = [("x", "float"), ("y", "float"), ("z", "float"), ("x", "double")]
+    rows = [(0.0, 0.0, 0.0, 9.0), (1.0, 0.0, 0.0, 9.0), (0.0, 1.0, 0.0, 9.0)]
+    path = tmp_path / "two_x.ply"
+    path.write_bytes(ply_bytes(fmt, [("vertex", props, rows)]))
+    expect_error(path, "more than one 'x'")
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_ply_normals_that_are_lists_are_ignored(tmp_path, fmt):
+    """An 'nx' list is no normal: the points are read, the normals left out (it raised)."""
+    props = [("x", "float"), ("y", "float"), ("z", "float"), ("nx", "list", "uchar", "float"),
+             ("ny", "float"), ("nz", "float")]  # fmt: skip
+    rows = [(*p, [5.0], 0.0, 1.0) for p in ((0, 0, 0), (1, 0, 0), (0, 1, 0))]
+    path = tmp_path / "list_nx.ply"
+    path.write_bytes(ply_bytes(fmt, [("vertex", props, rows)]))
+    mesh = read_mesh(path)
+    assert mesh.points.tolist() == [[0, 0, 0], [1, 0, 0], [0, 1, 0]] and mesh.normals is None
+
+
+@pytest.mark.parametrize("sign", [b"-", b"+"])
+@pytest.mark.parametrize("where", ["last value", "inside"])
+def test_a_lone_sign_in_ascii_ply_faces_is_not_a_number(tmp_path, sign, where):
+    """NumPy's integer text parser reads a lone sign as 0 (or joins it to the next number):
+    whole-number face lists are parsed as integers for speed, so this must still be refused."""
+    points, faces = grid_polygons("triangles")
+    data = ply_bytes(
+        "ascii",
+        [
+            ("vertex", [(c, "float") for c in "xyz"], points),
+            ("face", [("vertex_indices", "list", "uchar", "int")], [(f,) for f in faces]),
+        ],
+    )
+    lines = data.rstrip(b"\n").split(b"\n")
+    at = len(lines) - 1 if where == "last value" else len(lines) - 3
+    lines[at] = lines[at].rsplit(b" ", 1)[0] + b" " + sign
+    if where == "inside":
+        lines[at] += b" 1"
+    path = tmp_path / "sign.ply"
+    path.write_bytes(b"\n".join(lines))
+    expect_error(path, f"line {at + 1}", repr(sign.decode()), "not a number")

@@ -5,10 +5,12 @@ float64 points, int64 triangles (polygons are fan-triangulated) or ``None`` for 
 and per-vertex normals when the file carries them. Every problem with a file is reported as a
 :class:`~vg_addon.errors.GoniometerError` whose message names the file and what is wrong.
 
-Parsing never loops in Python over vertices. The one exception is a binary or ASCII PLY whose
-faces have *different* vertex counts: there the start of each face record depends on the count
-of the previous one, so the record starts are found with one light Python step per face; all
-values are then gathered with NumPy.
+Parsing never loops in Python over vertices. The one exception is a binary PLY whose faces have
+*different* vertex counts: there the start of each face record depends on the count of the
+previous one, so the record starts are found with one light Python step per face; all values are
+then gathered with NumPy. Text is read line by line, but with NumPy: the values of every line are
+counted at once and checked against what the line must hold, so a value too many or too few is
+refused with its line number instead of shifting every number after it.
 """
 
 from __future__ import annotations
@@ -92,7 +94,8 @@ def read_mesh(path: str | os.PathLike) -> MeshData:
     ------
     GoniometerError
         If the file is missing, unreadable, of an unknown format, truncated or malformed, has no
-        vertices, has non-finite coordinates or a face index out of range.
+        vertices, has non-finite coordinates or a face index out of range. Text files are read
+        line by line and a bad line is named with its number.
     """
     path = _as_path(path)
     readers = {".ply": read_ply, ".obj": read_obj, ".stl": read_stl}
@@ -201,14 +204,15 @@ def _fan(flat: np.ndarray, counts: np.ndarray) -> np.ndarray:
 _NOT_BLANK = re.compile(rb"\S")
 
 
-def _parse_numbers(text: bytes) -> np.ndarray | None:
-    """All whitespace-separated numbers in ``text`` as float64, or None if a token is not one."""
+def _parse_numbers(text: bytes, dtype=np.float64) -> np.ndarray | None:
+    """All whitespace-separated numbers in ``text`` (as ``dtype``), or None if a token is not
+    one."""
     if _NOT_BLANK.search(text) is None:
-        return np.empty(0)  # np.fromstring returns [-1.0] for blank text
+        return np.empty(0, dtype)  # np.fromstring returns [-1.0] for blank text
     with warnings.catch_warnings():
         warnings.simplefilter("error", DeprecationWarning)
         try:
-            return np.fromstring(text, dtype=np.float64, sep=" ")
+            return np.fromstring(text, dtype=dtype, sep=" ")
         except (ValueError, DeprecationWarning):
             return None
 
@@ -276,10 +280,11 @@ def _ply_header(data: bytes, path: Path) -> tuple[str, list[_PlyElement], int]:
                 f"'{path}': the PLY header has no 'end_header' line; the file is truncated or "
                 "not a PLY file."
             )
-        line = data[pos:end].decode("latin-1").strip()
+        # Words are split at ASCII whitespace only, like the body's values.
+        line = data[pos:end].strip().decode("latin-1")
+        words = [word.decode("latin-1") for word in data[pos:end].split()]
         pos = end + 1
         number += 1
-        words = line.split()
         if not words or words[0] in ("ply", "comment", "obj_info"):
             continue
         keyword = words[0]
@@ -294,7 +299,7 @@ def _ply_header(data: bytes, path: Path) -> tuple[str, list[_PlyElement], int]:
                 )
             fmt = words[1]
         elif keyword == "element":
-            if len(words) != 3 or not words[2].isdigit():
+            if len(words) != 3 or not (words[2].isascii() and words[2].isdigit()):
                 raise GoniometerError(f"{where}: expected 'element <name> <count>'.")
             elements.append(_PlyElement(words[1], int(words[2]), []))
         elif keyword == "property":
@@ -336,7 +341,9 @@ def read_ply(path: str | os.PathLike) -> MeshData:
     The ``vertex`` element must have ``x``, ``y``, ``z``; ``nx``, ``ny``, ``nz`` become the
     normals; other vertex properties (colours, quality, ...) are ignored in any order. The
     ``face`` element's ``vertex_indices`` (or ``vertex_index``) list is fan-triangulated; other
-    face properties and other elements are skipped.
+    face properties and other elements are skipped. An ASCII body is read line by line: each
+    element takes the next ``count`` non-blank lines, and each line must hold exactly the values
+    of its element's properties (one per scalar, a count and that many items per list).
 
     Parameters
     ----------
@@ -350,7 +357,9 @@ def read_ply(path: str | os.PathLike) -> MeshData:
     Raises
     ------
     GoniometerError
-        For a missing, unreadable, truncated or malformed file (see :func:`read_mesh`).
+        For a missing, unreadable, truncated or malformed file (see :func:`read_mesh`); in an
+        ASCII file, a line with the wrong count of values, a face index out of range, or element
+        counts that do not match the lines are named with the line number.
     """
     path = _as_path(path)
     data = _read_bytes(path)
@@ -368,14 +377,24 @@ def read_ply(path: str | os.PathLike) -> MeshData:
     for c in "xyz":
         if vertex.properties[names.index(c)].count_dtype is not None:
             raise GoniometerError(f"'{path}': the vertex coordinate '{c}' is a list, not a number.")
+    scalars = {p.name for p in vertex.properties if p.count_dtype is None}
+    wanted = {"vertex": {"x", "y", "z"}}
+    if {"nx", "ny", "nz"} <= scalars:
+        wanted["vertex"] |= {"nx", "ny", "nz"}
     face = next((e for e in elements if e.name == "face"), None)
-    face_list = _face_list_name(face, path) if face is not None else None
-
-    wanted = {"vertex": {"x", "y", "z", "nx", "ny", "nz"}}
     if face is not None:
+        face_list = _face_list_name(face, path)
         wanted["face"] = {face_list}
+    for element in (e for e in (vertex, face) if e is not None):
+        for name in wanted[element.name]:
+            if sum(p.name == name for p in element.properties) > 1:
+                raise GoniometerError(
+                    f"'{path}': the PLY '{element.name}' element has more than one '{name}' "
+                    "property, so which one to read is ambiguous; re-export the mesh."
+                )
+    lines = {}
     if fmt == "ascii":
-        found = _ply_ascii_body(data, body, elements, wanted, path)
+        found, lines = _ply_ascii_body(data, body, elements, wanted, path)
     else:
         found = _ply_binary_body(data, body, elements, wanted, _PLY_FORMATS[fmt], path)
 
@@ -387,9 +406,30 @@ def read_ply(path: str | os.PathLike) -> MeshData:
     triangles = None
     if face is not None and face.count > 0:
         flat, counts = found["face"][face_list]
-        triangles = _fan(flat.astype(np.int64), counts)
+        flat = flat.astype(np.int64)
+        _check_face_indices(flat, counts, len(points), path, lines.get("face"))
+        triangles = _fan(flat, counts)
     source_dtype = vertex.properties[names.index("x")].dtype.name
     return _finish(path, points, triangles, normals, source_dtype)
+
+
+def _check_face_indices(flat, counts, n, path, lines=None) -> None:
+    """Refuse a face index outside ``0..n-1`` (also in faces of fewer than three vertices,
+    which give no triangle), naming the face's line (``lines``, ASCII) or its number."""
+    bad = (flat < 0) | (flat >= n)
+    if bad.any():
+        k = int(np.argmax(bad))
+        face = int(np.searchsorted(np.cumsum(counts), k, side="right"))
+        where = (
+            f"'{path}', line {lines[face]}"
+            if lines is not None
+            else f"'{path}', face {face} (from 0)"
+        )
+        raise GoniometerError(
+            f"{where}: face index out of range: the face refers to vertex {flat[k]} (counting "
+            f"from 0), but the file has {n} vertices (valid 0..{n - 1}). The file is corrupt or "
+            "was written incorrectly; re-export it."
+        )
 
 
 def _face_list_name(face: _PlyElement, path: Path) -> str:
@@ -570,136 +610,245 @@ def _gather(buffer: np.ndarray, offsets: np.ndarray, dtype: np.dtype) -> np.ndar
     return np.ascontiguousarray(buffer[at]).view(dtype).reshape(-1)
 
 
-def _ply_ascii_body(data, pos, elements, wanted, path) -> dict:
-    """Read the needed properties from an ASCII body: all numbers are parsed at once."""
-    numbers = _parse_numbers(data[pos:])
-    if numbers is None:
-        raise GoniometerError(
-            f"'{path}'{_where_not_a_number(data, pos)}: the ASCII PLY data contains something "
-            "that is not a number; the file is corrupt."
-        )
+_SPACE = np.uint8(32)
+_SLASH = np.uint8(ord("/"))
+_MINUS = np.uint8(ord("-"))
+
+
+def _blank(buffer: np.ndarray) -> np.ndarray:
+    """Mask of the ASCII whitespace bytes (tab, newline, vertical tab, form feed, carriage
+    return, space): the separators ``np.fromstring`` and ``bytes.split`` use."""
+    return ((buffer - np.uint8(9)) < 5) | (buffer == _SPACE)
+
+
+def _ply_ascii_body(data, pos, elements, wanted, path) -> tuple[dict, dict]:
+    """Read an ASCII body line by line against the header.
+
+    Each element takes the next ``count`` non-blank lines, one record per line, and each line
+    must hold exactly the values its properties call for (one per scalar, a count and that
+    many items per list). Blank lines anywhere are skipped. Returns the needed values and, per
+    needed element, the 1-based line number of each record (for later messages).
+    """
+    buffer = np.frombuffer(data, np.uint8, offset=pos)
+    blank = _blank(buffer)
+    # A value starts at a non-blank byte after a blank one; the header's last newline
+    # precedes the body, so its first byte starts a value unless it is blank.
+    starts = np.empty(buffer.size, bool)
+    if buffer.size:
+        starts[0] = not blank[0]
+        np.less(blank[1:], blank[:-1], out=starts[1:])
+    value_at = np.flatnonzero(starts)
+    del starts, blank
+    line_starts = pos + np.concatenate([[0], np.flatnonzero(buffer == 10) + 1, [buffer.size]])
+    per_line = np.diff(np.searchsorted(value_at + pos, line_starts[:-1]), append=value_at.size)
+    del value_at
+    first_line = data.count(b"\n", 0, pos) + 1  # the body's first line, counted from 1
+    records = np.flatnonzero(per_line)  # body lines that hold values, one record each
+    widths = per_line[records]
+    del per_line
+
     found: dict[str, dict] = {}
+    lines: dict[str, np.ndarray] = {}
     at = 0
     for element in elements:
-        if all(name in found for name in wanted):
-            break  # later elements are not needed, so they need not even be complete
+        if element.count > records.size - at:
+            last = int(records[-1]) + first_line if records.size else first_line - 1
+            raise GoniometerError(
+                f"'{path}', line {last + 1}: the file ends after {records.size - at} of the "
+                f"{element.count} '{element.name}' lines the header declares: lines are "
+                "missing, the file is truncated or its header is wrong. Re-export it."
+            )
+        take = slice(at, at + element.count)
         need = wanted.get(element.name, set()) if element.name not in found else set()
-        values, at = _ascii_element(numbers, at, element, need, path)
+        record_lines = records[take] + first_line
+        numbers = np.empty(0)
+        if element.count:
+            begin, end = line_starts[records[at]], line_starts[records[take][-1] + 1]
+            numbers = _ascii_numbers(data, begin, end, element, widths[take].sum(), path)
+        values = _ascii_records(numbers, widths[take], record_lines, element, need, path)
         if need:
             found[element.name] = values
-    return found
+            lines[element.name] = record_lines
+        at += element.count
+    if at < records.size:
+        declared = ", ".join(f"{e.count} '{e.name}'" for e in elements) or "no elements"
+        raise GoniometerError(
+            f"'{path}', line {int(records[at]) + first_line}: a line after the last element "
+            f"the header declares ({declared} lines). The header's counts are wrong or the "
+            "file has lines too many; re-export it."
+        )
+    return found, lines
 
 
-def _ascii_first_record(numbers, at, props):
-    """Token width and list counts of the record starting at token ``at``, or None."""
-    width = 0
-    counts = {}
-    for i, p in enumerate(props):
-        if p.count_dtype is None:
-            width += 1
-            continue
-        if at + width >= numbers.size:
-            return None
-        count = numbers[at + width]
-        if not (0 <= count <= numbers.size and count == np.floor(count)):
-            return None
-        counts[i] = int(count)
-        width += 1 + counts[i]
-    return width, counts
+def _ascii_numbers(data, begin, end, element, expected, path) -> np.ndarray:
+    """The ``expected`` numbers of ``data[begin:end]`` (an element's lines) as float64."""
+    text = data[begin:end]
+    numbers = None
+    if (
+        all(
+            p.dtype.kind in "iu" and (p.count_dtype is None or p.count_dtype.kind in "iu")
+            for p in element.properties
+        )
+        and b"-" not in text
+        and b"+" not in text
+    ):
+        # Unsigned whole numbers (face lists) parse three times faster as integers. Signs take
+        # the float path: the integer parser reads a lone '-' as 0 or joins it to the next
+        # number. Values beyond int64 saturate, which every PLY integer type refuses anyway;
+        # anything else (3.0, 1e2) fails here and takes the float path too, where the declared
+        # type is checked.
+        numbers = _parse_numbers(text, np.int64)
+    numbers = _parse_numbers(text) if numbers is None else numbers.astype(np.float64)
+    if numbers is None or numbers.size != expected:
+        raise GoniometerError(
+            f"'{path}'{_where_not_a_number(data, begin)}: the '{element.name}' data of this "
+            "ASCII PLY contains something that is not a number; the file is corrupt."
+        )
+    return numbers
 
 
-def _ascii_element(numbers, at, element, need, path):
-    """Values of one element from the flat number array, starting at token ``at``."""
+def _ascii_records(numbers, widths, lines, element, need, path) -> dict:
+    """Check each record's value count against the element's properties and return the needed
+    values. ``numbers``: the element's values, record after record; ``widths``: how many each
+    record has; ``lines``: their line numbers."""
     props = element.properties
-    if element.count == 0:
-        return _empty_values(element, need), at
-    first = _ascii_first_record(numbers, at, props)
-    if first is not None and first[0] and at + first[0] * element.count <= numbers.size:
-        width, counts = first
-        table = numbers[at : at + width * element.count].reshape(element.count, width)
-        columns = {}
-        column = 0
-        for i, p in enumerate(props):
-            if p.count_dtype is None:
-                columns[i] = column
-                column += 1
-            else:
-                if (table[:, column] != counts[i]).any():
-                    break
-                columns[i] = column + 1
-                column += 1 + counts[i]
-        else:
+    n = widths.size
+    if n == 0:
+        return _empty_values(element, need)
+    if (widths == widths[0]).all():
+        # The common case, every record alike (e.g. all triangles): one table, read by column.
+        table = numbers.reshape(n, int(widths[0]))
+        layout = _ascii_table_layout(table, props)
+        if layout is not None:
             values = {}
-            for i, p in enumerate(props):
+            for p, (column, count) in zip(props, layout, strict=True):
                 if p.name not in need:
                     continue
-                if p.count_dtype is None:
-                    values[p.name] = _ascii_cast(table[:, columns[i]], p.dtype, element, path)
-                else:
-                    flat = table[:, columns[i] : columns[i] + counts[i]].reshape(-1)
-                    values[p.name] = (
-                        _ascii_cast(flat, p.dtype, element, path),
-                        np.full(element.count, counts[i], np.int64),
+                if count is None:
+                    values[p.name] = _ascii_cast(
+                        table[:, column], p.dtype, element, lines.__getitem__, path
                     )
-            return values, at + width * element.count
-
-    # Mixed list counts: walk the records (one Python step each), then gather with NumPy.
-    starts = np.empty(element.count, np.int64)
-    pos = at
-    try:
-        for r in range(element.count):
-            starts[r] = pos
-            for p in props:
-                if p.count_dtype is None:
-                    pos += 1
                     continue
-                count = numbers[pos]
-                if not (0 <= count <= numbers.size and count == np.floor(count)):
-                    raise GoniometerError(
-                        f"'{path}': list count {count:g} in the '{element.name}' element is "
-                        "not a non-negative integer; the file is corrupt."
-                    )
-                pos += 1 + int(count)
-    except IndexError:
-        raise _truncated(path, element) from None
-    if pos > numbers.size:
-        raise _truncated(path, element)
-    cursor = starts
-    values = {}
+                flat = table[:, column + 1 : column + 1 + count].reshape(-1)
+                values[p.name] = (
+                    _ascii_cast(flat, p.dtype, element, lambda k, c=count: lines[k // c], path),
+                    np.full(n, count, np.int64),
+                )
+            return values
+
+    # Walk the properties, all records at once: a list's count says where the next one starts.
+    firsts = np.cumsum(widths) - widths  # each record's first value
+    offset = np.zeros(n, np.int64)
+    bad = np.zeros(n, bool)
+    layout = []  # per property: the offset of its value (or of its list's count), and the count
     for p in props:
         if p.count_dtype is None:
-            if p.name in need:
-                values[p.name] = _ascii_cast(numbers[cursor], p.dtype, element, path)
-            cursor = cursor + 1
+            layout.append((offset, None))
+            offset = offset + 1
             continue
-        counts = numbers[cursor].astype(np.int64)
-        if p.name in need:
-            rank = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-            flat = numbers[np.repeat(cursor + 1, counts) + rank]
-            values[p.name] = (_ascii_cast(flat, p.dtype, element, path), counts)
-        cursor = cursor + 1 + counts
-    return values, pos
+        inside = offset < widths
+        count = numbers[firsts + np.minimum(offset, widths - 1)]
+        ok = inside & (count >= 0) & (count == np.floor(count)) & (count < widths - offset)
+        bad |= ~ok
+        count = np.where(ok, count, 0).astype(np.int64)
+        layout.append((offset, count))
+        offset = offset + 1 + count
+    bad |= offset != widths
+    if bad.any():
+        raise _ascii_record_error(numbers, firsts, widths, lines, element, bad, path)
+    values = {}
+    for p, (offset, count) in zip(props, layout, strict=True):
+        if p.name not in need:
+            continue
+        if count is None:
+            values[p.name] = _ascii_cast(
+                numbers[firsts + offset], p.dtype, element, lines.__getitem__, path
+            )
+            continue
+        rank = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+        flat = numbers[np.repeat(firsts + offset + 1, count) + rank]
+        ends = np.cumsum(count)
+
+        def line_of(k, ends=ends):
+            return lines[np.searchsorted(ends, k, side="right")]
+
+        values[p.name] = (_ascii_cast(flat, p.dtype, element, line_of, path), count)
+    return values
 
 
-def _ascii_cast(values: np.ndarray, dtype: np.dtype, element, path) -> np.ndarray:
-    """ASCII numbers stored as the declared type (so an ASCII file reads like its binary twin)."""
+def _ascii_table_layout(table, props) -> list | None:
+    """Column of each property in a table of equally long records (with its list's length,
+    or None for a scalar), or None if the records' list counts do not all make that length."""
+    column = 0
+    layout = []
+    for p in props:
+        if p.count_dtype is None:
+            layout.append((column, None))
+            column += 1
+            continue
+        if column >= table.shape[1]:
+            return None
+        count = table[0, column]
+        if not (0 <= count < table.shape[1] - column and count == np.floor(count)):
+            return None
+        if (table[:, column] != count).any():
+            return None
+        layout.append((column, int(count)))
+        column += 1 + int(count)
+    return layout if column == table.shape[1] else None
+
+
+def _ascii_record_error(numbers, firsts, widths, lines, element, bad, path) -> GoniometerError:
+    """The message for the first record in ``bad``, worked out again for that one line."""
+    r = int(np.argmax(bad))
+    values = numbers[firsts[r] : firsts[r] + widths[r]]
+    where = f"'{path}', line {lines[r]}"
+    expected = 0
+    parts = []
+    for p in element.properties:
+        if p.count_dtype is None:
+            expected += 1
+            parts.append(p.name)
+            continue
+        if expected >= values.size:
+            return GoniometerError(
+                f"{where}: the line ends before the count of the '{p.name}' list of the "
+                f"'{element.name}' element; a value is missing, the file is corrupt."
+            )
+        count = values[expected]
+        left = values.size - expected - 1
+        if not (0 <= count <= left and count == np.floor(count)):
+            return GoniometerError(
+                f"{where}: the count {count:g} of the '{p.name}' list in this "
+                f"'{element.name}' line is not a whole number from 0 to the {left} values "
+                "after it on the line; the file is corrupt."
+            )
+        expected += 1 + int(count)
+        parts.append(f"{p.name}: 1 + {int(count)}")
+    return GoniometerError(
+        f"{where}: this '{element.name}' line has {values.size} values, but the header's "
+        f"properties make it {expected} ({', '.join(parts)}). The line has a value too many "
+        "or too few, so the file is corrupt; re-export it."
+    )
+
+
+def _ascii_cast(values, dtype, element, line_of, path) -> np.ndarray:
+    """ASCII numbers stored as the declared type (so an ASCII file reads like its binary twin);
+    ``line_of(k)`` is the line number of value ``k``, for the message."""
     if dtype.kind in "iu" and values.size:
         info = np.iinfo(dtype)
-        if (values != np.floor(values)).any() or values.min() < info.min or values.max() > info.max:
+        bad = (values != np.floor(values)) | (values < info.min) | (values > info.max)
+        if bad.any():
+            k = int(np.argmax(bad))
             raise GoniometerError(
-                f"'{path}': a value in the '{element.name}' element is not a valid {dtype.name} "
-                "integer; the file is corrupt."
+                f"'{path}', line {line_of(k)}: the value {values[k]:g} in the "
+                f"'{element.name}' element is not a valid {dtype.name} integer; the file is "
+                "corrupt."
             )
     return values.astype(dtype)
 
 
 # -------------------------------------------------------------------------------------------- OBJ
-
-_WHITESPACE = np.zeros(256, dtype=bool)
-_WHITESPACE[[9, 10, 11, 12, 13, 32]] = True
-_SPACE = np.uint8(32)
-_SLASH = np.uint8(ord("/"))
-_MINUS = np.uint8(ord("-"))
 
 
 class _Text:
@@ -708,7 +857,7 @@ class _Text:
     def __init__(self, data: bytes, path: Path):
         self.path = path
         self.buffer = np.frombuffer(data + b"\n", np.uint8)
-        self.blank = _WHITESPACE[self.buffer]
+        self.blank = _blank(self.buffer)
         self.ends = np.flatnonzero(self.buffer == 10)  # each line's newline
         starts = np.concatenate([[0], self.ends[:-1] + 1])
         first = starts.copy()
@@ -751,6 +900,11 @@ class _Text:
         (the last segment runs to the end)."""
         at = np.searchsorted(positions, begin)
         return np.diff(at, append=positions.size).astype(np.int64)
+
+    def word_counts(self, lines: np.ndarray) -> np.ndarray:
+        """How many words each of the given lines holds."""
+        mask, begin = self.body(lines, 0)
+        return self.per_segment(np.flatnonzero(self.word_starts(mask, self.blank)), begin)
 
     def floats(self, lines: np.ndarray, skip: int, what: str) -> tuple[np.ndarray, np.ndarray]:
         """All numbers after the first ``skip`` bytes of the given lines, as float64, and how
@@ -804,6 +958,19 @@ class _Text:
         n_parts = self.per_segment(part_starts, corners)
         n_slashes = self.per_segment(np.flatnonzero(slash), corners)
         first_part = np.cumsum(n_parts) - n_parts
+        # A corner ends in a slash when the byte after its last part is one (1/, 1//, 1/2/).
+        bad = n_slashes > 2
+        if corners.size:
+            bad |= self.buffer[part_stops[first_part + n_parts - 1]] == _SLASH
+        if bad.any():
+            k = int(np.argmax(bad))
+            line = int(lines[np.searchsorted(begin, corners[k], side="right") - 1]) + 1
+            corner = self.buffer[corners[k] : self.ends[line - 1]].tobytes().split()[0]
+            raise GoniometerError(
+                f"'{self.path}', line {line}: the face corner "
+                f"{corner[:40].decode('utf-8', 'replace')!r} is not one of i, i/t, i//n or "
+                "i/t/n; the file is corrupt."
+            )
         vertex = parts[first_part]
         normal = None
         if corners.size and (n_slashes == 2).all() and (n_parts >= 2).all():
@@ -840,11 +1007,12 @@ def _parse_integers(buffer: np.ndarray, starts: np.ndarray, stops: np.ndarray):
 def read_obj(path: str | os.PathLike) -> MeshData:
     """Read a Wavefront OBJ file.
 
-    ``v`` lines give the points (columns after the third, e.g. colours, are ignored), ``f`` lines
-    the faces with corners in any of the forms ``i``, ``i/t``, ``i//n``, ``i/t/n``, negative
-    (relative) indices allowed; polygons are fan-triangulated. ``vn`` normals are returned only if
-    they map one-to-one to the vertices (as many as vertices, and every face corner's normal
-    index equals its vertex index). Comments and all other statements are ignored.
+    ``v`` lines give the points: ``x y z``, optionally followed by ``w`` or by colours ``r g b``
+    (both ignored). ``f`` lines give the faces with corners in any of the forms ``i``, ``i/t``,
+    ``i//n``, ``i/t/n``, negative (relative) indices allowed; polygons are fan-triangulated.
+    ``vn`` normals are returned only if they map one-to-one to the vertices (as many as
+    vertices, and every face corner's normal index equals its vertex index). Comments and all
+    other statements are ignored.
 
     Parameters
     ----------
@@ -858,16 +1026,23 @@ def read_obj(path: str | os.PathLike) -> MeshData:
     Raises
     ------
     GoniometerError
-        For a missing, unreadable or malformed file (see :func:`read_mesh`).
+        For a missing, unreadable or malformed file (see :func:`read_mesh`); a line with the
+        wrong count of numbers, a malformed corner or a face index 0 or out of range is named
+        with its line number.
     """
     path = _as_path(path)
     text = _Text(_read_bytes(path), path)
     v_lines = text.keyword(b"v")
     values, counts = text.floats(v_lines, 1, "'v'")
-    if v_lines.size and counts.min() < 3:
-        bad = v_lines[np.argmax(counts < 3)]
+    # x y z, then w (the official format) or r g b (the colour extension that MeshLab, Blender
+    # and others write and read); any other count is a value too many or too few.
+    bad = (counts != 3) & (counts != 4) & (counts != 6)
+    if bad.any():
+        k = int(np.argmax(bad))
         raise GoniometerError(
-            f"'{path}', line {bad + 1}: a 'v' line needs three coordinates x y z."
+            f"'{path}', line {v_lines[k] + 1}: a 'v' line needs three coordinates x y z, "
+            f"optionally followed by w or by r g b (3, 4 or 6 numbers); this one has "
+            f"{counts[k]} numbers. The file is corrupt; re-export it."
         )
     points = values[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
 
@@ -878,14 +1053,29 @@ def read_obj(path: str | os.PathLike) -> MeshData:
         corners = _obj_indices(
             vertex_refs, counts, np.searchsorted(v_lines, f_lines), f_lines, path, "vertex"
         )
+        bad = (corners < 0) | (corners >= v_lines.size)
+        if bad.any():
+            k = int(np.argmax(bad))
+            line = f_lines[np.searchsorted(np.cumsum(counts), k, side="right")] + 1
+            raise GoniometerError(
+                f"'{path}', line {line}: face index out of range: the face refers to vertex "
+                f"{vertex_refs[k]} (as written; OBJ counts from 1, or back from -1 for the last "
+                f"vertex defined so far), but the file has {v_lines.size} vertices. The file is "
+                "corrupt or was written incorrectly; re-export it."
+            )
         triangles = _fan(corners, counts)
 
     normals = None
     vn_lines = text.keyword(b"vn")
     if vn_lines.size and vn_lines.size == v_lines.size:
         values, ncounts = text.floats(vn_lines, 2, "'vn'")
-        if ncounts.min() >= 3:
-            normals = values[(np.cumsum(ncounts) - ncounts)[:, None] + np.arange(3)]
+        if (ncounts != 3).any():
+            k = int(np.argmax(ncounts != 3))
+            raise GoniometerError(
+                f"'{path}', line {vn_lines[k] + 1}: a 'vn' line needs three numbers "
+                f"x y z; this one has {ncounts[k]}. The file is corrupt; re-export it."
+            )
+        normals = values.reshape(-1, 3)
         if corners is not None:
             if normal_refs is None or (normal_refs == 0).any():
                 normals = None
@@ -917,8 +1107,12 @@ def read_stl(path: str | os.PathLike) -> MeshData:
     """Read a binary or ASCII STL file and merge identical vertices into an indexed mesh.
 
     Binary and ASCII are told apart by the binary size rule (84 + 50 bytes per triangle), so a
-    binary file whose header starts with ``solid`` is still read as binary. Corners with exactly
-    identical coordinates become one vertex, numbered in order of first appearance.
+    binary file whose header starts with ``solid`` is still read as binary. A binary file must
+    hold exactly the triangles its header declares; up to 49 bytes after the last one (less than
+    a triangle, which some writers add) are ignored. An ASCII file is read line by line: each
+    ``facet normal`` line has three numbers and is followed by exactly three ``vertex`` lines of
+    three numbers each. Corners with exactly identical coordinates become one vertex, numbered in
+    order of first appearance.
 
     Parameters
     ----------
@@ -933,43 +1127,43 @@ def read_stl(path: str | os.PathLike) -> MeshData:
     Raises
     ------
     GoniometerError
-        For a missing, unreadable, truncated or malformed file (see :func:`read_mesh`).
+        For a missing, unreadable, truncated or malformed file (see :func:`read_mesh`): a binary
+        file whose size does not match its header's triangle count (both counts are named), an
+        ASCII line with the wrong count of numbers or a facet without exactly three vertices
+        (named with its line number).
     """
     path = _as_path(path)
     data = _read_bytes(path)
     declared = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
     expected = 84 + _STL_RECORD.itemsize * declared
+    implied, extra = divmod(len(data) - 84, _STL_RECORD.itemsize)
     looks_ascii = data[:1024].lstrip()[:5].lower() == b"solid" and b"\0" not in data[:4096]
-    if declared >= 0 and (len(data) == expected or (len(data) > expected and not looks_ascii)):
+    if declared >= 0 and (len(data) == expected or (implied == declared and not looks_ascii)):
         records = np.frombuffer(data, _STL_RECORD, declared, 84)
         corners = records["corners"].reshape(-1, 3)
         source_dtype = "float32"
     elif looks_ascii:
-        text = _Text(data, path)
-        vertex_lines = text.keyword(b"vertex")
-        values, counts = text.floats(vertex_lines, 6, "'vertex'")
-        if vertex_lines.size and (counts != 3).any():
-            bad = vertex_lines[np.argmax(counts != 3)]
-            raise GoniometerError(
-                f"'{path}', line {bad + 1}: a 'vertex' line needs exactly three coordinates."
-            )
-        if vertex_lines.size % 3:
-            raise GoniometerError(
-                f"'{path}': the ASCII STL has {vertex_lines.size} vertex lines, not a multiple "
-                "of three; the file is truncated or corrupt."
-            )
-        if vertex_lines.size == 0 and declared >= 0:
+        corners = _stl_ascii_corners(data, path)
+        if corners.size == 0 and declared >= 0:
             raise GoniometerError(
                 f"'{path}' is neither a complete binary STL (its header declares {declared} "
-                f"triangles, {expected} bytes, the file has {len(data)}) nor an ASCII STL with "
-                "'vertex' lines. The file is truncated or corrupt; re-export it."
+                f"triangles, its size of {len(data)} bytes implies {implied}) nor an ASCII STL "
+                "with 'vertex' lines. The file is truncated or corrupt; re-export it."
             )
-        corners = values.reshape(-1, 3)
         source_dtype = "float64"
     elif declared >= 0:
+        size = f"{len(data)} bytes: 84 for the header and the count, then 50 per triangle"
+        size += f", and {extra} bytes more" if extra else ""
+        if len(data) < expected:
+            raise GoniometerError(
+                f"'{path}' is a truncated binary STL: its header declares {declared} triangles "
+                f"({expected} bytes), but the file's size implies {implied} ({size}). "
+                "Re-export or copy it again."
+            )
         raise GoniometerError(
-            f"'{path}' is a truncated binary STL: its header declares {declared} triangles "
-            f"({expected} bytes) but the file has {len(data)} bytes. Re-export or copy it again."
+            f"'{path}': the binary STL header declares {declared} triangles, but the file's "
+            f"size implies {implied} ({size}). The header's count is wrong or the file was "
+            "damaged; re-export it."
         )
     else:
         raise GoniometerError(
@@ -981,6 +1175,43 @@ def read_stl(path: str | os.PathLike) -> MeshData:
         return _finish(path, corners, None, None, source_dtype)
     points, triangles = _merge_exact(corners)
     return _finish(path, points, triangles, None, source_dtype)
+
+
+def _stl_ascii_corners(data: bytes, path: Path) -> np.ndarray:
+    """The ``(3 m, 3)`` corners of an ASCII STL, each facet line checked with its vertices."""
+    text = _Text(data, path)
+    facet_lines = text.keyword(b"facet")
+    vertex_lines = text.keyword(b"vertex")
+    # Facet normals are not used, so only their count is checked ("facet normal nx ny nz").
+    numbers = text.word_counts(facet_lines) - 2
+    if (numbers != 3).any():
+        k = int(np.argmax(numbers != 3))
+        raise GoniometerError(
+            f"'{path}', line {facet_lines[k] + 1}: a 'facet' line is 'facet normal nx ny nz'; "
+            f"this one has {max(numbers[k], 0)} numbers after 'facet normal'. The file is "
+            "corrupt; re-export it."
+        )
+    values, counts = text.floats(vertex_lines, 6, "'vertex'")
+    if (counts != 3).any():
+        k = int(np.argmax(counts != 3))
+        raise GoniometerError(
+            f"'{path}', line {vertex_lines[k] + 1}: a 'vertex' line needs exactly three "
+            f"coordinates; this one has {counts[k]} numbers. The file is corrupt; re-export it."
+        )
+    facet = np.searchsorted(facet_lines, vertex_lines)  # 1 + the facet each vertex line is in
+    if vertex_lines.size and facet[0] == 0:
+        raise GoniometerError(
+            f"'{path}', line {vertex_lines[0] + 1}: a 'vertex' line before any 'facet' line; "
+            "the file is corrupt."
+        )
+    per_facet = np.bincount(facet, minlength=facet_lines.size + 1)[1:]
+    if (per_facet != 3).any():
+        k = int(np.argmax(per_facet != 3))
+        raise GoniometerError(
+            f"'{path}', line {facet_lines[k] + 1}: this facet has {per_facet[k]} vertex lines, "
+            "not 3 (an STL facet is one triangle). The file is corrupt; re-export it."
+        )
+    return values.reshape(-1, 3)
 
 
 def _merge_exact(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
