@@ -12,6 +12,7 @@ from __future__ import annotations
 import signal
 import sys
 
+from ..vg_addon import GoniometerError
 from . import extension
 from .cli import UsageError, build_parser, check_args
 
@@ -38,8 +39,12 @@ def main(argv: list[str]) -> int:
             return run_demo(args)
         code, _ = run_batch(args)
         return code
-    except UsageError as error:
+    except (UsageError, GoniometerError) as error:
         print(f"vg_batch: error: {error}", file=sys.stderr, flush=True)
+        return 2
+    except OSError as error:  # a file or folder the run needs, gone or refused
+        where = f" ({error.filename})" if error.filename else ""
+        print(f"vg_batch: error: {error.strerror or error}{where}", file=sys.stderr, flush=True)
         return 2
     except KeyboardInterrupt:
         print("vg_batch: interrupted; the CSV holds what was measured so far", file=sys.stderr)

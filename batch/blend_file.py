@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import errno
+import os
 from pathlib import Path
 
 import bpy
@@ -9,6 +11,7 @@ import numpy as np
 
 from ..bridge import measuring, mesh_data
 from .measure import MeshResult
+from .pictures import disk_full
 from .stdio import quiet_stdout
 
 
@@ -44,10 +47,46 @@ def prepare_saved_file(objects) -> None:
 
 
 def save_blend(path: str, objects) -> None:
+    """Save the file with ``objects`` as a copy at ``path``: written beside it under another
+    name, read back, and only then moved over ``path`` in one step, so a failed save (a full
+    disk) keeps any earlier file and leaves no half-written one.
+
+    Raises
+    ------
+    OSError, RuntimeError
+        Why the file was not saved (a full disk as "No space left on device").
+    """
+    objects = [obj for obj in objects if obj is not None]
     prepare_saved_file(objects)
-    Path(path).resolve().parent.mkdir(parents=True, exist_ok=True)
-    with quiet_stdout():
-        bpy.ops.wm.save_as_mainfile(filepath=str(Path(path).resolve()), copy=True)
+    target = Path(path).resolve()
+    target.parent.mkdir(parents=True, exist_ok=True)
+    temporary = target.with_name(f".{target.stem}.saving.blend")
+    try:
+        with quiet_stdout():
+            bpy.ops.wm.save_as_mainfile(filepath=str(temporary), copy=True)
+        check_saved(temporary, [obj.name for obj in objects])
+        os.replace(temporary, target)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+
+
+def check_saved(path: Path, names) -> None:
+    """Raise OSError unless ``path`` is a .blend Blender can read, holding the objects
+    ``names``: Blender can report a save as done that a full disk cut short."""
+    try:
+        with bpy.data.libraries.load(str(path), link=False) as (source, _target):
+            found = set(source.objects)
+    except (OSError, RuntimeError, ValueError) as error:
+        found, why = None, str(error).strip()
+    else:
+        why = ""
+    if found is None or not set(names) <= found:
+        full = disk_full(path.parent)
+        raise OSError(
+            errno.ENOSPC if full else errno.EIO,
+            "No space left on device" if full else f"the saved file cannot be read back {why}",
+        )
 
 
 def forget(object_name: str) -> None:

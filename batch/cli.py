@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 from ..vg_addon import GoniometerError
 from ..vg_addon.method.sweep import sweep_radii
@@ -16,6 +17,11 @@ UNITS = {
     "um": ("METRIC", 1e-6, "MICROMETERS"),
     "in": ("IMPERIAL", 0.0254, "INCHES"),
 }
+
+# --render-size and --render-samples: a map's cost grows with pixels times samples, and Cycles
+# cannot be stopped inside a view, so both are bounded before anything is rendered.
+MAX_RENDER_SIDE = 8192
+MAX_RENDER_SAMPLES = 4096
 
 EPILOG = """\
 inputs:
@@ -256,14 +262,14 @@ def build_parser() -> argparse.ArgumentParser:
         type=int,
         default=[640, 480],
         metavar=("W", "H"),
-        help="resolution of each view in pixels, at least 16 (default 640 480)",
+        help="resolution of each view in pixels, 16 to 8192 (default 640 480)",
     )
     out.add_argument(
         "--render-samples",
         type=int,
         default=16,
         metavar="N",
-        help="Cycles samples per pixel (default 16)",
+        help="Cycles samples per pixel, 1 to 4096 (default 16)",
     )
     out.add_argument("--quiet", action="store_true", help="no progress lines (summary only)")
     scale = parser.add_argument_group("scaling")
@@ -293,6 +299,31 @@ def build_parser() -> argparse.ArgumentParser:
 
 class UsageError(Exception):
     """Bad arguments or input files: exit status 2."""
+
+
+def check_render_settings(size, samples: int) -> None:
+    """Refuse a map size or sample count outside the stated bounds, before anything renders."""
+    if not all(16 <= side <= MAX_RENDER_SIDE for side in size):
+        raise UsageError(
+            f"--render-size W H: each side must be 16 to {MAX_RENDER_SIDE:,} pixels (got "
+            f"{size[0]} {size[1]})."
+        )
+    if not 1 <= samples <= MAX_RENDER_SAMPLES:
+        raise UsageError(
+            f"--render-samples must be 1 to {MAX_RENDER_SAMPLES:,} (got {samples}); 16 to 64 "
+            "show the sides clearly."
+        )
+
+
+def check_edge_points(edges) -> None:
+    """Refuse an ``--edge`` or ``--via`` coordinate that is not a finite number."""
+    for number, edge in enumerate(edges, start=1):
+        points = [edge["start"], *edge["via"], edge["end"]]
+        if not all(math.isfinite(v) for point in points for v in point):
+            raise UsageError(
+                f"--edge {number}: every coordinate of its points must be a finite number (got "
+                f"{'; '.join(' '.join(f'{v:g}' for v in p) for p in points)})."
+            )
 
 
 def check_args(args) -> None:
@@ -333,8 +364,8 @@ def check_args(args) -> None:
         raise UsageError("--out CSV is required: the measurements CSV to write.")
     if args.jobs < 1:
         raise UsageError(f"--jobs must be 1 or more (got {args.jobs}).")
-    if min(args.render_size) < 16 or args.render_samples < 1:
-        raise UsageError("--render-size must be at least 16 16 and --render-samples positive.")
+    check_render_settings(args.render_size, args.render_samples)
+    check_edge_points(args.edge)
     if args.sweep:
         start, stop, count = args.sweep
         if count != int(count):

@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import itertools
+import math
+from pathlib import Path
+
 import bpy
 
 from ..bridge import edges, records
@@ -9,6 +15,7 @@ from ..properties import exact_numbers
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, profile_plot
+from ..vg_addon.method.edge_profile import check_station_count
 from .cli import UsageError
 
 
@@ -20,7 +27,8 @@ def edge_specs(args, sources) -> list[dict]:
     Raises
     ------
     UsageError
-        An unreadable edges CSV, a row without Points, Spacing or Radius, or naming no mesh given.
+        An unreadable edges CSV, a row without Points, Spacing or Radius, or naming no mesh
+        given; a spacing that would make more than ``edge_profile.MAX_STATIONS`` stations.
     """
     specs = [
         {
@@ -33,10 +41,15 @@ def edge_specs(args, sources) -> list[dict]:
         }
         for spec in args.edge
     ]
+    for number, spec in enumerate(specs, start=1):
+        try:
+            check_spacing(spec)
+        except GoniometerError as error:
+            raise UsageError(f"--edge {number} with --spacing {args.spacing:g}: {error}") from None
     if not args.edges_csv:
         return specs
     try:
-        rows = csvio.read_edges_csv(args.edges_csv)
+        rows = csvio.read_edges_csv(Path(args.edges_csv))
     except OSError as error:
         raise UsageError(f"{args.edges_csv}: {error.strerror or error}") from None
     except GoniometerError as error:
@@ -55,25 +68,41 @@ def edge_specs(args, sources) -> list[dict]:
         if name and not any(csvio.mesh_name_matches(name, s.names) for s in sources):
             problems.append(f"row {number}: no mesh given is named {name!r}")
             continue
-        specs.append(
-            {
-                "points": [list(p) for p in points],
-                "spacing": row.spacing,
-                "radius": row.radius,
-                "lam": args.lam if row.seg_param is None else row.seg_param,
-                "patch": row.patch or args.patch,
-                "mesh_name": name,
-                # Files of earlier versions hold world-space points (a mesh file's object is
-                # untransformed: the same numbers).
-                "space": "world" if row.coordinates == csvio.WORLD_COORDINATES else "mesh",
-            }
-        )
+        spec = {
+            "points": [list(p) for p in points],
+            "spacing": row.spacing,
+            "radius": row.radius,
+            "lam": args.lam if row.seg_param is None else row.seg_param,
+            "patch": row.patch or args.patch,
+            "mesh_name": name,
+            # Files of earlier versions hold world-space points (a mesh file's object is
+            # untransformed: the same numbers).
+            "space": "world" if row.coordinates == csvio.WORLD_COORDINATES else "mesh",
+        }
+        try:
+            check_spacing(spec)
+        except GoniometerError as error:
+            problems.append(f"row {number}: {error}")
+            continue
+        specs.append(spec)
     if problems:
         raise UsageError(
             f"{args.edges_csv}: {len(problems)} edge row(s) cannot be measured:\n"
             + bounded_list(problems, lines=True)
         )
     return specs
+
+
+def check_spacing(spec: dict) -> None:
+    """Refuse an edge whose spacing would make more stations than the core measures, before
+    any mesh is read: the traced path is at least as long as the straight lines through its
+    points, so their length already bounds the count from below."""
+    spacing = spec["spacing"]
+    if not (isinstance(spacing, float | int) and math.isfinite(spacing) and spacing > 0):
+        return  # refused with its own message when measured
+    points = spec["points"]
+    length = sum(math.dist(a, b) for a, b in itertools.pairwise(points))
+    check_station_count(length, spacing)
 
 
 def spec_applies(spec: dict, source) -> bool:
@@ -99,18 +128,23 @@ def failed_edge_row(number: int, spec: dict, mesh_name: str, message: str, units
     )
 
 
-def measure_edges(obj, source, options: dict, units: str, safe_name: str):
-    """Measure the run's edges that apply to ``source`` on its object ``obj``, record each as one
-    break of stations, and write each profile's plot beside the output CSV.
+def measure_edges(obj, source, options: dict, units: str, safe_name: str, surface, precision):
+    """Measure the run's edges that apply to ``source`` on its object ``obj`` (on ``surface``,
+    the surface the points are measured on: the file's float64 coordinates where Blender's
+    float32 copy would round them), and record each as one break of stations.
 
     Returns
     -------
     station_rows : list of csvio.MeasurementRow
-        Every edge's stations in order, or one error row for an edge that failed.
+        Every edge's stations in order, or one error row for an edge that failed; rows name the
+        mesh as the user gave it (``source.name``).
     edge_rows : list of csvio.EdgeRow
         One summary per measured edge.
+    plots : list of (what, path, png bytes function)
+        Each profile's plot, to draw beside the output CSV once the rows are written.
     """
-    station_rows, edge_rows = [], []
+    station_rows, edge_rows, plots = [], [], []
+    name = source.name
     for spec in options["edges"]:
         if not spec_applies(spec, source):
             continue
@@ -124,19 +158,30 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str):
                 spec["lam"],
                 spec["patch"],
                 space=spec.get("space", "mesh"),
+                surface=surface,
             )
         except GoniometerError as error:
             obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
-            station_rows.append(failed_edge_row(number, spec, obj.name, str(error), units))
+            station_rows.append(failed_edge_row(number, spec, name, str(error), units))
             continue
         station_rows.extend(
-            records.to_row(obj, item, stale=False, units=units)
+            dataclasses.replace(
+                records.to_row(obj, item, stale=False, units=units, precision=precision),
+                mesh_name=name,
+            )
             for item in obj.vg.measurements
             if item.edge_number == edge.number
         )
-        edge_rows.append(records.edge_row(obj, edge, units=units))
+        edge_rows.append(
+            dataclasses.replace(records.edge_row(obj, edge, units=units), mesh_name=name)
+        )
         numbers = exact_numbers(edge)
-        image = profile_plot.render_profile(numbers["arc_lengths"], numbers["angles"])
         path = f"{options['plots']}_{safe_name}_edge{edge.number}.png"
-        profile_plot.write_png(path, image, overwrite=True)
-    return station_rows, edge_rows
+        data = functools.partial(profile_png, numbers["arc_lengths"], numbers["angles"])
+        plots.append(("profile plot", path, data))
+    return station_rows, edge_rows, plots
+
+
+def profile_png(arc_lengths, angles) -> bytes:
+    """One edge profile's plot (angle against arc length) as PNG bytes."""
+    return profile_plot.png_bytes(profile_plot.render_profile(arc_lengths, angles))

@@ -14,9 +14,11 @@ from ..bridge import colors, measuring, mesh_data, records
 from ..bridge.measurement_map import safe_file_name
 from ..vg_addon import GoniometerError, Surface
 from ..vg_addon.formats import csvio, sweep_plot
+from ..vg_addon.formats.png import encode_png
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
 from .edges import failed_edge_row, measure_edges, spec_applies
+from .pictures import reason, try_picture
 from .render import add_sides_material, render_map
 from .sources import MeshSource, import_mesh
 
@@ -40,7 +42,7 @@ class MeshResult:
     prepare_seconds: float = 0.0
     measure_seconds: float = 0.0
     render: str = ""
-    render_error: str = ""
+    picture_errors: list = dataclasses.field(default_factory=list)  # pictures not written
     blend: str = ""  # a worker's one-object .blend, for --save-blend
     winding: str = ""  # see vg_addon.method.winding.WINDINGS
     sweep_rows: list = dataclasses.field(default_factory=list)  # [(task index, [cells])]
@@ -81,9 +83,16 @@ def error_row(task, mesh_name: str, message: str, units: str):
     )
 
 
-def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
-    """Load (or find) one mesh, measure its tasks, record them on the object, colour it and
-    optionally render it. Never raises for a problem of this mesh: it becomes the rows' error.
+def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, rows_ready=None):
+    """Load (or find) one mesh, measure its tasks, record them on the object, colour it, then
+    draw its pictures (map, sweep and profile plots). Never raises for a problem of this mesh:
+    it becomes the rows' error; a picture that cannot be written is one of
+    ``result.picture_errors``, never a row's.
+
+    ``rows_ready(result)`` is called once, when every row is known and before any picture is
+    drawn: the caller writes the rows then, so a run stopped while drawing keeps them. Rows
+    name the mesh as the user gave it (``source.name``: a mesh file's stem), whatever name
+    Blender gave its object.
 
     The numbers come from the extension's own pipeline: the object's evaluated mesh in its own
     coordinates (``mesh_data.evaluated_geometry``), its cached ``Surface``
@@ -95,9 +104,9 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
     """
     result = MeshResult(mesh=index)
     units = records.units_label(bpy.context.scene)
+    name = source.name
 
     def fail_all(message: str) -> MeshResult:
-        name = result.object_name or source.name
         result.rows = [(t.index, error_row(t, name, message, units)) for t in tasks]
         result.failed = len(tasks)
         applying = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
@@ -105,6 +114,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
             failed_edge_row(number, spec, name, message, units)
             for number, spec in enumerate(applying, start=1)
         ]
+        if rows_ready is not None:
+            rows_ready(result)
         return result
 
     start = time.perf_counter()
@@ -155,7 +166,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
                 last_report = now
         for task, m in zip(block, measured, strict=True):
             if isinstance(m, GoniometerError):
-                result.rows.append((task.index, error_row(task, obj.name, str(m), units)))
+                result.rows.append((task.index, error_row(task, name, str(m), units)))
                 result.failed += 1
                 continue
             data.next_number = base + task.number
@@ -163,12 +174,14 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
                 obj, m, geometry.fingerprint, note=task.label, break_number=task.break_number
             )
             row = records.to_row(obj, item, stale=False, units=units, precision=precision)
-            result.rows.append((task.index, row))
+            result.rows.append((task.index, dataclasses.replace(row, mesh_name=name)))
             measuring.keep_sides(obj, geometry, item, m)
             result.measured += 1
     result.measure_seconds = time.perf_counter() - start
+    stem = picture_stem(index, source, options)
+    sweep_plots = []
     if options.get("sweep"):
-        sweep_sites(result, surface, obj.name, tasks, options, geometry.matrix)
+        sweep_plots = sweep_sites(result, surface, name, stem, tasks, options, geometry.matrix)
     if len(data.measurements):
         data.next_number = max(item.number for item in data.measurements) + 1
         records.continue_after_recorded_breaks(obj)
@@ -178,17 +191,37 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None):
         add_sides_material(obj, colors.ATTRIBUTE_NAME)
         colors.show_sides_once(obj)
 
+    profile_plots = []
     if options.get("edges"):
-        result.station_rows, result.edge_rows = measure_edges(
-            obj, source, options, units, safe_file_name(obj.name)
+        result.station_rows, result.edge_rows, profile_plots = measure_edges(
+            obj, source, options, units, stem, surface, precision
         )
 
-    if options.get("render"):
-        try:
-            result.render = str(render_map(obj, Path(options["render"]), options))
-        except Exception as error:  # a render problem must not lose the measurements
-            result.render_error = f"{type(error).__name__}: {error}"
+    if rows_ready is not None:
+        rows_ready(result)  # the rows are written before any picture is drawn
+    draw_pictures(result, obj, options, stem, sweep_plots + profile_plots, name)
     return result
+
+
+def picture_stem(index: int, source: MeshSource, options) -> str:
+    """The file-name stem of this mesh's pictures, unique within the run."""
+    stems = options.get("picture_names") or []
+    return stems[index] if index < len(stems) else safe_file_name(source.name)
+
+
+def draw_pictures(result: MeshResult, obj, options, stem: str, plots, name: str) -> None:
+    """Write the mesh ``name``'s plots (``(what, path, png bytes function)``) and its map; each
+    failure is one line of ``result.picture_errors``, never a lost row."""
+    inputs = options.get("inputs", ())
+    for what, path, data in plots:
+        written = try_picture(result.picture_errors, what, path, data, inputs)
+        result.sweep_plots += written and what == "sweep plot"
+    if options.get("render"):
+        folder = Path(options["render"])
+        try:
+            result.render = str(render_map(obj, folder, options, stem))
+        except Exception as error:  # a render problem must not lose the measurements
+            result.picture_errors.append(f"render of {name}: {reason(error, folder)}")
 
 
 def _measure_task(surface, geometry, task, options):
@@ -209,11 +242,13 @@ def _measure_task(surface, geometry, task, options):
         return error
 
 
-def sweep_sites(result: MeshResult, surface, name: str, tasks, options, matrix) -> None:
-    """``--sweep``: each task's site at the sweep's radii, as CSV cells and a plot per site.
-    ``matrix`` is the object's ``matrix_world`` (for world-space rows of older exports)."""
+def sweep_sites(result: MeshResult, surface, name: str, stem: str, tasks, options, matrix):
+    """``--sweep``: each task's site at the sweep's radii, as CSV cells, and the plot of each
+    site to draw (``(what, path, png bytes function)``). ``matrix`` is the object's
+    ``matrix_world`` (for world-space rows of older exports)."""
     start, stop, count = options["sweep"]
     folder = Path(options["sweep_plots"])
+    plots = []
     for task in tasks:
         try:
             center = task.center
@@ -227,12 +262,16 @@ def sweep_sites(result: MeshResult, surface, name: str, tasks, options, matrix) 
                 SweepPoint(float(r), None, str(error)) for r in sweep_radii(start, stop, count)
             ]
         else:
-            path = folder / f"{safe_file_name(name)}_{task.number}.png"
-            sweep_plot.write_sweep_png(path, points)
-            result.sweep_plots += 1
+            path = folder / f"{stem}_{task.number}.png"
+            plots.append(("sweep plot", path, _sweep_png(points)))
         result.sweep_rows.extend(
             (task.index, csvio.sweep_cells(name, task.number, point)) for point in points
         )
+    return plots
+
+
+def _sweep_png(points):
+    return lambda: encode_png(sweep_plot.sweep_image(points))
 
 
 def exact_surface(source: MeshSource, points: np.ndarray, geometry) -> Surface:
@@ -265,18 +304,31 @@ def set_units(scene, unit: str | None) -> None:
         settings.length_unit = length
 
 
-def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress):
+def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, rows_ready=None):
     """:func:`measure_mesh`, with an unexpected error (a bug) turned into failed rows for this
-    mesh only, its traceback on stderr, so the other meshes are still measured."""
+    mesh only, its traceback on stderr, so the other meshes are still measured. An error after
+    the rows were handed to ``rows_ready`` costs only the pictures. ``rows_ready`` is called
+    exactly once either way."""
+    sent = []
+
+    def ready(result):
+        sent.append(result)
+        if rows_ready is not None:
+            rows_ready(result)
+
     try:
-        return measure_mesh(index, source, tasks, options, progress)
+        return measure_mesh(index, source, tasks, options, progress, ready)
     except Exception as error:
         traceback.print_exc()
         message = (
             f"internal error while measuring this mesh ({type(error).__name__}: {error}); "
             "please report it with the traceback printed on stderr"
         )
+        if sent:  # the rows are out: only the pictures are lost
+            sent[0].picture_errors.append(f"pictures of {source.name}: {message}")
+            return sent[0]
         units = records.units_label(bpy.context.scene)
         result = MeshResult(mesh=index, failed=len(tasks))
         result.rows = [(t.index, error_row(t, source.name, message, units)) for t in tasks]
+        ready(result)
         return result

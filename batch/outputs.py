@@ -23,7 +23,7 @@ def _same_file(a: str, b: str) -> bool:
 
 def input_files(args) -> list[tuple[str, str]]:
     """``(what, path)`` of every file the run reads: mesh files (also those in given folders),
-    the .blend and the points CSV."""
+    the .blend, the points CSV and the edges CSV."""
     found = []
     meshes = [p for p in args.inputs if not p.lower().endswith(".blend")]
     blends = [p for p in args.inputs if p.lower().endswith(".blend")]
@@ -37,7 +37,25 @@ def input_files(args) -> list[tuple[str, str]]:
         found.append(("input .blend", bpy.data.filepath))
     if args.points:
         found.append(("points CSV", args.points))
+    if getattr(args, "edges_csv", None):
+        found.append(("edges CSV", args.edges_csv))
     return found
+
+
+def input_of(path, inputs) -> str:
+    """The input ``path`` would overwrite (``"what path"``), or "" when it is none of
+    ``inputs`` (``(what, path)`` pairs, see :func:`input_files`)."""
+    for what, source in inputs:
+        if _same_file(os.fspath(path), source):
+            return f"the {what} {source}"
+    return ""
+
+
+def refuse_input(path, inputs) -> None:
+    """Raise :class:`GoniometerError` when writing ``path`` would overwrite an input: checked for
+    every picture just before it is written (their names depend on the meshes)."""
+    if victim := input_of(path, inputs):
+        raise GoniometerError(f"{path} is {victim}: it is not overwritten.")
 
 
 def _writable_folder(folder: Path, option: str, given: str) -> None:
@@ -56,6 +74,15 @@ def _writable_folder(folder: Path, option: str, given: str) -> None:
         )
 
 
+def _kind(out: str) -> str:
+    """How ``--out`` is written (see ``csvio.output_target``); a place that cannot be written
+    (a folder, a read-only file, ...) is refused naming the option."""
+    try:
+        return csvio.output_target(out)
+    except GoniometerError as error:
+        raise UsageError(f"--out {out}: {error}") from None
+
+
 def sweep_paths(out) -> tuple[Path, Path]:
     """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``."""
     out = Path(out).resolve()
@@ -72,10 +99,14 @@ def check_outputs(args) -> None:
     """
     outputs = [("--out", args.out), ("--save-blend", args.save_blend)]
     outputs = [(option, path) for option, path in outputs if path and path != csvio.STDOUT]
+    if (
+        args.out
+        and args.out != csvio.STDOUT
+        and (getattr(args, "edge", None) or getattr(args, "edges_csv", None))
+    ):
+        outputs.append(("--out's edge summary", str(csvio.edges_path_for(args.out))))
     if args.sweep:
-        if args.out == csvio.STDOUT or (
-            os.path.exists(args.out) and csvio.output_target(args.out) == "stream"
-        ):
+        if args.out == csvio.STDOUT or (os.path.exists(args.out) and _kind(args.out) == "stream"):
             raise UsageError(
                 f"--sweep writes <out>_sweep.csv and a plot folder beside --out, so --out "
                 f"{args.out} must be a file name, not standard output or a stream."
@@ -86,12 +117,11 @@ def check_outputs(args) -> None:
             raise UsageError(f"--sweep: {plots} (its plot folder) is a file; move it away.")
     inputs = input_files(args)
     for option, path in outputs:
-        for what, source in inputs:
-            if _same_file(path, source):
-                raise UsageError(
-                    f"{option} {path} is the {what} {source}: writing there would destroy an "
-                    "input. Choose another file name; nothing was read or written."
-                )
+        if victim := input_of(path, inputs):
+            raise UsageError(
+                f"{option} {path} is {victim}: writing there would destroy an input. Choose "
+                "another file name; nothing was read or written."
+            )
     for at, (option, path) in enumerate(outputs):
         for other, other_path in outputs[at + 1 :]:
             if _same_file(path, other_path):
@@ -100,11 +130,7 @@ def check_outputs(args) -> None:
                 )
     if args.out and args.out != csvio.STDOUT:
         if os.path.exists(args.out):
-            try:
-                kind = csvio.output_target(args.out)
-            except GoniometerError as error:
-                raise UsageError(f"--out {args.out}: {error}") from None
-            if kind == "file":
+            if _kind(args.out) == "file":
                 _writable_folder(Path(args.out).resolve().parent, "--out", args.out)
         else:
             _writable_folder(Path(args.out).resolve().parent, "--out", args.out)

@@ -9,6 +9,8 @@ from pathlib import Path
 import bpy
 
 from ..bridge import measurement_map
+from ..vg_addon import GoniometerError
+from .outputs import refuse_input
 from .stdio import quiet_stdout
 
 
@@ -31,15 +33,51 @@ def add_sides_material(obj, attribute: str):
     return material
 
 
-def render_map(obj, directory: Path, options: dict) -> Path:
+class NamedMap(measurement_map.MapJob):
+    """The extension's measurement map with the batch's file names: ``stem`` unique within the
+    run (see ``pictures.picture_names``) and never an input's path."""
+
+    def __init__(self, obj, directory, *, stem: str, inputs, **settings):
+        self.stem, self.inputs = stem, inputs
+        super().__init__(obj, directory, **settings)
+
+    def picture_path(self, view_name: str) -> Path:
+        view = measurement_map.safe_file_name(view_name)
+        path = self.directory / f"{self.stem}_map_{view}.png"
+        refuse_input(path, self.inputs)
+        return path
+
+    def finish(self) -> Path:
+        if not self.done:
+            raise GoniometerError("The map is not complete: render every view first.")
+        sheet = self.directory / f"{self.stem}_map.png"
+        refuse_input(sheet, self.inputs)
+        self.sheet = sheet
+        columns = 3 if len(self.written) > 2 else 2
+        measurement_map.write_contact_sheet(self.written, sheet, columns=columns)
+        return sheet
+
+
+def render_map(obj, directory: Path, options: dict, stem: str) -> Path:
     """Render the measurement map of ``obj`` into ``directory`` (the extension's own,
-    ``bridge.measurement_map``: the views' PNGs and a contact sheet); returns the sheet."""
+    ``bridge.measurement_map``: the views' PNGs and a contact sheet named after ``stem``);
+    returns the sheet. A map that fails leaves none of its pictures."""
     with quiet_stdout():
-        _views, sheet = measurement_map.render_map(
+        job = NamedMap(
             obj,
             directory,
+            stem=stem,
+            inputs=options.get("inputs", ()),
             views=options.get("render_views", "SIX"),
             size=tuple(options.get("render_size", (640, 480))),
             samples=options.get("render_samples", 16),
         )
-    return sheet
+        try:
+            while not job.done:
+                job.render_next()
+            return job.finish()
+        except BaseException:
+            job.abort()
+            raise
+        finally:
+            job.close()

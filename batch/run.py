@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import os
 import shutil
 import tempfile
 import threading
@@ -22,7 +23,8 @@ from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
 from .edges import edge_specs, spec_applies
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
-from .outputs import check_outputs, make_folders, sweep_paths
+from .outputs import check_outputs, input_files, make_folders, sweep_paths
+from .pictures import picture_names, reason
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
 from .workers import run_workers
@@ -52,6 +54,7 @@ class Run:
         # meshes finish, so a run that is stopped keeps what it measured.
         self.stream = csvio.output_target(args.out) == "stream"
         self.failed_outputs: list[str] = []  # .blend or pictures that could not be written
+        self.write_error = ""  # why the last write of the CSV failed ("" if it did not)
         for task in tasks:
             if task.mesh < 0:
                 self.rows[task.index] = error_row(task, task.mesh_name, task.error, self.units)
@@ -76,29 +79,37 @@ class Run:
                 f"{self.done_points:,}/{len(self.tasks):,} points, {failed:,} failed"
             )
 
-    def add(self, result: MeshResult) -> None:
+    def add(self, result: MeshResult, force_write: bool = False) -> None:
+        """Take a mesh's rows (before its pictures are drawn). A row that cannot be written
+        costs only its own cells (``csvio.writable_row``); the CSV is rewritten now and then
+        (always with ``force_write``: pictures follow), so a run that is stopped keeps them."""
         with self.lock:
             self.in_flight.pop(result.mesh, None)
             self.results.append(result)
             for index, row in result.rows:
-                self.rows[index] = row
+                self.rows[index] = csvio.writable_row(row)
             self.sweep_rows.extend(result.sweep_rows)
-            self.station_rows.extend(result.station_rows)
-            self.edge_rows.extend(result.edge_rows)
+            self.station_rows.extend(csvio.writable_row(row) for row in result.station_rows)
+            self.edge_rows.extend(csvio.writable_row(row) for row in result.edge_rows)
             if result.bad_file:
                 self.bad_files.append(result.bad_file)
-            if result.render_error:
-                name = self.sources[result.mesh].name
-                self.failed_outputs.append(f"render of {name}: {result.render_error}")
-            # Rewrite the CSV now and then (each write costs more as rows accumulate), so a run
-            # that is killed keeps what it measured; finish() always writes.
-            if not self.stream and (
-                time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds)
-            ):
-                self.write_csv()
+            # Each write costs more as rows accumulate; finish() always writes.
+            due = time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds)
+            if not self.stream and (due or force_write):
+                self.try_write_csv()
+
+    def pictures_done(self, result: MeshResult) -> None:
+        """Take a mesh's pictures (after :meth:`add`): note those that failed, report the
+        mesh."""
+        with self.lock:
+            for at, earlier in enumerate(self.results):
+                if earlier.mesh == result.mesh:
+                    self.results[at] = result  # a worker's final result: the same rows
+            self.failed_outputs.extend(result.picture_errors)
         source = self.sources[result.mesh]
         rate = result.measured / result.measure_seconds if result.measure_seconds > 0 else 0
-        note = f", render failed: {result.render_error}" if result.render_error else ""
+        failed = len(result.picture_errors)
+        note = f", {failed} picture(s) not written" if failed else ""
         if not self.args.quiet:
             self.say(
                 f"{source.name}: {result.measured:,} measured, {result.failed:,} failed"
@@ -110,14 +121,65 @@ class Run:
         if message := winding_message(result.object_name or source.name, result.winding):
             self.say(f"note: {message}")  # once per mesh, also with --quiet
 
-    def write_csv(self) -> None:
+    def try_write_csv(self) -> None:
+        """:meth:`write_csv` during the run: a failure (the folder gone, a full disk) is said
+        once and the run goes on; the CSV is written again at the end."""
+        try:
+            self.write_csv()
+        except (OSError, GoniometerError) as error:
+            if not self.write_error:
+                self.say(
+                    f"could not write the CSV to {self.args.out}: {reason(error)}; measuring "
+                    "goes on, and the CSV is written again at the end"
+                )
+            self.write_error = reason(error)
+            self.last_write = time.perf_counter()
+        else:
+            self.write_error = ""
+
+    def recover_csv(self, error) -> None:
+        """The CSV could not be written at the end: write the rows into the temporary folder
+        instead and say where, so nothing measured is lost."""
+        stem = Path(self.args.out).stem if self.args.out != csvio.STDOUT else "out"
+        handle, path = tempfile.mkstemp(prefix=f"vg_batch_{stem}_", suffix=".csv")
+        os.close(handle)
+        where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+        try:
+            self.write_csv(path)
+        except (OSError, GoniometerError) as second:
+            Path(path).unlink(missing_ok=True)
+            self.say(
+                f"could not write the CSV to {where}: {reason(error)}; nor to {path}: "
+                f"{reason(second)}. The rows are lost."
+            )
+            return
+        self.say(
+            f"could not write the CSV to {where}: {reason(error)}; the rows are in {path} "
+            "(move it where it belongs)"
+        )
+
+    def write_csv(self, out=None) -> None:
+        """Write the rows to ``out`` (default ``--out``), and the edge summaries beside it."""
+        out = self.args.out if out is None else out
         start = time.perf_counter()
         rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
-        csvio.write_measurements_csv(self.args.out, rows)
+        csvio.write_measurements_csv(out, rows)
         if self.args.edge or self.args.edges_csv:
-            csvio.write_edges_csv(csvio.edges_path_for(self.args.out), self.edge_rows)
+            csvio.write_edges_csv(csvio.edges_path_for(out), self.edge_rows)
         self.last_write = time.perf_counter()
         self.write_seconds = self.last_write - start
+
+    def write_sweep_csv(self) -> None:
+        """Write ``<out>_sweep.csv``; a failure is a failed output (exit 2), the rows kept."""
+        csv_path, plots = sweep_paths(self.args.out)
+        rows = [cells for _, cells in sorted(self.sweep_rows, key=lambda pair: pair[0])]
+        try:
+            csvio.replace_atomically(str(csv_path), csvio.format_sweep_rows(rows).encode("utf-8"))
+        except (OSError, GoniometerError) as error:
+            self.failed_outputs.append(f"sweep CSV {csv_path}: {reason(error, csv_path.parent)}")
+            return
+        drawn = sum(r.sweep_plots for r in self.results)
+        self.say(f"wrote {csv_path} ({len(rows):,} sweep rows) and {drawn} plot(s) in {plots}")
 
     def finish(self) -> int:
         missing = [t for t in self.tasks if t.index not in self.rows]
@@ -129,15 +191,10 @@ class Run:
         try:
             self.write_csv()
         except (OSError, GoniometerError) as error:
-            where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
-            self.say(f"could not write the CSV to {where}: {error}")
+            self.recover_csv(error)
             return 2
         if self.args.sweep:
-            csv_path, plots = sweep_paths(self.args.out)
-            rows = [cells for _, cells in sorted(self.sweep_rows, key=lambda pair: pair[0])]
-            csvio.replace_atomically(str(csv_path), csvio.format_sweep_rows(rows).encode("utf-8"))
-            drawn = sum(r.sweep_plots for r in self.results)
-            self.say(f"wrote {csv_path} ({len(rows):,} sweep rows) and {drawn} plot(s) in {plots}")
+            self.write_sweep_csv()
         failed = [(i, row) for i, row in sorted(self.rows.items()) if row.error]
         failed_edges = [row for row in self.station_rows if row.error]
         measured = len(self.rows) - len(failed)
@@ -221,7 +278,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             tasks = []  # edges only
         else:
             try:
-                rows = csvio.read_replication_csv(args.points)
+                rows = csvio.read_replication_csv(Path(args.points))  # a path, whatever it holds
             except OSError as error:
                 raise UsageError(f"{args.points}: {error.strerror or error}") from None
             tasks = bp.plan_rows(
@@ -247,6 +304,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             for mesh in range(len(sources))
             if mesh in groups or any(spec_applies(spec, sources[mesh]) for spec in edges)
         }
+    stems, renamed = picture_names([source.name for source in sources])
     units = args.units or ("none" if not blend else None)
     set_units(bpy.context.scene, units)
     make_folders(args)
@@ -261,11 +319,15 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "sweep": list(args.sweep) if args.sweep else None,
         "sweep_plots": str(sweep_paths(args.out)[1]) if args.sweep else "",
         "edges": edges,
+        "picture_names": stems,
+        "inputs": input_files(args),
         "plots": str(Path(args.out).resolve().parent / Path(args.out).stem) if edges else "",
     }
     if args.sweep:
         sweep_paths(args.out)[1].mkdir(parents=True, exist_ok=True)
     run = Run(args, sources, tasks, len(groups))
+    for note in renamed:
+        run.say(f"note: {note}")
     if args.shard and not args.quiet:
         run.say(f"shard {args.shard}: {len(tasks):,} point(s) on {len(groups)} mesh(es)")
     if not run.stream:
@@ -294,10 +356,14 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                 run.jobs = min(args.jobs, len(groups))
                 run_workers(run, groups, plan, args.jobs)
             else:
+                pictures = bool(args.render or args.sweep or edges)
+                rows_ready = functools.partial(run.add, force_write=pictures)
                 for mesh, mesh_tasks in groups.items():
                     progress = functools.partial(run.progress, mesh)
-                    result = safe_measure_mesh(mesh, sources[mesh], mesh_tasks, options, progress)
-                    run.add(result)
+                    result = safe_measure_mesh(
+                        mesh, sources[mesh], mesh_tasks, options, progress, rows_ready
+                    )
+                    run.pictures_done(result)
                     if args.save_blend or not sources[mesh].path:
                         kept.append(result.object_name)
                     elif result.object_name:
@@ -312,7 +378,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             try:
                 save_blend(args.save_blend, objects)
             except (RuntimeError, OSError) as error:
-                run.failed_outputs.append(f".blend {args.save_blend}: {str(error).strip()}")
+                run.failed_outputs.append(f".blend {args.save_blend}: {reason(error)}")
             else:
                 run.say(f"wrote {args.save_blend}")
     finally:

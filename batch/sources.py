@@ -87,7 +87,18 @@ def blend_objects(names: list[str], blend: str) -> list[MeshSource]:
     return sources
 
 
+def readable_name(name: str) -> str:
+    """A mesh name as text every output can hold: bytes of a file name that are not UTF-8
+    (Python keeps them as surrogate escapes) shown as U+FFFD, as a file manager shows them.
+    The same file always gets the same name, so a CSV written with it finds its mesh again."""
+    try:
+        return name.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+    except UnicodeEncodeError:
+        return name.encode("utf-8", "replace").decode("utf-8")
+
+
 def file_sources(inputs: list[str]) -> list[MeshSource]:
+    """The mesh files among ``inputs`` (and in given folders), named by their stems."""
     if not inputs:
         return []
     try:
@@ -95,7 +106,9 @@ def file_sources(inputs: list[str]) -> list[MeshSource]:
         names = batchplan.mesh_names(files)
     except GoniometerError as error:
         raise UsageError(str(error)) from None
-    return [MeshSource(name, str(path)) for name, path in zip(names, files, strict=True)]
+    return [
+        MeshSource(readable_name(name), str(path)) for name, path in zip(names, files, strict=True)
+    ]
 
 
 def import_mesh(source: MeshSource):

@@ -1,7 +1,9 @@
 """``--jobs N``: meshes measured in worker processes, each a Blender or bpy process of its own.
 
-A worker reads mesh indices on stdin and, per mesh, writes its result as JSON into the run's
-temporary folder, then a line ``MARK done N`` on stdout.
+A worker reads mesh indices on stdin and, per mesh, writes its rows as JSON into the run's
+temporary folder and says ``MARK rows N`` on stdout (the parent writes them into the CSV at
+once), draws the mesh's pictures, then writes its whole result and says ``MARK done N``. A
+worker that dies while drawing costs the pictures, never the rows.
 
 Nothing outlives the run: a worker watches its parent and, when the parent is gone (killed, even
 with SIGKILL), removes the run's temporary folder and exits; Ctrl-C is the parent's to handle
@@ -98,11 +100,22 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
             processes.add(process)
         return process
 
+    rows_in: set[int] = set()  # meshes whose rows the parent has (their pictures may follow)
+
     def fail(mesh: int, message: str) -> None:
         name = run.sources[mesh].name
         result = MeshResult(mesh=mesh, failed=len(groups[mesh]))
-        result.rows = [(t.index, error_row(t, name, message, run.units)) for t in groups[mesh]]
-        run.add(result)
+        if mesh in rows_in:  # the rows are written: only the pictures are lost
+            result = next(r for r in run.results if r.mesh == mesh)
+            result.picture_errors.append(f"pictures of {name}: {message}")
+        else:
+            result.rows = [(t.index, error_row(t, name, message, run.units)) for t in groups[mesh]]
+            run.add(result)
+        run.pictures_done(result)
+
+    def load(mesh: int, suffix: str) -> MeshResult:
+        with open(Path(folder) / f"mesh-{mesh}{suffix}", encoding="utf-8") as handle:
+            return MeshResult.from_json(json.load(handle), row_type)
 
     def slot():
         process = None
@@ -128,14 +141,19 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
                     words = line[at + len(MARK) :].split()
                     if words[:1] == ["progress"]:
                         run.progress(mesh, int(words[2]))
+                    elif words[:1] == ["rows"]:
+                        run.add(load(mesh, ".rows.json"), force_write=True)
+                        rows_in.add(mesh)
                     elif words[:1] == ["done"]:
                         finished = True
                         break
             except (BrokenPipeError, OSError):
                 pass
             if finished:
-                with open(Path(folder) / f"mesh-{mesh}.json", encoding="utf-8") as handle:
-                    run.add(MeshResult.from_json(json.load(handle), row_type))
+                result = load(mesh, ".json")
+                if mesh not in rows_in:
+                    run.add(result)
+                run.pictures_done(result)
                 continue
             code = process.wait()
             process = None
@@ -245,7 +263,11 @@ def _measure_from_stdin(plan: dict) -> int:
         def progress(done, mesh=mesh):
             print(f"{MARK} progress {mesh} {done}", flush=True)
 
-        result = safe_measure_mesh(mesh, sources[mesh], tasks[mesh], options, progress)
+        def send_rows(result, mesh=mesh):
+            if _write_result(Path(plan["folder"]) / f"mesh-{mesh}.rows.json", result):
+                print(f"{MARK} rows {mesh}", flush=True)
+
+        result = safe_measure_mesh(mesh, sources[mesh], tasks[mesh], options, progress, send_rows)
         if options.get("save_blend") and result.object_name:
             obj = bpy.data.objects.get(result.object_name)
             if obj is not None:
@@ -255,12 +277,18 @@ def _measure_from_stdin(plan: dict) -> int:
                 result.blend = path
         if result.object_name:
             forget(result.object_name)
-        target = Path(plan["folder"]) / f"mesh-{mesh}.json"
-        temporary = target.with_suffix(".tmp")
-        try:
-            temporary.write_text(json.dumps(result.to_json()), encoding="utf-8")
-            temporary.replace(target)
-        except FileNotFoundError:
+        if not _write_result(Path(plan["folder"]) / f"mesh-{mesh}.json", result):
             return 1  # the run is over and its folder removed: nobody waits for this result
         print(f"{MARK} done {mesh}", flush=True)
     return 0
+
+
+def _write_result(target: Path, result: MeshResult) -> bool:
+    """Write ``result`` as JSON to ``target`` in one step; False when the run's folder is gone."""
+    temporary = target.with_name(target.name + ".tmp")
+    try:
+        temporary.write_text(json.dumps(result.to_json()), encoding="utf-8")
+        temporary.replace(target)
+    except FileNotFoundError:
+        return False
+    return True

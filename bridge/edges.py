@@ -39,14 +39,26 @@ def free_break(obj) -> int:
 
 
 def measure_edge(
-    obj, points, spacing, radius, lam=2.0, patch="euclidean", *, depsgraph=None, space="mesh"
+    obj,
+    points,
+    spacing,
+    radius,
+    lam=2.0,
+    patch="euclidean",
+    *,
+    depsgraph=None,
+    space="mesh",
+    surface=None,
 ):
     """Trace and measure the edge through ``points`` on ``obj`` without recording anything:
     ``(EdgeProfile, Geometry, points)``, the last the points in mesh coordinates.
 
     ``points`` are in mesh coordinates, or world space with ``space="world"`` (converted by the
     object's ``matrix_world``); ``spacing`` and ``radius`` are in mesh units either way, like
-    ``measuring.measure_on_object``'s radius.
+    ``measuring.measure_on_object``'s radius. ``surface``: the ``Surface`` to measure on instead
+    of the object's cached one (the batch's float64 file coordinates, with the same vertices).
+    A spacing that would make more than ``edge_profile.MAX_STATIONS`` stations is refused
+    before anything is allocated for them.
     """
     check_measurable(obj)
     points = np.asarray(points, dtype=np.float64)
@@ -60,7 +72,8 @@ def measure_edge(
     geometry = evaluated_geometry(obj, depsgraph)
     if space == "world":
         points = mesh_points(points, geometry.matrix)
-    surface = surface_for(obj, geometry)
+    if surface is None:
+        surface = surface_for(obj, geometry)
     profile = surface.measure_along(points, spacing, radius, lam, patch)
     return profile, geometry, points
 
@@ -76,6 +89,7 @@ def measure_edge_on_object(
     depsgraph=None,
     note="",
     space="mesh",
+    surface=None,
 ):
     """Measure the edge through ``points`` and record every station as a measurement of one new
     break (its own colour pair), plus the edge's record with its summary and plot.
@@ -94,6 +108,8 @@ def measure_edge_on_object(
         Free text stored with the edge and each station.
     space : {"mesh", "world"}
         The coordinates ``points`` are given in; the edge records them in mesh coordinates.
+    surface : Surface, optional
+        Measure on this surface instead of the object's (see :func:`measure_edge`).
 
     Returns
     -------
@@ -106,7 +122,7 @@ def measure_edge_on_object(
         recorded then.
     """
     profile, geometry, clicks = measure_edge(
-        obj, points, spacing, radius, lam, patch, depsgraph=depsgraph, space=space
+        obj, points, spacing, radius, lam, patch, depsgraph=depsgraph, space=space, surface=surface
     )
     break_number = free_break(obj)
     edge_number = obj.vg.next_edge_number

@@ -567,8 +567,9 @@ def test_edges_write_station_rows_summaries_and_plots_equal_to_the_core(tmp_path
     )  # fmt: skip
     rows = rows_of(out)
     assert rows[0].edge_number is None and rows[0].number == 1
-    # Blender keeps coordinates in float32: the core measures the same numbers.
-    surface = Surface(meshio.read_mesh(mesh).points.astype(np.float32), shape.triangles)
+    # The file's float64 coordinates, which float32 would round, are measured as they are (as
+    # --at rows are): the core on the file's own coordinates gives the same numbers.
+    surface = Surface(meshio.read_mesh(mesh).points, shape.triangles)
     edges = csvio.read_edges_csv(out.with_name("out_edges.csv"))
     clicks = [[[-1.5, 0.01, 0], [0, -0.01, 0], [1.5, 0, 0]], [[-1, 0, 0], [1, 0, 0]]]
     for number, (edge, points) in enumerate(zip(edges, clicks, strict=True), start=1):
@@ -579,6 +580,7 @@ def test_edges_write_station_rows_summaries_and_plots_equal_to_the_core(tmp_path
         assert [(r.x, r.y, r.z) for r in stations] == [tuple(m.center) for m in profile.stations]
         assert (edge.mean, edge.pooled_angle) == (profile.mean, profile.pooled_angle)
         assert len({r.break_number for r in stations}) == 1
+        assert {r.precision for r in stations} == {"float64"}
         assert (
             np.abs(
                 np.array([r.angle for r in stations])

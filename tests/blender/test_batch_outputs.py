@@ -144,8 +144,9 @@ def test_a_render_that_fails_late_gives_a_nonzero_exit_and_keeps_the_csv(scan, t
 
 def test_a_blend_that_fails_late_gives_a_nonzero_exit_and_keeps_the_csv(scan, tmp_path):
     saved, out = tmp_path / "saved.blend", tmp_path / "o.csv"
-    # Blender writes "<name>@" first and renames it: a folder there makes the save fail late.
-    blocker = tmp_path / "saved.blend@"
+    # The batch saves to ".saved.saving.blend" first, for which Blender writes "<name>@" and
+    # renames it: a folder there makes the save fail late.
+    blocker = tmp_path / ".saved.saving.blend@"
     blocker.mkdir()
     (blocker / "keep").write_text("x")
     result = batch(scan, *AT, "--out", out, "--save-blend", saved)

@@ -60,3 +60,28 @@ def test_a_file_that_float32_holds_exactly_is_measured_as_blender_stores_it(tmp_
     (row,) = csvio.read_measurements_csv(out)
     assert row.precision == "float32"
     assert row.angle == Surface(points, shape.triangles).measure([0.05, 0, 0], 0.3).angle
+
+
+@pytest.mark.parametrize(
+    "offset",
+    [(1000.0, 2000.0, 50.0), (500_000.0, 5_000_000.0, 100.0)],
+    ids=["kilometre", "UTM-like"],
+)
+def test_edge_stations_of_a_float64_file_are_measured_at_its_precision(tmp_path, offset):
+    shape = wedge(60.0, n=40)
+    points = shape.points + np.array(offset)
+    path = meshio.write_ply(tmp_path / "far.ply", points, shape.triangles)
+    ends = [repr(float(v)) for end in ((-0.4, 0, 0), (0.4, 0, 0)) for v in np.add(offset, end)]
+    out = tmp_path / "out.csv"
+    result = batch(path, "--at", *ends[:3], "--edge", *ends, "--spacing", "0.2", "--radius",
+                   "0.3", "--out", out)  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    rows = csvio.read_measurements_csv(out)
+    stations = [row for row in rows if row.edge_number]
+    assert len(stations) >= 4 and {row.precision for row in rows} == {"float64"}
+    # The oracle: the core's profile on the file's own float64 coordinates, bit for bit.
+    profile = Surface(points, shape.triangles).measure_along(
+        [[float(v) for v in ends[:3]], [float(v) for v in ends[3:]]], 0.2, 0.3
+    )
+    assert [row.angle for row in stations] == profile.angles.tolist()
+    assert max(abs(row.angle - 60.0) for row in stations) < 1e-6

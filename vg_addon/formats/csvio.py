@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import dataclasses
 import io
 import math
 import operator
@@ -404,9 +405,14 @@ def parse_points(text: str) -> list[tuple[float, float, float]]:
         if len(values) != 3:
             raise GoniometerError(f"A point of the edge must be three numbers x y z; got {part!r}.")
         try:
-            points.append(tuple(float(v) for v in values))
+            point = tuple(float(v) for v in values)
         except ValueError:
             raise GoniometerError(f"A point of the edge is not three numbers: {part!r}.") from None
+        if not all(math.isfinite(v) for v in point):
+            raise GoniometerError(
+                f"A point of the edge must be three finite numbers; got {part.strip()!r}."
+            )
+        points.append(point)
     return points
 
 
@@ -567,14 +573,19 @@ def mesh_name_matches(csv_name: str | None, names) -> bool:
     names : str or iterable of str
         The mesh's names, e.g. its object name and its mesh data name.
 
-    A name matches exactly (case-sensitive, as Blender names are), or after dropping a folder
-    and a mesh file extension (``"scans/bone_12.ply"`` matches ``"bone_12"``).
+    A name matches exactly (case-sensitive, as Blender names are, surrounding spaces
+    included: a mesh file " lead.ply" is the mesh " lead"), or without its surrounding spaces
+    (a hand-typed cell), or after dropping a folder and a mesh file extension
+    (``"scans/bone_12.ply"`` matches ``"bone_12"``).
     """
-    name = (csv_name or "").strip()
-    if not name:
+    given = csv_name or ""
+    if not given.strip():
         return True
     candidates = set(_split_names(names))
-    return name in candidates or _mesh_stem(name) in candidates
+    return any(
+        name in candidates or _mesh_stem(name) in candidates
+        for name in dict.fromkeys((given, given.strip()))
+    )
 
 
 def rows_for_mesh(rows: Iterable[ReplicationRow], mesh_name) -> list[ReplicationRow]:
@@ -635,7 +646,10 @@ def _row_cells(index: int, row, schema=_SCHEMA) -> list[str]:
     for field, kind, columns in schema:
         value = getattr(row, field)
         if kind == "text":
-            cells.append(_escape_text("" if value is None else str(value)))
+            text = "" if value is None else str(value)
+            if not _is_utf8(text):
+                raise _cell_error(index, row, columns[0], value, "text UTF-8 can hold")
+            cells.append(_escape_text(text))
         elif kind == "float":
             cells.append(_float_cell(value, index, row, columns[0]))
         elif kind == "int":
@@ -663,6 +677,55 @@ def _row_cells(index: int, row, schema=_SCHEMA) -> list[str]:
                 for part, column in zip(parts, columns, strict=True)
             )
     return cells
+
+
+def _is_utf8(text: str) -> bool:
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:  # a lone surrogate, e.g. from a file name that is not UTF-8
+        return False
+    return True
+
+
+def _as_utf8(text: str) -> str:
+    """``text`` with what UTF-8 cannot hold replaced: a file name's undecodable bytes (Python's
+    surrogate escapes) by U+FFFD, as a file manager shows them."""
+    try:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+    except UnicodeEncodeError:
+        return text.encode("utf-8", "replace").decode("utf-8")
+
+
+def _schema_of(row):
+    return _EDGE_SCHEMA if isinstance(row, EdgeRow) else _SCHEMA
+
+
+def writable_row(row):
+    """``row`` (a :class:`MeasurementRow` or :class:`EdgeRow`) if every cell can be written,
+    else a copy that can: a number that is not finite (or not a number) left empty, text that
+    UTF-8 cannot hold with those characters replaced, and each change said in ``error``.
+
+    So one bad value costs its own cell, never the other rows of a file: writers that must
+    keep every good row (the batch) pass their rows through this first.
+    """
+    changes, problems = {}, []
+    for entry in _schema_of(row):
+        field, kind, columns = entry
+        try:
+            _row_cells(0, row, (entry,))
+        except GoniometerError:
+            value = getattr(row, field)
+            if kind == "text":
+                changes[field] = _as_utf8(str(value))
+                problems.append(f"{columns[0]} {changes[field]!r} had characters UTF-8 cannot hold")
+            else:
+                changes[field] = None
+                problems.append(f"{columns[0]} could not be written ({value!r}): left empty")
+    if not changes:
+        return row
+    error = changes.get("error", row.error)
+    changes["error"] = "; ".join(part for part in (error, *problems) if part)
+    return dataclasses.replace(row, **changes)
 
 
 def _csv_line(cells: Iterable[str]) -> str:
@@ -891,11 +954,22 @@ def _load(path_or_text) -> tuple[str, str]:
     """``(text, name for messages)``; a str with a line break is content, other str a path."""
     if isinstance(path_or_text, bytes):
         return _decode(path_or_text, "The CSV data"), "The CSV data"
-    if isinstance(path_or_text, str) and ("\n" in path_or_text or "\r" in path_or_text):
+    if isinstance(path_or_text, str) and _is_csv_text(path_or_text):
         return path_or_text, "The CSV text"
     path = Path(os.fspath(path_or_text))
     source = f"'{path.name}'"
     return _decode(path.read_bytes(), source), source
+
+
+def _is_csv_text(text: str) -> bool:
+    """Whether a str is CSV content rather than a path: it has a line break, is not the name of
+    an existing file (a path may hold a line break) and its first line has a delimiter."""
+    if "\n" not in text and "\r" not in text:
+        return False
+    if os.path.lexists(text):
+        return False
+    first = next((line for line in text.splitlines() if line.strip()), "")
+    return not first or any(delimiter in first for delimiter in _DELIMITER_NAMES)
 
 
 def _decode(data: bytes, source: str) -> str:
@@ -936,15 +1010,38 @@ def _records(text: str, source: str) -> list[tuple[int, list[str]]]:
     _check_delimiter(header_line, source)
     reader = csv.reader(io.StringIO(text, newline=""))
     records = []
+    width = 0
     try:
-        for number, cells in enumerate(reader, start=1):
-            records.append((number, cells))
+        while True:
+            line = reader.line_num + 1  # the physical line the record starts on
+            cells = next(reader, None)
+            if cells is None:
+                break
+            records.append((len(records) + 1, cells))
+            width = width or (len(cells) if not _blank(cells) else 0)
+            if reader.line_num > line:
+                _check_open_quote(cells, line, width, source)
     except csv.Error as error:
         raise GoniometerError(
             f"{source} is not a readable CSV near line {reader.line_num}: {error}. "
             "Check the quotes on that line."
         ) from None
     return records
+
+
+def _check_open_quote(cells: Sequence[str], line: int, width: int, source: str) -> None:
+    """Refuse a record whose quoted cell runs over lines that look like rows of their own: a
+    quote left open swallows every later row into one cell (until the file ends or another
+    quote closes it), which would otherwise read as one row with a long note."""
+    for column, cell in enumerate(cells, start=1):
+        swallowed = [part for part in cell.splitlines()[1:] if part.count(",") >= max(width - 1, 1)]
+        if swallowed:
+            raise GoniometerError(
+                f"{source}: line {line} opens a quote (in cell {column}) that is not closed on "
+                f"that line, so the {len(swallowed)} line(s) after it that look like rows would "
+                "be read as part of that one cell; nothing was read. Close the quote on line "
+                f'{line} (a quote inside a cell is written as two quotes "") and try again.'
+            )
 
 
 def _blank(cells: Sequence[str]) -> bool:
@@ -985,6 +1082,12 @@ def _parse_float(raw: str) -> tuple[float | None, str | None]:
 def _parse_optional_text(raw: str) -> str | None:
     text = raw.strip()
     return _unescape_text(text) if text else None
+
+
+def _parse_name(raw: str) -> str | None:
+    """A mesh name as written, surrounding spaces kept (a file " lead.ply" is the mesh
+    " lead"); ``None`` when blank."""
+    return _unescape_text(raw) if raw.strip() else None
 
 
 # Header aliases of the replication reader, normalised (case-folded, "_" as space, whitespace
@@ -1179,7 +1282,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
         rows.append(
             ReplicationRow(
                 row_number=number,
-                mesh_name=_parse_optional_text(cell("mesh_name")),
+                mesh_name=_parse_name(cell("mesh_name")),
                 x=values["x"],
                 y=values["y"],
                 z=values["z"],
@@ -1366,6 +1469,11 @@ def _parse_table(text, source, schema, row_type, optional, what):
                     problems.append(
                         f"row {number}: {', '.join(names)} must be all filled or all empty"
                     )
+        if values.get("points", "").strip() and row_type is EdgeRow:
+            try:
+                parse_points(values["points"])
+            except GoniometerError as error:
+                problems.append(f"row {number}: Points: {error}")
         rows.append(row_type(**values))
     if problems:
         raise _problems_error(source, problems)

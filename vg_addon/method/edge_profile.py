@@ -453,6 +453,36 @@ class EdgeProfile:
         )
 
 
+#: The most stations one edge is measured at. A spacing that would make more is refused before
+#: anything is allocated for them (a spacing of 1e-9 on an edge of length 1 would ask for about
+#: 12 GiB): 100,000 stations is far more than a profile plot or a reader can use.
+MAX_STATIONS = 100_000
+
+
+def station_count(length: float, spacing: float) -> int:
+    """How many stations ``spacing`` apart fit on an edge of arc ``length`` (at least one)."""
+    return int(np.floor(length / spacing * (1 + 1e-12))) + 1
+
+
+def check_station_count(length: float, spacing: float) -> None:
+    """Refuse a ``spacing`` that would make more than :data:`MAX_STATIONS` stations on an edge
+    of arc ``length``, before anything is allocated for them.
+
+    Raises
+    ------
+    GoniometerError
+        Naming the number of stations, the limit and the finest spacing allowed.
+    """
+    stations = length / spacing  # a float: may be far too large for an int array, or inf
+    if not np.isfinite(stations) or station_count(length, spacing) > MAX_STATIONS:
+        finest = length / (MAX_STATIONS - 1)
+        raise GoniometerError(
+            f"The spacing {spacing:g} would make {stations:,.0f} stations along this edge "
+            f"(length {length:.6g}); at most {MAX_STATIONS:,} are measured (MAX_STATIONS). Use "
+            f"a spacing of at least {finest:.4g}."
+        )
+
+
 def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
     """Positions in ``path.vertices`` of the stations ``spacing`` apart.
 
@@ -462,7 +492,8 @@ def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
     Raises
     ------
     GoniometerError
-        A spacing not positive, or so fine that two stations snap to one vertex.
+        A spacing not positive, one that would make more than :data:`MAX_STATIONS` stations,
+        or so fine that two stations snap to one vertex.
     """
     try:
         spacing = as_radius(spacing)
@@ -470,8 +501,9 @@ def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
         raise GoniometerError(
             f"The spacing must be a finite number greater than 0; got {spacing!r}."
         ) from None
+    check_station_count(path.length, spacing)
     arc = path.arc_lengths
-    count = int(np.floor(path.length / spacing * (1 + 1e-12))) + 1
+    count = station_count(path.length, spacing)
     targets = (path.length - (count - 1) * spacing) / 2.0 + spacing * np.arange(count)
     right = np.clip(np.searchsorted(arc, targets), 1, arc.size - 1)
     left = right - 1

@@ -1,0 +1,93 @@
+"""The pictures of a batch run (maps, profile and sweep plots): named so that no two meshes of
+a run share a file, written only after the mesh's rows, and never at the cost of a row.
+
+The rule, here and in ``run``: a bad row or a failed picture never costs a good row. A picture
+that cannot be written (a folder in its place, a full disk, an input at its path) is one line
+in the summary and exit status 2; the CSV is complete all the same.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..bridge.measurement_map import safe_file_name
+from ..vg_addon import GoniometerError
+from ..vg_addon.formats import csvio
+from .outputs import refuse_input
+
+# Below this much free space a failed picture is reported as a full disk (Blender's own errors
+# on a full disk name other symptoms, e.g. an empty pixel buffer).
+NEARLY_FULL_BYTES = 1 << 20
+
+
+def picture_names(names: list[str]) -> tuple[list[str], list[str]]:
+    """A file-name stem per mesh, unique within the run (also ignoring case, for file systems
+    that do), and a note for each mesh whose stem had to be changed.
+
+    ``safe_file_name`` maps "bone 1" and "bone_1" to the same "bone_1": the second gets
+    "bone_1-2", so its pictures never replace the first's.
+    """
+    taken: set[str] = set()
+    stems, notes = [], []
+    for name in names:
+        base = stem = safe_file_name(name)
+        suffix = 1
+        while stem.casefold() in taken:
+            suffix += 1
+            stem = f"{base}-{suffix}"
+        taken.add(stem.casefold())
+        stems.append(stem)
+        if stem != base:
+            notes.append(
+                f"the pictures of {name!r} are named {stem!r}: another mesh of this run "
+                f"already has the file name {base!r}"
+            )
+    return stems, notes
+
+
+def disk_full(folder) -> bool:
+    """Whether the file system holding ``folder`` has (almost) no space left."""
+    try:
+        info = os.statvfs(folder)
+    except (OSError, AttributeError):
+        return False
+    return info.f_bavail * info.f_frsize < NEARLY_FULL_BYTES
+
+
+def reason(error: BaseException, folder=None) -> str:
+    """What went wrong, in words: an OSError's own text, and a full disk named as such."""
+    if isinstance(error, OSError) and error.strerror:
+        text = error.strerror
+    else:
+        text = str(error).strip() or type(error).__name__
+        if not isinstance(error, GoniometerError | OSError):
+            text = f"{type(error).__name__}: {text}"
+    if folder is not None and "No space left" not in text and disk_full(folder):
+        text = f"No space left on device ({text})"
+    return text
+
+
+def write_picture(path, data, inputs) -> None:
+    """Write picture bytes ``data()`` to ``path`` atomically, unless ``path`` is an input or a
+    folder.
+
+    Raises
+    ------
+    GoniometerError, OSError
+        Why it was not written; an old file at ``path`` is then unchanged.
+    """
+    refuse_input(path, inputs)
+    if Path(path).is_dir():
+        raise GoniometerError("a folder is in its place; move it away")
+    csvio.replace_atomically(os.fspath(path), data())
+
+
+def try_picture(failures: list[str], what: str, path, data, inputs) -> bool:
+    """:func:`write_picture`, a failure added to ``failures`` as one line; whether written."""
+    try:
+        write_picture(path, data, inputs)
+    except (OSError, GoniometerError) as error:
+        failures.append(f"{what} {path}: {reason(error, Path(path).parent)}")
+        return False
+    return True

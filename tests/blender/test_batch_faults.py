@@ -1,0 +1,333 @@
+"""The second fault matrix of the batch (issues 24 and 25): no input overwritten, a bad row or a
+failed picture never costs a good row, pictures of two meshes never share a file, resources
+bounded before they are allocated, names as the user gave them. Run as a user runs it."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import math
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import bpy
+import numpy as np
+import pytest
+from unprivileged import as_user
+
+from vg_addon.formats import csvio, meshio
+from vg_addon.method.edge_profile import MAX_STATIONS
+from vg_addon.synthetic_meshes import wedge
+
+ROOT = Path(__file__).resolve().parents[2]
+SCRIPT = ROOT / "vg_batch.py"
+AT = ("--at", "0.05", "0", "0", "--radius", "0.3")
+EDGE = ("--edge", "-0.4", "0", "0", "0.4", "0", "0", "--radius", "0.3")
+SMALL_MAP = ("--render-size", "16", "16", "--render-samples", "1")
+
+
+def batch(*args, cwd=None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, str(SCRIPT), *(os.fsdecode(a) if isinstance(a, bytes) else str(a)
+                                        for a in args)],
+        capture_output=True,
+        text=True,
+        errors="replace",
+        timeout=600,
+        cwd=cwd,
+        check=False,
+    )  # fmt: skip
+
+
+def ok(result, code=0) -> subprocess.CompletedProcess:
+    assert result.returncode == code, result.stdout + result.stderr
+    assert "Traceback" not in result.stderr, result.stderr
+    return result
+
+
+def write_wedge(path, angle=90.0, seed=3) -> Path:
+    shape = wedge(angle, n=24, irregular=True, seed=seed)
+    # Coordinates float32 holds exactly: Blender's mesh is the file's.
+    points = shape.points.astype(np.float32).astype(np.float64)
+    return meshio.write_ply(path, points, shape.triangles)
+
+
+@pytest.fixture
+def scan(tmp_path) -> Path:
+    return write_wedge(tmp_path / "scan.ply")
+
+
+# --------------------------------------------------------------------------- inputs kept
+
+
+def test_an_edges_csv_is_never_overwritten_nor_taken_as_out(scan, tmp_path):
+    ok(batch(scan, *EDGE, "--spacing", "0.2", "--out", tmp_path / "o.csv"))
+    edges = tmp_path / "o_edges.csv"
+    lines = edges.read_text().splitlines()
+    edges.write_text(
+        "\n".join([lines[0] + ",my column", lines[1] + ",keep me"]) + "\n", encoding="utf-8"
+    )
+    before = edges.read_bytes()
+    # Its own OUT_edges.csv would be the input.
+    result = ok(batch(scan, "--edges", edges, "--out", tmp_path / "o.csv"), 2)
+    assert "is the edges CSV" in result.stderr and "nothing was read" in result.stderr
+    result = ok(batch(scan, "--edges", edges, "--out", edges), 2)
+    assert "--out" in result.stderr and "is the edges CSV" in result.stderr
+    assert edges.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["o.csv", "o_edges.csv",
+                                                          "o_scan_edge1.png", "scan.ply"]  # fmt: skip
+
+
+def test_a_non_finite_edge_point_is_refused_before_anything_is_measured(scan, tmp_path):
+    out = tmp_path / "o.csv"
+    result = ok(batch(scan, *AT, "--edge", "nan", "0", "0", "0.4", "0", "0", "--spacing", "0.2",
+                      "--out", out), 2)  # fmt: skip
+    assert "finite" in result.stderr and not out.exists()
+    ok(batch(scan, *EDGE, "--spacing", "0.2", "--out", tmp_path / "e.csv"))
+    edges = tmp_path / "e_edges.csv"
+    good = edges.read_text().splitlines()
+    bad = good[1].replace("'-0.4 0.0 0.0", "'nan 0.0 0.0", 1)
+    edges.write_text("\n".join([*good, bad]) + "\n", encoding="utf-8")
+    result = ok(batch(scan, "--edges", edges, "--out", out), 2)
+    assert "row 3: Points" in result.stderr and not out.exists()
+
+
+@pytest.mark.parametrize("where", ["--spacing", "edges CSV"])
+def test_a_spacing_making_too_many_stations_is_refused_naming_the_limit(scan, tmp_path, where):
+    out = tmp_path / "o.csv"
+    if where == "--spacing":
+        result = batch(scan, *AT, *EDGE, "--spacing", "1e-9", "--out", out)
+    else:
+        ok(batch(scan, *EDGE, "--spacing", "0.2", "--out", tmp_path / "e.csv"))
+        edges = tmp_path / "e_edges.csv"
+        lines = edges.read_text().splitlines()
+        header = lines[0].split(",")
+        cells = lines[1].split(",")
+        cells[header.index("Spacing")] = "1e-9"
+        edges.write_text("\n".join([lines[0], ",".join(cells)]) + "\n", encoding="utf-8")
+        result = batch(scan, "--edges", edges, "--out", out)
+    ok(result, 2)
+    assert f"{MAX_STATIONS:,}" in result.stderr and "stations" in result.stderr
+    assert not out.exists()  # refused before measuring
+
+
+def test_an_unclosed_quote_in_a_points_csv_stops_the_run_naming_its_line(scan, tmp_path):
+    points = tmp_path / "points.csv"
+    points.write_text('x,y,z,label\n0.05,0,0,"open\n0.1,0,0,b\n0.2,0,0,c\n0.3,0,0,d\n')
+    out = tmp_path / "o.csv"
+    result = ok(batch(scan, "--points", points, "--radius", "0.3", "--out", out), 2)
+    assert "line 2 opens a quote" in result.stderr and not out.exists()
+
+
+def test_paths_with_a_line_break_are_paths(scan, tmp_path):
+    folder = tmp_path / "two\nlines"
+    folder.mkdir()
+    points = folder / "points.csv"
+    points.write_text("x,y,z\n0.05,0,0\n", encoding="utf-8")
+    ok(batch(scan, *EDGE, "--spacing", "0.2", "--out", folder / "e.csv"))
+    out = tmp_path / "o.csv"
+    ok(batch(scan, "--points", points, "--radius", "0.3", "--edges", folder / "e_edges.csv",
+             "--out", out))  # fmt: skip
+    rows = csvio.read_measurements_csv(out)
+    assert len(rows) == 1 + sum(1 for r in rows if r.edge_number) and not rows[0].error
+
+
+# --------------------------------------------------------------------------- names
+
+
+def test_meshes_whose_file_names_collide_get_pictures_of_their_own(tmp_path):
+    one = write_wedge(tmp_path / "bone 1.ply", 90.0, seed=3)
+    two = write_wedge(tmp_path / "bone_1.ply", 60.0, seed=4)
+    out = tmp_path / "o.csv"
+    result = ok(batch(one, two, *AT, *EDGE, "--spacing", "0.2", "--sweep", "0.2", "0.3", "2",
+                      "--render", tmp_path / "maps", *SMALL_MAP, "--out", out))  # fmt: skip
+    assert "wrote 2 measurement map(s)" in result.stderr
+    assert "'bone 1'" in result.stderr and "'bone_1'" in result.stderr  # said which name is which
+    sheets = sorted(p.name for p in (tmp_path / "maps").glob("*_map.png"))
+    assert len(sheets) == 2, sheets
+    plots = sorted(p.name for p in tmp_path.glob("o_*_edge1.png"))
+    assert len(plots) == 2, plots
+    assert len(list((tmp_path / "o_sweep").glob("*.png"))) == 2
+
+
+def test_a_file_name_that_is_not_utf8_costs_no_row(tmp_path):
+    good = write_wedge(tmp_path / "good.ply")
+    odd = os.fsdecode(bytes(tmp_path) + b"/caf\xe9.ply")
+    write_wedge(odd, 60.0, seed=4)
+    out = tmp_path / "o.csv"
+    ok(batch(good, odd, *AT, "--out", out))
+    rows = csvio.read_measurements_csv(out)
+    assert [r.mesh_name for r in rows] == ["good", "caf\ufffd"]
+    assert abs(rows[0].angle - 90) < 0.01 and abs(rows[1].angle - 60) < 0.01
+    # The CSV it wrote is read back on the same files: the rows find their meshes.
+    again = tmp_path / "again.csv"
+    ok(batch(good, odd, "--points", out, "--out", again))
+    assert [r.angle for r in csvio.read_measurements_csv(again)] == [r.angle for r in rows]
+
+
+@pytest.mark.parametrize("names", [(" lead", "trail "), ("both ", " both")])
+def test_mesh_names_with_surrounding_spaces_round_trip(tmp_path, names):
+    files = [write_wedge(tmp_path / f"{name}.ply", 90.0 - 30 * i, seed=3 + i)
+             for i, name in enumerate(names)]  # fmt: skip
+    out = tmp_path / "o.csv"
+    ok(batch(*files, *AT, "--out", out))
+    rows = csvio.read_measurements_csv(out)
+    assert [r.mesh_name for r in rows] == list(names)
+    again = tmp_path / "again.csv"
+    ok(batch(*files, "--points", out, "--out", again))
+    back = csvio.read_measurements_csv(again)
+    assert [(r.mesh_name, r.angle) for r in back] == [(r.mesh_name, r.angle) for r in rows]
+
+
+def test_rows_name_the_mesh_file_a_blend_already_has_an_object_of(vg, tmp_path):
+    scan = write_wedge(tmp_path / "w90.ply")
+    for name in ("w90", "other"):
+        shape = wedge(70.0, n=12)
+        mesh = bpy.data.meshes.new(name)
+        mesh.from_pydata(shape.points.tolist(), [], shape.triangles.tolist())
+        bpy.context.scene.collection.objects.link(bpy.data.objects.new(name, mesh))
+    blend = tmp_path / "study.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend), copy=True)
+    out = tmp_path / "o.csv"
+    ok(batch(blend, scan, "--object", "other", *AT, "--out", out))
+    rows = csvio.read_measurements_csv(out)
+    assert [r.mesh_name for r in rows] == ["other", "w90"]
+    again = tmp_path / "again.csv"
+    only = tmp_path / "only.csv"
+    csvio.write_measurements_csv(only, [r for r in rows if r.mesh_name == "w90"])
+    ok(batch(scan, "--points", only, "--out", again))
+    assert csvio.read_measurements_csv(again)[0].angle == rows[1].angle
+
+
+# --------------------------------------------------------------------------- pictures, disks
+
+
+def test_a_plot_that_cannot_be_written_costs_no_row(scan, tmp_path):
+    out = tmp_path / "o.csv"
+    (tmp_path / "o_scan_edge1.png").mkdir()  # a folder where the profile plot goes
+    (tmp_path / "o_sweep").mkdir()
+    (tmp_path / "o_sweep" / "scan_1.png").mkdir()  # and where the sweep plot goes
+    result = ok(batch(scan, *AT, *EDGE, "--spacing", "0.2", "--sweep", "0.2", "0.3", "2",
+                      "--out", out), 2)  # fmt: skip
+    rows = csvio.read_measurements_csv(out)
+    assert rows and not any(r.error for r in rows), [r.error for r in rows]
+    assert abs(rows[0].angle - 90.0) < 0.01 and any(r.edge_number for r in rows)
+    assert "could not write" in result.stderr and "o_scan_edge1.png" in result.stderr
+    assert "scan_1.png" in result.stderr
+    assert csvio.read_edges_csv(tmp_path / "o_edges.csv")[0].n_stations > 1
+
+
+def arguments(**given) -> argparse.Namespace:
+    values = {"inputs": [], "points": None, "out": None, "save_blend": None, "render": None,
+              "sweep": None, "edge": [], "edges_csv": None}  # fmt: skip
+    return argparse.Namespace(**(values | given))
+
+
+def outcome_of_check(outputs, args) -> str:
+    try:
+        outputs.check_outputs(args)
+    except outputs.UsageError as error:
+        return f"refused: {error}"
+    return "accepted"
+
+
+@pytest.mark.skipif(os.name != "posix", reason="POSIX permissions")
+def test_unprivileged_sweep_with_a_read_only_out_is_refused_like_without(vg, user_folder):
+    out = user_folder / "o.csv"
+    out.write_text("keep\n")
+    out.chmod(0o444)
+    outputs = importlib.import_module(f"{vg.__name__}.batch.outputs")
+    for sweep in (None, [0.2, 0.3, 2.0]):
+        kind, said = as_user(outcome_of_check, outputs, arguments(out=str(out), sweep=sweep))
+        assert kind == "ok" and said.startswith("refused: --out") and "read-only" in said, said
+    assert out.read_text() == "keep\n"
+
+
+def test_the_out_folder_vanishing_mid_run_keeps_measuring_and_keeps_the_rows(vg, tmp_path):
+    run_module = importlib.import_module(f"{vg.__name__}.batch.run")
+    measure = importlib.import_module(f"{vg.__name__}.batch.measure")
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    folder = tmp_path / "results"
+    folder.mkdir()
+    out = folder / "o.csv"
+    args = argparse.Namespace(out=str(out), quiet=True, edge=[], edges_csv=None, sweep=None)
+    said = []
+    run = run_module.Run(args, [sources.MeshSource("a"), sources.MeshSource("b")], [], 2)
+    run.say = said.append
+    run.write_csv()
+    shutil.rmtree(folder)
+    for mesh in (0, 1):
+        row = csvio.MeasurementRow(mesh_name="ab"[mesh], angle=90.0 - mesh, x=0.0, y=0.0, z=0.0)
+        run.last_write = -math.inf  # a periodic write is due
+        run.add(measure.MeshResult(mesh=mesh, rows=[(mesh, row)], measured=1))
+    assert sum("could not write the CSV" in text for text in said) == 1, said  # said once
+    code = run.finish()
+    assert code == 2
+    recovered = [text for text in said if "the rows are in" in text]
+    assert recovered, said
+    path = Path(recovered[0].split("the rows are in ")[1].split(" ")[0].rstrip(".;:"))
+    try:
+        assert [r.angle for r in csvio.read_measurements_csv(path)] == [90.0, 89.0]
+    finally:
+        path.unlink(missing_ok=True)
+
+
+@pytest.fixture
+def full_disk(tmp_path):
+    """A small tmpfs, mounted for the test and filled up: every write into it fails with "No
+    space left on device" (root only; unmounted afterwards)."""
+    if os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root")
+    folder = tmp_path / "full"
+    folder.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(folder)],
+                             capture_output=True, text=True, check=False)  # fmt: skip
+    if mounted.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs: {mounted.stderr.strip()}")
+    try:
+        (folder / "old.blend").write_bytes(b"BLENDER-v300 an earlier save")
+        with open(folder / "filler", "wb") as handle:
+            try:
+                while True:
+                    handle.write(b"\0" * 4096)
+                    handle.flush()
+            except OSError:
+                pass
+        yield folder
+    finally:
+        subprocess.run(["umount", str(folder)], check=False)
+
+
+def test_save_blend_onto_a_full_disk_keeps_the_earlier_file_and_says_why(scan, tmp_path, full_disk):
+    out = tmp_path / "o.csv"
+    saved = full_disk / "old.blend"
+    filler = full_disk / "filler"
+    os.truncate(filler, filler.stat().st_size - 16384)  # room for the start of a .blend only
+    result = ok(batch(scan, *AT, "--out", out, "--save-blend", saved), 2)
+    assert "could not write the .blend" in result.stderr and "No space left" in result.stderr
+    assert f"wrote {saved}" not in result.stderr
+    assert saved.read_bytes() == b"BLENDER-v300 an earlier save"
+    assert sorted(p.name for p in full_disk.iterdir()) == ["filler", "old.blend"]
+    assert abs(csvio.read_measurements_csv(out)[0].angle - 90.0) < 0.01
+
+
+def test_render_onto_a_full_disk_says_no_space_left(scan, tmp_path, full_disk):
+    out = tmp_path / "o.csv"
+    result = ok(batch(scan, *AT, "--out", out, "--render", full_disk, *SMALL_MAP), 2)
+    assert "could not write the render of scan" in result.stderr
+    assert "No space left on device" in result.stderr
+    assert abs(csvio.read_measurements_csv(out)[0].angle - 90.0) < 0.01
+
+
+@pytest.mark.parametrize(
+    "option, said",
+    [(("--render-size", "60000", "60000"), "8,192"), (("--render-samples", "100000"), "4,096")],
+)
+def test_the_map_size_and_samples_are_bounded_before_anything_renders(scan, tmp_path, option,
+                                                                      said):  # fmt: skip
+    out = tmp_path / "o.csv"
+    result = ok(batch(scan, *AT, "--out", out, "--render", tmp_path / "maps", *option), 2)
+    assert said in result.stderr and not out.exists()

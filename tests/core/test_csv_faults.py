@@ -1,0 +1,117 @@
+"""CSV faults from the second fault hunt (issues 24 and 25): a bad row never costs a good row,
+a quote left open never swallows the rows after it silently, a path is never read as CSV text,
+and every CSV the product writes reads back to the same rows."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+
+from vg_addon import GoniometerError
+from vg_addon.formats import csvio
+from vg_addon.formats.csvio import MeasurementRow
+
+
+def edge_row(**given) -> csvio.EdgeRow:
+    values = {
+        "mesh_name": "bone",
+        "edge_number": 1,
+        "n_stations": 3,
+        "spacing": 0.5,
+        "radius": 0.3,
+        "seg_param": 2.0,
+        "patch": "euclidean",
+        "points": "0.0 0.0 0.0; 1.0 0.0 0.0",
+    }
+    return csvio.EdgeRow(**(values | given))
+
+
+@pytest.mark.parametrize("bad", ["nan", "inf", "-inf", "NaN"])
+def test_a_non_finite_point_in_an_edges_csv_is_refused_with_its_row(bad):
+    text = csvio.format_edges_csv([edge_row(), edge_row(points=f"0 0 0; {bad} 0 0", edge_number=2)])
+    with pytest.raises(GoniometerError, match=r"row 3: Points") as caught:
+        csvio.read_edges_csv(text)
+    assert "finite" in str(caught.value)
+    with pytest.raises(GoniometerError, match="finite"):
+        csvio.parse_points(f"0 0 0; {bad} 0 0")
+
+
+def test_a_row_that_cannot_be_written_costs_only_itself():
+    good = MeasurementRow(mesh_name="a", angle=90.0, radius=0.3, x=0.0, y=0.0, z=0.0)
+    bad = MeasurementRow(mesh_name="b", requested=(math.nan, 0.0, 0.0), radius=0.3, error="x")
+    odd = MeasurementRow(mesh_name="caf\udce9", angle=80.0, radius=0.3)  # a surrogate: not UTF-8
+    kept = [csvio.writable_row(row) for row in (good, bad, odd)]
+    assert kept[0] == good
+    assert kept[1].requested is None and kept[1].radius == 0.3
+    assert kept[1].error.startswith("x; ") and "Requested" in kept[1].error
+    assert kept[2].mesh_name == "caf\ufffd" and kept[2].angle == 80.0 and kept[2].error
+    text = csvio.format_measurements_csv(kept)
+    assert [row.mesh_name for row in csvio.read_measurements_csv(text)] == ["a", "b", "caf\ufffd"]
+    edge = csvio.writable_row(edge_row(mean=math.inf))
+    assert edge.mean is None and "Mean Angle" in edge.error
+
+
+@pytest.mark.parametrize(
+    "text, line",
+    [
+        ('x,y,z,label\n0,0,0,"note\n1,0,0,b\n2,0,0,c\n3,0,0,d\n', 2),
+        ('x,y,z,label\n0,0,0,a\n\n1,0,0,"note\n2,0,0,b\n3,0,0,"c"\n', 4),
+    ],
+    ids=["to the end", "closed by a later quote"],
+)
+def test_an_unclosed_quote_is_refused_with_the_line_where_it_opens(text, line):
+    with pytest.raises(GoniometerError, match=rf"line {line}\b.*quote") as caught:
+        csvio.read_replication_csv(text)
+    assert "nothing was read" in str(caught.value).lower()
+    export = csvio.format_measurements_csv([MeasurementRow(mesh_name="a", x=0.0, y=0.0, z=0.0)])
+    broken = export.replace("\na,", '\n"a,', 1) + export.split("\n", 1)[1]
+    with pytest.raises(GoniometerError, match="quote"):
+        csvio.read_measurements_csv(broken)
+
+
+def test_a_note_written_over_several_lines_still_reads():
+    rows = [MeasurementRow(mesh_name="a", user_data="two\nlines, one comma", x=0.0, y=0.0, z=0.0)]
+    (back,) = csvio.read_replication_csv(csvio.format_measurements_csv(rows))
+    assert back.label == "two\nlines, one comma"
+
+
+def test_a_path_with_a_line_break_is_read_as_a_path(tmp_path):
+    folder = tmp_path / "two\nlines"
+    folder.mkdir()
+    points = folder / "points.csv"
+    points.write_text("x,y,z\n1,2,3\n", encoding="utf-8")
+    (row,) = csvio.read_replication_csv(str(points))
+    assert (row.x, row.y, row.z) == (1.0, 2.0, 3.0)
+    edges = folder / "e_edges.csv"
+    csvio.write_edges_csv(edges, [edge_row()])
+    assert csvio.read_edges_csv(str(edges))[0].points == edge_row().points
+    assert csvio.is_edges_csv(str(edges))
+    export = folder / "m.csv"
+    csvio.write_measurements_csv(export, [MeasurementRow(mesh_name="a", x=0.0, y=0.0, z=0.0)])
+    assert csvio.read_measurements_csv(str(export))[0].mesh_name == "a"
+    with pytest.raises(FileNotFoundError):
+        csvio.read_replication_csv(str(folder / "missing\n.csv"))
+
+
+@pytest.mark.parametrize("name", [" lead", "trail ", " both  "])
+def test_mesh_names_with_surrounding_spaces_read_back_as_written(name):
+    row = MeasurementRow(mesh_name=name, x=0.5, y=0.0, z=0.0, radius=0.3)
+    (back,) = csvio.read_replication_csv(csvio.format_measurements_csv([row]))
+    assert back.mesh_name == name
+    assert csvio.mesh_name_matches(back.mesh_name, (name,))
+    assert csvio.mesh_name_matches(f"{name}.ply", (name,))
+    # A hand-typed name with stray spaces still finds its mesh.
+    assert csvio.mesh_name_matches(f" {name.strip()} ", (name.strip(),))
+    edges = csvio.format_edges_csv([edge_row(mesh_name=name)])
+    assert csvio.read_edges_csv(edges)[0].mesh_name == name
+
+
+def test_the_rows_of_a_written_csv_read_back_to_the_same_rows():
+    rows = [
+        MeasurementRow(mesh_name=name, user_data=note, x=0.5, y=0.0, z=0.0, radius=0.3)
+        for name, note in [(" a", "=1+1"), ("b ", " spaced "), ("c\td", "x\ny")]
+    ]
+    back = csvio.read_measurements_csv(csvio.format_measurements_csv(rows))
+    assert [dataclasses.replace(r, date="") for r in back] == rows
