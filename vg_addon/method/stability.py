@@ -147,7 +147,7 @@ def _best_splits(
     the upper side, and whether the row has a split leaving both sides enough vertices.
 
     Members come first in sorted order, non-members (+inf) after them; a split after position
-    ``j`` maximises the weighted between-sides sum of squares ``P_j² W / (L_j (W - L_j))``.
+    ``j`` maximises the between-sides sum of squares ``P_j² W / (L_j (W - L_j))``.
     ``draws``: for a bootstrap, the positions drawn in each row, ``(k, n)`` (their counts are
     ``weights``).
     """
@@ -161,39 +161,48 @@ def _best_splits(
         n_members = np.full(draws.shape[0], draws.shape[1])
     # Only the first (most members) columns can hold a split; the rest are +inf in every row.
     width = min(masked.shape[1], max(int(n_members.max(initial=0)), 2))
-    ordered_weights = None
     # Members tied at a value add equal terms, so the sorted values alone give the same sums as
     # any order of them would, if every member's projection is finite.
     ordered = np.sort(masked, axis=1)[:, :width]
     last = ordered[np.arange(ordered.shape[0]), np.maximum(n_members, 1) - 1]
-    finite = (np.isfinite(ordered[:, 0]) & np.isfinite(last)) | (n_members == 0)
-    if not finite.all():  # (never on finite coordinates; kept for safety)
-        masked = np.where(members, projection, np.inf)
-        n_members = members.sum(axis=1)
-        width = min(masked.shape[1], max(int(n_members.max(initial=0)), 2))
-        order = np.argsort(masked, axis=1)[:, :width]
-        ordered = np.take_along_axis(masked, order, axis=1)
-        ordered_weights = np.take_along_axis(weights, order, axis=1)
+    if not ((np.isfinite(ordered[:, 0]) & np.isfinite(last)) | (n_members == 0)).all():
+        return _weighted_splits(projection, members, weights, count, row_mean)
+    position = np.arange(width - 1)
+    lower = position + 1.0  # members below a split after position j
+    total = count[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # Past the members the sums are +inf: those splits are never allowed.
+        prefix = np.cumsum(ordered - row_mean, axis=1)[:, :-1]
+        between = prefix * prefix * total / (lower * (total - lower))
+    allowed = ordered[:, 1:] > ordered[:, :-1]
+    allowed &= position >= MIN_SIDE_VERTICES - 1
+    allowed &= position[None, :] < (n_members - MIN_SIDE_VERTICES)[:, None]
+    best = np.argmax(np.where(allowed, between, -np.inf), axis=1)
+    return ordered[np.arange(ordered.shape[0]), best + 1], allowed.any(axis=1)
+
+
+def _weighted_splits(projection, members, weights, count, row_mean):
+    """:func:`_best_splits` where some member's projection is not finite (never on finite
+    coordinates; kept so that such a row is refused, not a crash): a weighted split of the
+    finite values."""
+    masked = np.where(members, projection, np.inf)
+    n_members = members.sum(axis=1)
+    width = min(masked.shape[1], max(int(n_members.max(initial=0)), 2))
+    order = np.argsort(masked, axis=1)[:, :width]
+    ordered = np.take_along_axis(masked, order, axis=1)
+    ordered_weights = np.take_along_axis(weights, order, axis=1)
     total = count[:, None]
     inside = np.arange(width)[None, :] < n_members[:, None]
     centred = np.where(inside, ordered - row_mean, 0.0)
-    if ordered_weights is None:
-        lower = np.minimum(np.arange(1.0, width), total)  # weight below a split after position j
-    else:
-        # The sort leaves tied values in an order of its own (it differs between CPUs); their
-        # weights are summed first, exactly, and enter once per distinct value, at its last place.
-        running = np.cumsum(ordered_weights, axis=1, dtype=np.float64)
-        tied = ordered[:, 1:] == ordered[:, :-1]
-        tied &= inside[:, 1:]
-        if tied.any():
-            run_end = np.ones(ordered.shape, dtype=bool)
-            run_end[:, :-1] = ~tied
-            before = np.zeros_like(running)
-            before[:, 1:] = np.maximum.accumulate(np.where(run_end, running, 0.0), axis=1)[:, :-1]
-            centred *= np.where(run_end, running - before, 0.0)
-        else:
-            centred *= ordered_weights
-        lower = running[:, :-1]
+    # The sort leaves tied values in an order of its own (it differs between CPUs); their
+    # weights are summed first, exactly, and enter once per distinct value, at its last place.
+    running = np.cumsum(ordered_weights, axis=1, dtype=np.float64)
+    run_end = np.ones(ordered.shape, dtype=bool)
+    run_end[:, :-1] = ordered[:, 1:] != ordered[:, :-1]
+    before = np.zeros_like(running)
+    before[:, 1:] = np.maximum.accumulate(np.where(run_end, running, 0.0), axis=1)[:, :-1]
+    centred *= np.where(run_end, running - before, 0.0)
+    lower = running[:, :-1]
     prefix = np.cumsum(centred, axis=1)[:, :-1]
     with np.errstate(divide="ignore", invalid="ignore"):
         between = prefix * prefix * total / (lower * (total - lower))
