@@ -120,4 +120,3 @@ def test_the_kernels_tried_do_compute_differently():
         pytest.skip(f"this CPU runs fewer than two of the kernels {sorted(KERNELS)}")
     controls = {name: _run(["-c", CONTROL], ENVIRONMENTS[name]) for name in kernels}
     assert len(set(controls.values())) == len(kernels), controls
-

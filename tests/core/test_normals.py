@@ -58,7 +58,8 @@ def test_vertex_normals_are_bit_identical_to_the_reference(name, points, triangl
 
 
 @pytest.mark.parametrize(
-    "name", ["HalfAnnulus", "IntersectingSpheres", "sample_mesh", "project half annulus", "project lens"]
+    "name",
+    ["HalfAnnulus", "IntersectingSpheres", "sample_mesh", "project half annulus", "project lens"],
 )
 def test_reference_mesh_normals_are_bit_identical(name, request):
     if name == "project half annulus":

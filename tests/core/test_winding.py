@@ -49,7 +49,8 @@ def test_bone_fragment_and_its_inward_copy():
 
 
 @pytest.mark.parametrize(
-    "name", ["HalfAnnulus", "IntersectingSpheres", "sample_mesh", "project half annulus", "project lens"]
+    "name",
+    ["HalfAnnulus", "IntersectingSpheres", "sample_mesh", "project half annulus", "project lens"],
 )
 def test_reference_meshes_are_closed_and_outward(name, request):
     if name == "project half annulus":
