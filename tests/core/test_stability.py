@@ -152,3 +152,25 @@ def test_bootstrap_redoes_the_whole_method_on_each_resample():
             surface.points[chosen], surface.normals[chosen], m.lam, m.center, m.radius
         )
         assert ok and angle == pytest.approx(single.angle, abs=1e-6)
+
+
+def test_a_figure_too_large_to_compute_is_refused_before_allocating_it():
+    """A radius that takes in a whole large mesh: the measurement is made, the figure refused
+    with the limit named, before its arrays (runs × vertices) are allocated."""
+    import tracemalloc
+
+    from vg_addon.method.stability import MAX_RUN_VERTICES
+
+    shape = wedge(90.0, n=220)  # 96,800 vertices
+    surface = Surface(shape.points, shape.triangles)
+    m = surface.measure([0.0, 0.0, 0.0], 5.0)
+    assert m.n_vertices == surface.n_points
+    tracemalloc.start()
+    try:
+        with pytest.raises(GoniometerError, match=f"{MAX_RUN_VERTICES:,} run-vertices"):
+            surface.measure([0.0, 0.0, 0.0], 5.0, stability=True)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    # The measurement itself holds a few arrays of the patch; the figure would need 100 times it.
+    assert peak < 40 * m.n_vertices * 8, peak

@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from ..errors import GoniometerError
 from .algorithm import FLAT_TOLERANCE_DEG, MIN_SIDE_VERTICES
 from .fixed_order import (
     acos_degrees_array,
@@ -43,6 +44,12 @@ width; each costs about a tenth of a measurement, batched)."""
 
 BOOTSTRAP_SEED = 0
 """A fixed seed: the same measurement always gets the same figure."""
+
+MAX_RUN_VERTICES = 4_000_000
+"""The most perturbed runs times pool vertices the figure computes at once (its arrays hold a
+few dozen bytes per run and vertex: about 250 MB at this limit). 95 runs over a patch of 30,000
+vertices fit; a radius that takes in most of a large scan does not, and is refused before
+anything is allocated."""
 
 _RANK_TOLERANCE = 1e-10  # as Algorithm 1's test for a side on a line
 
@@ -348,6 +355,7 @@ def _bootstrap_steps(surface, m: Measurement, n_resamples: int, pool=None):
     """The bootstrap's batch; ``pool``: the perturbed runs' ``(ids, local, normals, split)``,
     which hold the patch, to share their features."""
     size = m.indices.size
+    _check_size(n_resamples, size)
     rng = np.random.default_rng(BOOTSTRAP_SEED)
     draws = rng.integers(0, size, size=(n_resamples, size))
     flat = (draws + size * np.arange(n_resamples)[:, None]).ravel()
@@ -428,12 +436,24 @@ def _perturbed_steps(surface, m: Measurement, center_ids, radii, lams, pool=None
     )
 
 
+def _check_size(runs: int, vertices: int) -> None:
+    """Refuse a figure larger than :data:`MAX_RUN_VERTICES`, before allocating it."""
+    if runs * vertices > MAX_RUN_VERTICES:
+        raise GoniometerError(
+            f"The stability figure would run {runs} perturbed measurements over {vertices:,} "
+            f"vertices, more than the {MAX_RUN_VERTICES:,} run-vertices it is limited to (about "
+            f"{MAX_RUN_VERTICES // runs:,} vertices around the centre): use a smaller radius, or "
+            "measure without the figure."
+        )
+
+
 def _pool(surface, m: Measurement, center_ids, radii):
     """The vertices every perturbed patch (and the measurement's own) is drawn from: sorted
     ids, coordinates relative to the centre in units of the radius, normals, and the split of
     their features for exact sums of up to all of them."""
     reach = float(np.linalg.norm(surface.points[center_ids] - m.center, axis=1).max())
     ids, _ = surface.index.ball(m.center, float(radii.max()) + reach)
+    _check_size(center_ids.size + N_BOOTSTRAP, ids.size)
     ids = np.sort(ids)
     local = (surface.points[ids] - m.center) / m.radius
     normals = surface.normals[ids]
