@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import os
 import time
 
 import bpy
@@ -14,6 +16,50 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
 from .measure import poll_measurable, typed_value
 from .progress import Progress
+
+# The CSV this session last exported or imported: what the Import dialog offers (Blender's
+# file browser would otherwise offer the .blend's own name).
+_last_csv = ""
+
+
+def _remember(path: str) -> None:
+    global _last_csv  # one value for the session, read by the next Import
+    _last_csv = path
+
+
+def offered_import_path(given: str = "") -> str:
+    """The path the Import dialog opens with: ``given`` when it is a CSV or text file (a
+    script's, or the last import's), else the last CSV this session exported or imported, else
+    the .blend's folder with no file name; ``""`` when there is none of these (the browser keeps
+    its own folder)."""
+    if os.path.splitext(given)[1].lower() in (".csv", ".txt"):
+        return given
+    if _last_csv:
+        if os.path.isfile(_last_csv):
+            return _last_csv
+        if os.path.isdir(os.path.dirname(_last_csv)):
+            return os.path.join(os.path.dirname(_last_csv), "")
+    if bpy.data.filepath:
+        return os.path.join(os.path.dirname(bpy.data.filepath), "")
+    return ""
+
+
+def own_timer_tick(operator, event) -> bool:
+    """Whether ``event`` is a tick of ``operator._timer`` not yet stepped on.
+
+    Blender's Event does not say which timer sent a TIMER event, and every running timer's
+    events reach a modal handler (another operator's, a second import's). A timer's
+    ``time_duration`` grows each time it fires, so a TIMER event is this timer's tick when that
+    has grown since the last step: one step per tick, whatever other timers run.
+    """
+    timer = getattr(operator, "_timer", None)
+    if event.type != "TIMER" or timer is None:
+        return False
+    duration = timer.time_duration
+    if duration == getattr(operator, "_stepped_at", None):
+        return False
+    operator._stepped_at = duration
+    return True
 
 
 def _path(operator) -> str:
@@ -100,6 +146,7 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
         except GoniometerError as error:
             self.report({"ERROR"}, f"{error} ({path} was not written)")
             return {"CANCELLED"}
+        _remember(path)
         stale = sum(row.stale for row in rows)
         note = f" ({stale} stale)" if stale else ""
         edges = f" and {len(edge_rows)} edge profile(s) to {csvio.edges_path_for(path)}"
@@ -144,8 +191,17 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         return poll_measurable(cls, context)
 
     def invoke(self, context, event):
+        """Open the file browser on the last exported CSV (Blender's own offer is the .blend's
+        name), showing only CSV files."""
         self.interactive = True
-        return ImportHelper.invoke(self, context, event)
+        offered = offered_import_path(
+            self.filepath if self.properties.is_property_set("filepath") else ""
+        )
+        if offered:
+            self.filepath = offered
+        self.filter_glob = "*.csv"
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
 
     def _start(self, context):
         """Read the file and prepare the steps; report and return None on a problem (an edge
@@ -172,6 +228,7 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                     f"Re-measured {len(edge_numbers)} edge profile(s) of "
                     f"{bpy.path.basename(path)} on '{obj.name}'",
                 )
+                _remember(path)
                 return {"FINISHED"}
             rows, source = measuring.read_rows(path)
             steps = measuring.replicate_steps(
@@ -193,6 +250,7 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             self.report({"ERROR"}, f"Could not read {path}: {error}")
             return None
         self._obj, self._path_name, self._steps = obj, bpy.path.basename(path), steps
+        self._full_path = path
         return steps
 
     def execute(self, context):
@@ -207,8 +265,11 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             self._timer = wm.event_timer_add(0.01, window=context.window)
             wm.modal_handler_add(self)
             return {"RUNNING_MODAL"}
-        with Progress(context, f"Re-measuring {self._path_name}") as progress:
-            return self._advance(progress, until=None)
+        self._progress = Progress(context, f"Re-measuring {self._path_name}")
+        try:
+            return self._advance(self._progress, until=None)
+        finally:
+            self._finish(context)
 
     def _advance(self, progress, until):
         """Measure rows until the time ``until`` (None: to the end); the operator's result, or
@@ -229,35 +290,57 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             f"Re-measured {len(numbers)} row(s) of {self._path_name} on '{self._obj.name}' "
             f"(measurements {numbers[0]}–{numbers[-1]})",
         )
+        _remember(self._full_path)
         return {"FINISHED"}
 
     def modal(self, context, event):
-        if event.type == "ESC":
-            self._finish(context)
-            self.report({"INFO"}, f"Import of {self._path_name} cancelled: nothing was imported.")
-            return {"CANCELLED"}
-        if event.type != "TIMER" or event.timer is not self._timer:
-            return {"RUNNING_MODAL"}
+        """A step of rows per tick of this operator's timer; Esc cancels. Whatever goes wrong
+        ends the import with nothing imported, the timer and status line removed, and a report
+        (never a traceback)."""
         try:
-            result = self._advance(self._progress, until=time.perf_counter() + self.STEP_SECONDS)
+            if event.type == "ESC":
+                self._finish(context)
+                self.report(
+                    {"INFO"}, f"Import of {self._path_name} cancelled: nothing was imported."
+                )
+                return {"CANCELLED"}
+            if not own_timer_tick(self, event):
+                return {"RUNNING_MODAL"}
+            until = time.perf_counter() + self.STEP_SECONDS
+            result = self._advance(self._progress, until=until)
         except ReferenceError:  # the object was deleted meanwhile
             result = {"CANCELLED"}
             self.report({"ERROR"}, "The object was deleted: nothing was imported.")
+        except Exception as error:  # a modal step must end cleanly, and say why
+            result = {"CANCELLED"}
+            self.report(
+                {"ERROR"},
+                f"Import of {self._path_name} failed ({type(error).__name__}: {error}): "
+                "nothing was imported.",
+            )
         if result is None:
             return {"RUNNING_MODAL"}
         self._finish(context)
         return result
 
     def cancel(self, context):
-        """Blender ends the operator (file load, window closed): nothing is imported."""
+        """Blender ends the operator (the file browser cancelled, file load, window closed):
+        nothing is imported."""
         self._finish(context)
 
     def _finish(self, context) -> None:
-        self._steps.close()
+        """End the steps, the timer and the progress display; safe to call more than once, and
+        before any of them was made (the file browser cancelled)."""
+        steps, self._steps = getattr(self, "_steps", None), None
+        if steps is not None:
+            steps.close()
         timer, self._timer = getattr(self, "_timer", None), None
         if timer is not None:
-            context.window_manager.event_timer_remove(timer)
-        self._progress.__exit__(None, None, None)
+            with contextlib.suppress(ReferenceError, RuntimeError, ValueError):
+                context.window_manager.event_timer_remove(timer)
+        progress, self._progress = getattr(self, "_progress", None), None
+        if progress is not None:
+            progress.__exit__(None, None, None)
 
 
 classes = (VG_OT_export_csv, VG_OT_import_csv)

@@ -3,12 +3,16 @@
 
 from __future__ import annotations
 
+import contextlib
+from pathlib import Path
+
 import bpy
 from bpy.props import EnumProperty, IntProperty, StringProperty
 
 from ..bridge import measurement_map
 from ..properties import BLEND_RELATIVE
 from ..vg_addon import GoniometerError
+from .csv_ops import own_timer_tick
 from .measure import poll_measured
 from .progress import Progress
 
@@ -55,20 +59,36 @@ class VG_OT_render_map(bpy.types.Operator):
         return folder
 
     def _start(self, context):
-        return measurement_map.MapJob(
-            context.active_object,
-            self._folder(),
-            views=self.views,
-            size=(self.width, self.height),
-            samples=self.samples,
-        )
+        """Make the map's job (its throwaway scene); remember whether its folder is new, so a
+        map that is not completed leaves no empty folder behind."""
+        folder = Path(self._folder())
+        self._new_folder = None if folder.exists() else folder
+        self._workspace = context.workspace
+        try:
+            self._job = measurement_map.MapJob(
+                context.active_object,
+                folder,
+                views=self.views,
+                size=(self.width, self.height),
+                samples=self.samples,
+            )
+        except BaseException:
+            self._remove_new_folder()
+            raise
+
+    def _refused(self, context, error) -> set:
+        """The map could not start (its settings, its folder): say why, keep nothing."""
+        self._stop(context, None)
+        self.report({"ERROR"}, str(error))
+        return {"CANCELLED"}
 
     def execute(self, context):
         try:
-            self._job = self._start(context)
+            self._start(context)
         except (GoniometerError, OSError) as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
+            return self._refused(context, error)
+        except Exception as error:  # whatever went wrong: keep nothing, say why
+            return self._stop(context, failure(error))
         job = self._job
         try:
             with Progress(context, f"Measurement map of '{job.obj.name}'") as progress:
@@ -76,8 +96,8 @@ class VG_OT_render_map(bpy.types.Operator):
                     progress.step(len(job.written), len(job.views))
                     job.render_next()
             job.finish()
-        except (GoniometerError, OSError, RuntimeError, ReferenceError) as error:
-            return self._stop(context, f"The map failed: {error}")
+        except Exception as error:  # whatever went wrong: keep nothing, say why
+            return self._stop(context, failure(error))
         return self._done(context)
 
     def invoke(self, context, event):
@@ -85,30 +105,39 @@ class VG_OT_render_map(bpy.types.Operator):
         if context.window is None:
             return self.execute(context)
         try:
-            self._job = self._start(context)
+            self._start(context)
         except (GoniometerError, OSError) as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
-        wm = context.window_manager
-        wm.progress_begin(0, len(self._job.views))
-        self._timer = wm.event_timer_add(0.05, window=context.window)
-        wm.modal_handler_add(self)
-        self._show_progress(context)
+            return self._refused(context, error)
+        except Exception as error:  # whatever went wrong: keep nothing, say why
+            return self._stop(context, failure(error))
+        try:
+            wm = context.window_manager
+            wm.progress_begin(0, len(self._job.views))
+            self._progress_begun = True
+            self._timer = wm.event_timer_add(0.05, window=context.window)
+            wm.modal_handler_add(self)
+            self._show_progress(context)
+        except Exception as error:  # whatever went wrong: keep nothing, say why
+            return self._stop(context, failure(error))
         return {"RUNNING_MODAL"}
 
     def modal(self, context, event):
-        if event.type == "ESC":
-            return self._stop(context, "The map was cancelled: no picture was kept.", "INFO")
-        if event.type != "TIMER" or event.timer is not self._timer:
-            return {"RUNNING_MODAL"}
+        """A view per tick of this operator's timer; Esc cancels. On a cancel or any failure the
+        pictures written, the folder made for them, the throwaway scene with its objects and
+        data, the timer and the status line are all removed, and a report says why (never a
+        traceback)."""
         try:
+            if event.type == "ESC":
+                return self._stop(context, "The map was cancelled: no picture was kept.", "INFO")
+            if not own_timer_tick(self, event):
+                return {"RUNNING_MODAL"}
             self._job.render_next()
             if not self._job.done:
                 self._show_progress(context)
                 return {"RUNNING_MODAL"}
             self._job.finish()
-        except (GoniometerError, OSError, RuntimeError, ReferenceError) as error:
-            return self._stop(context, f"The map failed: {error}")
+        except Exception as error:  # whatever went wrong: keep nothing, say why
+            return self._stop(context, failure(error))
         return self._done(context)
 
     def cancel(self, context):
@@ -120,26 +149,46 @@ class VG_OT_render_map(bpy.types.Operator):
         name = job.views[len(job.written)][0]
         text = f"Measurement map of '{job.obj.name}': {name} ({len(job.written) + 1} of "
         text += f"{len(job.views)}); Esc cancels"
-        if context.workspace is not None:
-            context.workspace.status_text_set(text)
+        if self._workspace is not None:
+            self._workspace.status_text_set(text)
         if context.window_manager.windows:
             context.window_manager.progress_update(len(job.written))
 
     def _clear_status(self, context) -> None:
-        timer = getattr(self, "_timer", None)
+        """Remove the timer, the progress cursor and the status line (of the workspace the map
+        was started in, whichever is shown now); safe to call more than once."""
+        wm = context.window_manager
+        timer, self._timer = getattr(self, "_timer", None), None
         if timer is not None:
-            context.window_manager.event_timer_remove(timer)
-            self._timer = None
-            context.window_manager.progress_end()
-        if context.workspace is not None:
-            context.workspace.status_text_set(None)
+            with contextlib.suppress(ReferenceError, RuntimeError, ValueError):
+                wm.event_timer_remove(timer)
+        if getattr(self, "_progress_begun", False):
+            self._progress_begun = False
+            with contextlib.suppress(ReferenceError, RuntimeError):
+                wm.progress_end()
+        workspace, self._workspace = getattr(self, "_workspace", None), None
+        if workspace is not None:
+            with contextlib.suppress(ReferenceError, RuntimeError, AttributeError):
+                workspace.status_text_set(None)
+
+    def _remove_new_folder(self) -> None:
+        """Remove the folder this map made, if nothing is in it."""
+        folder, self._new_folder = getattr(self, "_new_folder", None), None
+        if folder is not None:
+            with contextlib.suppress(OSError):
+                folder.rmdir()
 
     def _stop(self, context, message, level="ERROR"):
-        job = getattr(self, "_job", None)
-        if job is not None:
-            job.abort()
-            job.close()
-        self._clear_status(context)
+        """End a map that is not completed: no picture, folder, scene, timer or status line of
+        it is left; report ``message`` (None: say nothing)."""
+        job, self._job = getattr(self, "_job", None), None
+        try:
+            if job is not None:
+                job.abort()
+                job.close()
+            self._remove_new_folder()
+        finally:
+            self._clear_status(context)
         if message:
             self.report({level}, message)
         return {"CANCELLED"}
@@ -154,6 +203,14 @@ class VG_OT_render_map(bpy.types.Operator):
             f"sheet {job.sheet}",
         )
         return {"FINISHED"}
+
+
+def failure(error: BaseException) -> str:
+    """The report of a map that failed: the message of an expected error; the type too of an
+    unexpected one (a bug to report)."""
+    if isinstance(error, (GoniometerError, OSError, RuntimeError, ReferenceError)):
+        return f"The map failed: {error}"
+    return f"The map failed ({type(error).__name__}: {error}); no picture was kept."
 
 
 classes = (VG_OT_render_map,)

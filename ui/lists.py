@@ -1,4 +1,4 @@
-"""The measurement list (a UIList: it only draws)."""
+"""The measurement list and the edge-profile list (UILists: they only draw)."""
 
 import bpy
 
@@ -40,4 +40,41 @@ class VG_UL_measurements(bpy.types.UIList):
         swatches.prop(item, "color_minus", text="")
 
 
-classes = (VG_UL_measurements,)
+# Shares of an edge row: its number, then the mean angle, then the station count.
+EDGE_NUMBER_SHARE = 0.25
+EDGE_MEAN_SHARE = 0.5  # of what the number leaves
+
+
+def edge_row_texts(edge) -> tuple[str, str, str]:
+    """The three texts of an edge-profile row: ``"#number"``, the mean station angle (2
+    decimals) and the number of stations."""
+    stations = "station" if edge.n_stations == 1 else "stations"
+    return f"#{edge.number}", f"{edge.mean:.2f}°", f"{edge.n_stations} {stations}"
+
+
+def edge_changed(edge, measurements) -> bool:
+    """Whether any station of ``edge`` is stale or was deleted since the edge was measured
+    (its summary is then kept as recorded; the panel says so too)."""
+    stations = [m for m in measurements if m.edge_number == edge.number]
+    return len(stations) != edge.n_stations or any(m.stale for m in stations)
+
+
+class VG_UL_edges(bpy.types.UIList):
+    """One row per edge profile: its number, the mean angle of its stations (with a warning
+    icon when a station is stale or deleted) and how many stations it has."""
+
+    def draw_item(self, context, layout, data, item, icon, active_data, active_property, index):
+        number, mean, stations = edge_row_texts(item)
+        if self.layout_type == "GRID":
+            layout.alignment = "CENTER"
+            layout.label(text=number)
+            return
+        split = layout.split(factor=EDGE_NUMBER_SHARE, align=True)
+        split.label(text=number)
+        rest = split.split(factor=EDGE_MEAN_SHARE, align=True)
+        changed = edge_changed(item, data.measurements)
+        rest.label(text=mean, icon="ERROR" if changed else "NONE")
+        rest.label(text=stations)
+
+
+classes = (VG_UL_measurements, VG_UL_edges)

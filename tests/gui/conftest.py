@@ -6,6 +6,7 @@ package not installable) skips that root's tests with the provisioning script's 
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import shutil
@@ -33,6 +34,8 @@ POINTS = {
     "minus_in": face_point(0.15, 0.1, -1),
     "plus_out": face_point(0.15, 0.8, +1),
     "minus_out": face_point(0.15, 0.8, -1),
+    # Along the crease, for edge profiles clicked start to end.
+    **{f"crease_{round(10 * x):+d}": [x, 0.0, 0.0] for x in (-0.7, -0.5, 0.0, 0.1, 0.5, 0.7)},
 }
 
 
@@ -76,6 +79,23 @@ def blender_root(suite: str) -> None:
         pytest.skip(f"no real Blender from Debian {suite}: {_provisioned[suite]}")
 
 
+@pytest.fixture(autouse=True)
+def console_stays_clean(request):
+    """Every GUI test fails on a Python traceback or error from the extension in Blender's
+    console (a failing draw, a modal operator that raised, a list class not found) printed
+    while it ran, even when what it asserts came out right."""
+    if "gui" not in request.fixturenames:
+        yield
+        return
+    session = request.getfixturevalue("gui")
+    start = session.log_size()
+    yield
+    with contextlib.suppress(Exception):
+        session.settle(3)  # let Blender redraw, and print what a redraw prints
+    errors = session.console_errors(start)
+    assert not errors, "Blender's console has errors from the extension:\n" + "\n".join(errors)
+
+
 @pytest.fixture(scope="module", params=SUITES)
 def gui(request, extension_zip):
     """A GUI Blender of one Debian suite, extension installed, the wedge scene set up."""
@@ -86,5 +106,7 @@ def gui(request, extension_zip):
         yield session
     finally:
         session.close()
-        if request.session.testsfailed == failed_before:  # keep screenshots and logs of failures
+        # Keep screenshots and logs of failures (a console error found in the last test's
+        # teardown is not counted yet).
+        if request.session.testsfailed == failed_before and not session.console_errors():
             shutil.rmtree(session.tmp, ignore_errors=True)

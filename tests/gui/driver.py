@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import select
 import shlex
 import shutil
@@ -26,6 +27,7 @@ ROOT_SCRIPT = REPO / "scripts" / "blender_root.sh"
 SCREEN = (1280, 1800)  # tall: the whole sidebar shows without scrolling
 GUEST_REPO, GUEST_TMP = "/vg/repo", "/vg/tmp"
 END = "__vg_end__"
+EXTENSION_PACKAGE = "virtual_goniometer"  # in every path and module name of the installed zip
 
 
 class RootShell:
@@ -151,9 +153,12 @@ class GuiBlender:
                 raise RuntimeError("Xvfb did not start: " + (self.tmp / "xvfb.log").read_text())
             time.sleep(0.1)
         self.display = ":" + display.read_text().strip()
+        # Console output line by line (stdbuf, PYTHONUNBUFFERED), so a warning Blender prints on
+        # stdout stands beside the source line it prints on stderr (console_errors reads both).
         run(
             f"DISPLAY={self.display} VG_GUI_SCENE={self.scene} VG_GUI_STATE={GUEST_TMP}/state.json "
-            f"VG_GUI_POINTS={GUEST_TMP}/points.json blender -p 0 0 {width} {height} "
+            f"VG_GUI_POINTS={GUEST_TMP}/points.json PYTHONUNBUFFERED=1 "
+            f"stdbuf -oL -eL blender -p 0 0 {width} {height} "
             f"--python {GUEST_REPO}/tests/gui/harness_startup.py "
             f">{GUEST_TMP}/blender.log 2>&1 & echo $! >{GUEST_TMP}/blender.pid"
         )
@@ -170,6 +175,21 @@ class GuiBlender:
     def log(self) -> str:
         path = self.tmp / "blender.log"
         return path.read_text(errors="replace")[-4000:] if path.exists() else ""
+
+    def log_size(self) -> int:
+        """How far Blender's console output (stdout and stderr) has come, in bytes."""
+        path = self.tmp / "blender.log"
+        return path.stat().st_size if path.exists() else 0
+
+    def console_errors(self, since: int = 0) -> list[str]:
+        """The extension's complaints in Blender's console after byte ``since``
+        (:func:`extension_errors`)."""
+        path = self.tmp / "blender.log"
+        if not path.exists():
+            return []
+        with path.open("rb") as handle:
+            handle.seek(since)
+            return extension_errors(handle.read().decode(errors="replace"))
 
     # -- reading Blender's state -------------------------------------------------------------
     def state(self) -> dict:
@@ -269,6 +289,73 @@ class GuiBlender:
                     return x, y
         raise LookupError(f"no button copying {copied!r} in the {region} region")
 
+    # -- the sidebar ---------------------------------------------------------------------------
+    def open_goniometer_tab(self) -> None:
+        """Spend the swallowed first click on the sidebar's empty foot, then click the sidebar's
+        tabs (on its right edge) until the Goniometer tab is active, as a user would (in Blender
+        4.3 the tab cannot be set from Python)."""
+        left, top, width, height = self.state()["regions"]["UI"]
+        self.click((left + width // 2, top + height - 15))
+        for y in range(top + 10, top + height - 10, 12):
+            if self.state()["sidebar_category"] == "Goniometer":
+                return
+            self.click((left + width - 12, y))
+        if self.state()["sidebar_category"] != "Goniometer":
+            raise LookupError("no Goniometer tab on the sidebar")
+
+    def open_panel_with(self, copied: str, below: float) -> tuple[float, float]:
+        """Open the closed sidebar panel (below screen row ``below``) holding the button whose
+        Ctrl+C copies ``copied``; return that button's position. The closed panels' headers are
+        found by their disclosure triangles and tried in turn (a row where Ctrl+C copies
+        something is a button, not a header); a wrong one is closed again."""
+        region = self.state()["regions"]["UI"]
+        left, _top, width, _height = region
+        x = left + width // 3
+        for header in closed_headers(self.screenshot("panels"), region, below):
+            if self.copies((x, header)):
+                continue
+            self.click((x, header))
+            try:
+                return self.find_button("UI", copied, rows=range(header + 10, header + 90, 8))
+            except LookupError:
+                self.click((x, header))  # not this one: back as it was
+        raise LookupError(f"no closed panel below row {below} with a button copying {copied!r}")
+
+    def scroll_sidebar(self, clicks: int) -> None:
+        """Turn the mouse wheel over the sidebar: ``clicks`` notches down (negative: up)."""
+        left, top, width, height = self.state()["regions"]["UI"]
+        self.move((left + width // 2, top + height // 2))
+        button = "5" if clicks > 0 else "4"
+        self.xdotool("click", "--repeat", str(abs(clicks)), "--delay", "40", button)
+        self.settle()
+
+    def open_last_panel_with(self, copied: str) -> tuple[float, float]:
+        """Open the sidebar's last panel (scrolled to the end, the last header at its foot) and
+        return the position of its button whose Ctrl+C copies ``copied`` (the sidebar is
+        scrolled to the end again, so the whole panel shows)."""
+        self.scroll_sidebar(30)
+        left, top, width, height = region = self.state()["regions"]["UI"]
+        bottom = top + height
+        headers = closed_headers(self.screenshot("panels"), region, bottom - 160)
+        if not headers:
+            raise LookupError("no panel header at the foot of the sidebar")
+        self.click((left + width // 3, headers[-1]))
+        self.scroll_sidebar(30)
+        return self.find_button("UI", copied, upward=True, rows=range(bottom - 240, bottom - 4, 6))
+
+    def list_span(self, copied: str, rows: range) -> list[int]:
+        """The screen rows (y) of ``rows`` over which a UI list in the sidebar shows: where
+        Ctrl+Shift+C copies the list's active-index property (``copied``, e.g.
+        ``"active_edge_index"``; every row of a list copies the same), hovered in turn."""
+        left, _top, width, _height = self.state()["regions"]["UI"]
+        x = left + width // 3
+        return [
+            y
+            for y in rows
+            if (text := self.copies((x, y), key="ctrl+shift+c")) is not None
+            and text.endswith(copied)
+        ]
+
     # -- pictures ----------------------------------------------------------------------------
     def screenshot(self, name: str = "shot") -> np.ndarray:
         """The whole X screen as an (height, width, 3) uint8 array (also kept as ``name``.ppm)."""
@@ -327,3 +414,48 @@ def read_ppm(path: Path) -> np.ndarray:
         raise ValueError(f"{path}: not an 8-bit binary PPM")
     pixels = np.frombuffer(data, dtype=np.uint8, count=width * height * 3, offset=position + 1)
     return pixels.reshape(height, width, 3)
+
+
+def closed_headers(shot, region, below: float) -> list[int]:
+    """Screen rows of the panel headers in the sidebar below row ``below``: the rows where a
+    disclosure triangle shows in the column just inside the panels' left edge."""
+    left, top, _width, height = (int(v) for v in region)
+    band = shot[int(below) + 12 : top + height, left + 18 : left + 36].min(axis=2) > 140
+    rows = np.flatnonzero(band.any(axis=1)) + int(below) + 12
+    if rows.size == 0:
+        return []
+    groups = np.split(rows, np.flatnonzero(np.diff(rows) > 8) + 1)
+    return [int(group.mean()) for group in groups]
+
+
+_TRACEBACK = "Traceback (most recent call last)"
+_COMPLAINT = re.compile(r"error|warn|traceback|not found|exception", re.IGNORECASE)
+_EXTENSION_NAME = re.compile(rf"{EXTENSION_PACKAGE}|\bVG_[A-Z]+_\w+|\bvg\.[a-z_]+\(")
+_SOURCE_LINE = re.compile(rf"{EXTENSION_PACKAGE}/\S+\.py:\d+")
+
+
+def extension_errors(text: str) -> list[str]:
+    """Blender's console complaints about the extension in ``text``: each Python traceback
+    with a frame in the extension's package (with its exception line), each line naming the
+    extension (its package, a ``VG_*`` class, a ``vg.*(`` call) that says error, warning,
+    traceback, exception or "not found", and each bare ``file.py:line`` of the extension that
+    Blender prints under an RNA warning (with the warning line before it)."""
+    lines = text.splitlines()
+    found, index = [], 0
+    while index < len(lines):
+        line = lines[index]
+        if _TRACEBACK in line:
+            end = index + 1
+            while end < len(lines) and (lines[end].startswith((" ", "\t")) or not lines[end]):
+                end += 1
+            block = lines[index : end + 1]
+            if any(EXTENSION_PACKAGE in row for row in block):
+                found.append("\n".join(block))
+            index = end + 1
+            continue
+        if _SOURCE_LINE.search(line) and not line.lstrip().startswith("File "):
+            found.append("\n".join(lines[max(index - 1, 0) : index + 1]))
+        elif _EXTENSION_NAME.search(line) and _COMPLAINT.search(line):
+            found.append(line)
+        index += 1
+    return found

@@ -6,9 +6,11 @@ bone fragment of the README's pictures, its break sites written to ``$VG_GUI_POI
 writes what the test needs to read to ``$VG_GUI_STATE`` (JSON, replaced atomically): the
 measurements of every mesh object with their exact numbers, the active tool, the 3D view's
 regions in X screen pixels, the sidebar's tab, the 3D cursor, the running drag (found by
-looking, read-only, at the live ``DragSession`` objects), what a Ctrl+Shift+C copied, and the
-regions of an open file browser, the
-screen positions of the 3D points listed in ``$VG_GUI_POINTS``.
+looking, read-only, at the live ``DragSession`` objects), what a Ctrl+Shift+C copied, the
+regions of an open file browser and what it offers (folder, file name, filter), the screen
+positions of the 3D points listed in ``$VG_GUI_POINTS``, each mesh's edge profiles and active
+list rows, the scenes and every "VG Map" data-block in the file, the window's running modal
+operators and the .blend's path.
 """
 
 from __future__ import annotations
@@ -52,11 +54,23 @@ def _regions(window, area) -> dict:
 
 
 def _file_browser() -> dict | None:
-    """The regions of an open file browser (its own window, or an area of the main one)."""
+    """The regions of an open file browser (its own window, or an area of the main one), and
+    what it offers: its folder, the file name field and the filter."""
     for window in bpy.context.window_manager.windows:
         for area in window.screen.areas:
             if area.type == "FILE_BROWSER":
-                return _regions(window, area)
+                regions = _regions(window, area)
+                params = area.spaces.active.params
+                if params is not None:
+                    regions["params"] = {
+                        "directory": params.directory.decode(errors="replace")
+                        if isinstance(params.directory, bytes)
+                        else params.directory,
+                        "filename": params.filename,
+                        "filter_glob": params.filter_glob,
+                        "use_filter": params.use_filter,
+                    }
+                return regions
     return None
 
 
@@ -85,7 +99,9 @@ def _drag(window, area):
     region = next(r for r in area.regions if r.type == "WINDOW")
     region_3d = area.spaces.active.region_3d
     for obj in gc.get_objects():
-        if isinstance(obj, drag.DragSession):
+        # type(), not isinstance(): an ended operator's Python object raises ReferenceError on
+        # any attribute look-up, __class__ included.
+        if type(obj) is drag.DragSession:
             machine = obj.machine
             if machine.phase.name == "DRAGGING":
                 centre = Vector(machine.center)
@@ -125,8 +141,37 @@ def _objects(scene_) -> dict:
                 }
                 for item in obj.vg.measurements
             ],
+            "active_index": obj.vg.active_index,
+            "edges": [
+                {
+                    "number": edge.number,
+                    "break_number": edge.break_number,
+                    "n_stations": edge.n_stations,
+                    "mean": edge.mean,
+                }
+                for edge in obj.vg.edges
+            ],
+            "active_edge_index": obj.vg.active_edge_index,
         }
     return objects
+
+
+def _map_blocks() -> list[str]:
+    """Every data-block of the measurement map's throwaway scene still in the file."""
+    names = []
+    for collection in (
+        bpy.data.scenes,
+        bpy.data.objects,
+        bpy.data.meshes,
+        bpy.data.cameras,
+        bpy.data.lights,
+        bpy.data.worlds,
+        bpy.data.materials,
+        bpy.data.curves,
+        bpy.data.images,
+    ):
+        names += [block.name for block in collection if block.name.startswith("VG Map")]
+    return names
 
 
 def _setup(window) -> None:
@@ -172,6 +217,10 @@ def _tick():
             "drag": _drag(window, area) if area else None,
             "points": _projections(window, area) if area else {},
             "clipboard": _status["clipboard"][-20:],
+            "blend": bpy.data.filepath,
+            "scenes": [s.name for s in bpy.data.scenes],
+            "map_blocks": _map_blocks(),
+            "modal_operators": [op.bl_idname for op in window.modal_operators],
             "errors": _status["errors"][-5:],
         }
     except Exception:

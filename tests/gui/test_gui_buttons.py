@@ -1,0 +1,265 @@
+"""The panel's file-browser, modal and list buttons in a real Blender window, pressed with real
+mouse and key events (xdotool): CSV Import (Re-measure), Render Map, the Edge Profiles list.
+
+One GUI Blender per Debian suite (trixie: Blender 4.3, unstable: 5.2) on the 100° wedge of
+``scene.py``, the tests in file order on that one window, as one user session: measure, save the
+.blend, export, re-import, trace three edge profiles and pick them in their list, cancel and
+render the map. Every test also fails on an error from the extension in Blender's console
+(``conftest.console_stays_clean``). ``VG_GUI_PICTURES=DIR`` keeps the screenshots and the map.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+OBJ = "Wedge"
+WEDGE_ANGLE = 100.0
+VIEWS = ("front", "back", "right", "left", "top", "bottom")
+# Three edge profiles along the crease (start, end: points of conftest.POINTS).
+EDGES = (("crease_-7", "crease_+5"), ("crease_-5", "crease_+1"), ("crease_+0", "crease_+7"))
+
+
+# -- helpers -------------------------------------------------------------------------------------
+def point(gui, name: str) -> tuple[float, float]:
+    xy = gui.state()["points"][name]
+    assert xy is not None, f"{name} is not in view"
+    return tuple(xy)
+
+
+def measurements(gui) -> list[dict]:
+    return gui.measurements(OBJ)
+
+
+def keep_picture(path: Path) -> None:
+    """Copy a picture to ``$VG_GUI_PICTURES`` (when set), named after the Blender build."""
+    folder = os.environ.get("VG_GUI_PICTURES")
+    if folder:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        shutil.copy(path, Path(folder) / path.name)
+
+
+def sidebar_shot(gui, name: str, top: float, height: float) -> Path:
+    """A screenshot of the sidebar from screen row ``top``, ``height`` rows, kept as PNG."""
+    left, region_top, width, region_height = gui.state()["regions"]["UI"]
+    top = max(top, region_top)
+    height = min(height, region_top + region_height - top)
+    path = gui.tmp / f"{name}_{gui.suite}.png"
+    gui.save_png(name, path, crop=(left, top, width, height))
+    keep_picture(path)
+    return path
+
+
+def window_shot(gui, name: str) -> Path:
+    """A screenshot of the whole window, kept as PNG."""
+    path = gui.tmp / f"{name}_{gui.suite}.png"
+    gui.save_png(name, path)
+    keep_picture(path)
+    return path
+
+
+def open_browser(gui, button) -> dict:
+    gui.click(button)
+    return gui.wait_for(lambda s: s["file_browser"], 20, "the file browser")["file_browser"]
+
+
+def press_browser_button(gui, browser) -> None:
+    """Click the file browser's confirm button (bottom right) and wait for it to close."""
+    left, top, width, height = browser["EXECUTE"]
+    gui.click((left + width - 60, top + height / 2))
+    gui.wait_for(lambda s: s["file_browser"] is None, 20, "the file browser to close")
+
+
+def type_file_name(gui, browser, name: str) -> None:
+    """Type ``name`` into the file browser's file name field, as a user would."""
+    left, top, width, height = browser["EXECUTE"]
+    gui.click((left + width * 0.3, top + height / 2))  # edits the field, its text selected
+    gui.key("ctrl+a")
+    gui.type_text(name)
+    gui.key("Return")
+
+
+def map_running(state) -> bool:
+    return any("render_map" in op.lower() for op in state["modal_operators"])
+
+
+def home(gui) -> Path:
+    return gui.tmp / "home"
+
+
+# -- the session ---------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def places(gui):
+    """Screen places found once per window and shared by the tests (filled as they go)."""
+    return {}
+
+
+def test_goniometer_tab_and_two_measurements(gui, places):
+    gui.open_goniometer_tab()
+    measure = gui.find_button("UI", "vg.measure_xyz")
+    for name in ("crease_left", "crease"):
+        before = len(measurements(gui))
+        gui.click(point(gui, name), button=3, modifier="shift")  # the 3D cursor on the crease
+        gui.click(measure)
+        gui.wait_for(lambda s, n=before: len(s["objects"][OBJ]["measurements"]) == n + 1, 20, "")
+    items = measurements(gui)
+    assert len(items) == 2
+    assert all(abs(item["exact"]["angle"] - WEDGE_ANGLE) < 1e-6 for item in items)
+
+
+def test_save_the_blend_with_ctrl_s(gui):
+    """Ctrl+S in an unsaved file: the file browser, its Save button; the map's default folder
+    (//vg_map) and the Import dialog's offer now have a .blend beside them."""
+    gui.move(point(gui, "plus_out"))
+    gui.key("ctrl+s")
+    browser = gui.wait_for(lambda s: s["file_browser"], 20, "the save file browser")
+    press_browser_button(gui, browser["file_browser"])
+    state = gui.wait_for(lambda s: s["blend"], 20, "the .blend to be saved")
+    assert Path(state["blend"]).suffix == ".blend"
+
+
+def test_export_through_the_file_browser(gui, places):
+    note = gui.find_button("UI", ".note", step=10, key="ctrl+shift+c", upward=True)
+    export = gui.open_panel_with("vg.export_csv", below=note[1])
+    before = {p.name for p in home(gui).glob("*.csv")}
+    press_browser_button(gui, open_browser(gui, export))
+
+    def written(_state):
+        return sorted(set(p.name for p in home(gui).glob("*.csv")) - before)
+
+    gui.wait_for(written, 20, "the exported CSV")
+    (name,) = written(None)
+    places["csv"] = home(gui) / name
+    places["export"] = export
+    with places["csv"].open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [float(row["Angle"]) for row in rows] == [m["exact"]["angle"] for m in measurements(gui)]
+
+
+def test_import_dialog_offers_the_exported_csv_filtered_to_csv(gui, places):
+    """Issue 20, item 9: the Import dialog offers the last exported CSV, not the .blend, and
+    shows only *.csv files."""
+    export = places["export"]
+    places["import"] = gui.find_button(
+        "UI", "vg.import_csv", rows=range(export[1], export[1] + 60, 6)
+    )
+    browser = open_browser(gui, places["import"])
+    params = browser["params"]
+    gui.key("Escape")
+    gui.wait_for(lambda s: s["file_browser"] is None, 20, "the file browser to close")
+    assert params["filename"] == places["csv"].name
+    assert Path(params["directory"]).resolve() == Path("/vg/tmp/home").resolve()
+    assert params["filter_glob"] == "*.csv"
+    assert params["use_filter"]
+
+
+def test_import_remeasures_every_row_through_the_file_browser(gui, places):
+    """Issue 20, item 1: Import (Re-measure) from the panel, the CSV chosen in the file browser:
+    every row is measured again, and the angles are the exported ones, exactly."""
+    with places["csv"].open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    before = measurements(gui)
+    browser = open_browser(gui, places["import"])
+    if browser["params"]["filename"] != places["csv"].name:  # choose it, as a user would
+        type_file_name(gui, browser, places["csv"].name)
+    if gui.state()["file_browser"] is not None:
+        press_browser_button(gui, gui.state()["file_browser"])
+    gui.wait_for(
+        lambda s: (
+            len(s["objects"][OBJ]["measurements"]) == len(before) + len(rows)
+            or not any("import_csv" in op.lower() for op in s["modal_operators"])
+        ),
+        60,
+        "the import to end",
+    )
+    items = gui.settle()["objects"][OBJ]["measurements"]
+    assert len(items) == len(before) + len(rows), "every row of the CSV was re-measured"
+    again = items[len(before) :]
+    assert [m["exact"]["angle"] for m in again] == [float(row["Angle"]) for row in rows]
+    assert [m["exact"]["angle"] for m in again] == [m["exact"]["angle"] for m in before]
+    assert [m["exact"]["center"] for m in again] == [m["exact"]["center"] for m in before]
+    assert not any("import_csv" in op.lower() for op in gui.state()["modal_operators"])
+
+
+def test_edge_profiles_list_shows_each_edge_and_picks_by_click(gui, places):
+    """Issue 20, item 3: three edge profiles traced with the Edge Profile button (click start,
+    click end, Enter); their list draws a row for each, and clicking a row selects that edge."""
+    button = gui.find_button("UI", "vg.measure_edge", upward=True)
+    for start, end in EDGES:
+        count = len(gui.state()["objects"][OBJ]["edges"])
+        # The Selected panel above changes once a station is selected (a row more, no
+        # stability rows): find the button again.
+        y = int(button[1])
+        button = gui.find_button("UI", "vg.measure_edge", rows=range(y - 160, y + 100, 6))
+        gui.click(button)
+        gui.click(point(gui, start))
+        gui.click(point(gui, end))
+        gui.key("Return")
+        gui.wait_for(lambda s, n=count: len(s["objects"][OBJ]["edges"]) == n + 1, 60, "an edge")
+    edges = gui.settle()["objects"][OBJ]["edges"]
+    assert len(edges) == len(EDGES)
+    assert all(abs(edge["mean"] - WEDGE_ANGLE) < 1e-6 for edge in edges)
+    # The list is below the button and its hint line: where hovering copies its index
+    # property. Clicking down it selects each edge in turn, top to bottom.
+    below = int(button[1])
+    span = gui.list_span("active_edge_index", range(below + 16, below + 170, 4))
+    shot = sidebar_shot(gui, "edge_list", below - 100, 420)
+    assert span, f"no edge list is drawn ({shot})"
+    left, _top, width, _height = gui.state()["regions"]["UI"]
+    picked = {}  # edge index -> the screen rows whose click selected it
+    for y in range(span[0] + 2, span[-1] - 1, 5):
+        gui.click((left + width // 3, y))
+        picked.setdefault(gui.settle()["objects"][OBJ]["active_edge_index"], []).append(y)
+    assert sorted(picked) == list(range(len(EDGES))), f"rows clicked: {picked} ({shot})"
+    middles = [float(np.mean(picked[index])) for index in range(len(EDGES))]
+    assert middles == sorted(middles), "the edges are listed in order, one row each"
+    # Each row shows its texts (number, mean angle, stations): bright pixels in every row.
+    picture = gui.screenshot("edge_rows")
+    for index, y in enumerate(middles):
+        band = picture[int(y) - 6 : int(y) + 6, int(left) + 10 : int(left + width) - 60]
+        assert (band.min(axis=2) > 170).sum() > 20, f"row {index + 1} has no text ({shot})"
+
+
+def test_render_map_cancelled_with_escape_keeps_nothing(gui, places):
+    """Issue 20, item 2: Esc while the map renders: no picture, no folder it made, no "VG Map"
+    scene or data-block left in the file, the operator ended."""
+    render = gui.open_last_panel_with("vg.render_map")  # the sidebar is full: scrolled down
+    places["render"] = render
+    folder = home(gui) / "vg_map"
+    assert not folder.exists()
+    gui.click(render)
+    gui.wait_for(lambda s: "VG Map" in s["scenes"], 60, "the map's scene")
+    gui.key("Escape")
+    state = gui.wait_for(lambda s: not map_running(s), 120, "the map to be cancelled")
+    window_shot(gui, "map_cancelled")  # the status bar: no "Esc cancels" left
+    assert state["map_blocks"] == []
+    assert state["scenes"] == ["Scene"]
+    assert not folder.exists() or not any(folder.iterdir()), "a cancelled map keeps no picture"
+    assert not folder.exists(), "the folder the cancelled map made is removed"
+
+
+def test_render_map_writes_every_view_and_leaves_no_scene(gui, places):
+    """Issue 20, item 2: Render Map from the panel writes a PNG per view and the contact sheet
+    into //vg_map, and leaves nothing of its scene in the file."""
+    folder = home(gui) / "vg_map"
+    gui.click(places["render"])
+    gui.wait_for(
+        lambda s: map_running(s) or "VG Map" in s["scenes"] or folder.exists(), 30, "the map"
+    )
+    state = gui.wait_for(lambda s: not map_running(s), 600, "the map to be rendered")
+    window_shot(gui, "map_done")
+    assert state["map_blocks"] == []
+    assert state["scenes"] == ["Scene"]
+    expected = {f"{OBJ}_map_{view}.png" for view in VIEWS} | {f"{OBJ}_map.png"}
+    assert {p.name for p in folder.iterdir()} == expected
+    for name in expected:
+        data = (folder / name).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 2000, name
+    sheet = gui.tmp / f"map_{gui.suite}.png"
+    shutil.copy(folder / f"{OBJ}_map.png", sheet)
+    keep_picture(sheet)
