@@ -9,7 +9,6 @@ from pathlib import Path
 import bpy
 
 from ..bridge import measurement_map
-from ..vg_addon import GoniometerError
 from .outputs import refuse_input
 from .stdio import quiet_stdout
 
@@ -47,14 +46,9 @@ class NamedMap(measurement_map.MapJob):
         refuse_input(path, self.inputs)
         return path
 
-    def finish(self) -> Path:
-        if not self.done:
-            raise GoniometerError("The map is not complete: render every view first.")
+    def sheet_path(self) -> Path:
         sheet = self.directory / f"{self.stem}_map.png"
         refuse_input(sheet, self.inputs)
-        self.sheet = sheet
-        columns = 3 if len(self.written) > 2 else 2
-        measurement_map.write_contact_sheet(self.written, sheet, columns=columns)
         return sheet
 
 

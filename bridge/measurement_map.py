@@ -17,6 +17,9 @@ Everything made for the render is removed afterwards, whatever happens.
 from __future__ import annotations
 
 import contextlib
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import bpy
@@ -62,6 +65,10 @@ class MapJob:
     Use :meth:`render_next` until :attr:`done`, then :meth:`finish`; call :meth:`close` on
     every way out (it removes the throwaway scene), and :meth:`abort` to remove the pictures
     written so far when the map is not completed.
+
+    The views are rendered into a hidden folder inside ``directory`` and moved into place, each
+    replacing its file atomically, only when :meth:`finish` has made the contact sheet: a map
+    cancelled or failed half-way leaves an earlier map in the same folder as it was.
     """
 
     def __init__(self, obj, directory, *, views="SIX", size=(800, 600), samples=16):
@@ -86,6 +93,7 @@ class MapJob:
         self._scene = None
         self._label_objects: list = []
         self.directory.mkdir(parents=True, exist_ok=True)
+        self._staging: Path | None = Path(tempfile.mkdtemp(prefix=".vg-map-", dir=self.directory))
         try:
             self._build_scene()
         except BaseException:
@@ -98,9 +106,17 @@ class MapJob:
         return len(self.written) == len(self.views)
 
     def picture_path(self, view_name: str) -> Path:
+        """Where the picture of a view ends up."""
         return (
             self.directory / f"{safe_file_name(self.obj.name)}_map_{safe_file_name(view_name)}.png"
         )
+
+    def sheet_path(self) -> Path:
+        """Where the contact sheet ends up."""
+        return self.directory / f"{safe_file_name(self.obj.name)}_map.png"
+
+    def _staged(self, path: Path) -> Path:
+        return self._staging / path.name
 
     # -- the throwaway scene ------------------------------------------------------------------
 
@@ -206,7 +222,8 @@ class MapJob:
         return right, up, back, centre, front, scale
 
     def render_next(self) -> Path:
-        """Render the next view into its PNG; returns its path."""
+        """Render the next view into its PNG; returns where the picture is now (the job's hidden
+        folder, until :meth:`finish` moves it to :meth:`picture_path`)."""
         if self.done:
             raise GoniometerError("Every view of this map is rendered already.")
         name, look, up = self.views[len(self.written)]
@@ -223,13 +240,14 @@ class MapJob:
         self._sun.rotation_euler = Vector(-key).to_track_quat("-Z", "Y").to_euler()
         self._place_labels(name, right, up, back, centre, front, scale, rotation)
         path = self.picture_path(name)
+        staged = self._staged(path)
         scene = self._scene
-        scene.render.filepath = str(path.resolve())
+        scene.render.filepath = str(staged.resolve())
         bpy.ops.render.render(write_still=True, scene=scene.name)
-        if not path.is_file():
-            raise GoniometerError(f"Cycles wrote no picture to {path}.")
+        if not staged.is_file():
+            raise GoniometerError(f"Cycles wrote no picture to {staged}.")
         self.written.append(path)
-        return path
+        return staged
 
     def _visible(self, label, look) -> bool:
         """Whether the camera looking along ``look`` sees ``label``'s centre: a ray along
@@ -339,19 +357,32 @@ class MapJob:
     # -- the end ----------------------------------------------------------------------------------
 
     def finish(self) -> Path:
-        """Write the contact sheet of every view; returns its path."""
+        """Write the contact sheet of every view and move the pictures into place; returns the
+        sheet's path."""
         if not self.done:
             raise GoniometerError("The map is not complete: render every view first.")
-        self.sheet = self.directory / f"{safe_file_name(self.obj.name)}_map.png"
-        write_contact_sheet(self.written, self.sheet, columns=3 if len(self.written) > 2 else 2)
-        return self.sheet
+        sheet = self.sheet_path()
+        columns = 3 if len(self.written) > 2 else 2
+        write_contact_sheet(
+            [self._staged(p) for p in self.written], self._staged(sheet), columns=columns
+        )
+        for path in [*self.written, sheet]:
+            os.replace(self._staged(path), path)
+        self.sheet = sheet
+        self._remove_staging()
+        return sheet
 
     def abort(self) -> None:
-        """Remove the pictures this job wrote (a cancelled map leaves nothing half-done)."""
-        for path in [*self.written, *([self.sheet] if self.sheet else [])]:
-            with contextlib.suppress(OSError):
-                path.unlink()
-        self.written, self.sheet = [], None
+        """Remove the pictures of a map not finished (a cancelled map leaves nothing half-done,
+        and an earlier map in the folder as it was); a finished map stays."""
+        self._remove_staging()
+        if self.sheet is None:
+            self.written = []
+
+    def _remove_staging(self) -> None:
+        staging, self._staging = self._staging, None
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
 
     def _remove(self, block) -> None:
         with contextlib.suppress(ReferenceError, RuntimeError):
@@ -370,6 +401,8 @@ class MapJob:
 
     def close(self) -> None:
         """Remove everything made for the render (safe to call more than once)."""
+        if self.sheet is None:
+            self._remove_staging()
         made, self._made, self._label_objects = self._made, [], []
         # Objects first, then their data, the scene last but one: each removal is allowed.
         order = sorted(
