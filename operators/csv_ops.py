@@ -15,7 +15,7 @@ from ..bridge.mesh_data import check_measurable
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
 from .measure import poll_measurable, typed_value
-from .progress import Progress
+from .progress import Progress, own_timer_tick
 
 # The CSV this session last exported or imported: what the Import dialog offers (Blender's
 # file browser would otherwise offer the .blend's own name).
@@ -42,24 +42,6 @@ def offered_import_path(given: str = "") -> str:
     if bpy.data.filepath:
         return os.path.join(os.path.dirname(bpy.data.filepath), "")
     return ""
-
-
-def own_timer_tick(operator, event) -> bool:
-    """Whether ``event`` is a tick of ``operator._timer`` not yet stepped on.
-
-    Blender's Event does not say which timer sent a TIMER event, and every running timer's
-    events reach a modal handler (another operator's, a second import's). A timer's
-    ``time_duration`` grows each time it fires, so a TIMER event is this timer's tick when that
-    has grown since the last step: one step per tick, whatever other timers run.
-    """
-    timer = getattr(operator, "_timer", None)
-    if event.type != "TIMER" or timer is None:
-        return False
-    duration = timer.time_duration
-    if duration == getattr(operator, "_stepped_at", None):
-        return False
-    operator._stepped_at = duration
-    return True
 
 
 def _path(operator) -> str:

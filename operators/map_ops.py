@@ -12,9 +12,8 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 from ..bridge import measurement_map
 from ..properties import BLEND_RELATIVE
 from ..vg_addon import GoniometerError
-from .csv_ops import own_timer_tick
 from .measure import poll_measured
-from .progress import Progress
+from .progress import Progress, own_timer_tick
 
 VIEW_ITEMS = (
     ("SIX", "Six Views", "Front, back, right, left, top and bottom, orthographic"),

@@ -1,5 +1,5 @@
 """Progress of a long operation, in Blender's way: the window manager's progress cursor and a
-status-bar message, both removed on every way out."""
+status-bar message, both removed on every way out; and the timer steps of a modal operator."""
 
 from __future__ import annotations
 
@@ -53,3 +53,21 @@ class Progress:
         if self.workspace is not None:
             with contextlib.suppress(AttributeError, ReferenceError, RuntimeError):
                 self.workspace.status_text_set(None)
+
+
+def own_timer_tick(operator, event) -> bool:
+    """Whether ``event`` is a tick of ``operator._timer`` not yet stepped on.
+
+    Blender's Event does not say which timer sent a TIMER event, and every running timer's
+    events reach a modal handler (another operator's, a second import's). A timer's
+    ``time_duration`` grows each time it fires, so a TIMER event is this timer's tick when that
+    has grown since the last step: one step per tick, whatever other timers run.
+    """
+    timer = getattr(operator, "_timer", None)
+    if event.type != "TIMER" or timer is None:
+        return False
+    duration = timer.time_duration
+    if duration == getattr(operator, "_stepped_at", None):
+        return False
+    operator._stepped_at = duration
+    return True

@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 from conftest import POINTS
-from driver import GUEST_REPO, GUEST_TMP
+from driver import GUEST_REPO, GUEST_TMP, closed_headers
 
 OBJ = "Wedge"
 TOOL = "vg.measure_drag_tool"
@@ -75,18 +75,6 @@ def drag_measure(gui, distance: float = 70.0) -> dict:
     items = gui.measurements(OBJ)
     assert len(items) == before + 1, "a drag released in the viewport records one measurement"
     return items[-1]
-
-
-def closed_headers(shot, region, below: float) -> list[int]:
-    """Screen rows of the panel headers in the sidebar below row ``below``: the rows where a
-    disclosure triangle shows in the column just inside the panels' left edge."""
-    left, top, _width, height = (int(v) for v in region)
-    band = shot[int(below) + 12 : top + height, left + 18 : left + 36].min(axis=2) > 140
-    rows = np.flatnonzero(band.any(axis=1)) + int(below) + 12
-    if rows.size == 0:
-        return []
-    groups = np.split(rows, np.flatnonzero(np.diff(rows) > 8) + 1)
-    return [int(group.mean()) for group in groups]
 
 
 # -- the tests -----------------------------------------------------------------------------------
