@@ -368,6 +368,10 @@ def check_args(args) -> None:
     check_edge_points(args.edge)
     if args.sweep:
         start, stop, count = args.sweep
+        if not all(math.isfinite(value) for value in args.sweep):
+            raise UsageError(
+                f"--sweep R0 R1 N: every value must be a finite number (got {args.sweep})."
+            )
         if count != int(count):
             raise UsageError(f"--sweep R0 R1 N: N must be a whole number (got {count:g}).")
         try:

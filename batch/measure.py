@@ -312,9 +312,9 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, 
     sent = []
 
     def ready(result):
-        sent.append(result)
         if rows_ready is not None:
             rows_ready(result)
+        sent.append(result)  # only rows the run has taken count as delivered
 
     try:
         return measure_mesh(index, source, tasks, options, progress, ready)

@@ -16,6 +16,7 @@ import bpy
 from ..bridge import records
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio
+from ..vg_addon.method.result import stability_text, stability_warning
 from ..vg_addon.method.winding import winding_message
 from ..vg_addon.workflow import batchplan
 from . import extension
@@ -66,6 +67,22 @@ class Run:
     def say(self, text: str) -> None:
         say(text)
 
+    def say_flagged(self, by_index: dict) -> None:
+        """The summary's lines for unstable readings: how many, and the first ten with why."""
+        flagged = flagged_rows(self.rows)
+        if not flagged:
+            return
+        self.say(f"{len(flagged):,} flagged reading(s): unstable, or the ± figure undetermined")
+        for index, row, warning in flagged[:10]:
+            task = by_index[index]
+            where = f"row {task.source_row}" if task.source_row else f"point {task.number}"
+            self.say(
+                f"  flagged: {where} on {row.mesh_name!r}: {row.angle:.2f}° "
+                f"{stability_text(row.stability)}: {warning}"
+            )
+        if len(flagged) > 10:
+            self.say(f"  ... and {len(flagged) - 10} more flagged rows (see the Stability columns)")
+
     def progress(self, mesh: int, done: int, force: bool = False) -> None:
         with self.lock:
             self.in_flight[mesh] = done
@@ -79,10 +96,13 @@ class Run:
                 f"{self.done_points:,}/{len(self.tasks):,} points, {failed:,} failed"
             )
 
-    def add(self, result: MeshResult, force_write: bool = False) -> None:
+    def add(self, result: MeshResult, pictures_follow: bool = False) -> None:
         """Take a mesh's rows (before its pictures are drawn). A row that cannot be written
-        costs only its own cells (``csvio.writable_row``); the CSV is rewritten now and then
-        (always with ``force_write``: pictures follow), so a run that is stopped keeps them."""
+        costs only its own cells (``csvio.writable_row``); the CSV is rewritten now and then, so
+        a run that is stopped keeps them: at least every 5 s, and before a mesh's pictures
+        whenever the last rewrite took under a tenth of the time since (the whole CSV is
+        rewritten each time, so rewriting before every mesh's pictures would cost a run of
+        many meshes time that grows with the square of their number)."""
         with self.lock:
             self.in_flight.pop(result.mesh, None)
             self.results.append(result)
@@ -94,8 +114,11 @@ class Run:
             if result.bad_file:
                 self.bad_files.append(result.bad_file)
             # Each write costs more as rows accumulate; finish() always writes.
-            due = time.perf_counter() - self.last_write >= max(5.0, 10.0 * self.write_seconds)
-            if not self.stream and (due or force_write):
+            since = time.perf_counter() - self.last_write
+            due = since >= max(5.0, 10.0 * self.write_seconds)
+            if not self.stream and (
+                due or (pictures_follow and since >= 10.0 * self.write_seconds)
+            ):
                 self.try_write_csv()
 
     def pictures_done(self, result: MeshResult) -> None:
@@ -214,6 +237,7 @@ class Run:
             f"{measuring:.2f} s: {rate:,.0f} measurements/s{per} (import excluded)"
         )
         by_index = {t.index: t for t in self.tasks}
+        self.say_flagged(by_index)
         for index, row in failed[:10]:
             task = by_index[index]
             where = f"row {task.source_row}" if task.source_row else f"point {task.number}"
@@ -240,6 +264,21 @@ class Run:
         where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
         self.say(f"wrote the CSV to {where}")
         return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
+
+
+def flagged_rows(rows: dict) -> list:
+    """``(index, row, warning)`` of the measured rows whose stability figure flags them (see
+    ``vg_addon.method.result.stability_warning``), in row order."""
+    flagged = []
+    for index, row in sorted(rows.items()):
+        if row.error or row.stability is None:
+            continue
+        warning = stability_warning(
+            row.stability, row.stability_runs or 0, row.stability_refused or 0
+        )
+        if warning:
+            flagged.append((index, row, warning))
+    return flagged
 
 
 def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
@@ -341,6 +380,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         run.say("a .blend input is measured in this process (--jobs applies to mesh files only)")
     folder = tempfile.mkdtemp(prefix="vg-batch-") if parallel else ""
     kept = []  # objects measured in this process, kept for --save-blend
+    pictures = bool(args.render or args.sweep or edges)  # drawn after each mesh's rows
     try:
         try:
             if parallel:
@@ -352,12 +392,12 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                         str(m): [dataclasses.asdict(t) for t in ts] for m, ts in groups.items()
                     },
                     "options": options,
+                    "pictures": pictures,
                 }
                 run.jobs = min(args.jobs, len(groups))
                 run_workers(run, groups, plan, args.jobs)
             else:
-                pictures = bool(args.render or args.sweep or edges)
-                rows_ready = functools.partial(run.add, force_write=pictures)
+                rows_ready = functools.partial(run.add, pictures_follow=pictures)
                 for mesh, mesh_tasks in groups.items():
                     progress = functools.partial(run.progress, mesh)
                     result = safe_measure_mesh(

@@ -89,12 +89,14 @@ def blend_objects(names: list[str], blend: str) -> list[MeshSource]:
 
 def readable_name(name: str) -> str:
     """A mesh name as text every output can hold: bytes of a file name that are not UTF-8
-    (Python keeps them as surrogate escapes) shown as U+FFFD, as a file manager shows them.
-    The same file always gets the same name, so a CSV written with it finds its mesh again."""
+    (Python keeps them as surrogate escapes) shown as ``\\xe9``. The same file always gets the
+    same name, so a CSV written with it finds its mesh again, and two files differing only in
+    such bytes keep different names (U+FFFD for every bad byte would merge "caf\\xe9" and
+    "caf\\xe8")."""
     try:
-        return name.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+        return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
     except UnicodeEncodeError:
-        return name.encode("utf-8", "replace").decode("utf-8")
+        return name.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 def file_sources(inputs: list[str]) -> list[MeshSource]:

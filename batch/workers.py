@@ -142,15 +142,20 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
                     if words[:1] == ["progress"]:
                         run.progress(mesh, int(words[2]))
                     elif words[:1] == ["rows"]:
-                        run.add(load(mesh, ".rows.json"), force_write=True)
+                        run.add(load(mesh, ".rows.json"), pictures_follow=plan["pictures"])
                         rows_in.add(mesh)
                     elif words[:1] == ["done"]:
                         finished = True
                         break
-            except (BrokenPipeError, OSError):
-                pass
+            except (OSError, ValueError):  # a broken pipe, or a result file gone or damaged
+                if process.poll() is None:  # the worker waits for its next mesh: end it
+                    process.kill()
             if finished:
-                result = load(mesh, ".json")
+                try:
+                    result = load(mesh, ".json")
+                except (OSError, ValueError) as error:
+                    fail(mesh, f"the worker's result could not be read back: {error}")
+                    continue
                 if mesh not in rows_in:
                     run.add(result)
                 run.pictures_done(result)

@@ -157,18 +157,22 @@ def test_a_file_name_that_is_not_utf8_costs_no_row(tmp_path):
     good = write_wedge(tmp_path / "good.ply")
     odd = os.fsdecode(bytes(tmp_path) + b"/caf\xe9.ply")
     write_wedge(odd, 60.0, seed=4)
+    other = os.fsdecode(bytes(tmp_path) + b"/caf\xe8.ply")  # differs in the bad byte only
+    write_wedge(other, 120.0, seed=5)
     out = tmp_path / "o.csv"
-    ok(batch(good, odd, *AT, "--out", out))
+    ok(batch(good, odd, other, *AT, "--out", out))
     rows = csvio.read_measurements_csv(out)
-    assert [r.mesh_name for r in rows] == ["good", "caf\ufffd"]
-    assert abs(rows[0].angle - 90) < 0.01 and abs(rows[1].angle - 60) < 0.01
+    assert sorted(r.mesh_name for r in rows) == ["caf\\xe8", "caf\\xe9", "good"]
+    angles = {r.mesh_name: r.angle for r in rows}
+    assert abs(angles["good"] - 90) < 0.01 and abs(angles["caf\\xe9"] - 60) < 0.01
+    assert abs(angles["caf\\xe8"] - 120) < 0.01
     # The CSV it wrote is read back on the same files: the rows find their meshes.
     again = tmp_path / "again.csv"
-    ok(batch(good, odd, "--points", out, "--out", again))
+    ok(batch(good, odd, other, "--points", out, "--out", again))
     assert [r.angle for r in csvio.read_measurements_csv(again)] == [r.angle for r in rows]
 
 
-@pytest.mark.parametrize("names", [(" lead", "trail "), ("both ", " both")])
+@pytest.mark.parametrize("names", [(" lead", "trail "), ("both ", " both"), (" lead", "lead")])
 def test_mesh_names_with_surrounding_spaces_round_trip(tmp_path, names):
     files = [write_wedge(tmp_path / f"{name}.ply", 90.0 - 30 * i, seed=3 + i)
              for i, name in enumerate(names)]  # fmt: skip
@@ -331,3 +335,12 @@ def test_the_map_size_and_samples_are_bounded_before_anything_renders(scan, tmp_
     out = tmp_path / "o.csv"
     result = ok(batch(scan, *AT, "--out", out, "--render", tmp_path / "maps", *option), 2)
     assert said in result.stderr and not out.exists()
+
+
+@pytest.mark.parametrize("sweep", [("0.2", "0.3", "inf"), ("0.2", "nan", "3")])
+def test_a_sweep_with_a_value_that_is_not_finite_is_refused_clearly(tmp_path, sweep):
+    mesh = write_wedge(tmp_path / "w.ply")
+    result = batch(mesh, *AT, "--sweep", *sweep, "--out", tmp_path / "o.csv")
+    assert result.returncode == 2, result.stderr
+    assert "finite" in result.stderr and "Traceback" not in result.stderr
+    assert not (tmp_path / "o.csv").exists()

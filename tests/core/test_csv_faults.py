@@ -71,6 +71,29 @@ def test_an_unclosed_quote_is_refused_with_the_line_where_it_opens(text, line):
         csvio.read_measurements_csv(broken)
 
 
+def test_an_unclosed_quote_before_rows_with_columns_left_out_is_refused():
+    """Rows that leave optional columns out have fewer cells than the header: a quote left open
+    before them must still not swallow them (the file ends inside the quote)."""
+    text = 'x,y,z,radius,label\n0,0,0,1,"open\n1,0,0\n2,0,0\n'
+    with pytest.raises(GoniometerError, match="quote"):
+        csvio.read_replication_csv(text)
+
+
+def test_notes_with_many_commas_over_several_lines_still_read():
+    """What the product writes, and what a hand-written file with a well-closed note holds, reads
+    back, however many commas a note's lines hold."""
+    note = "first line\n" + ", ".join(f"point {k}" for k in range(60))
+    rows = [MeasurementRow(mesh_name="a", user_data=note, x=0.0, y=0.0, z=0.0)]
+    text = csvio.format_measurements_csv(rows * 2)
+    assert [row.user_data for row in csvio.read_measurements_csv(text)] == [note, note]
+    assert [row.label for row in csvio.read_replication_csv(text)] == [note, note]
+    hand = 'x,y,z,label\n0,0,0,"two lines\nsee: a, b, c, d"\n1,0,0,plain\n'
+    assert [row.label for row in csvio.read_replication_csv(hand)] == [
+        "two lines\nsee: a, b, c, d",
+        "plain",
+    ]
+
+
 def test_a_note_written_over_several_lines_still_reads():
     rows = [MeasurementRow(mesh_name="a", user_data="two\nlines, one comma", x=0.0, y=0.0, z=0.0)]
     (back,) = csvio.read_replication_csv(csvio.format_measurements_csv(rows))

@@ -563,8 +563,28 @@ def _mesh_stem(name: str) -> str:
     return base
 
 
+def mesh_name_match(csv_name: str | None, names) -> int | None:
+    """How closely a CSV's mesh name refers to a mesh known by ``names``: 0 exactly (surrounding
+    spaces included: a mesh file " lead.ply" is the mesh " lead"), 1 without its surrounding
+    spaces (a hand-typed cell), 2 after dropping a folder and a mesh file extension
+    (``"scans/bone_12.ply"`` matches ``"bone_12"``); None when it does not. A blank name is 2
+    for any mesh."""
+    given = csv_name or ""
+    if not given.strip():
+        return 2
+    candidates = set(_split_names(names))
+    if given in candidates:
+        return 0
+    if given.strip() in candidates:
+        return 1
+    if any(_mesh_stem(name) in candidates for name in (given, given.strip())):
+        return 2
+    return None
+
+
 def mesh_name_matches(csv_name: str | None, names) -> bool:
-    """Whether a CSV's mesh name refers to a mesh known by ``names``.
+    """Whether a CSV's mesh name refers to a mesh known by ``names`` (see
+    :func:`mesh_name_match`).
 
     Parameters
     ----------
@@ -572,20 +592,8 @@ def mesh_name_matches(csv_name: str | None, names) -> bool:
         The row's mesh name. Blank or ``None`` matches any mesh.
     names : str or iterable of str
         The mesh's names, e.g. its object name and its mesh data name.
-
-    A name matches exactly (case-sensitive, as Blender names are, surrounding spaces
-    included: a mesh file " lead.ply" is the mesh " lead"), or without its surrounding spaces
-    (a hand-typed cell), or after dropping a folder and a mesh file extension
-    (``"scans/bone_12.ply"`` matches ``"bone_12"``).
     """
-    given = csv_name or ""
-    if not given.strip():
-        return True
-    candidates = set(_split_names(names))
-    return any(
-        name in candidates or _mesh_stem(name) in candidates
-        for name in dict.fromkeys((given, given.strip()))
-    )
+    return mesh_name_match(csv_name, names) is not None
 
 
 def rows_for_mesh(rows: Iterable[ReplicationRow], mesh_name) -> list[ReplicationRow]:
@@ -708,12 +716,17 @@ def writable_row(row):
     So one bad value costs its own cell, never the other rows of a file: writers that must
     keep every good row (the batch) pass their rows through this first.
     """
+    try:
+        _row_cells(0, row, _schema_of(row))
+        return row  # the usual case: the whole row at once
+    except Exception:  # any cell that cannot be written costs only itself, below
+        pass
     changes, problems = {}, []
     for entry in _schema_of(row):
         field, kind, columns = entry
         try:
             _row_cells(0, row, (entry,))
-        except GoniometerError:
+        except Exception:
             value = getattr(row, field)
             if kind == "text":
                 changes[field] = _as_utf8(str(value))
@@ -1008,9 +1021,12 @@ def _records(text: str, source: str) -> list[tuple[int, list[str]]]:
         )
     header_line = next(line for line in text.splitlines() if line.strip())
     _check_delimiter(header_line, source)
-    reader = csv.reader(io.StringIO(text, newline=""))
+    # strict: a quote still open at the end of the file, or text after a closing quote, is an
+    # error, not a cell that swallows the rest of the file.
+    reader = csv.reader(io.StringIO(text, newline=""), strict=True)
     records = []
-    width = 0
+    header: list[str] = []
+    line = 1
     try:
         while True:
             line = reader.line_num + 1  # the physical line the record starts on
@@ -1018,10 +1034,17 @@ def _records(text: str, source: str) -> list[tuple[int, list[str]]]:
             if cells is None:
                 break
             records.append((len(records) + 1, cells))
-            width = width or (len(cells) if not _blank(cells) else 0)
+            header = header or ([] if _blank(cells) else cells)
             if reader.line_num > line:
-                _check_open_quote(cells, line, width, source)
+                _check_open_quote(cells, line, header, source)
     except csv.Error as error:
+        if "end of data" in str(error) or reader.line_num > line:  # a quote that never closes
+            raise GoniometerError(
+                f"{source}: line {line} opens a quote that is not closed where its cell ends "
+                f"({error}), so the lines after it would be read as part of one cell; nothing "
+                f"was read. Close the quote on line {line} (a quote inside a cell is written as "
+                'two quotes "") and try again.'
+            ) from None
         raise GoniometerError(
             f"{source} is not a readable CSV near line {reader.line_num}: {error}. "
             "Check the quotes on that line."
@@ -1029,12 +1052,14 @@ def _records(text: str, source: str) -> list[tuple[int, list[str]]]:
     return records
 
 
-def _check_open_quote(cells: Sequence[str], line: int, width: int, source: str) -> None:
+def _check_open_quote(cells: Sequence[str], line: int, header: Sequence[str], source: str) -> None:
     """Refuse a record whose quoted cell runs over lines that look like rows of their own: a
-    quote left open swallows every later row into one cell (until the file ends or another
-    quote closes it), which would otherwise read as one row with a long note."""
+    quote left open swallows later rows into one cell until another quote closes it, which would
+    otherwise read as one row with a long note. A line looks like a row when it has numbers in
+    the header's x, y and z columns (or, without them, as many cells as a header of six or more
+    columns). A note written over several lines, commas and all, does not."""
     for column, cell in enumerate(cells, start=1):
-        swallowed = [part for part in cell.splitlines()[1:] if part.count(",") >= max(width - 1, 1)]
+        swallowed = [part for part in cell.splitlines()[1:] if _looks_like_a_row(part, header)]
         if swallowed:
             raise GoniometerError(
                 f"{source}: line {line} opens a quote (in cell {column}) that is not closed on "
@@ -1042,6 +1067,28 @@ def _check_open_quote(cells: Sequence[str], line: int, width: int, source: str) 
                 "be read as part of that one cell; nothing was read. Close the quote on line "
                 f'{line} (a quote inside a cell is written as two quotes "") and try again.'
             )
+
+
+def _coordinate_columns(header: Sequence[str]) -> list[int] | None:
+    names = [_normalise(cell) for cell in header]
+    found = []
+    for axis in ("x", "y", "z"):
+        position = next((names.index(a) for a in _REPLICATION_ALIASES[axis] if a in names), None)
+        if position is None:
+            return None
+        found.append(position)
+    return found
+
+
+def _looks_like_a_row(line: str, header: Sequence[str]) -> bool:
+    try:
+        cells = next(csv.reader([line]), [])
+    except csv.Error:
+        return False
+    columns = _coordinate_columns(header)
+    if columns is None:
+        return len(header) >= 6 and len(cells) == len(header)
+    return len(cells) > max(columns) and all(_parse_float(cells[k])[0] is not None for k in columns)
 
 
 def _blank(cells: Sequence[str]) -> bool:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import GoniometerError, bounded_list
-from ..formats.csvio import ReplicationRow, mesh_name_matches
+from ..formats.csvio import ReplicationRow, mesh_name_match
 from ..method.algorithm import as_center, as_lambda, as_radius
 from ..method.surface import check_patch_mode
 
@@ -312,11 +312,15 @@ def plan_rows(
 
 def _match(row: ReplicationRow, meshes: Sequence[Sequence[str]]) -> tuple[int, str]:
     """``(mesh index, "")`` for the mesh ``row`` names, or ``(-1, why not)``."""
-    found = [i for i, names in enumerate(meshes) if mesh_name_matches(row.mesh_name, names)]
-    if len(found) > 1:
-        # A name can be one object's name and another's mesh data name: prefer primary names.
-        primary = [i for i in found if mesh_name_matches(row.mesh_name, meshes[i][:1])]
-        found = primary or found
+    # The closest match wins: an exact name before one without surrounding spaces before a file
+    # stem, and a mesh's primary name (its object's) before its other names (mesh data).
+    closeness = {}
+    for i, names in enumerate(meshes):
+        primary, any_name = (mesh_name_match(row.mesh_name, n) for n in (names[:1], names))
+        if any_name is not None:
+            closeness[i] = (any_name, 0 if primary == any_name else 1)
+    best = min(closeness.values(), default=None)
+    found = [i for i, key in closeness.items() if key == best]
     if len(found) == 1:
         return found[0], ""
     where = f"row {row.row_number}"
