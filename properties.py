@@ -27,6 +27,12 @@ from bpy.types import PropertyGroup
 from mathutils import Vector
 
 from .vg_addon import palette
+from .vg_addon.method.result import (
+    UNDETERMINED_REFUSED,
+    UNSTABLE_DEGREES,
+    stability_text,
+    stored_stability_warning,
+)
 
 # Paths may start with // (the .blend's folder); Blender 4.5 and later want that declared.
 BLEND_RELATIVE = {"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else set()
@@ -59,7 +65,9 @@ def exact_numbers(item) -> dict:
     (floats) and ``center``, ``requested``, ``normal_plus``, ``normal_minus`` (lists of 3 floats);
     since the oriented rule also ``rule``, ``convexity``, ``correlation`` and ``stability`` (a
     dict of its parts, or None). Records without ``rule`` were measured with the paper's rule.
-    A station of an edge profile adds ``arc_length``, ``spacing`` and ``plus_left``. Keys of
+    A station of an edge profile adds ``arc_length``, ``spacing`` and ``plus_left``; a
+    measurement whose sides are painted the other way round ``painted_swapped`` (see
+    ``bridge.records``). Keys of
     an edge profile: see ``bridge.edges``.
     """
     try:
@@ -107,8 +115,11 @@ def _stability_text(self):
     parts = exact_numbers(self).get("stability")
     if not parts:
         return "not computed"
-    spread = parts["spread"]
-    return f"± {spread:.2f}°" if spread < 0.1 else f"± {spread:.1f}°"
+    return stability_text(parts["spread"])
+
+
+def _stability_warning(self):
+    return stored_stability_warning(exact_numbers(self).get("stability"))
 
 
 def _stability_part(key):
@@ -230,6 +241,13 @@ class VG_Measurement(PropertyGroup):
         description="The largest change of the angle with the centre moved two edge lengths, "
         "the radius ±10%, λ from 1 to 3, and the vertices resampled",
         get=_stability_text,
+    )
+    stability_warning: StringProperty(
+        name="Stability warning",
+        description=f"Why the reading is flagged: its stability figure is more than "
+        f"{UNSTABLE_DEGREES:g}° (unstable), or more than {UNDETERMINED_REFUSED:.0%} of its "
+        "perturbed runs were refused (undetermined); empty for a reading that is not flagged",
+        get=_stability_warning,
     )
     stability_center: FloatProperty(name="Centre moved (°)", get=_stability_part("center"))
     stability_radius: FloatProperty(name="Radius ±10% (°)", get=_stability_part("radius"))

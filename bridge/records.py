@@ -6,7 +6,7 @@ from __future__ import annotations
 import hashlib
 import json
 import tomllib
-from functools import cache
+from functools import cache, lru_cache
 from pathlib import Path
 
 import bpy
@@ -15,6 +15,7 @@ import numpy as np
 from ..properties import exact_numbers
 from ..vg_addon import GoniometerError, palette
 from ..vg_addon.formats import csvio
+from ..vg_addon.method.break_sides import paint_swapped
 from .mesh_data import uniform_scale
 
 _MANIFEST = Path(__file__).resolve().parents[1] / "blender_manifest.toml"
@@ -125,6 +126,10 @@ def add_measurement(
             f"{break_number!r}. Nothing was recorded."
         )
     numbers = exact_record(m, station)
+    if station is None and paint_swapped(
+        m.normal_plus, m.normal_minus, m.center, m.radius, _break_sides(data, break_number)
+    ):
+        numbers[SWAPPED] = True  # painted the other way round; the numbers are as measured
     exact = json.dumps(numbers)
     # Everything that can fail is done: from here on the item is written whole.
     item = data.measurements.add()
@@ -140,7 +145,7 @@ def add_measurement(
     item.n_minus = int(m.n_minus)
     item.date = csvio.now_iso()
     item.note = note
-    item.colors = "/".join(station_colours(item.break_number, numbers.get("plus_left", True)))
+    item.colors = "/".join(station_colours(item.break_number, _plus_first(numbers)))
     item.fingerprint = geometry_fingerprint
     item.stale = False
     stamp(item)
@@ -177,15 +182,60 @@ def continue_after_recorded_breaks(obj) -> None:
 
 
 def station_colours(break_number: int, plus_left: bool = True) -> tuple[str, str]:
-    """The "+"/"-" colour names of a measurement: its break's pair, swapped for an edge station
-    whose "+" side lies right of the path (the edge's left side always gets the first colour)."""
+    """The "+"/"-" colour names of a measurement: its break's pair, swapped when its "+" side is
+    painted in the second colour (an edge station whose "+" side lies right of the path: the
+    edge's left side always gets the first colour; a measurement painted swapped to agree with
+    its break's earlier ones)."""
     names = tuple(palette.pair_names(break_number))
     return names if plus_left else names[::-1]
 
 
+# The key of a record's exact numbers that says its sides are painted the other way round (only
+# present when they are): its "+" side agreed better with the side its break's earlier
+# measurements painted in the second colour (see ``vg_addon.method.break_sides``).
+SWAPPED = "painted_swapped"
+
+# The earlier measurements of a break that orient a new one's colours: the latest this many
+# (each oriented by its own predecessors), so a click reads a bounded number of records.
+BREAK_NEIGHBOURS = 32
+
+
+def _plus_first(numbers: dict) -> bool:
+    """Whether the "+" side of a record with these exact numbers is painted in the first colour
+    of its break's pair."""
+    return bool(numbers.get("plus_left", True)) and not numbers.get(SWAPPED, False)
+
+
 def plus_on_pair_side(item) -> bool:
     """Whether ``item``'s "+" side is painted in the first colour of its break's pair."""
-    return bool(exact_numbers(item).get("plus_left", True))
+    return _plus_first(exact_numbers(item))
+
+
+@lru_cache(maxsize=4096)
+def _painted_normals(exact: str):
+    """(first-colour normal, second-colour normal, centre) of a record's exact numbers in mesh
+    coordinates, or None (a world-space record of an earlier version, or numbers missing)."""
+    try:
+        numbers = json.loads(exact)
+        plus, minus, center = numbers["normal_plus"], numbers["normal_minus"], numbers["center"]
+    except (ValueError, KeyError, TypeError):
+        return None
+    if numbers.get("space") != MESH:
+        return None
+    return (plus, minus, center) if _plus_first(numbers) else (minus, plus, center)
+
+
+def _break_sides(data, break_number: int) -> list:
+    """The painted normals and centres (see :func:`_painted_normals`) of the latest
+    :data:`BREAK_NEIGHBOURS` measurements of ``break_number`` in ``data.measurements``."""
+    items = data.measurements
+    if not len(items):
+        return []
+    breaks = np.empty(len(items), dtype=np.int32)
+    items.foreach_get("break_number", breaks)
+    latest = np.flatnonzero(breaks == break_number)[-BREAK_NEIGHBOURS:]
+    sides = (_painted_normals(items[int(index)].exact) for index in latest)
+    return [entry for entry in sides if entry is not None]
 
 
 _KEYS = (

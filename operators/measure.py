@@ -176,6 +176,8 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
             f"(fit error {fit_text(item.fit_error, item.radius)}, "
             f"{item.n_vertices} vertices)",
         )
+        if item.stability_warning:
+            self.report({"WARNING"}, f"Measurement {item.number}: {item.stability_warning}")
         for warning in (_stale_warning(obj), non_uniform_scale_note(obj)):
             if warning:
                 self.report({"WARNING"}, warning)
@@ -323,10 +325,53 @@ class VG_OT_repaint(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _listed_item(context, index: int):
+    """The active object's measurement at list position ``index``, or None."""
+    data = getattr(context.active_object, "vg", None)
+    if data is None or not 0 <= index < len(data.measurements):
+        return None
+    return data.measurements[index]
+
+
+class VG_OT_stability_warning(bpy.types.Operator):
+    """Why this reading is flagged: its stability figure is large or undetermined"""
+
+    bl_idname = "vg.stability_warning"
+    bl_label = "Unstable Reading"
+    bl_options = {"INTERNAL"}  # noqa: RUF012 (Blender wants a set)
+
+    index: IntProperty(name="Index", description="Position in the list", default=0, min=0)
+
+    @classmethod
+    def poll(cls, context):
+        data = getattr(context.active_object, "vg", None)
+        if data is None or not len(data.measurements):
+            cls.poll_message_set("The active object has no measurements.")
+            return False
+        return True
+
+    @classmethod
+    def description(cls, context, properties):
+        """The flagged row's tooltip: the reason, in the words of every other place."""
+        item = _listed_item(context, properties.index)
+        return (item.stability_warning if item is not None else "") or cls.__doc__
+
+    def execute(self, context):
+        item = _listed_item(context, self.index)
+        if item is None:
+            self.report({"ERROR"}, f"No measurement at list position {self.index}.")
+            return {"CANCELLED"}
+        context.active_object.vg.active_index = self.index  # select the row clicked
+        warning = item.stability_warning or "not flagged: its stability figure is small."
+        self.report({"WARNING"}, f"Measurement {item.number}: {warning}")
+        return {"FINISHED"}
+
+
 classes = (
     VG_OT_measure_xyz,
     VG_OT_next_break,
     VG_OT_delete_measurement,
     VG_OT_clear_measurements,
     VG_OT_repaint,
+    VG_OT_stability_warning,
 )

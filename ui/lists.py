@@ -2,6 +2,8 @@
 
 import bpy
 
+from ..properties import exact_numbers
+
 # Shares of a row at the default sidebar width (about 170 pixels for the list at UI scale 1): the
 # angle first and widest (room for a warning icon, "179.99°" and a word such as "concave"), then
 # the number, then the two side colours (which also tell the break). Labels in a plain row share
@@ -21,18 +23,43 @@ def row_texts(item) -> tuple[str, str]:
     return f"{item.angle:.2f}°{kind}", f"#{item.number}"
 
 
+def row_flag(item) -> str:
+    """The stability figure a flagged row shows beside its angle (``"±78°"``, highlighted, with
+    a warning icon; the reason is the tooltip), or ``""`` for a row that is not flagged (see
+    ``vg_addon.method.result.stability_warning``)."""
+    if not item.stability_warning:
+        return ""
+    return f"±{(exact_numbers(item).get('stability') or {}).get('spread', 0.0):.0f}°"
+
+
+def flagged_text(item) -> str:
+    """A flagged row's first text: the angle and the figure, ``"71.01° ±78°"`` (the edge word
+    makes way for the figure; the Selected Measurement panel still names the edge)."""
+    return f"{item.angle:.2f}° {row_flag(item)}"
+
+
 class VG_UL_measurements(bpy.types.UIList):
-    """One row per measurement: angle (with "concave" or "unclear" where the edge is), number
-    and break, the colours of its two sides."""
+    """One row per measurement: angle (with "concave" or "unclear" where the edge is, and the
+    stability figure highlighted where the reading is unstable), number and break, the colours
+    of its two sides."""
 
     def draw_item(self, context, layout, data, item, icon, active_data, active_property, index):
         angle, number = row_texts(item)
+        flag = row_flag(item)
         if self.layout_type == "GRID":
             layout.alignment = "CENTER"
-            layout.label(text=angle)
+            layout.label(text=angle, icon="ERROR" if flag else "NONE")
             return
         split = layout.split(factor=ANGLE_SHARE, align=True)
-        split.label(text=angle, icon="ERROR" if item.stale else "NONE")
+        if flag:  # a button that looks like the label, for its tooltip: the reason
+            cell = split.row(align=True)
+            cell.alert = True
+            button = cell.operator(
+                "vg.stability_warning", text=flagged_text(item), icon="ERROR", emboss=False
+            )
+            button.index = index
+        else:
+            split.label(text=angle, icon="ERROR" if item.stale else "NONE")
         rest = split.split(factor=NUMBER_SHARE, align=True)
         rest.label(text=number)
         swatches = rest.row(align=True)

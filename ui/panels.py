@@ -102,6 +102,11 @@ class VIEW3D_PT_vg_selected(_GoniometerPanel, bpy.types.Panel):
             box = layout.box()
             box.label(text="Stale: the mesh changed since this measurement", icon="ERROR")
             box.label(text="Numbers kept as recorded; not painted")
+        if warning := item.stability_warning:  # the list's flag, with its reason in full
+            box = layout.box()
+            box.alert = True
+            for number, line in enumerate(textwrap.wrap(warning, 42)):
+                box.label(text=line, icon="ERROR" if number == 0 else "BLANK1")
         # Recorded values are shown as text, exactly as stored, not as (rounded, editable)
         # fields; only the note is the user's.
         column = layout.column(align=True)

@@ -101,3 +101,21 @@ def test_help_documents_the_new_options():
     text = batch("--help").stdout
     for needed in ("--rule", "oriented", "paper", "--stability", "--sweep R0 R1 N", "_sweep.csv"):
         assert needed in text, needed
+
+
+def test_the_summary_flags_unstable_readings_in_the_words_of_the_list(tmp_path):
+    shape = wedge(90, n=40, irregular=True)
+    path = tmp_path / "wedge.ply"
+    meshio.write_ply(path, shape.points, shape.triangles)
+    points = tmp_path / "points.csv"
+    points.write_text("x,y,z\n0,0,0\n0,0.1,-0.02\n", encoding="utf-8")
+    out = tmp_path / "angles.csv"
+    run = batch(path, "--points", points, "--radius", "0.12", "--stability", "--out", out)
+    rows = csvio.read_measurements_csv(out)
+    assert rows[0].stability < 5.0 < rows[1].stability
+    flagged = [line for line in run.stderr.splitlines() if "flagged:" in line]
+    assert "1 flagged reading(s)" in run.stderr and len(flagged) == 1, run.stderr
+    assert (
+        f"{rows[1].angle:.2f}° ± {rows[1].stability:.1f}°: Unstable: the angle moves"
+        in (flagged[0])
+    )

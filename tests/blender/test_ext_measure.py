@@ -5,12 +5,15 @@ import bpy
 import numpy as np
 import pytest
 from bpy_helpers import (
+    BREAK_PAIRS,
     COLOUR_ATTRIBUTE,
+    OKABE_ITO_HEX,
     colours,
     evaluated_surface,
     exact,
     expected_colours,
     half_annulus_with_edge_vertices,
+    linear_rgba,
     local_points,
     mesh_object,
     wedge_object,
@@ -389,3 +392,46 @@ def test_a_mesh_without_faces_is_measured_as_a_point_cloud(vg, with_edges):
     assert abs(item.angle - 100.0) < 1.0
     painted = colours(obj)
     assert painted is not None and painted.shape == (len(shape.points), 4)
+
+
+def test_one_face_of_a_break_keeps_one_colour_along_it(vg):
+    """Seven measurements along one crease, where Algorithm 1's binormal (a sign convention)
+    turns over between centres, so that one face is the "+" side at some and the "−" side at
+    others: each face keeps one colour of the break's pair at every measurement, the list and
+    the CSV's Colors say which colour each "+" side got, and the numbers stay as measured."""
+    from vg_addon.synthetic_meshes import wedge
+
+    shape = wedge(90.0, n=40, irregular=True)
+    c = np.sqrt(0.5)
+    # The crease along (1, -1, 0) in mesh coordinates: the tangent's sign convention (its largest
+    # component positive) then picks x at some centres and y at others.
+    rotation = np.array([[c, c, 0.0], [-c, c, 0.0], [0.0, 0.0, 1.0]])
+    obj = mesh_object("Ridge", shape.points @ rotation.T, shape.triangles)
+    along, across = rotation @ [1.0, 0.0, 0.0], rotation @ [0.0, 1.0, 0.0]
+    face = np.sign(np.round(local_points(obj).astype(np.float64) @ across, 6))  # 0: the crease
+    pair = BREAK_PAIRS[0]
+    palette = {name: linear_rgba(OKABE_ITO_HEX[name]).astype(np.float32) for name in pair}
+
+    def names(rgba):
+        return {
+            next((n for n, c in palette.items() if np.allclose(colour, c, atol=1e-6)), "other")
+            for colour in rgba
+        }
+
+    surface = core_surface(obj)
+    seen = {1.0: set(), -1.0: set()}
+    for x in np.linspace(-0.45, 0.45, 7):
+        centre = x * along
+        bpy.ops.vg.measure_xyz(location=tuple(centre), space="MESH", radius=0.3)
+        item = obj.vg.measurements[-1]
+        m = surface.measure(centre, 0.3)
+        assert_same(item, m, requested=False)  # the numbers, "+" and "−" included, as measured
+        painted = colours(obj)[m.indices]  # this measurement's patch, painted last
+        for sign in seen:
+            seen[sign] |= names(painted[face[m.indices] == sign])
+    plus_faces = [np.sign(np.dot(exact(i)["normal_plus"], across)) for i in obj.vg.measurements]
+    assert set(plus_faces) == {1.0, -1.0}, "the binormal never turned over: the test shows nothing"
+    assert len(seen[1.0]) == 1 and len(seen[-1.0]) == 1, seen
+    assert seen[1.0] | seen[-1.0] == set(pair)
+    for item, plus_face in zip(obj.vg.measurements, plus_faces, strict=True):
+        assert item.colors == f"{min(seen[plus_face])}/{min(seen[-plus_face])}"

@@ -174,3 +174,40 @@ def test_list_row_texts_fit_the_default_sidebar_at_ui_scale_1(vg, lists):
     assert blf.dimensions(0, "179.99° concave")[0] <= angle_room
     assert blf.dimensions(0, "179.99°")[0] + icon <= angle_room
     assert blf.dimensions(0, "#999")[0] <= number_room
+
+
+def test_an_unstable_reading_is_flagged_in_its_list_row(vg, lists, panels, capfd):
+    """A 90° wedge measured off its crease with a small radius reads "90.00° ± 78.7°": its row
+    shows the warning icon and the figure, its tooltip and the panel the reason, the report a
+    warning; a reading on the crease is not flagged."""
+    obj = wedge_object(90.0)
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.3)
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.1, -0.02), radius=0.12)
+    stable, unstable = obj.vg.measurements
+    assert exact(unstable)["stability"]["spread"] > 5.0 > exact(stable)["stability"]["spread"]
+
+    assert stable.stability_warning == "" and lists.row_flag(stable) == ""
+    assert unstable.stability_warning.startswith("Unstable: the angle moves by up to 78.")
+    assert "more than 5°" in unstable.stability_warning
+    spread = exact(unstable)["stability"]["spread"]
+    assert lists.row_flag(unstable) == f"±{spread:.0f}°"
+    assert lists.flagged_text(unstable) == f"{exact(unstable)['angle']:.2f}° ±{spread:.0f}°"
+    assert f"{unstable.stability_text}" == f"± {spread:.1f}°"
+    # The row's tooltip: the reason, the same words.
+    operator = bpy.types.VG_OT_stability_warning
+    assert operator.description(bpy.context, type("P", (), {"index": 1})) == (
+        unstable.stability_warning
+    )
+    assert bpy.ops.vg.stability_warning(index=1) == {"FINISHED"}
+    assert obj.vg.active_index == 1
+    assert "Measurement 2: Unstable: the angle moves" in capfd.readouterr().out
+
+
+def test_the_flagged_row_fits_the_default_sidebar(vg, lists):
+    # As test_list_row_texts_fit_the_default_sidebar_at_ui_scale_1: the widest angle, the widest
+    # figure and the warning icon.
+    import blf
+
+    blf.size(0, bpy.context.preferences.ui_styles[0].widget.points)
+    row, icon, padding = 170.0, 20.0, 10.0
+    assert blf.dimensions(0, "179.99° ±99°")[0] + icon <= lists.ANGLE_SHARE * row - padding

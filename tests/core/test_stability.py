@@ -174,3 +174,39 @@ def test_a_figure_too_large_to_compute_is_refused_before_allocating_it():
         tracemalloc.stop()
     # The measurement itself holds a few arrays of the patch; the figure would need 100 times it.
     assert peak < 40 * m.n_vertices * 8, peak
+
+
+def test_the_flag_rule_unstable_above_5_degrees_undetermined_above_10_percent_refused():
+    from vg_addon.method.result import (
+        Stability,
+        stability_text,
+        stability_warning,
+        stored_stability_warning,
+    )
+
+    assert stability_warning(5.0, 80, 8) == ""  # at the thresholds: not flagged
+    assert stability_warning(0.0, 0, 0) == ""
+    unstable = stability_warning(78.4, 80, 1)
+    assert unstable.startswith("Unstable: the angle moves by up to 78.4°")
+    assert "more than 5°" in unstable and "Undetermined" not in unstable
+    undetermined = stability_warning(0.2, 80, 9)
+    assert undetermined.startswith("Undetermined: 9 of 80 perturbed measurements were refused")
+    assert "more than 10%" in undetermined and "Unstable" not in undetermined
+    both = stability_warning(6.0, 10, 2)
+    assert both.startswith("Unstable") and "Undetermined: 2 of 10" in both
+    # From the stored numbers (a record's stability dict, the CSV's columns) the same words.
+    stored = {"spread": 78.4, "runs": 80, "refused": 1, "center": 78.4}
+    assert stored_stability_warning(stored) == unstable
+    assert stored_stability_warning(None) == "" and stored_stability_warning({}) == ""
+    figure = Stability(78.4, 78.4, 1.0, 1.0, 1.0, 0.0, 80, 1)
+    assert figure.warning == unstable and figure.text() == stability_text(78.4) == "± 78.4°"
+    assert stability_text(0.04) == "± 0.04°"
+
+
+def test_a_reading_off_the_crease_with_a_small_radius_is_flagged_unstable():
+    mesh = wedge(90.0, n=40, irregular=True)
+    surface = Surface(mesh.points.astype(np.float32).astype(np.float64), mesh.triangles)
+    flagged = surface.measure([0.0, 0.1, -0.02], 0.12, stability=True)
+    assert flagged.stability.spread > 5.0 and flagged.stability.warning.startswith("Unstable")
+    steady = surface.measure([0.0, 0.0, 0.0], 0.3, stability=True)
+    assert steady.stability.warning == ""

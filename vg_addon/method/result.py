@@ -27,6 +27,54 @@ def fit_text(fit_error: float, radius: float) -> str:
     return f"< {math.ceil(bound / 10.0**exponent - 1e-9):d}e{exponent:+03d}"
 
 
+UNSTABLE_DEGREES = 5.0
+"""A stability figure above this many degrees flags the reading as unstable: the angle depends on
+where the measurement was taken more than the differences a user looks for between edges."""
+
+UNDETERMINED_REFUSED = 0.1
+"""More than this share of the stability figure's perturbed runs refused flags the figure as
+undetermined: the refused runs add nothing to it, so it may be far too small."""
+
+
+def stability_text(spread: float) -> str:
+    """The stability figure as shown: ``"± 0.4°"`` (two decimals below 0.1°)."""
+    return f"± {spread:.2f}°" if spread < 0.1 else f"± {spread:.1f}°"
+
+
+def stability_warning(spread: float, runs: int = 0, refused: int = 0) -> str:
+    """Why a reading with this stability figure should not be trusted as it stands, or ``""``.
+
+    The one rule every place that shows a reading uses (the list, the Selected Measurement
+    panel, the operator's report, the batch's summary): unstable when the figure (``spread``,
+    degrees) is more than :data:`UNSTABLE_DEGREES`; undetermined when more than
+    :data:`UNDETERMINED_REFUSED` of its ``runs`` perturbed measurements were ``refused``.
+    """
+    reasons = []
+    if spread > UNSTABLE_DEGREES:
+        reasons.append(
+            f"Unstable: the angle moves by up to {spread:.1f}° when the centre, radius or λ "
+            f"change slightly or the vertices are resampled (more than {UNSTABLE_DEGREES:g}°)."
+        )
+    if runs > 0 and refused > UNDETERMINED_REFUSED * runs:
+        reasons.append(
+            f"Undetermined: {refused} of {runs} perturbed measurements were refused (more than "
+            f"{UNDETERMINED_REFUSED:.0%}), so the ± figure may be far too small."
+        )
+    if not reasons:
+        return ""
+    return " ".join(reasons) + " Measure again on the edge, or with a larger radius."
+
+
+def stored_stability_warning(parts: dict | None) -> str:
+    """:func:`stability_warning` of a stored stability record (the JSON dict with ``spread``,
+    ``runs`` and ``refused``, as a measurement record and the CSV keep it); ``""`` for none."""
+    if not parts:
+        return ""
+    return stability_warning(
+        float(parts.get("spread", 0.0)), int(parts.get("runs") or 0), int(parts.get("refused") or 0)
+    )
+
+
 @dataclass(frozen=True)
 class Stability:
     """How much a measurement's angle depends on where and how it was taken.
@@ -69,7 +117,13 @@ class Stability:
 
     def text(self) -> str:
         """The figure as shown: ``"± 0.4°"`` (two decimals below 0.1°)."""
-        return f"± {self.spread:.2f}°" if self.spread < 0.1 else f"± {self.spread:.1f}°"
+        return stability_text(self.spread)
+
+    @property
+    def warning(self) -> str:
+        """Why the reading is flagged (unstable, or the figure undetermined), or ``""``: see
+        :func:`stability_warning`."""
+        return stability_warning(self.spread, self.n_runs, self.n_failed)
 
 
 @dataclass(frozen=True, eq=False)
