@@ -100,9 +100,9 @@ class Run:
         """Take a mesh's rows (before its pictures are drawn). A row that cannot be written
         costs only its own cells (``csvio.writable_row``); the CSV is rewritten now and then, so
         a run that is stopped keeps them: at least every 5 s, and before a mesh's pictures
-        whenever the last rewrite took under a tenth of the time since (the whole CSV is
-        rewritten each time, so rewriting before every mesh's pictures would cost a run of
-        many meshes time that grows with the square of their number)."""
+        whenever the last rewrite took under 50 ms or under a tenth of the time since (the whole
+        CSV is rewritten each time, so rewriting before every mesh's pictures would cost a run
+        of many meshes time that grows with the square of their number)."""
         with self.lock:
             self.in_flight.pop(result.mesh, None)
             self.results.append(result)
@@ -116,9 +116,8 @@ class Run:
             # Each write costs more as rows accumulate; finish() always writes.
             since = time.perf_counter() - self.last_write
             due = since >= max(5.0, 10.0 * self.write_seconds)
-            if not self.stream and (
-                due or (pictures_follow and since >= 10.0 * self.write_seconds)
-            ):
+            cheap = self.write_seconds < 0.05 or since >= 10.0 * self.write_seconds
+            if not self.stream and (due or (pictures_follow and cheap)):
                 self.try_write_csv()
 
     def pictures_done(self, result: MeshResult) -> None:

@@ -11,6 +11,7 @@ import os
 import shutil
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import bpy
@@ -344,3 +345,27 @@ def test_a_sweep_with_a_value_that_is_not_finite_is_refused_clearly(tmp_path, sw
     assert result.returncode == 2, result.stderr
     assert "finite" in result.stderr and "Traceback" not in result.stderr
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_a_run_killed_while_its_map_renders_keeps_the_meshs_rows(tmp_path):
+    """Rows are written before pictures: SIGKILL the run as soon as a map has begun (its hidden
+    folder appears in the render folder), and the CSV on disk holds that mesh's rows."""
+    mesh = write_wedge(tmp_path / "w.ply")
+    maps, out = tmp_path / "maps", tmp_path / "o.csv"
+    process = subprocess.Popen(
+        [sys.executable, str(SCRIPT), str(mesh), *AT, "--render", str(maps),
+         "--render-size", "1200", "900", "--render-samples", "64", "--out", str(out)],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 300
+        while not list(maps.glob(".vg-map-*")) and process.poll() is None:
+            assert time.monotonic() < deadline, "the map never began"
+            time.sleep(0.02)
+        assert process.poll() is None, "the run ended before it could be stopped mid-map"
+        process.kill()
+    finally:
+        process.wait()
+    rows = csvio.read_measurements_csv(out)
+    assert len(rows) == 1 and abs(rows[0].angle - 90.0) < 0.01
+    assert not list(maps.glob("*.png"))  # no picture of the stopped map was kept in place
