@@ -308,9 +308,14 @@ def split_exactly(features: np.ndarray, max_terms: int) -> ExactSplit:
         scaled = features * np.ldexp(1.0, shift)
     else:  # columns of values near 1e-300, whose 2^shift is beyond float64
         scaled = np.ldexp(features, shift)
-    high = np.rint(scaled)
-    low = np.rint((scaled - high) * 2.0**bits)
-    return ExactSplit(np.hstack([high, low]), np.ldexp(1.0, -shift), bits)
+    f = features.shape[1]
+    parts = np.empty((features.shape[0], 2 * f))
+    high, low = parts[:, :f], parts[:, f:]
+    np.rint(scaled, out=high)
+    np.subtract(scaled, high, out=low)
+    low *= 2.0**bits
+    np.rint(low, out=low)
+    return ExactSplit(parts, np.ldexp(1.0, -shift), bits)
 
 
 def exact_integer_sums(weights: np.ndarray, split: ExactSplit) -> np.ndarray:

@@ -280,9 +280,10 @@ def _algorithm_steps(
     weights = np.asarray(weights)
     # Whole-number weights (0/1 or counts) are gathered and summed in their own narrow type: their
     # running sums are exact integers, the same in float64 whatever the order.
-    raw = weights if weights.dtype.kind in "biu" else weights.astype(np.float64)
+    whole = weights.dtype.kind in "biu"  # booleans and integers are whole numbers already
+    raw = weights if whole else weights.astype(np.float64)
     weights = weights.astype(np.float64)
-    if not np.array_equal(weights, np.round(weights)):
+    if not whole and not np.array_equal(weights, np.round(weights)):
         raise ValueError("batched_angles needs whole-number weights (memberships or counts)")
     members = weights > 0
     count = weights.sum(axis=1)
