@@ -225,16 +225,24 @@ def _painted_normals(exact: str):
     return (plus, minus, center) if _plus_first(numbers) else (minus, plus, center)
 
 
+# How far back among an object's measurements a new one looks for its break's latest ones: a
+# record reads a bounded number of records, however many the object holds (a batch or an import
+# of many rows would otherwise cost time that grows with the square of their number).
+BREAK_WINDOW = 1024
+
+
 def _break_sides(data, break_number: int) -> list:
     """The painted normals and centres (see :func:`_painted_normals`) of the latest
-    :data:`BREAK_NEIGHBOURS` measurements of ``break_number`` in ``data.measurements``."""
+    :data:`BREAK_NEIGHBOURS` measurements of ``break_number`` among the last
+    :data:`BREAK_WINDOW` of ``data.measurements``."""
     items = data.measurements
-    if not len(items):
-        return []
-    breaks = np.empty(len(items), dtype=np.int32)
-    items.foreach_get("break_number", breaks)
-    latest = np.flatnonzero(breaks == break_number)[-BREAK_NEIGHBOURS:]
-    sides = (_painted_normals(items[int(index)].exact) for index in latest)
+    latest = []
+    for index in range(len(items) - 1, max(len(items) - BREAK_WINDOW, 0) - 1, -1):
+        if items[index].break_number == break_number:
+            latest.append(items[index].exact)
+            if len(latest) == BREAK_NEIGHBOURS:
+                break
+    sides = (_painted_normals(exact) for exact in reversed(latest))
     return [entry for entry in sides if entry is not None]
 
 

@@ -338,7 +338,7 @@ class VG_OT_stability_warning(bpy.types.Operator):
 
     bl_idname = "vg.stability_warning"
     bl_label = "Unstable Reading"
-    bl_options = {"INTERNAL"}  # noqa: RUF012 (Blender wants a set)
+    bl_options = {"INTERNAL", "UNDO"}  # noqa: RUF012 (Blender wants a set)
 
     index: IntProperty(name="Index", description="Position in the list", default=0, min=0)
 

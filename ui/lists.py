@@ -3,6 +3,7 @@
 import bpy
 
 from ..properties import exact_numbers
+from ..vg_addon.method.result import stability_undetermined
 
 # Shares of a row at the default sidebar width (about 170 pixels for the list at UI scale 1): the
 # angle first and widest (room for a warning icon, "179.99°" and a word such as "concave"), then
@@ -29,13 +30,17 @@ def row_flag(item) -> str:
     ``vg_addon.method.result.stability_warning``)."""
     if not item.stability_warning:
         return ""
-    return f"±{(exact_numbers(item).get('stability') or {}).get('spread', 0.0):.0f}°"
+    parts = exact_numbers(item).get("stability") or {}
+    if stability_undetermined(int(parts.get("runs") or 0), int(parts.get("refused") or 0)):
+        return "±?"  # the figure itself may be far too small: no number that looks steady
+    return f"±{float(parts.get('spread', 0.0)):.0f}°"
 
 
 def flagged_text(item) -> str:
-    """A flagged row's first text: the angle and the figure, ``"71.01° ±78°"`` (the edge word
-    makes way for the figure; the Selected Measurement panel still names the edge)."""
-    return f"{item.angle:.2f}° {row_flag(item)}"
+    """A flagged row's first text: the angle and the figure, ``"71.0° ±78°"`` (the edge word
+    makes way for the figure, and a second decimal, which such a reading does not have; the
+    Selected Measurement panel still names the edge and gives both)."""
+    return f"{item.angle:.1f}° {row_flag(item)}"
 
 
 class VG_UL_measurements(bpy.types.UIList):

@@ -191,7 +191,7 @@ def test_an_unstable_reading_is_flagged_in_its_list_row(vg, lists, panels, capfd
     assert "more than 5°" in unstable.stability_warning
     spread = exact(unstable)["stability"]["spread"]
     assert lists.row_flag(unstable) == f"±{spread:.0f}°"
-    assert lists.flagged_text(unstable) == f"{exact(unstable)['angle']:.2f}° ±{spread:.0f}°"
+    assert lists.flagged_text(unstable) == f"{exact(unstable)['angle']:.1f}° ±{spread:.0f}°"
     assert f"{unstable.stability_text}" == f"± {spread:.1f}°"
     # The row's tooltip: the reason, the same words.
     operator = bpy.types.VG_OT_stability_warning
@@ -203,6 +203,24 @@ def test_an_unstable_reading_is_flagged_in_its_list_row(vg, lists, panels, capfd
     assert "Measurement 2: Unstable: the angle moves" in capfd.readouterr().out
 
 
+def test_an_undetermined_figure_shows_no_number_that_looks_steady(vg, lists):
+    """More than a tenth of the figure's runs refused: the row says "±?", not a small "±0°"."""
+    import json
+
+    wedge_object(90.0)
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.3)
+    item = bpy.context.active_object.vg.measurements[0]
+    recorded = item.exact
+    try:
+        for spread, runs, refused, shown in ((0.2, 83, 79, "±?"), (150.0, 83, 0, "±150°")):
+            numbers = json.loads(recorded)
+            numbers["stability"].update(spread=spread, runs=runs, refused=refused)
+            item.exact = json.dumps(numbers)
+            assert item.stability_warning and lists.row_flag(item) == shown
+    finally:
+        item.exact = recorded  # the record as measured, for the checks after the test
+
+
 def test_the_flagged_row_fits_the_default_sidebar(vg, lists):
     # As test_list_row_texts_fit_the_default_sidebar_at_ui_scale_1: the widest angle, the widest
     # figure and the warning icon.
@@ -210,4 +228,5 @@ def test_the_flagged_row_fits_the_default_sidebar(vg, lists):
 
     blf.size(0, bpy.context.preferences.ui_styles[0].widget.points)
     row, icon, padding = 170.0, 20.0, 10.0
-    assert blf.dimensions(0, "179.99° ±99°")[0] + icon <= lists.ANGLE_SHARE * row - padding
+    for widest in ("180.0° ±180°", "180.0° ±?"):
+        assert blf.dimensions(0, widest)[0] + icon <= lists.ANGLE_SHARE * row - padding

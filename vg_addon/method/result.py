@@ -41,6 +41,12 @@ def stability_text(spread: float) -> str:
     return f"± {spread:.2f}°" if spread < 0.1 else f"± {spread:.1f}°"
 
 
+def stability_undetermined(runs: int, refused: int) -> bool:
+    """Whether more than :data:`UNDETERMINED_REFUSED` of a figure's ``runs`` were ``refused``:
+    the figure is then undetermined (it may be far too small)."""
+    return runs > 0 and refused > UNDETERMINED_REFUSED * runs
+
+
 def stability_warning(spread: float, runs: int = 0, refused: int = 0) -> str:
     """Why a reading with this stability figure should not be trusted as it stands, or ``""``.
 
@@ -55,7 +61,7 @@ def stability_warning(spread: float, runs: int = 0, refused: int = 0) -> str:
             f"Unstable: the angle moves by up to {spread:.1f}° when the centre, radius or λ "
             f"change slightly or the vertices are resampled (more than {UNSTABLE_DEGREES:g}°)."
         )
-    if runs > 0 and refused > UNDETERMINED_REFUSED * runs:
+    if stability_undetermined(runs, refused):
         reasons.append(
             f"Undetermined: {refused} of {runs} perturbed measurements were refused (more than "
             f"{UNDETERMINED_REFUSED:.0%}), so the ± figure may be far too small."
