@@ -130,17 +130,20 @@ def test_a_cancelled_map_keeps_no_picture(vg, tmp_path):
 
 def test_a_map_cancelled_or_failed_half_way_keeps_an_earlier_map_as_it_was(vg, tmp_path):
     """Rendering a map again into its folder: the earlier pictures are replaced only when the new
-    map is complete, so a stop half-way loses nothing."""
+    map is complete, so a stop half-way loses nothing (the same files, untouched: same bytes and
+    inodes); a completed map replaces every one of them (new inodes)."""
     obj = measured_annulus(vg)
     render_map = vg.bridge.measurement_map.render_map
+
+    def files():
+        return {p.name: (p.read_bytes(), p.stat().st_ino) for p in tmp_path.iterdir()}
+
     render_map(obj, tmp_path, size=SIZE, samples=1)
-    earlier = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    earlier = files()
     assert len(earlier) == 7
-    obj.location.z += 0.5  # a different map from here on
-    bpy.context.view_layer.update()
     with pytest.raises(vg.vg_addon.GoniometerError, match="cancelled"):
         render_map(obj, tmp_path, size=SIZE, samples=1, progress=lambda done, total: done < 3)
-    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == earlier
+    assert files() == earlier
     job = vg.bridge.measurement_map.MapJob(obj, tmp_path, size=SIZE, samples=1)
     try:
         job.render_next()
@@ -148,10 +151,11 @@ def test_a_map_cancelled_or_failed_half_way_keeps_an_earlier_map_as_it_was(vg, t
         job.abort()  # as the operator and the batch do when a view fails
     finally:
         job.close()
-    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == earlier
-    _, sheet = render_map(obj, tmp_path, size=SIZE, samples=1)
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(earlier)  # replaced, no leftovers
-    assert sheet.read_bytes() != earlier[sheet.name]
+    assert files() == earlier
+    render_map(obj, tmp_path, size=SIZE, samples=1)
+    now = files()
+    assert sorted(now) == sorted(earlier)  # the same names, no leftovers
+    assert all(now[name][1] != earlier[name][1] for name in now)  # each file replaced
 
 
 def test_the_operator_refuses_a_relative_folder_of_an_unsaved_file(vg):
