@@ -417,7 +417,8 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             try:
                 save_blend(args.save_blend, objects)
             except (RuntimeError, OSError) as error:
-                run.failed_outputs.append(f".blend {args.save_blend}: {reason(error)}")
+                where = Path(args.save_blend).resolve().parent
+                run.failed_outputs.append(f".blend {args.save_blend}: {reason(error, where)}")
             else:
                 run.say(f"wrote {args.save_blend}")
     finally:

@@ -294,11 +294,12 @@ def full_disk(tmp_path):
         pytest.skip(f"cannot mount a tmpfs: {mounted.stderr.strip()}")
     try:
         (folder / "old.blend").write_bytes(b"BLENDER-v300 an earlier save")
-        with open(folder / "filler", "wb") as handle:
+        # Unbuffered: the write that fills the disk raises at once, and nothing is left for
+        # close() to flush (Python 3.11 raises "No space left" again there).
+        with open(folder / "filler", "wb", buffering=0) as handle:
             try:
                 while True:
                     handle.write(b"\0" * 4096)
-                    handle.flush()
             except OSError:
                 pass
         yield folder
