@@ -181,3 +181,21 @@ def half_annulus_with_edge_vertices():
         middle = np.median(points[on_edge], axis=0)
         picks.append(int(on_edge[np.argmin(np.linalg.norm(points[on_edge] - middle, axis=1))]))
     return points, mesh.triangles, picks
+
+
+def arguments(**given):
+    """Parsed ``vg_batch.py`` options as the output checks read them: none given but ``given``."""
+    import argparse
+
+    values = {"inputs": [], "points": None, "out": None, "save_blend": None, "render": None,
+              "sweep": None, "edge": [], "edges_csv": None}  # fmt: skip
+    return argparse.Namespace(**(values | given))
+
+
+def outcome_of_check(outputs, args) -> str:
+    """``"accepted"``, or ``"refused: <message>"``, from the batch's output checks on ``args``."""
+    try:
+        outputs.check_outputs(args)
+    except outputs.UsageError as error:
+        return f"refused: {error}"
+    return "accepted"

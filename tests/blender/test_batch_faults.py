@@ -17,6 +17,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
+from bpy_helpers import arguments, outcome_of_check
 from unprivileged import as_user
 
 from vg_addon.formats import csvio, meshio
@@ -223,20 +224,6 @@ def test_a_plot_that_cannot_be_written_costs_no_row(scan, tmp_path):
     assert "could not write" in result.stderr and "o_scan_edge1.png" in result.stderr
     assert "scan_1.png" in result.stderr
     assert csvio.read_edges_csv(tmp_path / "o_edges.csv")[0].n_stations > 1
-
-
-def arguments(**given) -> argparse.Namespace:
-    values = {"inputs": [], "points": None, "out": None, "save_blend": None, "render": None,
-              "sweep": None, "edge": [], "edges_csv": None}  # fmt: skip
-    return argparse.Namespace(**(values | given))
-
-
-def outcome_of_check(outputs, args) -> str:
-    try:
-        outputs.check_outputs(args)
-    except outputs.UsageError as error:
-        return f"refused: {error}"
-    return "accepted"
 
 
 @pytest.mark.skipif(os.name != "posix", reason="POSIX permissions")

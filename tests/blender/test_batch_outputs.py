@@ -5,7 +5,6 @@ depend on permissions also as an unprivileged user."""
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import os
 import subprocess
@@ -14,6 +13,7 @@ from pathlib import Path
 
 import bpy
 import pytest
+from bpy_helpers import arguments, outcome_of_check
 from unprivileged import as_user
 
 from vg_addon.formats import csvio, meshio
@@ -157,26 +157,6 @@ def test_a_blend_that_fails_late_gives_a_nonzero_exit_and_keeps_the_csv(scan, tm
 
 
 # --------------------------------------------------------------------------- as a normal user
-
-
-def arguments(**given) -> argparse.Namespace:
-    values = {
-        "inputs": [],
-        "points": None,
-        "out": None,
-        "save_blend": None,
-        "render": None,
-        "sweep": None,
-    }
-    return argparse.Namespace(**(values | given))
-
-
-def outcome_of_check(outputs, args) -> str:
-    try:
-        outputs.check_outputs(args)
-    except outputs.UsageError as error:
-        return f"refused: {error}"
-    return "accepted"
 
 
 @pytest.mark.skipif(os.name != "posix", reason="POSIX permissions")
