@@ -2,11 +2,10 @@
 
 import numpy as np
 import pytest
+from reference_data import REFERENCE_NAMES, reference_mesh
 
-from vg_addon.formats.meshio import read_mesh
 from vg_addon.method.normals import face_normals, vertex_normals
 from vg_addon.method.spatial import bounds
-from vg_addon.reference_shapes import half_annulus, intersecting_spheres
 from vg_addon.synthetic_meshes import bone_fragment, wedge
 
 
@@ -57,17 +56,9 @@ def test_vertex_normals_are_bit_identical_to_the_reference(name, points, triangl
         assert np.array_equal(valid, expected[1])
 
 
-@pytest.mark.parametrize(
-    "name",
-    ["HalfAnnulus", "IntersectingSpheres", "sample_mesh", "project half annulus", "project lens"],
-)
+@pytest.mark.parametrize("name", REFERENCE_NAMES)
 def test_reference_mesh_normals_are_bit_identical(name, request):
-    if name == "project half annulus":
-        mesh = half_annulus()
-    elif name == "project lens":
-        mesh = intersecting_spheres()
-    else:
-        mesh = read_mesh(request.getfixturevalue("shared_data") / f"{name}.ply")
+    mesh = reference_mesh(name, request)
     normals, valid = vertex_normals(mesh.points, mesh.triangles)
     expected = reference_vertex_normals(mesh.points, mesh.triangles)
     assert normals.tobytes() == expected[0].tobytes()

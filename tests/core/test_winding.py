@@ -2,11 +2,12 @@
 
 import numpy as np
 import pytest
+from reference_data import REFERENCE_NAMES, reference_mesh
 
 from vg_addon import Surface
 from vg_addon.formats.meshio import read_mesh
 from vg_addon.method.winding import mesh_winding
-from vg_addon.reference_shapes import half_annulus, intersecting_spheres
+from vg_addon.reference_shapes import intersecting_spheres
 from vg_addon.synthetic_meshes import bone_fragment, wedge
 
 # A unit tetrahedron wound outward by hand: each face's corners run counter-clockwise seen from
@@ -48,17 +49,9 @@ def test_bone_fragment_and_its_inward_copy():
     assert Surface(bone.points, bone.triangles[:, ::-1]).winding == "inward"
 
 
-@pytest.mark.parametrize(
-    "name",
-    ["HalfAnnulus", "IntersectingSpheres", "sample_mesh", "project half annulus", "project lens"],
-)
+@pytest.mark.parametrize("name", REFERENCE_NAMES)
 def test_reference_meshes_are_closed_and_outward(name, request):
-    if name == "project half annulus":
-        mesh = half_annulus()
-    elif name == "project lens":
-        mesh = intersecting_spheres()
-    else:
-        mesh = read_mesh(request.getfixturevalue("shared_data") / f"{name}.ply")
+    mesh = reference_mesh(name, request)
     assert Surface(mesh.points, mesh.triangles).winding == "outward"
     assert mesh_winding(mesh.points, mesh.triangles[:, ::-1]) == "inward"
 
