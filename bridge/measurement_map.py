@@ -11,6 +11,13 @@ material showing the "VG Sides" colours, orthographic cameras, a sun and a grey 
 labels as text objects with their own flat materials, on a plane in front of the mesh so the
 mesh never hides them. A label is only drawn in a view that sees its centre (a ray from the
 camera reaches it), and labels too close to a more important one on the picture are left out.
+
+Every measurement appears in at least one view: the views are planned before anything is
+rendered, and a measurement that none of the chosen views shows gets a view of its own, looking
+onto its surface along its mean normal (or tilted from it, or from the other side, until a ray
+reaches its centre). One that no direction sees (inside a closed cavity) is listed on a last
+picture, "not shown", which the contact sheet includes. The labels are set in DejaVu Sans Mono,
+which Blender ships: its "1" has a flag and a foot, so "11" never reads "II".
 Everything made for the render is removed afterwards, whatever happens.
 """
 
@@ -27,7 +34,7 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from ..vg_addon import GoniometerError
-from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, place_labels
+from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, looks_at, place_labels, view_up
 from .colors import ATTRIBUTE_NAME
 from .label_data import labels_of
 from .mesh_data import read_positions, world_points
@@ -37,6 +44,8 @@ TEXT_FRACTION = 0.035  # label height, as a fraction of the picture's width
 GLYPH_EM = 0.6  # the width of a label's character (at most, about), in label heights
 OUTLINE = 0.07  # the black ring around label text, in label heights
 MARGIN = 1.25  # the frame around the object, room for labels at its edges
+FONT_FILE = "DejaVuSansMono.woff2"  # in Blender's datafiles/fonts: a "1" unlike "I"
+NOT_SHOWN = "not shown"  # the name of the picture listing measurements no view can show
 
 
 def safe_file_name(name: str) -> str:
@@ -85,8 +94,10 @@ class MapJob:
         self.size = (width, height)
         self.samples = int(samples)
         self.depsgraph = bpy.context.evaluated_depsgraph_get()
-        self.views = view_list(obj, views, self.depsgraph)
+        self.views = list(view_list(obj, views, self.depsgraph))
         self.labels = labels_of(obj)
+        self.placements: list[list] = []  # per view: (label index, side) of each label drawn
+        self.not_shown: list = []  # labels no view can show (listed on the last picture)
         self.written: list[Path] = []
         self.sheet: Path | None = None
         self._made: list = []
@@ -96,6 +107,7 @@ class MapJob:
         self._staging: Path | None = Path(tempfile.mkdtemp(prefix=".vg-map-", dir=self.directory))
         try:
             self._build_scene()
+            self._plan()
         except BaseException:
             self.close()
             raise
@@ -175,6 +187,19 @@ class MapJob:
         scene.view_settings.view_transform = "Standard"
         self._white = self._flat_material("VG Map label", (1.0, 1.0, 1.0, 1.0))
         self._black = self._flat_material("VG Map outline", (0.0, 0.0, 0.0, 1.0))
+        self._copy = copy
+        self._font = self._label_font()
+
+    def _label_font(self):
+        """Blender's DejaVu Sans Mono, or None (Blender's built-in font) if it is not there."""
+        folder = bpy.utils.system_resource("DATAFILES", path="fonts")
+        path = os.path.join(folder, FONT_FILE) if folder else ""
+        if not os.path.isfile(path):
+            return None
+        try:
+            return self._keep(bpy.data.fonts.load(path, check_existing=False))
+        except (RuntimeError, OSError):
+            return None
 
     def _sides_material(self):
         material = self._keep(bpy.data.materials.new("VG Map sides"))
@@ -221,12 +246,68 @@ class MapJob:
         front = float(along[2].max())
         return right, up, back, centre, front, scale
 
+    # -- which views show which labels ------------------------------------------------------
+
+    def _layout(self, look, up, focus=None) -> list:
+        """The labels a view looking along ``look`` draws: ``(label index, side)`` of each one
+        whose centre it sees and that has room on the picture; ``focus`` (a label index) first,
+        then the selected measurement, then the newest."""
+        right, up, back, centre, _front, scale = self._frame(look, up)
+        pixel = scale / self.size[0]
+        shown = [i for i, label in enumerate(self.labels) if self._visible(label, -back)]
+        if not shown:
+            return []
+        anchors = [
+            [((self.labels[i].position - centre) @ right) / pixel,
+             ((self.labels[i].position - centre) @ up) / pixel]
+            for i in shown
+        ]  # fmt: skip
+        total = len(shown)
+        priority = [
+            (2 * total if i == focus else total if self.labels[i].active else 0) + rank
+            for rank, i in enumerate(shown)
+        ]
+        text_px = TEXT_FRACTION * self.size[0]
+        widths = [GLYPH_EM * len(self.labels[i].text) * text_px for i in shown]
+        placed = place_labels(anchors, widths, text_px, priority, gap=0.45 * text_px)
+        return [(shown[index], side) for index, side in placed]
+
+    def _plan(self) -> None:
+        """Lay out the chosen views, add a view for each measurement none of them shows, and a
+        last picture listing those that no direction shows."""
+        self.placements = [self._layout(look, up) for _name, look, up in self.views]
+        drawn = {index for placed in self.placements for index, _side in placed}
+        for index, label in enumerate(self.labels):
+            if index in drawn:
+                continue
+            for look in looks_at(label.outward):
+                if not self._visible(label, look):
+                    continue
+                up = view_up(look)
+                placed = self._layout(look, up, focus=index)
+                if any(i == index for i, _side in placed):
+                    self.views.append((f"measurement {label.number}", tuple(look), up))
+                    self.placements.append(placed)
+                    drawn.update(i for i, _side in placed)
+                    break
+            else:
+                self.not_shown.append(label)
+        if self.not_shown:
+            self.views.append((NOT_SHOWN, None, None))
+            self.placements.append([])
+
+    # -- rendering ------------------------------------------------------------------------------
+
     def render_next(self) -> Path:
         """Render the next view into its PNG; returns where the picture is now (the job's hidden
         folder, until :meth:`finish` moves it to :meth:`picture_path`)."""
         if self.done:
             raise GoniometerError("Every view of this map is rendered already.")
-        name, look, up = self.views[len(self.written)]
+        step = len(self.written)
+        name, look, up = self.views[step]
+        self._copy.hide_render = look is None
+        if look is None:
+            look, up = SIX_VIEWS[0][1:]
         right, up, back, centre, front, scale = self._frame(look, up)
         rotation = Matrix(np.column_stack([right, up, back]).tolist()).to_4x4()
         camera = self._camera
@@ -238,7 +319,12 @@ class MapJob:
         camera.data.clip_end = 3.0 * self._size
         key = -np.asarray(look) + 0.5 * right + 0.6 * up
         self._sun.rotation_euler = Vector(-key).to_track_quat("-Z", "Y").to_euler()
-        self._place_labels(name, right, up, back, centre, front, scale, rotation)
+        if name == NOT_SHOWN and self.views[step][1] is None:
+            self._list_not_shown(right, up, back, centre, front, scale, rotation)
+        else:
+            self._place_labels(
+                name, self.placements[step], right, up, back, centre, front, scale, rotation
+            )
         path = self.picture_path(name)
         staged = self._staged(path)
         scene = self._scene
@@ -274,43 +360,57 @@ class MapJob:
                 return True
         return False
 
-    def _place_labels(self, view_name, right, up, back, centre, front, scale, rotation) -> None:
+    def _clear_labels(self) -> None:
         for block in self._label_objects:
             self._remove(block)
         self._label_objects = []
-        width, height = self.size
+
+    def _place_labels(
+        self, view_name, placed, right, up, back, centre, front, scale, rotation
+    ) -> None:
+        self._clear_labels()
+        width = self.size[0]
         pixel = scale / width  # world size of one pixel
         text_height = TEXT_FRACTION * width * pixel
-        look = -back
-        shown = [label for label in self.labels if self._visible(label, look)]
-        positions = np.array(
-            [
-                [
-                    ((label.position - centre) @ right) / pixel,
-                    ((label.position - centre) @ up) / pixel,
-                ]
-                for label in shown
-            ]
-        ).reshape(-1, 2)
-        priority = [(len(shown) if label.active else 0) + i for i, label in enumerate(shown)]
         plane = front + 0.05 * self._size  # in front of the mesh, behind the camera
-        text_px = TEXT_FRACTION * width
-        widths = [GLYPH_EM * len(label.text) * text_px for label in shown]
-        gap = 0.45 * text_px
-        for index, side in place_labels(positions, widths, text_px, priority, gap=gap):
-            label = shown[index]
+        gap = 0.45 * TEXT_FRACTION * width
+        for index, side in placed:
+            label = self.labels[index]
             on_plane = label.position + back * (plane - label.position @ back)
             self._marker(on_plane, rotation, 0.22 * text_height)
             at = on_plane + side * right * gap * pixel
             self._text(label.text, at, rotation, text_height, "LEFT" if side > 0 else "RIGHT")
-        # The caption: object and view, in the top-left corner.
-        corner = centre + back * plane
+        self._caption(f"{self.obj.name} · {view_name}", centre, back * plane, scale, rotation)
+
+    def _caption(self, text, centre, plane, scale, rotation, line=0) -> None:
+        """A line of text in the top-left corner of the picture (``line`` 0 the top one)."""
+        right, up = np.array(rotation.col[0][:3]), np.array(rotation.col[1][:3])
+        width, height = self.size
+        text_height = TEXT_FRACTION * scale
         corner = (
-            corner
+            centre
+            + plane
             - right * (scale / 2 - text_height)
-            + up * (scale * height / width / 2 - 1.2 * text_height)
+            + up * (scale * height / width / 2 - (1.2 + 1.5 * line) * text_height)
         )
-        self._text(f"{self.obj.name} · {view_name}", corner, rotation, text_height)
+        self._text(text, corner, rotation, text_height)
+
+    def _list_not_shown(self, right, up, back, centre, front, scale, rotation) -> None:
+        """The picture of the measurements no view shows: their numbers, a line each few."""
+        self._clear_labels()
+        plane = back * (front + 0.05 * self._size)
+        room = max(8, int(self.size[0] / (GLYPH_EM * TEXT_FRACTION * self.size[0])) - 3)
+        lines = [f"{self.obj.name}: not shown in any view", "(no line of sight to the centre):"]
+        line = ""
+        for label in self.not_shown:
+            word = f"#{label.number}"
+            if line and len(line) + 2 + len(word) > room:
+                lines.append(line + ",")
+                line = ""
+            line = f"{line}, {word}" if line else word
+        lines.append(line)
+        for number, text in enumerate(lines):
+            self._caption(text, centre, plane, scale, rotation, line=number)
 
     def _text(self, text, at, rotation, height, align="LEFT") -> None:
         """White text ringed in black, its left (or right) middle at ``at``, facing the camera:
@@ -326,6 +426,8 @@ class MapJob:
         curve.size = height
         curve.align_x = align
         curve.align_y = "CENTER"
+        if self._font is not None:
+            curve.font = self._font
         curve.materials.append(self._black)
         white = self._keep(curve.copy())
         white.materials[0] = self._white
@@ -395,6 +497,7 @@ class MapJob:
                 bpy.types.World: bpy.data.worlds,
                 bpy.types.Material: bpy.data.materials,
                 bpy.types.Scene: bpy.data.scenes,
+                bpy.types.VectorFont: bpy.data.fonts,
             }.get(type(block))
             if collection is not None:
                 collection.remove(block)

@@ -171,9 +171,138 @@ def test_the_operator_writes_the_map(vg, tmp_path):
         directory=str(folder), views="FLAKE", width=120, height=90, samples=1
     )
     assert result == {"FINISHED"}
+    # The two faces miss measurement 1: it gets a view of its own.
     assert sorted(p.name for p in folder.iterdir()) == [
         f"{obj.name}_map.png",
         f"{obj.name}_map_face_A.png",
         f"{obj.name}_map_face_B.png",
+        f"{obj.name}_map_measurement_1.png",
     ]
-    assert pixels_of(folder / f"{obj.name}_map.png").shape == (90, 240, 4)
+    assert pixels_of(folder / f"{obj.name}_map.png").shape == (90, 360, 4)
+
+
+def _frame_to(direction):
+    """A rotation taking +z to ``direction`` (columns: the new x, y, z)."""
+    z = np.asarray(direction, dtype=np.float64) / np.linalg.norm(direction)
+    x = np.cross([0.0, 0.0, 1.0], z) if abs(z[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+def _quad(a, b, c, d, start):
+    return [(start + a, start + b, start + c), (start + a, start + c, start + d)]
+
+
+def hidden_measurements_mesh():
+    """Three ridges (wedges whose outward normal is the local +z): one open to the sky at
+    ``OPEN``; one at the bottom of a square tube along (1, 1, 1) over a floor plate at ``PIT``,
+    which no axis-aligned view can see into; one shut in a closed box at ``SHUT``."""
+    from vg_addon.synthetic_meshes import wedge
+
+    points, triangles = [], []
+
+    def add(vertices, faces):
+        start = sum(len(p) for p in points)
+        points.append(np.asarray(vertices, dtype=np.float64))
+        triangles.extend((start + a, start + b, start + c) for a, b, c in faces)
+
+    ridge = wedge(120.0, half_width=0.3, depth=0.3, n=12)
+    for centre, rotation in ((OPEN, np.eye(3)), (PIT, _frame_to(DIAGONAL)), (SHUT, np.eye(3))):
+        add(ridge.points @ rotation.T + centre, ridge.triangles)
+    rotation = _frame_to(DIAGONAL)
+    u, v, d = rotation.T
+    plate = [
+        PIT + d * -0.4 + 3.0 * (su * u + sv * v) for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1))
+    ]
+    add(plate, _quad(0, 1, 2, 3, 0))
+    w = 0.45
+    for side, across in ((u, v), (-u, v), (v, u), (-v, u)):
+        wall = [
+            PIT + w * side + a * across * w + h * d
+            for a, h in ((-1, -0.4), (1, -0.4), (1, 3.0), (-1, 3.0))
+        ]
+        add(wall, _quad(0, 1, 2, 3, 0))
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * 0.6
+    box = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    add(corners + SHUT, [t for q in box for t in _quad(*q, 0)])
+    return np.vstack(points), np.array(triangles)
+
+
+OPEN, PIT, SHUT = np.array([4.0, 0.0, 0.0]), np.zeros(3), np.array([0.0, 0.0, -4.0])
+DIAGONAL = np.array([1.0, 1.0, 1.0]) / np.sqrt(3.0)
+
+
+def first_hit(points, triangles, origin, direction) -> float:
+    """The distance along ``direction`` from ``origin`` to the first triangle it meets (inf if
+    none): Moller-Trumbore over every triangle, in NumPy, not Blender's ray cast."""
+    a, b, c = (points[triangles[:, k]] for k in range(3))
+    e1, e2 = b - a, c - a
+    p = np.cross(direction, e2)
+    det = np.einsum("ij,ij->i", e1, p)
+    ok = np.abs(det) > 1e-12
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    s = origin - a
+    u = np.einsum("ij,ij->i", s, p) * inv
+    q = np.cross(s, e1)
+    v = (q @ direction) * inv
+    t = np.einsum("ij,ij->i", e2, q) * inv
+    hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
+    return float(t[hit].min()) if hit.any() else float("inf")
+
+
+def seen_along(points, triangles, centre, look) -> bool:
+    """Whether a ray along ``look`` from far outside first meets the mesh at ``centre``."""
+    far = 50.0
+    return abs(first_hit(points, triangles, centre - far * look, look) - far) < 0.02
+
+
+def test_every_measurement_appears_in_some_view_or_is_listed(vg, tmp_path):
+    """Issue 20, item 5: a ridge at the bottom of a tube no axis-aligned view can see into gets a
+    view of its own, and one shut in a closed box is listed on the contact sheet. The oracle is
+    a NumPy ray cast from each rendered camera along its axis to each measured centre, and the
+    label text objects in the scene that camera rendered."""
+    points, triangles = hidden_measurements_mesh()
+    obj = mesh_object("Hidden", points, triangles)
+    for at in (OPEN, PIT, SHUT):
+        vg.bridge.measuring.measure_on_object(obj, at, 0.2)
+    centres = {item.number: np.asarray(exact(item)["center"]) for item in obj.vg.measurements}
+    assert len(centres) == 3
+    pit = next(n for n, c in centres.items() if np.linalg.norm(c - PIT) < 0.1)
+    shut = next(n for n, c in centres.items() if np.linalg.norm(c - SHUT) < 0.1)
+    axes = [np.array(look) for _name, look, _up in vg.vg_addon.workflow.labels.SIX_VIEWS]
+    assert not any(seen_along(points, triangles, centres[pit], look) for look in axes)
+    assert not any(
+        seen_along(points, triangles, centres[shut], look)
+        for look in vg.vg_addon.workflow.labels.looks_at(np.array([0.3, -0.2, 1.0]))
+    )
+    job = vg.bridge.measurement_map.MapJob(obj, tmp_path, size=(320, 240), samples=4)
+    appears, listed, fonts = set(), "", set()
+
+    try:
+        while not job.done:
+            job.render_next()
+            camera = job._camera.matrix_world
+            look = -np.array(camera.col[2][:3])
+            texts = [o.data for o in job._scene.objects if o.type == "FONT"]
+            fonts.update(t.font.name for t in texts)
+            bodies = {t.body for t in texts}
+            if job.written[-1].name == "Hidden_map_not_shown.png":
+                listed = " ".join(bodies)
+            for number, centre in centres.items():
+                label = any(b.startswith(f"{number}: ") for b in bodies)
+                if label and seen_along(points, triangles, centre, look):
+                    appears.add(number)
+        job.finish()
+    finally:
+        job.close()
+    assert appears == set(centres) - {shut}
+    assert f"#{shut}" in listed and f"#{pit}" not in listed
+    assert [p.name for p in job.written][6:] == [
+        f"Hidden_map_measurement_{pit}.png",
+        "Hidden_map_not_shown.png",
+    ]
+    assert {f.rsplit(" ", 1)[0] for f in fonts} == {
+        "DejaVu Sans Mono"
+    }  # its "1" has a flag and a foot, unlike "I"
+    sheet = pixels_of(job.sheet)
+    assert sheet.shape == (3 * 240, 3 * 320, 4)  # eight pictures, three to a row

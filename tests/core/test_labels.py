@@ -116,3 +116,20 @@ def test_a_label_that_would_cross_the_right_edge_goes_left():
     for index, side in bounded.items():
         box = label_box(np.array(anchors[index]), widths[index], 12.0, side, 6.0)
         assert box[2] <= 100.0
+
+
+def test_looks_at_a_measurement_start_straight_onto_its_surface():
+    from vg_addon.workflow.labels import looks_at, view_up
+
+    outward = np.array([0.0, 3.0, 4.0])
+    looks = looks_at(outward)
+    assert len(looks) == 2 * (1 + 3 * 8)
+    np.testing.assert_allclose(looks[0], [0.0, -0.6, -0.8])
+    np.testing.assert_allclose(looks[25], [0.0, 0.6, 0.8])  # then from the other side
+    np.testing.assert_allclose(np.linalg.norm(looks, axis=1), 1.0)
+    angles = np.degrees(np.arccos(np.clip(np.asarray(looks[1:25]) @ looks[0], -1, 1)))
+    np.testing.assert_allclose(sorted(angles), np.repeat([20.0, 40.0, 60.0], 8), atol=1e-9)
+    assert looks_at(np.zeros(3)) == [] and looks_at(np.array([np.nan, 0, 1])) == []
+    for look in looks:
+        up = np.array(view_up(look))
+        assert abs(up @ look) < 1e-12 and abs(np.linalg.norm(up) - 1.0) < 1e-12

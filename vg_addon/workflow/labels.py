@@ -140,3 +140,45 @@ def flake_views(points) -> tuple:
 def label_text(number: int, angle: float) -> str:
     """A label: the measurement number and its angle to the 0.01° it is reported to."""
     return f"{number}: {angle:.2f}°"
+
+
+def view_up(look) -> tuple:
+    """The up direction of a picture looking along ``look``: world Z made square to it, or world
+    Y when ``look`` is nearly vertical."""
+    look = np.asarray(look, dtype=np.float64)
+    look = look / np.linalg.norm(look)
+    up = np.array([0.0, 0.0, 1.0]) if abs(look[2]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    up = up - (up @ look) * look
+    return tuple(up / np.linalg.norm(up))
+
+
+def looks_at(outward, tilts=(20.0, 40.0, 60.0), turns: int = 8) -> list:
+    """Directions to look at a measurement from, best first: straight onto its surface (along
+    minus its mean normal ``outward``), then tilted ``tilts`` degrees from it at ``turns``
+    evenly spaced turns, then the same from the other side (a normal can point inwards).
+
+    Parameters
+    ----------
+    outward : array_like, shape (3,)
+        The mean of the measurement's two side normals; a zero vector gives no direction.
+
+    Returns
+    -------
+    list of ndarray
+        Unit look directions (the way the camera points).
+    """
+    outward = np.asarray(outward, dtype=np.float64)
+    length = float(np.linalg.norm(outward))
+    if not np.isfinite(length) or length == 0.0:
+        return []
+    axis = -outward / length
+    side = np.array(view_up(axis))
+    other = np.cross(axis, side)
+    looks = []
+    for sign in (1.0, -1.0):
+        looks.append(sign * axis)
+        for tilt in np.radians(tilts):
+            for turn in np.arange(turns) * (2.0 * np.pi / turns):
+                bend = np.cos(turn) * side + np.sin(turn) * other
+                looks.append(sign * (np.cos(tilt) * axis + np.sin(tilt) * bend))
+    return looks
