@@ -1604,3 +1604,85 @@ def write_sweep_csv(path, mesh_name: str, points, number: int | None = None) -> 
     """Write one site's sweep to ``path`` atomically (as :func:`write_measurements_csv`)."""
     text = format_sweep_rows(sweep_cells(mesh_name, number, point) for point in points)
     replace_atomically(os.fspath(path), text.encode("utf-8"))
+
+
+# --------------------------------------------------------------------------- any table
+
+
+def read_table(path_or_text) -> tuple[str, list[str], list[tuple[int, list[str]]]]:
+    """Any comma-separated table, cell by cell, with this module's checks (UTF-8, the
+    delimiter, quotes left open), for readers that judge each cell themselves.
+
+    ``path_or_text`` is taken as in :func:`read_replication_csv`.
+
+    Returns
+    -------
+    source : str
+        The file's name for messages (``"'session.csv'"``).
+    header : list of str
+        The first non-blank record.
+    rows : list of (int, list of str)
+        The non-blank records after it, each with its row number as a spreadsheet shows it.
+    """
+    text, source = _load(path_or_text)
+    records = _records(text, source)
+    header_at, header = _header(records, source)
+    return (
+        source,
+        header,
+        [(n, cells) for n, cells in records[header_at + 1 :] if not _blank(cells)],
+    )
+
+
+def header_columns(header: Sequence[str], aliases: dict) -> tuple[dict, list[str]]:
+    """``(field -> column index, problems)`` for a header, its names matched as this module
+    matches them (case, spaces and ``_`` ignored; the first alias found wins)."""
+    problems: list[str] = []
+    normalised = {field: tuple(_normalise(a) for a in names) for field, names in aliases.items()}
+    return _resolve_columns(list(header), normalised, problems), problems
+
+
+def number_cell(raw: str) -> tuple[float | None, str | None]:
+    """A non-blank cell as a finite number: ``(value, None)``, or ``(None, why not)`` worded as
+    this module's messages are (a decimal comma named as the cause)."""
+    return _parse_float(raw)
+
+
+def break_number_cell(raw: str) -> int | str | None:
+    """A ``Break #`` cell: the number, ``None`` when blank, or why it is not one (a str)."""
+    return _parse_break_number(raw)
+
+
+def text_cell(raw: str) -> str:
+    """A text cell as written by :func:`writable_row` read back (the spreadsheet apostrophe
+    removed)."""
+    return _unescape_text(raw)
+
+
+def mesh_stem(name: str) -> str:
+    """A mesh name without a folder and a mesh file extension (``scans/bone.ply`` -> ``bone``;
+    Blender's ``bone.001`` stays as it is)."""
+    return _mesh_stem(name.strip())
+
+
+def format_table(header: Sequence[str], rows: Iterable[Sequence]) -> str:
+    """A table's CSV text in this module's form: floats as ``repr`` (they read back exactly),
+    ``None`` empty, text guarded against spreadsheet formulas."""
+
+    def cell(value) -> str:
+        if value is None:
+            return ""
+        if isinstance(value, bool):
+            return "TRUE" if value else "FALSE"
+        if isinstance(value, (int, float)):
+            return repr(value) if isinstance(value, float) else str(value)
+        return _escape_text(str(value))
+
+    lines = [_csv_line(cell(h) for h in header)]
+    lines += [_csv_line(cell(value) for value in row) for row in rows]
+    return "".join(lines)
+
+
+def write_table(path, header: Sequence[str], rows: Iterable[Sequence]) -> None:
+    """Write :func:`format_table`'s text to ``path`` atomically (the old file kept on failure)."""
+    replace_atomically(path, format_table(header, rows).encode("utf-8"))

@@ -1,0 +1,36 @@
+"""From measurement CSVs to the paper's replication analysis (its Section 4).
+
+The parts here need NumPy and the standard library only, like the rest of ``vg_addon``:
+``sessions`` reads each CSV as one session (an observer's repetition with one method), ``matching``
+pairs the rows of different sessions by mesh, break and, where a break holds several stations,
+nearest centre, and ``iov`` computes the intra- and inter-observer variability per break.
+
+The statistics (``stats``, ``icc``), the figures (``figures``) and the report (``report``) import
+SciPy, statsmodels and matplotlib inside their functions, so importing this package never needs
+them; :func:`missing_libraries` says which are absent (Blender's own Python has none of them).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+
+#: What the statistics and figures need beyond NumPy: import name -> pip name.
+REPORT_LIBRARIES = {"scipy": "scipy", "statsmodels": "statsmodels", "matplotlib": "matplotlib"}
+
+
+def missing_libraries() -> list[str]:
+    """The pip names of the report's libraries this Python cannot import (empty: all there)."""
+    return [pip for name, pip in REPORT_LIBRARIES.items() if importlib.util.find_spec(name) is None]
+
+
+def missing_message(command: str = "python vg_batch.py --report DIR SESSION.csv ...") -> str:
+    """Why the report cannot run here and what does the same elsewhere; empty when it can."""
+    missing = missing_libraries()
+    if not missing:
+        return ""
+    return (
+        f"The report needs {', '.join(missing)}, which this Python does not have (Blender's own "
+        "Python has NumPy only). Install them into it "
+        f"(python -m pip install {' '.join(missing)}), or run the same report from the "
+        f"repository's environment: {command}"
+    )
