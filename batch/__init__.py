@@ -34,6 +34,11 @@ def main(argv: list[str]) -> int:
         if args.worker:
             return worker_main(args.worker)
         signal.signal(signal.SIGTERM, _stop)
+        if args.report:
+            from .report import check_report_args, run_report
+
+            check_report_args(args)
+            return run_report(args)
         check_args(args)
         if args.demo:
             return run_demo(args)

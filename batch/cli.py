@@ -68,8 +68,9 @@ output:
   before anything is read or written.
 
 exit status:
-  0  every point measured
-  1  some rows failed (see their `error` column)
+  0  every point measured (--report: every row read was used)
+  1  some rows failed (see their `error` column; --report: some rows or files left out, each
+     named in the report and on stderr)
   2  bad arguments, missing or unreadable files, a malformed points CSV, an output refused
      or a .blend/picture that could not be written
 
@@ -87,6 +88,7 @@ examples:
   blender -b study.blend --python vg_batch.py -- --object Bone_12 --points p.csv --out a.csv
   python vg_batch.py scan.ply --edge 0 0 0 10 2 0 --via 5 1.5 0.2 --spacing 1 --radius 2 \
       --out edge.csv
+  python vg_batch.py --report report/ obs1_drag_1.csv obs1_drag_2.csv obs1_xyz_1.csv manual.csv
   python vg_batch.py --demo
 """
 
@@ -120,6 +122,7 @@ def build_parser() -> argparse.ArgumentParser:
         "       [--lambda L] [--patch euclidean|geodesic] [--rule oriented|paper]\n"
         "       [--stability] [--sweep R0 R1 N] --out CSV [--save-blend PATH]\n"
         "       [--render DIR] [--jobs N] [--shard K/N]\n"
+        "   or: --report DIR CSV... [--method M]... [--observer O]... [--compare A B]...\n"
         "   or: --demo [--out-dir DIR]",
         description="Measure break-edge angles (the Virtual Goniometer) on meshes and point "
         "lists, headless, and write them to a CSV.",
@@ -293,6 +296,38 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument(
         "--out-dir", metavar="DIR", help="the demo's output folder (default ./vg_demo_output)"
     )
+    report = parser.add_argument_group("report (see docs/REPORT.md)")
+    report.add_argument(
+        "--report",
+        metavar="DIR",
+        help="instead of measuring: the replication report over the CSVs given (one session "
+        "each), written into DIR (report.html, breaks.csv, summary.csv, figures/)",
+    )
+    report.add_argument(
+        "--method",
+        action="append",
+        default=[],
+        metavar="M",
+        help="the sessions' method (manual, drag, xyz or any name): once for all CSVs or once "
+        "per CSV in order; default: the Method column, else a method word in the file name",
+    )
+    report.add_argument(
+        "--observer",
+        action="append",
+        default=[],
+        metavar="O",
+        help="the sessions' observer, as --method; default: the Observer column, else obsN in "
+        "the file name",
+    )
+    report.add_argument(
+        "--compare",
+        nargs=2,
+        action="append",
+        default=[],
+        metavar=("A", "B"),
+        help="also a Bland-Altman analysis of A against B, each a method or a session's file "
+        "name (repeatable)",
+    )
     parser.add_argument("--worker", help=argparse.SUPPRESS)
     return parser
 
@@ -347,6 +382,8 @@ def check_args(args) -> None:
         return
     if args.out_dir:
         raise UsageError("--out-dir is for --demo; use --out CSV for a batch run.")
+    if args.method or args.observer or args.compare:
+        raise UsageError("--method, --observer and --compare are for --report DIR CSV ...")
     if args.at and args.points:
         raise UsageError(
             "give the points to measure with --at X Y Z (repeatable) or --points CSV, not both."
