@@ -40,7 +40,7 @@ make_env() {  # make_env DIR PYTHON-VERSION REQUIREMENTS
     local dir=$1 want=$2 requirements=$3 python stamp
     python=$(find_python "$want")
     stamp=$( (
-        cat requirements/dev.txt "$requirements"
+        cat requirements/dev.txt requirements/report.txt "$requirements"
         "$python" -VV
     ) | sha256sum | cut -c1-16)
     if [ -f "$dir/.vg-stamp" ] && [ "$(cat "$dir/.vg-stamp")" = "$stamp" ]; then
