@@ -26,7 +26,7 @@ from bpy.props import (
 from bpy.types import PropertyGroup
 from mathutils import Vector
 
-from .vg_addon import palette
+from .vg_addon import palette, units
 from .vg_addon.method.result import (
     UNDETERMINED_REFUSED,
     UNSTABLE_DEGREES,
@@ -302,8 +302,48 @@ class VG_EdgeProfile(PropertyGroup):
     radius: FloatProperty(name="Radius", subtype="DISTANCE", unit="LENGTH", get=_number("radius"))
 
 
+UNIT_ITEMS = (
+    (units.SCENE, "Scene Units", "Blender units, as the scene's unit system says (Scene > Units)"),
+    *(
+        (key, symbol, f"The scan's coordinates are in {name.lower()}")
+        for key, name, symbol, _m in units.UNITS
+    ),
+)
+
+
+def _unit_chosen(data, _context) -> None:
+    """The user chose the unit: it is no longer a guess, and no later guess replaces it."""
+    if data.get("unit_guessing"):
+        return
+    data.unit_chosen = True
+    data.unit_guessed = False
+
+
 class VG_ObjectData(PropertyGroup):
     """An object's measurements (``Object.vg``)."""
+
+    unit: EnumProperty(
+        name="Scan Units",
+        items=UNIT_ITEMS,
+        default=units.SCENE,
+        description="The unit of the scan's coordinates, used to show lengths and in the CSV's "
+        "Units column; no stored number changes. Guessed on the first measurement from the "
+        "mesh's size (2 units across or more: mm, else m) when the scene's units are "
+        "Blender's default",
+        update=_unit_chosen,
+    )
+    unit_guessed: BoolProperty(
+        name="Unit guessed",
+        description="The scan's unit was guessed from its size, not chosen",
+        default=False,
+        options={"HIDDEN"},
+    )
+    unit_chosen: BoolProperty(
+        name="Unit chosen",
+        description="The user chose the scan's unit (no guess replaces it)",
+        default=False,
+        options={"HIDDEN"},
+    )
 
     measurements: CollectionProperty(type=VG_Measurement)
     active_index: IntProperty(name="Active measurement", default=0, min=0)
@@ -337,13 +377,11 @@ class VG_SceneSettings(PropertyGroup):
     radius: FloatProperty(
         name="Radius",
         description="Patch radius around the centre, in the mesh's own units (its coordinates, "
-        "whatever the object's scale)",
+        "whatever the object's scale: the Scan Units the panel shows)",
         default=1.0,
         min=0.0,
         soft_min=1e-4,
         precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
     )
     seg_param: FloatProperty(
         name="λ (SegParam)",
@@ -370,31 +408,25 @@ class VG_SceneSettings(PropertyGroup):
     )
     sweep_start: FloatProperty(
         name="From",
-        description="First radius of a radius sweep, scene units",
+        description="First radius of a radius sweep, in the mesh's own units",
         default=0.5,
         min=0.0,
         precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
     )
     edge_spacing: FloatProperty(
         name="Spacing",
-        description="Arc length between the stations of an edge profile, in scene units",
+        description="Arc length between the stations of an edge profile, in the mesh's own units",
         default=1.0,
         min=0.0,
         soft_min=1e-4,
         precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
     )
     sweep_stop: FloatProperty(
         name="To",
-        description="Last radius of a radius sweep, scene units",
+        description="Last radius of a radius sweep, in the mesh's own units",
         default=2.0,
         min=0.0,
         precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
     )
     sweep_count: IntProperty(
         name="Radii", description="Number of radii in a sweep", default=16, min=2, max=1000

@@ -13,7 +13,7 @@ import bpy
 import numpy as np
 
 from ..properties import exact_numbers
-from ..vg_addon import GoniometerError, palette
+from ..vg_addon import GoniometerError, palette, units
 from ..vg_addon.formats import csvio
 from ..vg_addon.method.break_sides import paint_swapped
 from .mesh_data import uniform_scale
@@ -117,6 +117,7 @@ def add_measurement(
         A break number out of range; nothing is added then.
     """
     data = obj.vg
+    guess_unit(obj, bpy.context.scene)
     break_number = data.break_number if break_number is None else break_number
     if not (
         isinstance(break_number, int | np.integer) and 1 <= break_number <= csvio.MAX_BREAK_NUMBER
@@ -206,6 +207,32 @@ def _plus_first(numbers: dict) -> bool:
     return bool(numbers.get("plus_left", True)) and not numbers.get(SWAPPED, False)
 
 
+def honour_colours(item, cell: str) -> bool:
+    """Paint ``item``'s sides the way round a CSV's ``Colors`` cell says (a re-imported row whose
+    file gives its break's pair the other way round); returns whether that changed anything.
+
+    Only the order of the item's own pair can follow the file: another pair, an unreadable cell
+    or an edge station (whose order is its path's side) leaves it as it is. The measured numbers
+    never change; only which side is painted in which colour.
+    """
+    if not cell or item.edge_number:
+        return False
+    try:
+        wanted = csvio.format_colors(cell)
+        mine = csvio.format_colors(tuple(item.colors.split("/")))
+    except GoniometerError:
+        return False
+    if wanted == mine or wanted != "/".join(reversed(mine.split("/"))):
+        return False
+    numbers = json.loads(item.exact)
+    if numbers.pop(SWAPPED, False) is False:
+        numbers[SWAPPED] = True
+    item.exact = json.dumps(numbers)
+    item.colors = "/".join(reversed(item.colors.split("/")))
+    stamp(item)
+    return True
+
+
 def plus_on_pair_side(item) -> bool:
     """Whether ``item``'s "+" side is painted in the first colour of its break's pair."""
     return _plus_first(exact_numbers(item))
@@ -292,22 +319,60 @@ def replay_args(item) -> dict:
     }
 
 
+def unit_symbol(obj, scene) -> str:
+    """The symbol of ``obj``'s coordinate unit (``"mm"``): the one its Scan Units say, else what
+    one Blender unit is in ``scene`` (``"BU"`` if no unit is exactly that)."""
+    key = getattr(getattr(obj, "vg", None), "unit", units.SCENE)
+    if key in units.SYMBOLS:
+        return units.SYMBOLS[key]
+    settings = scene.unit_settings
+    return units.scene_symbol(settings.system, settings.scale_length)
+
+
+def guess_unit(obj, scene) -> None:
+    """Guess ``obj``'s Scan Units from its size, once, before its first measurement: only when
+    nobody chose them and the scene's units are Blender's default (a scene set up with its own
+    units says what a Blender unit is); see ``vg_addon.units.guess_unit``."""
+    data = obj.vg
+    settings = scene.unit_settings
+    if (
+        len(data.measurements)
+        or data.unit_chosen
+        or data.unit != units.SCENE
+        or settings.system != "METRIC"
+        or settings.scale_length != 1.0
+    ):
+        return
+    corners = np.array([tuple(c) for c in obj.bound_box], dtype=np.float64)
+    extent = float((corners.max(axis=0) - corners.min(axis=0)).max())
+    data["unit_guessing"] = True
+    try:
+        data.unit = units.guess_unit(extent)
+    finally:
+        del data["unit_guessing"]
+    data.unit_guessed = True
+
+
 def units_label(scene, obj=None) -> str:
-    """What one coordinate unit is: Blender units and their length in the scene's unit system,
-    for a mesh shown at its own size; for an object scaled by ``s``, one mesh unit is ``s``
-    Blender units in the scene, and the label says so."""
-    units = scene.unit_settings
+    """What one coordinate unit is: the object's Scan Units (``"mm"``) when it has them, else
+    Blender units and their length in the scene's unit system, for a mesh shown at its own size;
+    for an object scaled by ``s``, one mesh unit is ``s`` Blender units in the scene, and the
+    label says so."""
+    key = getattr(getattr(obj, "vg", None), "unit", units.SCENE)
+    if key in units.SYMBOLS:
+        return units.SYMBOLS[key]  # the mesh's own coordinates, whatever the object's scale
+    units_ = scene.unit_settings
     scale = None
     if obj is not None:
         scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
         if scale is None:
             return "mesh units (the object's scale is not uniform)"
-    if units.system == "NONE":
+    if units_.system == "NONE":
         base = "BU"
         metres = None
     else:
-        base = f"BU (1 BU = {units.scale_length:g} m, shown in {units.length_unit.lower()})"
-        metres = units.scale_length
+        base = f"BU (1 BU = {units_.scale_length:g} m, shown in {units_.length_unit.lower()})"
+        metres = units_.scale_length
     if scale is None or scale == 1.0:
         return base
     shown = f"{scale:g} BU" if metres is None else f"{scale * metres:g} m"

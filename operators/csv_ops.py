@@ -10,9 +10,9 @@ import bpy
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from ..bridge import edges, measuring
+from ..bridge import edges, measuring, records
 from ..bridge.mesh_data import check_measurable
-from ..vg_addon import GoniometerError
+from ..vg_addon import GoniometerError, units
 from ..vg_addon.formats import csvio
 from .measure import poll_measurable, typed_value
 from .progress import Progress, own_timer_tick
@@ -267,10 +267,11 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
+        extra = follow_export(self._obj, self._full_path, numbers)
         self.report(
             {"INFO"},
             f"Re-measured {len(numbers)} row(s) of {self._path_name} on '{self._obj.name}' "
-            f"(measurements {numbers[0]}–{numbers[-1]})",
+            f"(measurements {numbers[0]}–{numbers[-1]}){extra}",
         )
         _remember(self._full_path)
         return {"FINISHED"}
@@ -323,6 +324,35 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         progress, self._progress = getattr(self, "_progress", None), None
         if progress is not None:
             progress.__exit__(None, None, None)
+
+
+def follow_export(obj, path, numbers) -> str:
+    """After re-measuring an export of this extension: take its Units as ``obj``'s Scan Units
+    (unless the user chose them) and paint each new measurement's sides the way round its
+    Colors cell says; returns what to add to the report ("" for a file of another kind)."""
+    try:
+        rows = csvio.read_measurements_csv(path)
+    except (GoniometerError, OSError, ValueError):
+        return ""  # MeshLab's, the earlier add-on's or a points file: no Units, no Colors
+    if len(rows) != len(numbers):
+        return ""
+    extra = ""
+    found = {units.unit_of_text(row.units) for row in rows}
+    if len(found) == 1 and None not in found and not obj.vg.unit_chosen:
+        (key,) = found
+        if obj.vg.unit != key:
+            obj.vg.unit = key
+            extra += f"; Scan Units {units.SYMBOLS[key]}, as the file says"
+    by_number = {item.number: item for item in obj.vg.measurements}
+    turned = sum(
+        records.honour_colours(by_number[number], row.colors)
+        for number, row in zip(numbers, rows, strict=True)
+        if number in by_number
+    )
+    if turned:
+        measuring.repaint(obj)
+        extra += f"; {turned} painted the other way round, as its Colors say"
+    return extra
 
 
 classes = (VG_OT_export_csv, VG_OT_import_csv)

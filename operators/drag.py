@@ -25,7 +25,9 @@ from ..bridge.mesh_data import (
     uniform_scale,
     world_points,
 )
+from ..bridge.records import unit_symbol
 from ..vg_addon import GoniometerError
+from ..vg_addon.units import length_text
 from ..vg_addon.workflow.drag_state import DragMachine, Phase, surface_callbacks
 from .drag_overlay import DragOverlay, patch_vertex_data
 from .measure import MeasureProperties, VG_OT_measure_xyz, poll_measurable, typed_value
@@ -106,8 +108,11 @@ def translate_event(event_type: str, value: str, *, ctrl=False, shift=False, alt
     return "ignore", None
 
 
-def format_length(scene, value: float) -> str:
-    """``value`` (Blender units) in the scene's length units, e.g. ``"2.5 mm"``."""
+def format_length(scene, value: float, obj=None) -> str:
+    """``value`` in ``obj``'s Scan Units when it has them (mesh units: ``"0.3 mm"``), else
+    (Blender units) in the scene's length units, e.g. ``"2.5 mm"``."""
+    if getattr(getattr(obj, "vg", None), "unit", "SCENE") != "SCENE":
+        return length_text(value, unit_symbol(obj, scene))
     units = scene.unit_settings
     if units.system == "NONE":
         return f"{value:.5g}"
@@ -314,8 +319,8 @@ class DragSession:
     def header_text(self, scene) -> str:
         """The header line: radius, vertex count, λ, the angle after a λ change, and any hint."""
         machine = self.machine
-        if uniform_scale(self.matrix) == 1.0:
-            radius = format_length(scene, machine.radius)
+        if self.obj.vg.unit != "SCENE" or uniform_scale(self.matrix) == 1.0:
+            radius = format_length(scene, machine.radius, self.obj)
         else:  # the scene's units measure world lengths, not the scaled mesh's
             radius = f"{machine.radius:.5g} mesh units"
         parts = [f"Goniometer radius {radius}"]

@@ -162,11 +162,11 @@ class EdgeSession:
         machine = self.machine
         parts = [f"Edge profile: {len(machine.clicks)} point(s)"]
         if machine.path is not None:
-            parts.append(f"path {format_length(scene, machine.path.length)}")
+            parts.append(f"path {format_length(scene, machine.path.length, self.obj)}")
         settings = scene.vg_settings
         parts.append(
-            f"spacing {format_length(scene, settings.edge_spacing)}, radius "
-            f"{format_length(scene, settings.radius)}"
+            f"spacing {format_length(scene, settings.edge_spacing, self.obj)}, radius "
+            f"{format_length(scene, settings.radius, self.obj)}"
         )
         if machine.message:
             parts.append(machine.message.splitlines()[0])

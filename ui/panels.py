@@ -4,6 +4,7 @@ import textwrap
 
 import bpy
 
+from ..bridge.records import unit_symbol, units_label
 from ..operators.measure import non_uniform_scale_note
 from ..properties import exact_numbers
 from ..vg_addon.method.winding import winding_message
@@ -37,16 +38,21 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         settings = context.scene.vg_settings
+        obj = _active_mesh(context)
+        unit = unit_symbol(obj, context.scene)
         column = layout.column(align=True)
         column.use_property_split = True
         column.use_property_decorate = False
-        column.prop(settings, "radius")
+        if obj is not None:
+            column.prop(obj.vg, "unit", text="Scan Units")
+            if obj.vg.unit_guessed:
+                column.label(text="Guessed from its size", icon="INFO")
+        column.prop(settings, "radius", text=f"Radius ({unit})")
         column.prop(settings, "seg_param")
         column.prop(settings, "patch")
         column.prop(settings, "rule")
         column.prop(settings, "stability")
 
-        obj = _active_mesh(context)
         if obj is None:
             layout.label(text="Select a mesh object to measure", icon="INFO")
             return
@@ -183,9 +189,13 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
     ):
         if key in stability:
             rows.append((label, exact_text(stability[key]) + "°"))
-    units = scene.unit_settings
-    scale = "" if units.system == "NONE" else f" (1 BU = {units.scale_length:g} m)"
-    rows.append(("Lengths in", "BU" + scale))
+    obj = item.id_data
+    if obj.vg.unit != "SCENE":  # the scan's own unit, whatever the object's scale
+        rows.append(("Lengths in", units_label(scene, obj)))
+    else:
+        units = scene.unit_settings
+        scale = "" if units.system == "NONE" else f" (1 BU = {units.scale_length:g} m)"
+        rows.append(("Lengths in", "BU" + scale))
     rows.append(("Date", item.date))
     return rows
 
@@ -215,8 +225,9 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         column = layout.column(align=True)
         column.use_property_split = True
         column.use_property_decorate = False
-        column.prop(settings, "edge_spacing")
-        column.prop(settings, "radius", text="Radius")
+        unit = unit_symbol(obj, context.scene)
+        column.prop(settings, "edge_spacing", text=f"Spacing ({unit})")
+        column.prop(settings, "radius", text=f"Radius ({unit})")
         layout.operator("vg.measure_edge", text="Edge Profile", icon="CURVE_PATH")
         layout.label(text="Click start, via points, end; Enter measures")
         if not len(obj.vg.edges):
@@ -235,7 +246,9 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         column = layout.column(align=True)
         _text(column, "Edge", f"{edge.number}, break {edge.break_number}")
         _text(
-            column, "Stations", f"{edge.n_stations} every {edge.spacing:.4g} over {edge.length:.4g}"
+            column,
+            "Stations",
+            f"{edge.n_stations} every {edge.spacing:.4g} over {edge.length:.4g} {unit}",
         )
         _text(column, "Mean ± SD", f"{edge.mean:.2f}° ± {edge.std:.2f}°")
         _text(column, "Min, max", f"{edge.min:.2f}°, {edge.max:.2f}°")
@@ -280,8 +293,9 @@ class VIEW3D_PT_vg_sweep(_GoniometerPanel, bpy.types.Panel):
         column = layout.column(align=True)
         column.use_property_split = True
         column.use_property_decorate = False
-        column.prop(settings, "sweep_start")
-        column.prop(settings, "sweep_stop")
+        unit = unit_symbol(_active_mesh(context), context.scene)
+        column.prop(settings, "sweep_start", text=f"From ({unit})")
+        column.prop(settings, "sweep_stop", text=f"To ({unit})")
         column.prop(settings, "sweep_count")
         layout.operator("vg.radius_sweep", text="Sweep at 3D Cursor", icon="GRAPH")
 

@@ -139,6 +139,7 @@ def test_export_is_in_mesh_coordinates_and_replicates_on_the_file_with_the_core(
         rotation=(math.pi / 2, 0.0, 0.3),
         scale=(0.01, 0.01, 0.01),
     )
+    obj.vg.unit = "SCENE"  # chosen: the label tells mesh units by the scene's (no mm guess)
     for vertex in picks:  # the 3D cursor on a vertex, in world space
         cursor = world(mesh.points[vertex : vertex + 1], obj)[0]
         bpy.ops.vg.measure_xyz(location=cursor.tolist(), radius=0.3, seg_param=2.0)

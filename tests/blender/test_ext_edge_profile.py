@@ -229,7 +229,9 @@ def test_panel_shows_only_for_a_mesh_and_the_settings_have_lengths(vg):
     assert panel.poll(bpy.context)
     settings = bpy.context.scene.vg_settings
     assert settings.edge_spacing > 0
-    assert settings.bl_rna.properties["edge_spacing"].unit == "LENGTH"
+    # A length in the mesh's own units: the panel labels it with the object's Scan Units, not
+    # the scene's (which measure Blender units).
+    assert settings.bl_rna.properties["edge_spacing"].unit == "NONE"
     assert bpy.types.VG_OT_measure_edge.poll(bpy.context)
     assert not bpy.types.VG_OT_delete_edge.poll(bpy.context)  # no edge yet
 

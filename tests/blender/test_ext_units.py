@@ -1,0 +1,115 @@
+"""Scan Units (issue 20, item 7): the unit of an object's coordinates, said once per object or
+guessed from its size, shown in the panel, the drag header and the CSV; stored numbers never
+change."""
+
+import importlib
+
+import bpy
+import numpy as np
+from bpy_helpers import colours, exact, wedge_object
+
+from vg_addon.formats import csvio
+
+
+def modules(vg):
+    return (
+        importlib.import_module(f"{vg.__name__}.ui.panels"),
+        importlib.import_module(f"{vg.__name__}.operators.drag"),
+    )
+
+
+def measured(vg, scale, name="Wedge"):
+    """A 100° wedge whose coordinates are ``scale`` times the unit wedge's (2 units across at
+    scale 1), measured twice at radius ``0.4 * scale``."""
+    obj = wedge_object(100.0, name)
+    points = np.empty(len(obj.data.vertices) * 3, dtype=np.float32)
+    obj.data.vertices.foreach_get("co", points)
+    obj.data.vertices.foreach_set("co", points * np.float32(scale))
+    obj.data.update()
+    bpy.context.view_layer.update()
+    for x in (0.0, 0.3):
+        bpy.ops.vg.measure_xyz(location=(x * scale, 0.0, 0.0), radius=0.4 * scale)
+    return obj
+
+
+def lengths_in(panels, obj):
+    rows = panels.selected_rows(obj.vg.measurements[0], bpy.context.scene)
+    return next(text for label, text in rows if label == "Lengths in")
+
+
+def test_a_scan_tens_of_units_across_is_guessed_millimetres_and_shown_so(vg, tmp_path):
+    panels, drag = modules(vg)
+    obj = measured(vg, 15.0)  # 30 units across: a 30 mm flake
+    assert (obj.vg.unit, obj.vg.unit_guessed, obj.vg.unit_chosen) == ("MM", True, False)
+    assert lengths_in(panels, obj) == "mm"
+    assert drag.format_length(bpy.context.scene, 6.0, obj) == "6 mm"
+    path = tmp_path / "mm.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    rows = csvio.read_measurements_csv(path)
+    assert [r.units for r in rows] == ["mm", "mm"]
+    assert [r.radius for r in rows] == [6.0, 6.0]  # the stored number, not converted
+
+
+def test_a_small_mesh_is_guessed_metres_and_a_chosen_unit_is_never_replaced(vg):
+    panels, _drag = modules(vg)
+    small = measured(vg, 0.2, "Small")  # 0.4 units across
+    assert small.vg.unit == "M" and small.vg.unit_guessed
+    chosen = wedge_object(100.0, "Chosen")
+    chosen.vg.unit = "IN"  # as the panel's menu sets it
+    assert chosen.vg.unit_chosen and not chosen.vg.unit_guessed
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.4)
+    assert chosen.vg.unit == "IN" and lengths_in(panels, chosen) == "in"
+    small.vg.unit = "CM"  # changing a guess: only the label changes
+    assert not small.vg.unit_guessed and lengths_in(panels, small) == "cm"
+    assert exact(small.vg.measurements[0])["radius"] == 0.08  # as typed, unchanged
+
+
+def test_a_scene_with_its_own_units_is_not_second_guessed(vg):
+    """An old file, or a scene set up in millimetres: Scene Units stay, shown as before."""
+    panels, drag = modules(vg)
+    units = bpy.context.scene.unit_settings
+    units.system, units.scale_length, units.length_unit = "METRIC", 0.001, "MILLIMETERS"
+    obj = measured(vg, 15.0)
+    assert (obj.vg.unit, obj.vg.unit_guessed) == ("SCENE", False)
+    assert lengths_in(panels, obj) == "BU (1 BU = 0.001 m)"
+    assert drag.format_length(bpy.context.scene, 2.5, obj).replace(" ", "") == "2.5mm"
+
+
+def test_the_csv_round_trip_keeps_the_units_and_the_colours(vg, tmp_path):
+    """Export from a scan said to be in centimetres, edit one row's Colors to its pair the other
+    way round, import on a fresh copy (whose guess from its size is mm): the copy takes the
+    file's cm, the same numbers bit for bit, and paints that row's sides the other way round."""
+    obj = measured(vg, 15.0)
+    obj.vg.unit = "CM"
+    path = tmp_path / "cm.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    text = path.read_text(encoding="utf-8")
+    first = csvio.read_measurements_csv(path)[0].colors
+    plus, minus = first.split("/")
+    edited = path.with_name("edited.csv")
+    edited.write_text(text.replace(first, f"{minus}/{plus}", 1), encoding="utf-8")
+    copy = obj.copy()
+    copy.data = obj.data.copy()
+    copy.vg.measurements.clear()
+    bpy.context.scene.collection.objects.link(copy)
+    for target, source in ((obj, path), (copy, edited)):
+        bpy.context.view_layer.objects.active = target
+        if target is copy:
+            copy.vg.unit = "SCENE"
+            copy.vg.unit_chosen = False
+        else:
+            bpy.ops.vg.clear_measurements()
+        assert bpy.ops.vg.import_csv(filepath=str(source), ignore_mesh_names=True) == {"FINISHED"}
+    assert copy.vg.unit == "CM" and not copy.vg.unit_guessed
+    for a, b in zip(obj.vg.measurements, copy.vg.measurements, strict=True):
+        numbers_a, numbers_b = exact(a), exact(b)
+        swapped = numbers_b.pop("painted_swapped", False) != numbers_a.pop("painted_swapped", False)
+        assert numbers_a == numbers_b
+        assert swapped == (a.number == obj.vg.measurements[0].number)
+    assert (
+        copy.vg.measurements[0].colors.split("/") == obj.vg.measurements[0].colors.split("/")[::-1]
+    )
+    # The painted sides follow: where the original shows one colour, the copy shows the other.
+    painted_a, painted_b = colours(obj), colours(copy)
+    differ = np.any(painted_a[:, :3] != painted_b[:, :3], axis=1)
+    assert differ.sum() > 20
