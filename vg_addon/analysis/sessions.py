@@ -251,7 +251,8 @@ def _fingerprint(session: Session) -> tuple:
         (r.mesh, r.break_number, r.angle, r.centre, r.radius, r.vertices, r.date)
         for r in session.readings
     )
-    return (session.method, session.observer, readings)
+    # Not the observer: a copy of a file under another observer's name is still one session.
+    return (session.method, readings)
 
 
 def load_sessions(paths, methods=None, observers=None) -> Loaded:
