@@ -313,10 +313,16 @@ UNIT_ITEMS = (
 
 def _unit_chosen(data, _context) -> None:
     """The user chose the unit: it is no longer a guess, and no later guess replaces it."""
-    if data.get("unit_guessing"):
-        return
     data.unit_chosen = True
     data.unit_guessed = False
+
+
+def set_unit(data, key: str, *, guessed: bool) -> None:
+    """Set an object's Scan Units from code (a guess, a CSV's Units) without tagging the object
+    for a depsgraph update (only labels change: nothing to re-evaluate or re-check)."""
+    data["unit"] = next(i for i, item in enumerate(UNIT_ITEMS) if item[0] == key)
+    data["unit_guessed"] = guessed
+    data["unit_chosen"] = not guessed
 
 
 class VG_ObjectData(PropertyGroup):

@@ -12,7 +12,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..properties import exact_numbers
+from ..properties import exact_numbers, set_unit
 from ..vg_addon import GoniometerError, palette, units
 from ..vg_addon.formats import csvio
 from ..vg_addon.method.break_sides import paint_swapped
@@ -345,12 +345,7 @@ def guess_unit(obj, scene) -> None:
         return
     corners = np.array([tuple(c) for c in obj.bound_box], dtype=np.float64)
     extent = float((corners.max(axis=0) - corners.min(axis=0)).max())
-    data["unit_guessing"] = True
-    try:
-        data.unit = units.guess_unit(extent)
-    finally:
-        del data["unit_guessing"]
-    data.unit_guessed = True
+    set_unit(data, units.guess_unit(extent), guessed=True)
 
 
 def units_label(scene, obj=None) -> str:

@@ -12,6 +12,7 @@ from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from ..bridge import edges, measuring, records
 from ..bridge.mesh_data import check_measurable
+from ..properties import set_unit
 from ..vg_addon import GoniometerError, units
 from ..vg_addon.formats import csvio
 from .measure import poll_measurable, typed_value
@@ -341,7 +342,7 @@ def follow_export(obj, path, numbers) -> str:
     if len(found) == 1 and None not in found and not obj.vg.unit_chosen:
         (key,) = found
         if obj.vg.unit != key:
-            obj.vg.unit = key
+            set_unit(obj.vg, key, guessed=False)
             extra += f"; Scan Units {units.SYMBOLS[key]}, as the file says"
     by_number = {item.number: item for item in obj.vg.measurements}
     turned = sum(

@@ -126,10 +126,10 @@ OKABE_ITO_HEX = {
     "reddish purple": "#CC79A7",
 }
 BREAK_PAIRS = [
-    ("orange", "blue"),
+    ("yellow", "blue"),
     ("vermillion", "sky blue"),
     ("reddish purple", "bluish green"),
-    ("yellow", "blue"),
+    ("orange", "blue"),
 ]
 GREY_HEX = "#808080"
 

@@ -68,7 +68,7 @@ def test_wedge_angle_matches_core_bit_for_bit(vg, angle):
     assert_same(item, m)
     assert abs(item.angle - obj["true_angle"]) < 0.01
     assert (item.number, item.break_number) == (1, 1)
-    assert item.date and item.colors == "orange/blue"
+    assert item.date and item.colors == "yellow/blue"
 
 
 def test_typed_values_are_kept_as_typed(vg):

@@ -148,9 +148,10 @@ def test_painted_sides_show_in_the_viewport(gui):
         x, y = (round(v) for v in point(gui, name))
         return shot[y - 2 : y + 3, x - 2 : x + 3].reshape(-1, 3).mean(axis=0)
 
-    warm = colour(names[plus_face][0])  # the + side: orange (230, 159, 0)
+    warm = colour(names[plus_face][0])  # the + side: yellow (240, 228, 66)
     cool = colour(names[-plus_face][0])  # the − side: blue (0, 114, 178)
-    assert warm[0] - warm[2] > 60, f"+ side pixel {warm} is not orange"
+    # Yellow, not the orange of Blender's selection outline: green nearly as strong as red.
+    assert warm[0] - warm[2] > 60 and warm[1] > 0.8 * warm[0], f"+ side {warm} is not yellow"
     assert cool[2] - cool[0] > 60, f"− side pixel {cool} is not blue"
     for name in ("plus_out", "minus_out"):  # outside the patch: the neutral grey
         rgb = colour(name)
