@@ -159,18 +159,20 @@ class EdgeSession:
             self._workspace.status_text_set(_draw_status_hints)
 
     def header_text(self, scene) -> str:
+        """The header while tracing: short enough for a viewport's header (a longer line was
+        cut at both ends); the keys are in the status bar, the settings in the panel."""
         machine = self.machine
-        parts = [f"Edge profile: {len(machine.clicks)} point(s)"]
+        parts = [f"Edge Profile: {len(machine.clicks)} point(s)"]
         if machine.path is not None:
             parts.append(f"path {format_length(scene, machine.path.length, self.obj)}")
         settings = scene.vg_settings
         parts.append(
-            f"spacing {format_length(scene, settings.edge_spacing, self.obj)}, radius "
+            f"every {format_length(scene, settings.edge_spacing, self.obj)}, r "
             f"{format_length(scene, settings.radius, self.obj)}"
         )
         if machine.message:
             parts.append(machine.message.splitlines()[0])
-        return "  ·  ".join(parts)
+        return " · ".join(parts)
 
     def finish(self) -> None:
         """Remove the drawing and the texts; safe to call more than once."""

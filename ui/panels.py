@@ -1,13 +1,12 @@
 """The "Goniometer" tab of the 3D viewport sidebar (panels only draw; operators do the work)."""
 
-import textwrap
-
 import bpy
 
 from ..bridge.records import unit_symbol, units_label
 from ..operators.measure import non_uniform_scale_note
 from ..properties import exact_numbers
 from ..vg_addon.method.winding import winding_message
+from .text import fits_beside, region_width, text_width, wrapped_label
 
 # What the angle of a measurement is, by its convexity label.
 ANGLE_MEANING = {
@@ -57,18 +56,19 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
             layout.label(text="Select a mesh object to measure", icon="INFO")
             return
         if non_uniform_scale_note(obj):
-            box = layout.box()
-            box.label(text="Non-uniform scale: not measured", icon="INFO")
-            box.label(text="Angles are those of the mesh as stored;")
-            box.label(text="apply the scale (Ctrl A) to change its shape")
+            wrapped_label(
+                layout.box(),
+                context,
+                "Non-uniform scale: not measured. Angles are those of the mesh as stored; apply "
+                "the scale (Ctrl A) to change its shape",
+                icon="INFO",
+            )
         if message := winding_message(obj.name, obj.vg.winding):
-            box = layout.box()
-            for number, line in enumerate(textwrap.wrap(message, 42)):
-                box.label(text=line, icon="ERROR" if number == 0 else "BLANK1")
+            wrapped_label(layout.box(), context, message, icon="ERROR")
         layout.operator("vg.measure_xyz", text="Measure at 3D Cursor", icon="PIVOT_CURSOR")
         drag = layout.operator("wm.tool_set_by_id", text="Drag to Measure", icon="MOUSE_LMB_DRAG")
         drag.name = "vg.measure_drag_tool"
-        layout.label(text="Place the cursor on the edge: Shift + Right-click")
+        wrapped_label(layout, context, "3D cursor on the edge: Shift + Right-click", "MOUSE_RMB")
         row = layout.row(align=True)
         row.label(text=f"Break {obj.vg.break_number}")
         row.operator("vg.next_break", text="Next Break", icon="ADD")
@@ -105,19 +105,22 @@ class VIEW3D_PT_vg_selected(_GoniometerPanel, bpy.types.Panel):
         item = obj.vg.measurements[obj.vg.active_index]
         layout = self.layout
         if item.stale:
-            box = layout.box()
-            box.label(text="Stale: the mesh changed since this measurement", icon="ERROR")
-            box.label(text="Numbers kept as recorded; not painted")
+            wrapped_label(
+                layout.box(),
+                context,
+                "Stale: the mesh changed since this measurement. Numbers kept as recorded; not "
+                "painted",
+                icon="ERROR",
+            )
         if warning := item.stability_warning:  # the list's flag, with its reason in full
             box = layout.box()
             box.alert = True
-            for number, line in enumerate(textwrap.wrap(warning, 42)):
-                box.label(text=line, icon="ERROR" if number == 0 else "BLANK1")
+            wrapped_label(box, context, warning, icon="ERROR")
         # Recorded values are shown as text, exactly as stored, not as (rounded, editable)
         # fields; only the note is the user's.
         column = layout.column(align=True)
         for label, value in selected_rows(item, context.scene):
-            _text(column, label, value)
+            _text(column, label, value, context)
         row = column.row(align=True)
         row.prop(item, "color_plus")
         row.prop(item, "color_minus", text="")
@@ -174,11 +177,11 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
     if numbers.get("space") == "mesh":
         # Where the measured vertex is now, the object's transform applied (float32, as shown).
         for axis, value in zip("XYZ", item.center_world, strict=True):
-            rows.append(("Centre (world)" if axis == "X" else "", f"{axis}  {value:.9g}"))
+            rows.append(("World" if axis == "X" else "", f"{axis}  {value:.9g}"))
         rows.append(("Coordinates", "mesh (the object's own)"))
     else:
         rows.append(("Coordinates", "world (recorded by an older version)"))
-    rows.append(("Snap distance", number("snap_distance")))
+    rows.append(("Snapped", number("snap_distance")))
     stability = numbers.get("stability") or {}
     for label, key in (
         ("± centre", "center"),
@@ -196,12 +199,33 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
         units = scene.unit_settings
         scale = "" if units.system == "NONE" else f" (1 BU = {units.scale_length:g} m)"
         rows.append(("Lengths in", "BU" + scale))
-    rows.append(("Date", item.date))
+    day, _, time = item.date.partition("T")  # the ISO date and time on a row each
+    rows.append(("Date", day))
+    if time:
+        rows.append(("", time))
     return rows
 
 
-def _text(layout, label, value):
-    split = layout.split(factor=0.33, align=True)
+LABEL_SHARE = 0.4  # of a row, for the label of a value ("λ (SegParam)" is 71 pixels)
+
+
+def _text(layout, label, value, context=None):
+    """A row: ``label`` right-aligned, then ``value``; where the value is too long to fit beside
+    it in this sidebar (an exact number with all its digits), the label and then the value on a
+    row of its own, so nothing is cut."""
+    if context is not None and not fits_beside(
+        label,
+        value,
+        region_width(context),
+        LABEL_SHARE,
+        lambda t: text_width(context, t),
+        context.preferences.system.ui_scale,
+    ):
+        if label:
+            layout.label(text=label)
+        layout.label(text=value, icon="BLANK1")
+        return
+    split = layout.split(factor=LABEL_SHARE, align=True)
     left = split.row()
     left.alignment = "RIGHT"
     left.label(text=label)
@@ -229,7 +253,7 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         column.prop(settings, "edge_spacing", text=f"Spacing ({unit})")
         column.prop(settings, "radius", text=f"Radius ({unit})")
         layout.operator("vg.measure_edge", text="Edge Profile", icon="CURVE_PATH")
-        layout.label(text="Click start, via points, end; Enter measures")
+        wrapped_label(layout, context, "Click start, via points, end; Enter measures", "INFO")
         if not len(obj.vg.edges):
             return
         row = layout.row()
@@ -240,9 +264,12 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         edge = obj.vg.edges[obj.vg.active_edge_index]
         stations = [m for m in obj.vg.measurements if m.edge_number == edge.number]
         if any(m.stale for m in stations) or len(stations) != edge.n_stations:
-            box = layout.box()
-            box.label(text="Stations stale or deleted since measured", icon="ERROR")
-            box.label(text="The summary is kept as it was recorded")
+            wrapped_label(
+                layout.box(),
+                context,
+                "Stations stale or deleted since measured: the summary is kept as it was recorded",
+                icon="ERROR",
+            )
         column = layout.column(align=True)
         _text(column, "Edge", f"{edge.number}, break {edge.break_number}")
         _text(
@@ -255,7 +282,12 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         _text(column, "Pooled", f"{edge.pooled_angle:.2f}°")
         image = bpy.data.images.get(edge.plot)
         if image is not None:  # the image's preview icon, made on demand by layout.icon
-            layout.template_icon(icon_value=layout.icon(image), scale=10.0)
+            # As wide as the sidebar (scale counts 20-pixel icon units): a fixed 10 units left
+            # the plot's numbers too small to read.
+            ui_scale = context.preferences.system.ui_scale
+            width = context.region.width if context.region is not None else 240 * ui_scale
+            units = max(8.0, (width - 30 * ui_scale) / (20 * ui_scale))
+            layout.template_icon(icon_value=layout.icon(image), scale=units)
             layout.label(text="Angle (°) against arc length")
         layout.prop(edge, "note")
 
@@ -274,10 +306,11 @@ class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
         op = row.operator("vg.export_csv", text="Export", icon="EXPORT")
         op.all_objects = settings.export_all_objects
         row.prop(settings, "export_all_objects", text="All Objects")
-        row = layout.row(align=True)
-        op = row.operator("vg.import_csv", text="Import (Re-measure)", icon="IMPORT")
+        # The button on a row of its own: beside the toggle its words were cut.
+        op = layout.operator("vg.import_csv", text="Import (Re-measure)", icon="IMPORT")
         op.ignore_mesh_names = settings.ignore_mesh_names
-        row.prop(settings, "ignore_mesh_names", text="Ignore Names")
+        layout.prop(settings, "ignore_mesh_names", text="Ignore Mesh Names")
+        layout.operator("vg.report", text="Replication Report…", icon="GRAPH")
 
 
 class VIEW3D_PT_vg_sweep(_GoniometerPanel, bpy.types.Panel):

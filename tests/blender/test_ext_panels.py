@@ -80,7 +80,7 @@ def test_selected_panel_shows_every_number_exactly_as_stored(vg, panels):
         ("Fit error −", "fit_minus"),
         ("Radius", "radius"),
         ("λ (SegParam)", "lam"),
-        ("Snap distance", "snap_distance"),
+        ("Snapped", "snap_distance"),
     ):
         assert float(selected_value(rows, label)) == numbers[key], label
     for label, key in (
@@ -230,3 +230,40 @@ def test_the_flagged_row_fits_the_default_sidebar(vg, lists):
     row, icon, padding = 170.0, 20.0, 10.0
     for widest in ("180.0° ±180°", "180.0° ±?"):
         assert blf.dimensions(0, widest)[0] + icon <= lists.ANGLE_SHARE * row - padding
+
+
+def test_panel_texts_fit_the_default_sidebar_or_are_wrapped(vg, panels):
+    """Issue 20, item 8: at the default sidebar width every fixed label fits (Blender's own
+    font metrics), and long help text is wrapped into lines that each fit."""
+    import blf
+
+    text = importlib.import_module(f"{vg.__name__}.ui.text")
+    points = bpy.context.preferences.ui_styles[0].widget.points
+    blf.size(0, points)
+
+    def width(t):
+        return blf.dimensions(0, t)[0]
+
+    sidebar = 240.0  # Blender's default sidebar width at UI scale 1
+    panel = sidebar - text.MARGIN
+    _obj, item = measured()
+    rows = panels.selected_rows(item, bpy.context.scene)
+    beside = set()
+    for label, value in rows:
+        # Every label fits its share; a value that does not fit beside it gets a row of its own.
+        assert width(label) <= panels.LABEL_SHARE * panel - 8, label
+        if text.fits_beside(label, value, sidebar, panels.LABEL_SHARE, width):
+            beside.add(label)
+            assert width(value) <= (1 - panels.LABEL_SHARE) * panel - 8, value
+        else:
+            assert width(value) + text.ICON <= panel, value
+    assert {"Number", "Edge", "Rule", "Stability", "Patch", "Vertices", "Date"} <= beside
+    assert width("Import (Re-measure)") + 20 <= panel  # a row of its own, with its icon
+    hint = "3D cursor on the edge: Shift + Right-click"
+    room = panel - text.ICON
+    lines = text.wrap(hint, room, width)
+    assert all(width(line) <= room for line in lines) and " ".join(lines) == hint
+    long = "word " * 40
+    lines = text.wrap(long, 150.0, width)
+    assert len(lines) > 3 and all(width(line) <= 150.0 for line in lines)
+    assert " ".join(lines) == long.strip()
