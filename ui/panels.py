@@ -311,6 +311,7 @@ class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
         op.ignore_mesh_names = settings.ignore_mesh_names
         layout.prop(settings, "ignore_mesh_names", text="Ignore Mesh Names")
         layout.operator("vg.report", text="Replication Report…", icon="GRAPH")
+        layout.operator("vg.report", text="Replication Report…", icon="GRAPH")
 
 
 class VIEW3D_PT_vg_sweep(_GoniometerPanel, bpy.types.Panel):

@@ -1,0 +1,139 @@
+"""The Report operator: the replication report (``vg_addon.analysis``) over the scene's
+measurements and chosen session CSVs, as ``vg_batch.py --report`` writes it.
+
+Blender's own Python has NumPy only; the report needs SciPy, statsmodels and matplotlib. Where
+they are missing the operator refuses before writing anything, naming what to install and the
+batch command that writes the same report.
+"""
+
+from __future__ import annotations
+
+import os
+
+import bpy
+from bpy.props import BoolProperty, CollectionProperty, EnumProperty, StringProperty
+from bpy.types import OperatorFileListElement
+from bpy_extras.io_utils import ImportHelper
+
+from ..bridge import measuring
+from ..vg_addon import GoniometerError
+from ..vg_addon.analysis import missing_message
+from ..vg_addon.analysis.report import write_report
+from ..vg_addon.formats import csvio
+
+SCENE_SESSION = "scene_measurements.csv"
+
+
+def batch_command(folder: str, paths: list[str]) -> str:
+    """The ``vg_batch.py --report`` command that writes the same report."""
+    quoted = " ".join(f'"{p}"' if " " in p else p for p in paths) or "SESSION.csv ..."
+    return f"python vg_batch.py --report {folder or 'DIR'} {quoted}"
+
+
+class VG_OT_report(bpy.types.Operator, ImportHelper):
+    """Write the replication report (IOV per break and method, inter-observer ICC, Tukey HSD,
+    regression, Bland-Altman, figures) over the chosen session CSVs and, if ticked, this
+    scene's measurements: report.html and CSV tables in the report folder"""
+
+    bl_idname = "vg.report"
+    bl_label = "Replication Report"
+    bl_options = {"REGISTER"}  # noqa: RUF012 (Blender wants a set)
+
+    filename_ext = ".csv"
+    filter_glob: StringProperty(default="*.csv", options={"HIDDEN"})
+    files: CollectionProperty(type=OperatorFileListElement, options={"HIDDEN", "SKIP_SAVE"})
+    directory: StringProperty(subtype="DIR_PATH", options={"HIDDEN", "SKIP_SAVE"})
+    include_scene: BoolProperty(
+        name="This scene's measurements",
+        description="Add the measurements of every mesh in this scene as one more session",
+        default=True,
+    )
+    scene_method: EnumProperty(
+        name="Their method",
+        description="The method of this scene's measurements as a session",
+        items=(
+            ("drag", "Drag", "Centres placed and radii dragged by hand"),
+            ("xyz", "xyz", "Re-measured at given centres (CSV import)"),
+        ),
+        default="drag",
+    )
+    report_folder: StringProperty(
+        name="Report folder",
+        description="Where report.html, the CSV tables and figures/ go (default: a folder "
+        "'vg_report' beside the first CSV, or beside the .blend file)",
+        subtype="DIR_PATH",
+        default="",
+    )
+
+    def _sessions(self) -> list[str]:
+        folder = bpy.path.abspath(self.directory) if self.directory else ""
+        names = [f.name for f in self.files if f.name]
+        if not names and self.filepath and os.path.isfile(bpy.path.abspath(self.filepath)):
+            return [bpy.path.abspath(self.filepath)]
+        return [os.path.join(folder, name) for name in names]
+
+    def _folder(self, sessions: list[str]) -> str:
+        if self.report_folder:
+            return bpy.path.abspath(self.report_folder)
+        if sessions:
+            return os.path.join(os.path.dirname(sessions[0]), "vg_report")
+        if bpy.data.filepath:
+            return os.path.join(os.path.dirname(bpy.data.filepath), "vg_report")
+        return ""
+
+    def execute(self, context):
+        sessions = self._sessions()
+        folder = self._folder(sessions)
+        missing = missing_message(batch_command(folder, sessions))
+        if missing:
+            self.report({"ERROR"}, missing)
+            return {"CANCELLED"}
+        if not folder:
+            self.report(
+                {"ERROR"}, "Choose a report folder (this .blend file has not been saved yet)."
+            )
+            return {"CANCELLED"}
+        measured = [o for o in context.scene.objects if o.type == "MESH" and len(o.vg.measurements)]
+        try:
+            if self.include_scene and measured:
+                os.makedirs(folder, exist_ok=True)
+                scene_csv = os.path.join(folder, SCENE_SESSION)
+                rows = measuring.export_rows(
+                    sorted(measured, key=lambda o: o.name),
+                    context.scene,
+                    depsgraph=context.evaluated_depsgraph_get(),
+                )
+                csvio.write_measurements_csv(scene_csv, rows)
+                sessions = [*sessions, scene_csv]
+            methods = [None] * len(sessions)
+            if self.include_scene and measured:
+                methods[-1] = self.scene_method
+            if not sessions:
+                raise GoniometerError(
+                    "No sessions: choose session CSVs, or measure in this scene and tick "
+                    "'This scene's measurements'."
+                )
+            outcome = write_report(sessions, folder, methods=_methods(methods))
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        except OSError as error:
+            self.report({"ERROR"}, f"Could not write the report into {folder}: {error}")
+            return {"CANCELLED"}
+        left = f"; {len(outcome.left_out)} left out (listed in the report)"
+        self.report(
+            {"WARNING"} if outcome.left_out else {"INFO"},
+            f"Wrote {os.path.join(folder, 'report.html')}: {outcome.sessions} sessions, "
+            f"{outcome.readings} of {outcome.rows} rows used" + (left if outcome.left_out else ""),
+        )
+        return {"FINISHED"}
+
+
+def _methods(methods: list) -> list[str] | None:
+    """Per-file methods for :func:`write_report`: ``None`` where every file names its own."""
+    if all(m is None for m in methods):
+        return None
+    return [m or "" for m in methods]
+
+
+classes = (VG_OT_report,)
