@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..properties import exact_numbers
+from ..vg_addon.method.result import stability_undetermined
 from ..vg_addon.workflow.labels import label_text
 from . import records
 from .mesh_data import world_points
@@ -31,6 +32,8 @@ class Label:
         The patch radius in world units (mesh radius times the object's mean scale).
     active : bool
         The list's selected measurement.
+    unstable : bool
+        An unstable reading (flagged in the list): its text carries the stability figure.
     """
 
     number: int
@@ -40,6 +43,19 @@ class Label:
     outward: np.ndarray
     radius: float
     active: bool
+    unstable: bool = False
+
+
+def stability_flag(item) -> str:
+    """The stability figure an unstable reading is flagged with (``"±78°"``; ``"±?"`` where the
+    figure is undetermined), or ``""`` for a reading that is not flagged (see
+    ``vg_addon.method.result.stability_warning``)."""
+    if not item.stability_warning:
+        return ""
+    parts = exact_numbers(item).get("stability") or {}
+    if stability_undetermined(int(parts.get("runs") or 0), int(parts.get("refused") or 0)):
+        return "±?"  # the figure itself may be far too small: no number that looks steady
+    return f"±{float(parts.get('spread', 0.0)):.0f}°"
 
 
 def labels_of(obj, *, active_break_only: bool = False) -> list[Label]:
@@ -68,15 +84,18 @@ def labels_of(obj, *, active_break_only: bool = False) -> list[Label]:
             np.asarray(numbers["normal_plus"]) + np.asarray(numbers["normal_minus"])
         )
         length = np.linalg.norm(outward)
+        flag = stability_flag(item)
+        text = label_text(item.number, numbers["angle"])
         labels.append(
             Label(
                 number=item.number,
                 break_number=item.break_number,
-                text=label_text(item.number, numbers["angle"]),
+                text=f"{text} {flag}" if flag else text,
                 position=world_points(np.asarray(numbers["center"])[None, :], matrix)[0],
                 outward=outward / length if length > 0 else outward,
                 radius=float(numbers["radius"]) * scale,
                 active=index == data.active_index,
+                unstable=bool(flag),
             )
         )
     return labels

@@ -1,5 +1,6 @@
 """Measurement labels in the 3D viewport: each current measurement's number and angle beside
-its centre, white with a dark outline so they read on dark and light backgrounds alike.
+its centre, white with a dark outline so they read on dark and light backgrounds alike; an
+unstable reading in red with its stability figure ("3: 71.01° ±78°"), as its list row.
 
 A ``POST_PIXEL`` draw handler, added on register; it only reads the records (through
 ``bridge.label_data``) and the scene's label settings. The active object's measurements are
@@ -24,6 +25,7 @@ from ..vg_addon.workflow.labels import place_labels
 FONT_ID = 0
 TEXT_COLOR = (1.0, 1.0, 1.0, 1.0)
 ACTIVE_COLOR = (1.0, 0.85, 0.2, 1.0)
+UNSTABLE_COLOR = (1.0, 0.45, 0.4, 1.0)  # the list's alert red: an unstable reading
 OUTLINE_COLOR = (0.0, 0.0, 0.0, 0.9)
 OUTLINE_OFFSETS = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
 
@@ -63,7 +65,15 @@ def _draw() -> None:
     for index, side in shown:
         label, (x, y) = placed[index]
         x = x + gap if side > 0 else x - gap - widths[index]
-        _outlined(label.text, x, y - 0.35 * size, ACTIVE_COLOR if label.active else TEXT_COLOR)
+        _outlined(label.text, x, y - 0.35 * size, label_colour(label))
+
+
+def label_colour(label):
+    """White; the selected measurement yellow; an unstable reading red (its text carries the
+    stability figure, as its list row does)."""
+    if label.unstable:
+        return UNSTABLE_COLOR
+    return ACTIVE_COLOR if label.active else TEXT_COLOR
 
 
 def _visible_right(context, region) -> float:

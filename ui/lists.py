@@ -2,8 +2,7 @@
 
 import bpy
 
-from ..properties import exact_numbers
-from ..vg_addon.method.result import stability_undetermined
+from ..bridge.label_data import stability_flag
 
 # Shares of a row at the default sidebar width (about 170 pixels for the list at UI scale 1): the
 # angle first and widest (room for a warning icon, "179.99°" and a word such as "concave"), then
@@ -26,14 +25,9 @@ def row_texts(item) -> tuple[str, str]:
 
 def row_flag(item) -> str:
     """The stability figure a flagged row shows beside its angle (``"±78°"``, highlighted, with
-    a warning icon; the reason is the tooltip), or ``""`` for a row that is not flagged (see
-    ``vg_addon.method.result.stability_warning``)."""
-    if not item.stability_warning:
-        return ""
-    parts = exact_numbers(item).get("stability") or {}
-    if stability_undetermined(int(parts.get("runs") or 0), int(parts.get("refused") or 0)):
-        return "±?"  # the figure itself may be far too small: no number that looks steady
-    return f"±{float(parts.get('spread', 0.0)):.0f}°"
+    a warning icon; the reason is the tooltip), or ``""`` for a row that is not flagged; the
+    viewport labels and the map show the same (``bridge.label_data.stability_flag``)."""
+    return stability_flag(item)
 
 
 def flagged_text(item) -> str:

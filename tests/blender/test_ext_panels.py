@@ -201,6 +201,16 @@ def test_an_unstable_reading_is_flagged_in_its_list_row(vg, lists, panels, capfd
     assert bpy.ops.vg.stability_warning(index=1) == {"FINISHED"}
     assert obj.vg.active_index == 1
     assert "Measurement 2: Unstable: the angle moves" in capfd.readouterr().out
+    # The viewport label (and the map's) says it too: the figure after the angle, in red.
+    label_of = {label.number: label for label in vg.bridge.label_data.labels_of(obj)}
+    assert not label_of[stable.number].unstable
+    assert label_of[stable.number].text == f"{stable.number}: {exact(stable)['angle']:.2f}°"
+    assert label_of[unstable.number].unstable
+    assert label_of[unstable.number].text.endswith(f"° ±{spread:.0f}°")
+    viewport = importlib.import_module(f"{vg.__name__}.ui.labels")
+    red = viewport.label_colour(label_of[unstable.number])
+    assert red[0] > 0.9 and red[1] < 0.6 and red[2] < 0.6
+    assert viewport.label_colour(label_of[stable.number]) != red
 
 
 def test_an_undetermined_figure_shows_no_number_that_looks_steady(vg, lists):
