@@ -127,9 +127,7 @@ def add_measurement(
             f"{break_number!r}. Nothing was recorded."
         )
     numbers = exact_record(m, station)
-    if station is None and paint_swapped(
-        m.normal_plus, m.normal_minus, m.center, m.radius, _break_sides(data, break_number)
-    ):
+    if station is None and _painted_swapped(data, m, break_number):
         numbers[SWAPPED] = True  # painted the other way round; the numbers are as measured
     exact = json.dumps(numbers)
     # Everything that can fail is done: from here on the item is written whole.
@@ -256,6 +254,24 @@ def _painted_normals(exact: str):
 # record reads a bounded number of records, however many the object holds (a batch or an import
 # of many rows would otherwise cost time that grows with the square of their number).
 BREAK_WINDOW = 1024
+
+
+def _painted_swapped(data, m, break_number: int) -> bool:
+    """Whether ``m``, recorded now in ``break_number``, gets its sides painted the other way
+    round (to agree with its break's earlier measurements)."""
+    return paint_swapped(
+        m.normal_plus, m.normal_minus, m.center, m.radius, _break_sides(data, break_number)
+    )
+
+
+def colours_as_painted(obj, m) -> tuple[tuple, tuple]:
+    """The 8-bit sRGB colours ``("+" side, "-" side)`` that recording measurement ``m`` on
+    ``obj`` now (in its current break) would paint: what the drag previews before the release."""
+    data = obj.vg
+    plus, minus = palette.pair_srgb8(data.break_number)
+    if _painted_swapped(data, m, data.break_number):
+        return minus, plus
+    return plus, minus
 
 
 def _break_sides(data, break_number: int) -> list:

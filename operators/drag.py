@@ -25,7 +25,7 @@ from ..bridge.mesh_data import (
     uniform_scale,
     world_points,
 )
-from ..bridge.records import unit_symbol
+from ..bridge.records import colours_as_painted, unit_symbol
 from ..vg_addon import GoniometerError
 from ..vg_addon.units import length_text
 from ..vg_addon.workflow.drag_state import DragMachine, Phase, surface_callbacks
@@ -304,12 +304,16 @@ class DragSession:
         """Hand the preview to the overlay and update the header; redraw the viewport."""
         machine = self.machine
         measurement = machine.measurement
+        colours = None
         if measurement is not None:
             coords = patch_vertex_data(self.surface.points, measurement.indices)
             labels = measurement.labels
+            colours = colours_as_painted(self.obj, measurement)  # what the release paints
         else:
             coords, labels = patch_vertex_data(self.surface.points, machine.indices), None
-        self.overlay.update(machine.center, machine.radius, coords, labels, matrix=self.matrix)
+        self.overlay.update(
+            machine.center, machine.radius, coords, labels, matrix=self.matrix, colours=colours
+        )
         if self._area is not None:
             self._area.header_text_set(self.header_text(context.scene))
             self._area.tag_redraw()

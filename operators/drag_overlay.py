@@ -26,7 +26,14 @@ from mathutils import Matrix
 from ..vg_addon import palette
 
 PATCH_COLOR = (1.0, 1.0, 0.6, 0.9)
-SIDE_COLORS = tuple((*(c / 255.0 for c in rgb), 0.95) for rgb in palette.pair_srgb8(1))
+
+
+def side_colours(pair) -> tuple:
+    """The drawing colours (RGBA, 0-1) of an 8-bit sRGB ("+", "-") pair."""
+    return tuple((*(c / 255.0 for c in rgb), 0.95) for rgb in pair)
+
+
+SIDE_COLORS = side_colours(palette.pair_srgb8(1))
 CIRCLE_COLOR = (1.0, 1.0, 1.0, 0.9)
 POINT_SIZE = 4.0
 LINE_WIDTH = 2.0
@@ -73,6 +80,7 @@ class DragOverlay:
         self.center: np.ndarray | None = None
         self.radius = 0.0
         self.matrix = np.eye(4)
+        self.side_colours = SIDE_COLORS
 
     @property
     def active(self) -> bool:
@@ -99,15 +107,24 @@ class DragOverlay:
             bpy.types.SpaceView3D.draw_handler_remove(handle, "WINDOW")
 
     def update(
-        self, center, radius: float, coords: np.ndarray | None, labels=None, *, matrix=None
+        self,
+        center,
+        radius: float,
+        coords: np.ndarray | None,
+        labels=None,
+        *,
+        matrix=None,
+        colours=None,
     ) -> None:
         """New preview: the circle ``center``/``radius`` and the patch vertices.
 
         ``coords`` is a float32 (k, 3) array (see :func:`patch_vertex_data`); ``labels``, when a
         measurement of the patch exists, is its bool "+" side per vertex, drawn in two colours.
         Everything is in mesh coordinates; ``matrix`` (the object's ``matrix_world``, default
-        the identity) places it in the viewport.
+        the identity) places it in the viewport. ``colours``: the 8-bit sRGB ("+", "-") pair the
+        release will paint (default: the first break's).
         """
+        self.side_colours = SIDE_COLORS if colours is None else side_colours(colours)
         self.matrix = np.eye(4) if matrix is None else np.asarray(matrix, dtype=np.float64)
         self.center = None if center is None else np.asarray(center, dtype=np.float64)
         self.radius = float(radius)
@@ -122,7 +139,8 @@ class DragOverlay:
         if labels is None:
             groups = [(coords, PATCH_COLOR)]
         else:
-            groups = [(coords[labels], SIDE_COLORS[0]), (coords[~labels], SIDE_COLORS[1])]
+            plus, minus = self.side_colours
+            groups = [(coords[labels], plus), (coords[~labels], minus)]
         return [
             (batch_for_shader(shader, "POINTS", {"pos": group}), color)
             for group, color in groups

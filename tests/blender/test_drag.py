@@ -7,6 +7,7 @@ so ``invoke``/``modal`` themselves are not called; they only forward to ``DragSe
 mode, so the test mesh is placed in front of the startup file's saved perspective view.
 """
 
+import dataclasses
 import importlib
 from types import SimpleNamespace
 
@@ -563,3 +564,50 @@ def test_tool_registers_in_the_toolbar(drag, view):
         if registered_here:
             drag.unregister_tool()
             assert not drag.tool_registered()
+
+
+def test_the_preview_shows_the_colours_the_release_paints(drag, view, vg):
+    """Issue 20: the drag's preview draws each side in the colour the release then paints (its
+    break's pair, the way round that agrees with the break's earlier measurements), read back
+    from the painted "VG Sides" attribute, for drags in two breaks (the sides show once a λ
+    key has measured the patch)."""
+    from bpy_helpers import colours
+
+    def linear(rgb8):  # sRGB to scene-linear, IEC 61966-2-1, as the attribute holds it
+        c = np.asarray(rgb8, dtype=np.float64)
+        c = c / 255.0 if c.max() > 1.0 else c
+        return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+    for k, offset, break_number in ((10, 0.5, 1), (16, 0.6, 1), (21, 0.45, 1), (12, 0.5, 2)):
+        if break_number != view.obj.vg.break_number:
+            bpy.ops.vg.next_break()
+        vertex = ridge_vertex(view, k)
+        session = start(drag, view, vertex)
+        far = pixel(view, view.points[vertex] + offset * view.right)
+        send(drag, session, "MOUSEMOVE", "NOTHING", far)
+        send(drag, session, "L")  # a λ step: the preview measures and shows the two sides
+        preview = [np.array(c[:3]) for c in session.overlay.side_colours]
+        plus_side = session.machine.measurement.labels
+        indices = session.machine.measurement.indices
+        send(drag, session, "LEFTMOUSE", "RELEASE", far)
+        session.finish(bpy.context)
+        assert bpy.ops.vg.measure_drag("EXEC_DEFAULT", **drag.record_properties(session)) == {
+            "FINISHED"
+        }
+        painted = colours(view.obj)[:, :3]
+        for side, colour in ((plus_side, preview[0]), (~plus_side, preview[1])):
+            got = painted[indices[side]]
+            np.testing.assert_allclose(got, np.broadcast_to(linear(colour), got.shape), atol=2e-3)
+    records = vg.bridge.records
+    # A measurement whose "+" side lies on the face its break painted in the second colour:
+    # the preview says swapped, as recording it does.
+    item = view.obj.vg.measurements[-1]
+    first = session.machine.measurement
+    turned = dataclasses.replace(
+        first, normal_plus=first.normal_minus, normal_minus=first.normal_plus
+    )
+    expected = records.colours_as_painted(view.obj, turned)
+    assert expected == records.colours_as_painted(view.obj, first)[::-1]
+    recorded = records.add_measurement(view.obj, turned, item.fingerprint)
+    names = recorded.colors.split("/")
+    assert tuple(vg.vg_addon.palette.OKABE_ITO[n] for n in names) == expected
