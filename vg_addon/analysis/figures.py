@@ -156,6 +156,7 @@ def regression_plots(reg, title: str):
     qq.set_title("Q-Q plot of the residuals")
     cook.stem(np.arange(1, len(reg.cooks) + 1), reg.cooks, basefmt=" ")
     cook.axhline(4 / max(reg.n, 1), color="grey", linestyle="--", linewidth=1, label="4/n")
+    cook.xaxis.get_major_locator().set_params(integer=True)
     cook.set_xlabel("break (row of the fit)")
     cook.set_ylabel("Cook's distance")
     cook.set_title("Cook's distances")
