@@ -14,6 +14,7 @@ import numpy as np
 from ..vg_addon import GoniometerError, Measurement
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
+from ..vg_addon.method.algorithm import DEFAULT_RULE
 from ..vg_addon.method.sweep import radius_sweep
 from . import colors, legacy, painting, records
 from .mesh_data import (
@@ -67,7 +68,7 @@ def measure(
     patch="euclidean",
     *,
     depsgraph=None,
-    rule="oriented",
+    rule=DEFAULT_RULE,
     stability=False,
     space="mesh",
 ):
@@ -104,7 +105,7 @@ def sweep(
     patch="euclidean",
     *,
     depsgraph=None,
-    rule="oriented",
+    rule=DEFAULT_RULE,
     space="mesh",
 ):
     """A radius sweep at ``location`` on ``obj`` (nothing is recorded): ``SweepPoint`` list.
@@ -129,7 +130,7 @@ def measure_on_object(
     *,
     depsgraph=None,
     note="",
-    rule="oriented",
+    rule=DEFAULT_RULE,
     stability=False,
     space="mesh",
 ):
@@ -156,8 +157,8 @@ def measure_on_object(
         Free text stored with the measurement (the CSV's User Data).
     space : {"mesh", "world"}
         The coordinates ``location`` is given in.
-    rule : {"oriented", "paper"}
-        How the projection is signed (``vg_addon.method.algorithm.RULES``).
+    rule : {"refined", "oriented", "paper"}
+        How the measurement is taken (``vg_addon.method.algorithm.RULES``).
     stability : bool
         Also compute and record the stability figure.
 
@@ -367,7 +368,7 @@ def replicate_rows(
     patch="euclidean",
     depsgraph=None,
     source="the CSV",
-    rule="oriented",
+    rule=DEFAULT_RULE,
     stability=False,
     progress=None,
 ):
@@ -445,7 +446,7 @@ def replicate_steps(
     patch="euclidean",
     depsgraph=None,
     source="the CSV",
-    rule="oriented",
+    rule=DEFAULT_RULE,
     stability=False,
 ):
     """:func:`replicate_rows` a row at a time: a generator that yields ``(done, total)`` before

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .marching_tetrahedra import march
+from .method.fixed_order import in_frame
 
 # Faces of the half annulus: the cut plane x = 0.5 meets the ring twice (y > 0 and y < 0).
 CUT, BOTTOM, OUTER, INNER, TOP, CUT_2 = range(6)
@@ -107,3 +108,51 @@ def intersecting_spheres(spacing: float = 0.02) -> LabelledMesh:
     points, triangles = march(lambda p: terms(p).max(axis=1), lower, upper, spacing)
     labels = np.argmax(terms(points), axis=1).astype(np.int64)
     return LabelledMesh(points, triangles, labels)
+
+
+def _turn(seed: int) -> np.ndarray:
+    """A rotation about a random axis by a random angle (Rodrigues' formula, element-wise, so the
+    same bits on every machine)."""
+    rng = np.random.default_rng(seed)
+    axis = rng.normal(size=3)
+    axis = axis / math.sqrt(float(axis[0] ** 2 + axis[1] ** 2 + axis[2] ** 2))
+    angle = float(rng.uniform(0.3, 2.8))
+    (x, y, z), c, s = axis.tolist(), math.cos(angle), math.sin(angle)
+    return np.array(
+        [
+            [c + x * x * (1 - c), x * y * (1 - c) - z * s, x * z * (1 - c) + y * s],
+            [y * x * (1 - c) + z * s, c + y * y * (1 - c), y * z * (1 - c) - x * s],
+            [z * x * (1 - c) - y * s, z * y * (1 - c) + x * s, c + z * z * (1 - c)],
+        ]
+    )
+
+
+def marched_wedge(
+    angle_deg: float, spacing: float = 0.02, *, turn_seed: int | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A wedge of interior angle ``angle_deg`` marched by tetrahedra, as a scanner's
+    reconstruction meshes a crease: the crease runs between rows of vertices, and the
+    triangles across it cut the corner.
+
+    The solid is ``|x| ≤ y tan(angle / 2)``, ``y ≤ 0.8``, ``|z| ≤ 0.4``, ``|x| ≤ 0.8``, turned by a
+    random rotation drawn from ``turn_seed`` (none by default); its crease is the turned z axis.
+
+    Returns
+    -------
+    points, triangles : ndarray
+        The mesh, wound outward. Reverse the triangles for the valley of the same angle.
+    crease_point, crease_direction : ndarray, shape (3,)
+        The crease's point at the origin (the origin) and its unit direction.
+    """
+    half = math.tan(math.radians(angle_deg) / 2.0)
+    turn = np.eye(3) if turn_seed is None else _turn(turn_seed)
+
+    def inside(points):
+        local = in_frame(points, turn.T)
+        x, y, z = local[:, 0], local[:, 1], local[:, 2]
+        across = (np.abs(x) - y * half) / math.sqrt(1.0 + half * half)
+        return np.maximum.reduce([across, y - 0.8, np.abs(z) - 0.4, np.abs(x) - 0.8])
+
+    offset = np.array([0.0123, 0.371, 0.6577]) * spacing  # no grid point on the crease
+    points, triangles = march(inside, np.full(3, -1.25) + offset, np.full(3, 1.25), spacing)
+    return points, triangles, np.zeros(3), turn[:, 2].copy()

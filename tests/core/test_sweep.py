@@ -72,7 +72,7 @@ def test_sweep_csv_reads_back_exactly(surface):
         assert float(row["Radius"]) == point.radius
         assert float(row["Angle"]) == m.angle and float(row["fit"]) == m.fit_error
         assert int(row["Vertices +"]) + int(row["Vertices -"]) == int(row["Number of Vertices"])
-        assert (row["Convexity"], row["Rule"], row["error"]) == ("concave", "oriented", "")
+        assert (row["Convexity"], row["Rule"], row["error"]) == ("concave", "refined", "")
 
 
 def read_png(data: bytes) -> np.ndarray:

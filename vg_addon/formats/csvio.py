@@ -275,7 +275,8 @@ class MeasurementRow:
         The mesh changed since the measurement was taken.
     extension_version, blender_version : str
     rule : str
-        ``"oriented"`` or ``"paper"``: how the projection was signed (see ``vg_addon.method``).
+        ``"refined"``, ``"oriented"`` or ``"paper"``: how the measurement was taken (see
+        ``vg_addon.method.algorithm.RULES``).
     convexity : str
         ``"convex"``, ``"concave"`` (the angle is then the open wedge's) or ``"unclear"``.
     correlation : float or None

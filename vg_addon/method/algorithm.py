@@ -8,6 +8,7 @@ import numpy as np
 
 from ..errors import GoniometerError
 from .fixed_order import acos_degrees, dot3, eigh3, moments, norm3, row_dot, total
+from .refinement import mean_edge_length, refine_sides
 from .result import Measurement
 from .withinss import withinss_split
 
@@ -21,11 +22,16 @@ MAX_LAMBDA = 1e6
 FLAT_TOLERANCE_DEG = 0.5
 """Angles closer than this to 180° mean the patch holds no break edge."""
 
-RULES = ("oriented", "paper")
-"""How the position term of the projection is signed. ``"oriented"`` (the default) multiplies it
-by the sign of the covariance between ``Nᵀb`` and ``(X − x̄)ᵀb``, which makes concave edges and
-inward-wound meshes read right; ``"paper"`` is Algorithm 1 as printed, ``p = bᵀ[N + (λ/r)(X − x̄)]``,
-kept to replicate measurements taken with the MeshLab plugin and the earlier add-on."""
+RULES = ("refined", "oriented", "paper")
+"""How a measurement is taken. ``"oriented"`` multiplies the position term of the projection by
+the sign of the covariance between ``Nᵀb`` and ``(X − x̄)ᵀb``, which makes concave edges and
+inward-wound meshes read right. ``"refined"`` (the default) is the oriented rule followed by
+:func:`~vg_addon.method.refinement.refine_sides`: each side's plane from the vertices that lie on
+it, exact where the crease runs between rows of vertices. ``"paper"`` is Algorithm 1 as printed,
+``p = bᵀ[N + (λ/r)(X − x̄)]``, kept to replicate measurements taken with the MeshLab plugin and the
+earlier add-on; ``"oriented"`` replicates this extension's measurements from before 0.2."""
+
+DEFAULT_RULE = "refined"
 
 CONVEXITIES = ("convex", "concave", "unclear")
 """The edge labels of a measurement, relative to the given (outward) normals."""
@@ -147,8 +153,8 @@ def check_rule(rule) -> str:
     name = str(rule).lower()
     if name not in RULES:
         raise GoniometerError(
-            f"Unknown rule {rule!r}: use 'oriented' (the default, right on concave edges and "
-            "inward-wound meshes) or 'paper' (Algorithm 1 as printed, to replicate old measurements)."
+            f"Unknown rule {rule!r}: use 'refined' (the default), 'oriented' (this extension's rule "
+            "before 0.2) or 'paper' (Algorithm 1 as printed, to replicate old measurements)."
         )
     return name
 
@@ -161,16 +167,8 @@ def _correlation(a: np.ndarray, b: np.ndarray) -> float:
     return total(a * b) / scale if scale > 0 else 0.0
 
 
-def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray]:
-    """Steps 9-13 of Algorithm 1: the WithinSS split of ``projection`` and a plane per side.
-
-    Returns the measured fields, and the step from the "−" side's centroid to the "+" side's
-    (their own vertices).
-    """
-    threshold, _ = withinss_split(projection, min_size=MIN_SIDE_VERTICES)
-    labels = projection >= threshold
-    normal_plus, error_plus, shared_plus, mean_plus = _fit_side(points, joined, labels, "+")
-    normal_minus, error_minus, shared_minus, mean_minus = _fit_side(points, joined, ~labels, "-")
+def _checked_angle(normal_plus, normal_minus) -> float:
+    """``180 − arccos(v₊·v₋)``, refused where the planes fold onto each other or are flat."""
     angle = 180.0 - acos_degrees(dot3(normal_plus, normal_minus))
     if angle < FLAT_TOLERANCE_DEG:
         raise GoniometerError(
@@ -182,6 +180,20 @@ def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray]:
             f"No break edge found: the two sides fit planes within {180.0 - angle:.2f}° of each other, "
             "so the patch is flat. Move the centre onto the break edge, or use a larger radius."
         )
+    return angle
+
+
+def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray]:
+    """Steps 9-13 of Algorithm 1: the WithinSS split of ``projection`` and a plane per side.
+
+    Returns the measured fields, and the step from the "−" side's centroid to the "+" side's
+    (their own vertices).
+    """
+    threshold, _ = withinss_split(projection, min_size=MIN_SIDE_VERTICES)
+    labels = projection >= threshold
+    normal_plus, error_plus, shared_plus, mean_plus = _fit_side(points, joined, labels, "+")
+    normal_minus, error_minus, shared_minus, mean_minus = _fit_side(points, joined, ~labels, "-")
+    angle = _checked_angle(normal_plus, normal_minus)
     fields = {
         "angle": angle,
         "fit_error": error_plus + error_minus,
@@ -211,7 +223,7 @@ def measure_patch(
     center: np.ndarray,
     radius: float,
     lam: float,
-    rule: str = "oriented",
+    rule: str = DEFAULT_RULE,
 ) -> dict:
     """Run Algorithm 1 on a validated, canonically ordered float64 patch.
 
@@ -244,7 +256,8 @@ def measure_patch(
     along_normal = row_dot(normals, binormal)  # bᵀN
     across = row_dot(points - center, binormal)  # bᵀ(X − x̄)
     correlation = _correlation(along_normal, across)
-    orientation = -1 if rule == "oriented" and correlation < 0 else 1
+    oriented = rule != "paper"
+    orientation = -1 if oriented and correlation < 0 else 1
 
     def projection(sign: int) -> np.ndarray:
         """p = bᵀN + sign (λ/r) bᵀ(X − x̄); sign +1 is the paper's projection."""
@@ -252,7 +265,7 @@ def measure_patch(
 
     joined = np.concatenate((points, normals), axis=1)
     weak = abs(correlation) < WEAK_CORRELATION
-    if not (rule == "oriented" and weak and lam > 0):
+    if not (oriented and weak and lam > 0):
         fields, step = _split_and_fit(points, joined, projection(orientation))
         other_angle = None
     else:
@@ -284,7 +297,38 @@ def measure_patch(
         convexity=convexity,
         orientation_difference=0.0 if other_angle is None else abs(other_angle - fields["angle"]),
     )
+    if rule == "refined":
+        _refine(points, normals, center, radius, fields)
     return fields
+
+
+def _refine(points, normals, center, radius, fields) -> None:
+    """Replace Algorithm 1's planes by :func:`refine_sides`' where it applies (in place)."""
+    refined = refine_sides(
+        points,
+        normals,
+        fields["labels"],
+        center,
+        radius,
+        mean_edge_length(radius, points.shape[0]),
+        fields["fit_error"],
+    )
+    if refined is None:
+        return
+    try:
+        angle = _checked_angle(refined["normal_plus"], refined["normal_minus"])
+    except GoniometerError:
+        return  # the refined planes would be refused: keep Algorithm 1's reading
+    labels, used = refined.pop("labels"), refined.pop("used")
+    fields.update(
+        refined,
+        split_angle=fields["angle"],
+        angle=angle,
+        labels=labels,
+        n_plus=int(labels.sum()),
+        n_minus=int((~labels).sum()),
+        n_left_out=int((~used).sum()),
+    )
 
 
 def as_points(name: str, values, *, allow_empty: bool = False) -> np.ndarray:
@@ -369,7 +413,7 @@ def as_normals(normals, n_points: int) -> np.ndarray:
 
 
 def goniometer(
-    points, normals, lam: float = 2.0, center=None, radius=None, rule: str = "oriented"
+    points, normals, lam: float = 2.0, center=None, radius=None, rule: str = DEFAULT_RULE
 ) -> Measurement:
     """Measure the break angle of a patch you already have (Algorithm 1 of the paper).
 
@@ -385,8 +429,8 @@ def goniometer(
         The centre ``x̄`` of the projection; default the mean of ``points``.
     radius : float, optional
         The ``r`` of the projection; default the largest distance from ``center`` to a point.
-    rule : {"oriented", "paper"}, optional
-        How the projection's position term is signed (see :data:`RULES`); default ``"oriented"``.
+    rule : {"refined", "oriented", "paper"}, optional
+        How the measurement is taken (see :data:`RULES`); default ``"refined"``.
 
     Returns
     -------

@@ -72,6 +72,49 @@ def moments(rows: np.ndarray) -> np.ndarray:
 _UPPER = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
 
+def gram(columns: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The normal equations of a least-squares fit, ``(A.T @ A, A.T @ values)``.
+
+    ``columns`` has shape ``(m, k)``: ``m`` basis functions at ``k`` points, so ``A`` is its
+    transpose. Every entry is NumPy's pairwise sum of one contiguous row of products.
+    """
+    m = columns.shape[0]
+    matrix = np.empty((m, m))
+    for i in range(m):
+        for j in range(i, m):
+            matrix[i, j] = matrix[j, i] = np.add.reduce(columns[i] * columns[j])
+    return matrix, np.array([np.add.reduce(columns[i] * values) for i in range(m)])
+
+
+def solve(matrix, rhs) -> list[float] | None:
+    """Solve the small linear system ``matrix @ x = rhs`` by Gaussian elimination with partial
+    pivoting on Python floats; None when singular (a pivot below 1e-13 of the largest entry)."""
+    a = [list(row) for row in np.asarray(matrix, dtype=np.float64).tolist()]
+    b = [float(value) for value in rhs]
+    n = len(b)
+    largest = max(abs(value) for row in a for value in row)
+    if not math.isfinite(largest) or largest == 0.0:
+        return None
+    for column in range(n):
+        pivot = max(range(column, n), key=lambda row: abs(a[row][column]))
+        if abs(a[pivot][column]) <= 1e-13 * largest:
+            return None
+        a[column], a[pivot] = a[pivot], a[column]
+        b[column], b[pivot] = b[pivot], b[column]
+        for row in range(column + 1, n):
+            factor = a[row][column] / a[column][column]
+            for k in range(column, n):
+                a[row][k] -= factor * a[column][k]
+            b[row] -= factor * b[column]
+    x = [0.0] * n
+    for row in range(n - 1, -1, -1):
+        value = b[row]
+        for k in range(row + 1, n):
+            value -= a[row][k] * x[k]
+        x[row] = value / a[row][row]
+    return x
+
+
 def solve3(matrix, rhs: np.ndarray) -> np.ndarray | None:
     """Solve ``matrix @ x_i = rhs_i`` for every row ``rhs_i`` of an ``(n, 3)`` array.
 

@@ -175,7 +175,8 @@ class Measurement:
     patch : str
         How the patch was chosen: ``"euclidean"``, ``"geodesic"`` or ``"given"``.
     rule : str
-        ``"oriented"`` (the default) or ``"paper"``: how the projection's position term was signed.
+        ``"refined"`` (the default), ``"oriented"`` or ``"paper"``: how the measurement was taken
+        (see ``vg_addon.method.algorithm.RULES``).
     orientation : int
         The sign ``s`` (+1 or -1) the position term was given; always +1 under the paper's rule.
     correlation : float
@@ -194,6 +195,12 @@ class Measurement:
     stability : Stability or None
         How much the angle moves under small changes of centre, radius and λ, and under a
         bootstrap of the vertices (``None`` unless asked for).
+    split_angle : float or None
+        Under the refined rule, where the refinement applied: the angle of Algorithm 1's split
+        before it (``None`` where Algorithm 1's planes were kept).
+    n_left_out : int
+        Under the refined rule: vertices next to the crease that lie on neither face and were
+        left out of the plane fits (they keep their side in ``labels``). Usually 0.
     """
 
     angle: float
@@ -225,6 +232,8 @@ class Measurement:
     orientation_difference: float
     n_shared: int
     stability: Stability | None = None
+    split_angle: float | None = None
+    n_left_out: int = 0
 
     @property
     def angle_meaning(self) -> str:

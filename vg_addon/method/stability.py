@@ -10,8 +10,6 @@ vertices.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..errors import GoniometerError
@@ -24,6 +22,7 @@ from .fixed_order import (
     rows_dot,
     split_exactly,
 )
+from .refinement import mean_edge_length
 from .result import Measurement, Stability
 
 CENTER_EDGE_LENGTHS = 2.0
@@ -52,15 +51,6 @@ vertices fit; a radius that takes in most of a large scan does not, and is refus
 anything is allocated."""
 
 _RANK_TOLERANCE = 1e-10  # as Algorithm 1's test for a side on a line
-
-
-def mean_edge_length(radius: float, n_vertices: int) -> float:
-    """Mean edge length of a triangulated disk of ``radius`` holding ``n_vertices`` vertices.
-
-    An equilateral triangulation with edge ``h`` has one vertex per ``(√3 / 2) h²`` of area, so
-    ``h = r √(2π / (√3 n))``: an estimate from the patch itself, valid for meshes and point clouds.
-    """
-    return radius * math.sqrt(2.0 * math.pi / (math.sqrt(3.0) * n_vertices))
 
 
 def _moved_centers(surface, m: Measurement) -> np.ndarray:
@@ -308,7 +298,7 @@ def _algorithm_steps(
     center_b = rows_dot(centers, binormal)
     sum_q = rows_dot(binormal, weighted_normal)
     sum_u = rows_dot(binormal, sums[:, _L]) - count * center_b
-    if rule == "oriented":
+    if rule != "paper":
         cross_moments = sums[:, _NL].reshape(-1, 3, 3)
         terms = binormal[:, :, None] * cross_moments * binormal[:, None, :]
         sum_qu = np.add.reduce(terms.reshape(-1, 9), axis=1) - center_b * sum_q

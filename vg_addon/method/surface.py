@@ -8,6 +8,7 @@ import numpy as np
 
 from ..errors import GoniometerError
 from .algorithm import (
+    DEFAULT_RULE,
     MIN_SIDE_VERTICES,
     as_center,
     as_lambda,
@@ -188,7 +189,7 @@ class Surface:
         radius: float,
         lam: float = 2.0,
         patch: str = "euclidean",
-        rule: str = "oriented",
+        rule: str = DEFAULT_RULE,
         stability: bool = False,
     ) -> Measurement:
         """Measure the break angle at ``center`` (Algorithm 1 on the patch around it).
@@ -203,9 +204,9 @@ class Surface:
             Segmentation parameter λ ≥ 0 (default 2).
         patch : {"euclidean", "geodesic"}, optional
             How the patch is chosen (default ``"euclidean"``).
-        rule : {"oriented", "paper"}, optional
-            How the projection's position term is signed (default ``"oriented"``; ``"paper"`` is
-            Algorithm 1 as printed, for replicating old measurements).
+        rule : {"refined", "oriented", "paper"}, optional
+            How the measurement is taken (default ``"refined"``; ``"paper"`` is Algorithm 1 as
+            printed, for replicating old measurements; see ``algorithm.RULES``).
         stability : bool, optional
             Also compute :attr:`Measurement.stability` (about as costly as a dozen measurements,
             batched; default ``False``).

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import GoniometerError
-from .algorithm import as_radius
+from .algorithm import DEFAULT_RULE, as_radius
 from .result import Measurement
 
 MAX_SWEEP_RADII = 1000
@@ -56,7 +56,7 @@ def radius_sweep(
     count: int,
     lam: float = 2.0,
     patch: str = "euclidean",
-    rule: str = "oriented",
+    rule: str = DEFAULT_RULE,
 ) -> list[SweepPoint]:
     """Measure at ``center`` with ``count`` radii from ``start`` to ``stop``.
 

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ..errors import GoniometerError, bounded_list
 from ..formats.csvio import ReplicationRow, mesh_name_match
-from ..method.algorithm import as_center, as_lambda, as_radius
+from ..method.algorithm import DEFAULT_RULE, as_center, as_lambda, as_radius
 from ..method.surface import check_patch_mode
 
 #: Mesh file types a batch run reads (by file name extension, case-insensitive).
@@ -61,7 +61,7 @@ class Task:
         but a world-space row, see :attr:`ReplicationRow.coordinates`); ``"world"``: in Blender
         world space, to be converted by the object's transform.
     rule : str
-        ``"oriented"`` or ``"paper"``: a CSV row's own rule (MeshLab and earlier add-on rows
+        ``"refined"``, ``"oriented"`` or ``"paper"``: a CSV row's own rule (MeshLab and earlier add-on rows
         carry the paper's), else the run's.
     """
 
@@ -78,7 +78,7 @@ class Task:
     mesh_name: str = ""
     error: str = ""
     coordinates: str = "mesh"
-    rule: str = "oriented"
+    rule: str = DEFAULT_RULE
 
 
 # --------------------------------------------------------------------------- command line values
@@ -190,7 +190,7 @@ def plan_points(
     radius,
     lam: float,
     patch: str,
-    rule: str = "oriented",
+    rule: str = DEFAULT_RULE,
 ) -> list[Task]:
     """Tasks for ``--at`` points: every point on every mesh (mesh by mesh, points in order).
 
@@ -229,7 +229,7 @@ def plan_rows(
     patch: str = "euclidean",
     ignore_mesh_names: bool = False,
     source: str = "the points CSV",
-    rule: str = "oriented",
+    rule: str = DEFAULT_RULE,
 ) -> list[Task]:
     """Tasks for the rows of a points or measurements CSV, in file order.
 

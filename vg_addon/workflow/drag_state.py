@@ -19,7 +19,7 @@ from enum import StrEnum
 import numpy as np
 
 from ..errors import GoniometerError
-from ..method.algorithm import MIN_RADIUS, MIN_SIDE_VERTICES
+from ..method.algorithm import DEFAULT_RULE, MIN_RADIUS, MIN_SIDE_VERTICES
 
 MIN_PATCH_VERTICES = 2 * MIN_SIDE_VERTICES
 """The fewest patch vertices that can be measured (three per side)."""
@@ -295,7 +295,7 @@ class DragMachine:
         self.measurement = None
 
 
-def surface_callbacks(surface, patch: str = "euclidean", rule: str = "oriented") -> dict:
+def surface_callbacks(surface, patch: str = "euclidean", rule: str = DEFAULT_RULE) -> dict:
     """The ``snap``, ``query`` and ``measure`` callables of a :class:`DragMachine` on a Surface.
 
     ``snap`` moves a point to its nearest measurable vertex (however far), ``query`` returns the
@@ -305,7 +305,7 @@ def surface_callbacks(surface, patch: str = "euclidean", rule: str = "oriented")
     ----------
     surface : Surface
     patch : {"euclidean", "geodesic"}, optional
-    rule : {"oriented", "paper"}, optional
+    rule : {"refined", "oriented", "paper"}, optional
         The rule the measurement (and so the preview) uses.
     """
 
