@@ -38,10 +38,16 @@ from .vg_addon.method.result import (
 BLEND_RELATIVE = {"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else set()
 RULE_ITEMS = (
     (
+        "refined",
+        "Refined",
+        "The oriented rule, then each side's plane from the vertices that lie on it: exact where "
+        "the crease runs between rows of vertices (the default)",
+    ),
+    (
         "oriented",
         "Oriented",
         "Sign the position term by the edge's convexity: right on concave edges and on meshes "
-        "wound inward (the default)",
+        "wound inward (this extension's rule before 0.2)",
     ),
     (
         "paper",
@@ -404,8 +410,8 @@ class VG_SceneSettings(PropertyGroup):
     rule: EnumProperty(
         name="Rule",
         items=RULE_ITEMS,
-        default="oriented",
-        description="How the projection is signed",
+        default="refined",
+        description="How the measurement is taken",
     )
     stability: BoolProperty(
         name="Stability",

@@ -207,10 +207,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     how.add_argument(
         "--rule",
-        choices=("oriented", "paper"),
-        default="oriented",
-        help="how the projection is signed: oriented (default; right on concave edges) or paper "
-        "(Algorithm 1 as printed); rows of MeshLab/earlier add-on CSVs keep the paper's",
+        choices=("refined", "oriented", "paper"),
+        default="refined",
+        help="how the measurement is taken: refined (default; exact where the crease runs between "
+        "vertex rows), oriented (before 0.2; right on concave edges) or paper (Algorithm 1 as "
+        "printed); rows of MeshLab/earlier add-on CSVs keep the paper's",
     )
     how.add_argument(
         "--stability",

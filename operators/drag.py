@@ -194,7 +194,7 @@ class DragSession:
     call repeatedly) removes the drawing and the header and status texts on every way out.
     """
 
-    def __init__(self, obj, surface, patch: str, lam: float, rule: str = "oriented", matrix=None):
+    def __init__(self, obj, surface, patch: str, lam: float, rule: str = "refined", matrix=None):
         self.obj = obj
         self.surface = surface
         self.matrix = np.eye(4) if matrix is None else np.asarray(matrix, dtype=np.float64)
