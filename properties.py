@@ -47,7 +47,7 @@ RULE_ITEMS = (
         "oriented",
         "Oriented",
         "Sign the position term by the edge's convexity: right on concave edges and on meshes "
-        "wound inward (this extension's rule before 0.2)",
+        "wound inward (the default before the refined rule)",
     ),
     (
         "paper",

@@ -210,7 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("refined", "oriented", "paper"),
         default="refined",
         help="how the measurement is taken: refined (default; exact where the crease runs between "
-        "vertex rows), oriented (before 0.2; right on concave edges) or paper (Algorithm 1 as "
+        "vertex rows), oriented (the earlier default; right on concave edges) or paper (Algorithm 1 as "
         "printed); rows of MeshLab/earlier add-on CSVs keep the paper's",
     )
     how.add_argument(

@@ -29,7 +29,7 @@ inward-wound meshes read right. ``"refined"`` (the default) is the oriented rule
 :func:`~vg_addon.method.refinement.refine_sides`: each side's plane from the vertices that lie on
 it, exact where the crease runs between rows of vertices. ``"paper"`` is Algorithm 1 as printed,
 ``p = bᵀ[N + (λ/r)(X − x̄)]``, kept to replicate measurements taken with the MeshLab plugin and the
-earlier add-on; ``"oriented"`` replicates this extension's measurements from before 0.2."""
+earlier add-on; ``"oriented"`` replicates this extension's measurements taken before the refined rule."""
 
 DEFAULT_RULE = "refined"
 
@@ -153,8 +153,8 @@ def check_rule(rule) -> str:
     name = str(rule).lower()
     if name not in RULES:
         raise GoniometerError(
-            f"Unknown rule {rule!r}: use 'refined' (the default), 'oriented' (this extension's rule "
-            "before 0.2) or 'paper' (Algorithm 1 as printed, to replicate old measurements)."
+            f"Unknown rule {rule!r}: use 'refined' (the default), 'oriented' (the default before "
+            "'refined') or 'paper' (Algorithm 1 as printed, to replicate old measurements)."
         )
     return name
 
