@@ -45,7 +45,11 @@ GLYPH_EM = 0.6  # the width of a label's character (at most, about), in label he
 OUTLINE = 0.07  # the black ring around label text, in label heights
 MARGIN = 1.25  # the frame around the object, room for labels at its edges
 FONT_FILE = "DejaVuSansMono.woff2"  # in Blender's datafiles/fonts: a "1" unlike "I"
-NOT_SHOWN = "not shown"  # the name of the picture listing measurements no view can show
+NOT_SHOWN = "not shown"
+CLOSE_UPS = (
+    4.0,
+    12.0,
+)  # how much nearer a close-up looks, for labels crowded out of a view  # the name of the picture listing measurements no view can show
 
 
 def safe_file_name(name: str) -> str:
@@ -229,8 +233,10 @@ class MapJob:
 
     # -- one view -------------------------------------------------------------------------------
 
-    def _frame(self, look, up):
-        """Camera axes, placement and ortho scale that frame the object seen along ``look``."""
+    def _frame(self, look, up, zoom=None):
+        """Camera axes, placement and ortho scale that frame the object seen along ``look``;
+        ``zoom`` ``(point, factor)``: a close-up, centred on ``point``, ``factor`` times
+        nearer."""
         back = -np.asarray(look, dtype=np.float64)
         up = np.asarray(up, dtype=np.float64)
         right = np.cross(up, back)
@@ -244,57 +250,93 @@ class MapJob:
             + up * (along[1].max() + along[1].min()) / 2
         )
         front = float(along[2].max())
+        if zoom is not None:
+            point, factor = zoom
+            centre = right * (point @ right) + up * (point @ up)
+            scale /= factor
         return right, up, back, centre, front, scale
 
     # -- which views show which labels ------------------------------------------------------
 
-    def _layout(self, look, up, focus=None) -> list:
+    def _layout(self, look, up, focus=None, zoom=None) -> list:
         """The labels a view looking along ``look`` draws: ``(label index, side)`` of each one
-        whose centre it sees and that has room on the picture; ``focus`` (a label index) first,
-        then the selected measurement, then the newest."""
-        right, up, back, centre, _front, scale = self._frame(look, up)
-        pixel = scale / self.size[0]
-        shown = [i for i, label in enumerate(self.labels) if self._visible(label, -back)]
+        whose centre it sees, on the picture, and that has room there; ``focus`` (a label
+        index) first, then the selected measurement, then the newest."""
+        right, up, back, centre, _front, scale = self._frame(look, up, zoom)
+        width, height = self.size
+        pixel = scale / width
+        text_px = TEXT_FRACTION * width
+        anchors, shown = [], []
+        for i, label in enumerate(self.labels):
+            x = ((label.position - centre) @ right) / pixel
+            y = ((label.position - centre) @ up) / pixel
+            inside = abs(x) < width / 2 - text_px and abs(y) < height / 2 - text_px
+            if inside and self._visible(label, -back):
+                anchors.append([x, y])
+                shown.append(i)
         if not shown:
             return []
-        anchors = [
-            [((self.labels[i].position - centre) @ right) / pixel,
-             ((self.labels[i].position - centre) @ up) / pixel]
-            for i in shown
-        ]  # fmt: skip
         total = len(shown)
         priority = [
             (2 * total if i == focus else total if self.labels[i].active else 0) + rank
             for rank, i in enumerate(shown)
         ]
-        text_px = TEXT_FRACTION * self.size[0]
         widths = [GLYPH_EM * len(self.labels[i].text) * text_px for i in shown]
-        placed = place_labels(anchors, widths, text_px, priority, gap=0.45 * text_px)
+        # Never cut by the picture's edge: a text that would cross it goes on the other side.
+        edge = width / 2 - 0.3 * text_px
+        placed = place_labels(
+            anchors, widths, text_px, priority, gap=0.45 * text_px, bounds=(-edge, edge)
+        )
         return [(shown[index], side) for index, side in placed]
 
     def _plan(self) -> None:
-        """Lay out the chosen views, add a view for each measurement none of them shows, and a
-        last picture listing those that no direction shows."""
+        """Lay out the chosen views and add views until every measurement is drawn in one: a
+        close-up where a view sees it but its label had no room (neighbours crowd it), else a
+        view looking onto its surface (see ``looks_at``); a last picture lists those that no
+        direction shows."""
         self.placements = [self._layout(look, up) for _name, look, up in self.views]
+        self._zooms: dict[int, tuple] = {}
         drawn = {index for placed in self.placements for index, _side in placed}
         for index, label in enumerate(self.labels):
-            if index in drawn:
-                continue
-            for look in looks_at(label.outward):
-                if not self._visible(label, look):
-                    continue
-                up = view_up(look)
-                placed = self._layout(look, up, focus=index)
-                if any(i == index for i, _side in placed):
-                    self.views.append((f"measurement {label.number}", tuple(look), up))
-                    self.placements.append(placed)
-                    drawn.update(i for i, _side in placed)
-                    break
-            else:
+            if index not in drawn and not self._add_view_for(index, label, drawn):
                 self.not_shown.append(label)
         if self.not_shown:
             self.views.append((NOT_SHOWN, None, None))
             self.placements.append([])
+
+    def _add_view_for(self, index, label, drawn) -> bool:
+        """Add a view that draws ``label``; whether one was found. ``drawn`` grows by every
+        label the new view draws."""
+        # The chosen view that looks most squarely onto its surface, for a close-up.
+        seen_in = sorted(
+            (
+                (look, up)
+                for _n, look, up in self.views[:6]
+                if look is not None and self._visible(label, look)
+            ),
+            key=lambda view: float(np.asarray(view[0]) @ label.outward),
+        )
+        candidates = [
+            (f"close-up {label.number}", look, up, (label.position, factor))
+            for look, up in seen_in[:1]
+            for factor in CLOSE_UPS
+        ]
+        candidates += [
+            (f"measurement {label.number}", tuple(look), view_up(look), None)
+            for look in looks_at(label.outward)
+        ]
+        for name, look, up, zoom in candidates:
+            if zoom is None and not self._visible(label, look):
+                continue
+            placed = self._layout(look, up, focus=index, zoom=zoom)
+            if any(i == index for i, _side in placed):
+                if zoom is not None:
+                    self._zooms[len(self.views)] = zoom
+                self.views.append((name, tuple(look), up))
+                self.placements.append(placed)
+                drawn.update(i for i, _side in placed)
+                return True
+        return False
 
     # -- rendering ------------------------------------------------------------------------------
 
@@ -308,7 +350,7 @@ class MapJob:
         self._copy.hide_render = look is None
         if look is None:
             look, up = SIX_VIEWS[0][1:]
-        right, up, back, centre, front, scale = self._frame(look, up)
+        right, up, back, centre, front, scale = self._frame(look, up, self._zooms.get(step))
         rotation = Matrix(np.column_stack([right, up, back]).tolist()).to_4x4()
         camera = self._camera
         camera.matrix_world = Matrix.Translation(Vector(centre + back * (front + self._size))) @ (

@@ -32,7 +32,14 @@ def _overlaps(boxes: np.ndarray, box: np.ndarray) -> bool:
 
 
 def place_labels(
-    anchors, widths, height: float, priority, *, gap: float | None = None, right_edge=None
+    anchors,
+    widths,
+    height: float,
+    priority,
+    *,
+    gap: float | None = None,
+    right_edge=None,
+    bounds=None,
 ) -> list:
     """Which labels to show and on which side of their anchor, so that no two overlap.
 
@@ -54,6 +61,9 @@ def place_labels(
     right_edge : float, optional
         Where the visible picture ends on the right (pixels): a label whose text would cross it
         tries the left side first.
+    bounds : (float, float), optional
+        Where the picture ends on the left and on the right (pixels): a text that would cross
+        either is not put on that side (a map's picture cuts what crosses its edges).
 
     Returns
     -------
@@ -85,6 +95,8 @@ def place_labels(
             sides = (-1, 1)
         for side in sides:
             box = label_box(anchor, widths[index], height, side, gap)
+            if bounds is not None and (box[0] < bounds[0] or box[2] > bounds[1]):
+                continue
             padded = box + np.array([-pad, -pad, pad, pad])
             if not taken.size or not (_overlaps(taken, padded) or _overlaps(taken, mark)):
                 shown.append((int(index), side))
