@@ -6,7 +6,7 @@ from ..bridge.records import unit_symbol, units_label
 from ..operators.measure import non_uniform_scale_note
 from ..properties import exact_numbers
 from ..vg_addon.method.winding import winding_message
-from .text import fits_beside, region_width, text_width, wrapped_label
+from .text import fits_beside, region_width, text_width, ui_scale, wrapped_label
 
 # What the angle of a measurement is, by its convexity label.
 ANGLE_MEANING = {
@@ -42,10 +42,9 @@ class VIEW3D_PT_vg_measure(_GoniometerPanel, bpy.types.Panel):
         column = layout.column(align=True)
         column.use_property_split = True
         column.use_property_decorate = False
-        if obj is not None:
-            column.prop(obj.vg, "unit", text="Scan Units")
-            if obj.vg.unit_guessed:
-                column.label(text="Guessed from its size", icon="INFO")
+        if obj is not None:  # one row whatever it says: the buttons below never move
+            guessed = obj.vg.unit_guessed
+            column.prop(obj.vg, "unit", text="Units (guessed)" if guessed else "Scan Units")
         column.prop(settings, "radius", text=f"Radius ({unit})")
         column.prop(settings, "seg_param")
         column.prop(settings, "patch")
@@ -119,8 +118,11 @@ class VIEW3D_PT_vg_selected(_GoniometerPanel, bpy.types.Panel):
         # Recorded values are shown as text, exactly as stored, not as (rounded, editable)
         # fields; only the note is the user's.
         column = layout.column(align=True)
+        stacked = False  # a vector's Y and Z rows follow its X row
         for label, value in selected_rows(item, context.scene):
-            _text(column, label, value, context)
+            if label or not value.startswith(("Y  ", "Z  ")):
+                stacked = not _fits(context, label, value)
+            _text(column, label, value, stacked=stacked)
         row = column.row(align=True)
         row.prop(item, "color_plus")
         row.prop(item, "color_minus", text="")
@@ -209,18 +211,23 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
 LABEL_SHARE = 0.4  # of a row, for the label of a value ("λ (SegParam)" is 71 pixels)
 
 
-def _text(layout, label, value, context=None):
-    """A row: ``label`` right-aligned, then ``value``; where the value is too long to fit beside
-    it in this sidebar (an exact number with all its digits), the label and then the value on a
-    row of its own, so nothing is cut."""
-    if context is not None and not fits_beside(
+def _fits(context, label, value) -> bool:
+    """Whether ``label`` and ``value`` fit side by side in this sidebar."""
+    return fits_beside(
         label,
         value,
         region_width(context),
         LABEL_SHARE,
         lambda t: text_width(context, t),
-        context.preferences.system.ui_scale,
-    ):
+        ui_scale(context),
+    )
+
+
+def _text(layout, label, value, *, stacked=False):
+    """A row: ``label`` right-aligned, then ``value``; ``stacked`` (a value too long to fit
+    beside its label in this sidebar, such as an exact number with all its digits): the label,
+    then the value on a row of its own, so nothing is cut."""
+    if stacked:
         if label:
             layout.label(text=label)
         layout.label(text=value, icon="BLANK1")
@@ -230,6 +237,11 @@ def _text(layout, label, value, context=None):
     left.alignment = "RIGHT"
     left.label(text=label)
     split.label(text=value)
+
+
+def _text_fitted(layout, context, label, value) -> None:
+    """:func:`_text`, stacked where the value does not fit beside its label."""
+    _text(layout, label, value, stacked=not _fits(context, label, value))
 
 
 class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
@@ -271,22 +283,22 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
                 icon="ERROR",
             )
         column = layout.column(align=True)
-        _text(column, "Edge", f"{edge.number}, break {edge.break_number}")
-        _text(
+        _text_fitted(column, context, "Edge", f"{edge.number}, break {edge.break_number}")
+        _text_fitted(
             column,
+            context,
             "Stations",
             f"{edge.n_stations} every {edge.spacing:.4g} over {edge.length:.4g} {unit}",
         )
-        _text(column, "Mean ± SD", f"{edge.mean:.2f}° ± {edge.std:.2f}°")
-        _text(column, "Min, max", f"{edge.min:.2f}°, {edge.max:.2f}°")
-        _text(column, "Pooled", f"{edge.pooled_angle:.2f}°")
+        _text_fitted(column, context, "Mean ± SD", f"{edge.mean:.2f}° ± {edge.std:.2f}°")
+        _text_fitted(column, context, "Min, max", f"{edge.min:.2f}°, {edge.max:.2f}°")
+        _text_fitted(column, context, "Pooled", f"{edge.pooled_angle:.2f}°")
         image = bpy.data.images.get(edge.plot)
         if image is not None:  # the image's preview icon, made on demand by layout.icon
             # As wide as the sidebar (scale counts 20-pixel icon units): a fixed 10 units left
             # the plot's numbers too small to read.
-            ui_scale = context.preferences.system.ui_scale
-            width = context.region.width if context.region is not None else 240 * ui_scale
-            units = max(8.0, (width - 30 * ui_scale) / (20 * ui_scale))
+            scale = ui_scale(context)
+            units = max(8.0, (region_width(context) - 60 * scale) / (20 * scale))
             layout.template_icon(icon_value=layout.icon(image), scale=units)
             layout.label(text="Angle (°) against arc length")
         layout.prop(edge, "note")
@@ -310,7 +322,6 @@ class VIEW3D_PT_vg_csv(_GoniometerPanel, bpy.types.Panel):
         op = layout.operator("vg.import_csv", text="Import (Re-measure)", icon="IMPORT")
         op.ignore_mesh_names = settings.ignore_mesh_names
         layout.prop(settings, "ignore_mesh_names", text="Ignore Mesh Names")
-        layout.operator("vg.report", text="Replication Report…", icon="GRAPH")
         layout.operator("vg.report", text="Replication Report…", icon="GRAPH")
 
 
