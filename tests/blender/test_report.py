@@ -147,6 +147,7 @@ def test_report_html_is_self_contained_with_every_figure(study):
         "regression_drag",
         "angles_by_method",
         "angles_by_mesh",
+        "angles_by_type",
         "bland_altman_1",
     } <= names
     assert {p.stem for p in (report / "figures").glob("*.svg")} == names

@@ -380,6 +380,12 @@ def _regressions(c: _Context, located: list[str]) -> None:
         ]
         zero = [r for r in rows if r["angle"] <= 0]
         rows = [r for r in rows if r["angle"] > 0]
+        if zero and not rows:
+            c.skip(
+                f"the regression for {m}",
+                f"the angle IOV of every break ({len(zero)}) is 0: no logarithm, nothing varies",
+            )
+            continue
         if zero:
             line = f"regression of {m}: {len(zero)} breaks with angle IOV 0 (no logarithm)"
             c.outcome.not_computed.append(line)
@@ -513,6 +519,7 @@ def _bland_altman_section(c: _Context, compare) -> None:
 
     c.page.heading("Bland–Altman agreement")
     rows = []
+    plots = []
     for index, (a, b, first, second) in enumerate(_pairs_to_compare(c, compare), start=1):
         shared = [u for u in first if u in second]
         try:
@@ -536,11 +543,7 @@ def _bland_altman_section(c: _Context, compare) -> None:
                 *ba.upper_ci,
             ]
         )
-        c.figure(
-            figures.bland_altman_plot(ba, DEG),
-            f"bland_altman_{index}",
-            f"Bland–Altman plot of {b} against {a} (mean angle per break); shaded: 95% CIs.",
-        )
+        plots.append((index, a, b, ba))
     header = ["first", "second", "n", "bias", "SD", "lower limit", "upper limit", "bias CI low"]
     header += ["bias CI high", "lower limit CI low", "lower limit CI high", "upper limit CI low"]
     header += ["upper limit CI high"]
@@ -550,6 +553,12 @@ def _bland_altman_section(c: _Context, compare) -> None:
             header,
             rows,
             text_columns=2,
+        )
+    for index, a, b, ba in plots:
+        c.figure(
+            figures.bland_altman_plot(ba, DEG),
+            f"bland_altman_{index}",
+            f"Bland–Altman plot of {b} against {a} (mean angle per break); shaded: 95% CIs.",
         )
     csvio.write_table(c.folder / "bland_altman.csv", header, rows)
 
@@ -565,6 +574,11 @@ def _distribution_section(c: _Context) -> None:
             by_method.setdefault(c.sessions[s].method, []).append(r.angle)
             by_mesh.setdefault(b.unit.mesh, []).append(r.angle)
     by_method = {m: by_method[m] for m in c.methods if m in by_method}
+    by_kind: dict[str, list[float]] = {}
+    for b in c.stats:
+        kinds = [r.kind for r in b.unit.readings.values() if r.kind]
+        if kinds:
+            by_kind.setdefault(kinds[0], []).extend(r.angle for r in b.unit.readings.values())
     c.figure(
         figures.distributions(by_method, "Angles by method (every reading)", "method", DEG),
         "angles_by_method",
@@ -575,6 +589,14 @@ def _distribution_section(c: _Context) -> None:
         "angles_by_mesh",
         "Angles by mesh, every reading of every method.",
     )
+    if by_kind:
+        c.figure(
+            figures.distributions(
+                dict(sorted(by_kind.items())), "Angles by break type", "type", DEG
+            ),
+            "angles_by_type",
+            "Angles by break type (the Break Type column), every reading of every method.",
+        )
     profiles: dict[tuple[str, int], dict[str, tuple[list[int], list[float]]]] = {}
     for b in c.stats:
         if not b.unit.several:

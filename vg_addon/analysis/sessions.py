@@ -34,6 +34,7 @@ COLUMNS = {
     "edge": ("Edge #", "Edge Number"),
     "error": ("error",),
     "date": ("Date",),
+    "kind": ("Break Type", "Fracture Type", "Type"),
 }
 REQUIRED = ("mesh", "break", "angle")
 
@@ -74,6 +75,8 @@ class Reading:
     date : str
         When it was measured, where the file says (tells two identical re-measurements apart
         from one file given twice).
+    kind : str
+        The break's type (``Break Type`` column, e.g. transverse, oblique, spiral), or empty.
     """
 
     mesh: str
@@ -84,6 +87,7 @@ class Reading:
     vertices: float | None = None
     row: int = 0
     date: str = ""
+    kind: str = ""
 
 
 @dataclass
@@ -187,7 +191,8 @@ def _reading(number: int, cells, columns) -> tuple[Reading | None, str]:
         return None, f"row {number}: " + "; ".join(problems)
     centre = None if None in parts else tuple(parts)
     date = _cell(cells, columns, "date").strip()
-    return Reading(mesh, break_number, angle, centre, radius, vertices, number, date), ""
+    kind = csvio.text_cell(_cell(cells, columns, "kind").strip())
+    return Reading(mesh, break_number, angle, centre, radius, vertices, number, date, kind), ""
 
 
 def _read_file(path, method, observer) -> tuple[list[Session], str]:

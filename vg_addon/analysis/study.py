@@ -25,7 +25,7 @@ MANUAL_SD = 4.0
 @dataclass(frozen=True)
 class Plan:
     """One session's plan: its file stem and rows (mesh, break, label, x, y, z, radius), or
-    for a manual session rows (mesh, break, angle)."""
+    for a manual session rows (mesh, break, angle, break type)."""
 
     name: str
     method: str
@@ -74,13 +74,13 @@ def plan_study(
             for name, fragment in meshes.items():
                 for number, site in enumerate(fragment.sites, start=1):
                     reading = float(np.round(site.angle + rng.normal(0.0, MANUAL_SD)))
-                    rows.append((name, number, reading))
+                    rows.append((name, number, reading, site.label.split("/")[0]))
             plans.append(
                 Plan(
                     f"{observer}_manual_{rep}",
                     "manual",
                     observer,
-                    ("Mesh", "Break #", "Angle"),
+                    ("Mesh", "Break #", "Angle", "Break Type"),
                     tuple(rows),
                 )
             )
