@@ -81,6 +81,17 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
             return os.path.join(os.path.dirname(bpy.data.filepath), "vg_report")
         return ""
 
+    def invoke(self, context, event):
+        """Refuse at once where the libraries are missing (no files to choose in vain), else
+        open the file browser on CSV files."""
+        missing = missing_message(batch_command(self.report_folder, []))
+        if missing:
+            self.report({"ERROR"}, missing)
+            return {"CANCELLED"}
+        self.filter_glob = "*.csv"
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
     def execute(self, context):
         sessions = self._sessions()
         folder = self._folder(sessions)
