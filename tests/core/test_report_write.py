@@ -1,0 +1,57 @@
+"""write_report on hand-built sessions in any Python with the report's libraries: stations of
+one break plotted as an edge profile, what was left out counted, the outputs never an input."""
+
+from __future__ import annotations
+
+import csv
+
+import pytest
+
+pytest.importorskip("matplotlib", reason="the report's figures need requirements/report.txt")
+pytest.importorskip("statsmodels", reason="the report's regression needs statsmodels")
+
+from vg_addon import GoniometerError
+from vg_addon.analysis.report import write_report
+
+
+def session(folder, name, rows):
+    path = folder / name
+    lines = ["Mesh,Break #,Angle,x,y,z,Radius"] + [f"m,1,{r}" for r in rows]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def test_stations_make_an_edge_profile_and_the_ambiguous_row_is_counted(tmp_path):
+    paths = [
+        session(tmp_path, "obs1_drag_1.csv", ["100,0,0,0,3", "110,4,0,0,3", "120,8,0,0,3"]),
+        session(tmp_path, "obs1_drag_2.csv", ["101,0.2,0,0,3", "111,4.1,0,0,3", "119,8,0.3,0,3"]),
+        session(tmp_path, "obs1_drag_3.csv", ["99,0,0.1,0,3", "112,3.9,0,0,3", "115,6,0,0,3"]),
+    ]
+    outcome = write_report(paths, tmp_path / "out")
+    # 6,0,0 is as near to the stations at 4 and 8: ambiguous, left out, said.
+    assert outcome.left_out == [
+        "obs1_drag_3.csv row 4: m break 1: ambiguous, as near to rows 3 and 4 of obs1_drag_1.csv "
+        "(2); left out"
+    ]
+    assert outcome.code == 1 and outcome.sessions == 3
+    assert "profile_1" in outcome.figures
+    assert (tmp_path / "out" / "figures" / "profile_1.svg").is_file()
+    with open(tmp_path / "out" / "breaks.csv", encoding="utf-8", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [(r["Station"], r["drag n"]) for r in rows] == [("1", "3"), ("2", "3"), ("3", "2")]
+    assert float(rows[0]["drag angle IOV"]) == pytest.approx((1 + 1 + 2) / 3)
+    assert float(rows[2]["drag angle IOV"]) == 1.0
+    left = (tmp_path / "out" / "left_out.csv").read_text(encoding="utf-8")
+    assert "obs1_drag_3.csv row 4" in left
+
+
+def test_nothing_usable_writes_nothing(tmp_path):
+    bad = tmp_path / "obs1_drag_1.csv"
+    bad.write_text("Mesh,Angle\nm,90\n", encoding="utf-8")
+    with pytest.raises(GoniometerError, match="no session could be used; nothing was written"):
+        write_report([bad], tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+    blocker = tmp_path / "file"
+    blocker.write_text("x", encoding="utf-8")
+    with pytest.raises(GoniometerError, match="is not a folder"):
+        write_report([bad], blocker)
