@@ -4,7 +4,8 @@ Entered from ``vg_batch.py`` (``blender -b --python vg_batch.py -- ARGS`` or
 ``python vg_batch.py ARGS`` with the PyPI ``bpy``). ``cli`` parses, ``run`` plans and drives a
 run, ``sources`` imports the meshes, ``measure`` measures one mesh through the bridge,
 ``workers`` runs ``--jobs`` processes, ``render`` and ``blend_file`` write the pictures and the
-.blend, ``demo`` is ``--demo``. Imports run batch → bridge → vg_addon.
+.blend (``map_process`` renders the maps in a child process that a stop signal ends at once),
+``demo`` is ``--demo``. Imports run batch → bridge → vg_addon.
 """
 
 from __future__ import annotations
@@ -18,21 +19,31 @@ from .cli import UsageError, build_parser, check_args
 
 
 def _stop(signum, frame):
-    # SIGTERM (`kill PID`, a job scheduler's stop) ends the run as Ctrl-C does: the workers
-    # stopped, the CSV written with what was measured, the temporary folder removed.
+    # SIGINT (Ctrl-C) and SIGTERM (`kill PID`, a job scheduler's stop) end the run at once: a
+    # map being rendered is killed with its child process, the workers are stopped, the CSV is
+    # written with what was measured, the temporary folders are removed, exit status 130. A
+    # second signal must not cut that short, so it is ignored from now on.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise KeyboardInterrupt
 
 
 def main(argv: list[str]) -> int:
     """Run the batch command with the script's arguments; returns the process exit status."""
+    from . import map_process
     from .demo import run_demo
     from .run import run_batch
     from .workers import worker_main
 
     args = build_parser().parse_args(argv)
     try:
+        if args.map_worker:
+            return map_process.map_worker_main(args.map_worker)
         if args.worker:
             return worker_main(args.worker)
+        # Set here, not left to Python: Blender's own SIGINT handler (blender -b) only asks a
+        # render to stop.
+        signal.signal(signal.SIGINT, _stop)
         signal.signal(signal.SIGTERM, _stop)
         if args.report:
             from .report import check_report_args, run_report
@@ -54,6 +65,8 @@ def main(argv: list[str]) -> int:
     except KeyboardInterrupt:
         print("vg_batch: interrupted; the CSV holds what was measured so far", file=sys.stderr)
         return 130
+    finally:
+        map_process.close()
 
 
 __all__ = ["extension", "main"]

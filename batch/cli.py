@@ -330,6 +330,7 @@ def build_parser() -> argparse.ArgumentParser:
         "name (repeatable)",
     )
     parser.add_argument("--worker", help=argparse.SUPPRESS)
+    parser.add_argument("--map-worker", help=argparse.SUPPRESS)
     return parser
 
 

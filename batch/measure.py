@@ -18,8 +18,9 @@ from ..vg_addon.formats.png import encode_png
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
 from .edges import failed_edge_row, measure_edges, spec_applies
+from .map_process import draw_map
 from .pictures import reason, try_picture
-from .render import add_sides_material, render_map
+from .render import add_sides_material
 from .sources import MeshSource, import_mesh
 
 _BLOCK = 64  # tasks measured before they are recorded
@@ -219,7 +220,7 @@ def draw_pictures(result: MeshResult, obj, options, stem: str, plots, name: str)
     if options.get("render"):
         folder = Path(options["render"])
         try:
-            result.render = str(render_map(obj, folder, options, stem))
+            result.render = str(draw_map(obj, folder, options, stem, name))
         except Exception as error:  # a render problem must not lose the measurements
             result.picture_errors.append(f"render of {name}: {reason(error, folder)}")
 

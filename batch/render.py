@@ -52,10 +52,14 @@ class NamedMap(measurement_map.MapJob):
         return sheet
 
 
-def render_map(obj, directory: Path, options: dict, stem: str) -> Path:
+def render_map(obj, directory: Path, options: dict, stem: str, progress=None) -> Path:
     """Render the measurement map of ``obj`` into ``directory`` (the extension's own,
-    ``bridge.measurement_map``: the views' PNGs and a contact sheet named after ``stem``);
-    returns the sheet. A map that fails leaves none of its pictures."""
+    ``bridge.measurement_map``: the views' PNGs and a contact sheet named after ``stem``) in
+    this process; returns the sheet. A map that fails leaves none of its pictures.
+
+    ``options["staging"]``: the hidden folder to render into (default: one made in
+    ``directory``); ``progress(done, total, view)`` is called before each view.
+    """
     with quiet_stdout():
         job = NamedMap(
             obj,
@@ -65,9 +69,12 @@ def render_map(obj, directory: Path, options: dict, stem: str) -> Path:
             views=options.get("render_views", "SIX"),
             size=tuple(options.get("render_size", (640, 480))),
             samples=options.get("render_samples", 16),
+            staging=options.get("staging"),
         )
         try:
             while not job.done:
+                if progress is not None:
+                    progress(len(job.written), len(job.views), job.views[len(job.written)][0])
                 job.render_next()
             return job.finish()
         except BaseException:

@@ -30,7 +30,7 @@ import bpy
 
 from ..vg_addon.formats import csvio
 from ..vg_addon.workflow import batchplan
-from . import extension
+from . import child_process, extension, map_process
 from .blend_file import forget
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
 from .sources import MeshSource
@@ -41,25 +41,7 @@ if TYPE_CHECKING:
 
 PARENT_POLL_SECONDS = 0.2  # how often a worker checks that its parent is still there
 STOP_SECONDS = 10.0  # how long a stopped worker may take to end before it is killed
-MARK = "@@vg-batch@@"  # prefix of the lines a worker sends to its parent on stdout
-
-
-def worker_command(plan_path: str) -> list[str]:
-    """The command line of a worker: the same Blender binary, or the same Python with bpy."""
-    script = str(extension.package_folder() / "vg_batch.py")
-    if bpy.app.binary_path:
-        return [
-            bpy.app.binary_path,
-            "-b",
-            "--factory-startup",
-            "-noaudio",
-            "--python",
-            script,
-            "--",
-            "--worker",
-            plan_path,
-        ]
-    return [sys.executable, script, "--worker", plan_path]
+MARK = child_process.MARK  # prefix of the lines a worker sends to its parent on stdout
 
 
 def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
@@ -76,26 +58,10 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
     processes: set[subprocess.Popen] = set()
     stopping = threading.Event()
 
-    # One BLAS/OpenMP thread per worker: the workers are the parallelism.
-    env = dict(os.environ)
-    for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-        env.setdefault(name, "1")
-    # Blender makes a session folder in the temporary directory of every process: the workers'
-    # go inside the run's folder, so removing it removes them, however a worker ended.
-    for name in ("TMPDIR", "TEMP", "TMP"):
-        env[name] = folder
-
     def start():
-        process = subprocess.Popen(
-            worker_command(plan_path),
-            env=env,
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-            encoding="utf-8",
-            errors="replace",
-            bufsize=1,
-        )
+        # Blender makes a session folder in the temporary directory of every process: the
+        # workers' go inside the run's folder, so removing it removes them, however one ended.
+        process = child_process.start(["--worker", plan_path], folder)
         with lock:
             processes.add(process)
         return process
@@ -201,6 +167,7 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
 
 
 def _quit(folders, status: int) -> None:
+    map_process.kill()  # a map being rendered: its child ends with this worker, at once
     for folder in folders:
         if folder:
             shutil.rmtree(folder, ignore_errors=True)

@@ -82,9 +82,11 @@ class MapJob:
     The views are rendered into a hidden folder inside ``directory`` and moved into place, each
     replacing its file atomically, only when :meth:`finish` has made the contact sheet: a map
     cancelled or failed half-way leaves an earlier map in the same folder as it was.
+    ``staging``: that hidden folder, made by the caller (it must be inside ``directory``, on the
+    same file system); by default one is made.
     """
 
-    def __init__(self, obj, directory, *, views="SIX", size=(800, 600), samples=16):
+    def __init__(self, obj, directory, *, views="SIX", size=(800, 600), samples=16, staging=None):
         if obj is None or obj.type != "MESH":
             raise GoniometerError("Select the measured mesh object to make its map.")
         width, height = (int(v) for v in size)
@@ -108,7 +110,9 @@ class MapJob:
         self._scene = None
         self._label_objects: list = []
         self.directory.mkdir(parents=True, exist_ok=True)
-        self._staging: Path | None = Path(tempfile.mkdtemp(prefix=".vg-map-", dir=self.directory))
+        self._staging: Path | None = Path(
+            staging or tempfile.mkdtemp(prefix=".vg-map-", dir=self.directory)
+        )
         try:
             self._build_scene()
             self._plan()

@@ -197,3 +197,75 @@ def test_a_stop_signal_ends_the_run_cleanly(started, tmp_path, stop, to_group):
     if to_group:
         expected += ("worker process measuring this mesh stopped (exit status 143)",)
     assert all(any(text in row.error for text in expected) for row in rows[3:])
+
+
+# --------------------------------------------------------------------------- a map rendering
+
+BIG_MAP = ("--render-size", "1200", "900", "--render-samples", "64")  # a view takes many seconds
+STOP_WITHIN = 2.0  # seconds from the signal to the exit (1 s promised; the machine is shared)
+
+
+def descendants(pid: int) -> list[int]:
+    """Living processes below ``pid``: its children, theirs, and so on."""
+    found = children(pid)
+    for child in list(found):
+        found += descendants(child)
+    return found
+
+
+@pytest.mark.parametrize(
+    ("stop", "to_group", "jobs"),
+    [
+        (signal.SIGINT, False, 1),
+        (signal.SIGTERM, False, 1),
+        (signal.SIGTERM, True, 1),
+        (signal.SIGTERM, False, 2),
+        (signal.SIGINT, True, 2),
+    ],
+    ids=[
+        "SIGINT to the parent",
+        "SIGTERM to the parent",
+        "SIGTERM to the process group",
+        "SIGTERM to the parent of workers",
+        "SIGINT to the process group with workers",
+    ],
+)
+def test_a_stop_signal_ends_a_run_whose_map_renders_within_a_second(
+    tmp_path, inputs, stop, to_group, jobs
+):
+    """Cycles renders a view without returning to Python: before the map was drawn in a child
+    process, a stop signal waited for the whole map (about 50 s) and the run ended with 0."""
+    out, maps = tmp_path / "out.csv", tmp_path / "maps"
+    run = Batch(tmp_path, inputs["fast"], inputs["slow"], "--at", "0", "0", "0", "--radius",
+                "0.3", "--render", maps, *BIG_MAP, "--jobs", jobs, "--out", out)  # fmt: skip
+    try:
+        rendering = wait_for(
+            lambda: next((line for line in run.lines if "rendering the map, view 1" in line), None),
+            "a map to start rendering",
+        )
+        processes = descendants(run.process.pid)
+        assert processes, "the map is rendered in a child process"
+        signalled = time.monotonic()
+        if to_group:
+            os.killpg(run.process.pid, stop)
+        else:
+            os.kill(run.process.pid, stop)
+        code = run.process.wait(timeout=WAIT)
+        took = time.monotonic() - signalled
+        left = [pid for pid in processes if alive(pid)]
+        _, stderr = run.finish()
+    finally:
+        run.stop()
+    print(f"{stop.name}{' to the group' if to_group else ''}, --jobs {jobs}: ended {took:.2f} s "
+          "after the signal")  # fmt: skip
+    assert code == 130, stderr
+    assert took < STOP_WITHIN, f"the run took {took:.2f} s to end after {stop.name}"
+    assert not left, f"processes outlived the run: {left}"
+    assert "interrupted" in stderr and "Traceback" not in stderr
+    assert list(maps.iterdir()) == []  # no picture, and no hidden folder of the stopped map
+    assert list(run.temp.iterdir()) == []  # no temporary folder of the run or its children
+    rows = {row.mesh_name: row for row in csvio.read_measurements_csv(out)}
+    assert set(rows) == {"fast", "slow"}
+    rendered = rendering.split("vg_batch: ")[1].split(":")[0]  # the mesh whose map was stopped
+    truth = {"fast": 90.0, "slow": 60.0}[rendered]
+    assert not rows[rendered].error and abs(rows[rendered].angle - truth) < 0.5
