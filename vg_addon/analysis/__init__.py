@@ -24,13 +24,15 @@ def missing_libraries() -> list[str]:
 
 
 def missing_message(command: str = "python vg_batch.py --report DIR SESSION.csv ...") -> str:
-    """Why the report cannot run here and what does the same elsewhere; empty when it can."""
+    """Why the report cannot run here and what does the same elsewhere, in short lines (a
+    Blender popup does not wrap); empty when it can run."""
     missing = missing_libraries()
     if not missing:
         return ""
     return (
-        f"The report needs {', '.join(missing)}, which this Python does not have (Blender's own "
-        "Python has NumPy only). Install them into it "
-        f"(python -m pip install {' '.join(missing)}), or run the same report from the "
-        f"repository's environment: {command}"
+        f"The report needs {', '.join(missing)}, which this Python does not have\n"
+        "(Blender's own Python has NumPy only). Install them into it:\n"
+        f"  python -m pip install {' '.join(missing)}\n"
+        "or run the same report from the repository's environment:\n"
+        f"  {command}"
     )
