@@ -10,7 +10,7 @@ looking, read-only, at the live ``DragSession`` objects), what a Ctrl+Shift+C co
 regions of an open file browser and what it offers (folder, file name, filter), the screen
 positions of the 3D points listed in ``$VG_GUI_POINTS``, each mesh's edge profiles and active
 list rows, the scenes and every "VG Map" data-block in the file, the window's running modal
-operators and the .blend's path.
+operators and the .blend's path; on request, the Info log's reports (as copied text).
 """
 
 from __future__ import annotations
@@ -187,6 +187,23 @@ def _setup(window) -> None:
             scene.frame_view(area.spaces.active)
 
 
+def _copy_reports(window) -> None:
+    """On the test's request (the file ``$VG_GUI_STATE.reports``), copy the reports of the Info
+    log to the clipboard, where the state passes them on: a report of a refused operator goes
+    to the Info log and a popup, not to the console. The 3D view is the Info editor for that
+    moment only."""
+    os.remove(STATE + ".reports")
+    area = _view3d(window)
+    area.type = "INFO"
+    try:
+        region = next(r for r in area.regions if r.type == "WINDOW")
+        with bpy.context.temp_override(window=window, area=area, region=region):
+            bpy.ops.info.select_all(action="SELECT")
+            bpy.ops.info.report_copy()
+    finally:
+        area.type = "VIEW_3D"
+
+
 def _tick():
     try:
         window = bpy.context.window_manager.windows[0]
@@ -194,6 +211,8 @@ def _tick():
             _setup(window)
             _status["ready"] = True
         wm = bpy.context.window_manager
+        if os.path.exists(STATE + ".reports") and _view3d(window):
+            _copy_reports(window)
         if wm.clipboard:
             _status["clipboard"].append([_status["seq"], wm.clipboard])
             wm.clipboard = ""

@@ -1,5 +1,6 @@
 """The panel's file-browser, modal and list buttons in a real Blender window, pressed with real
-mouse and key events (xdotool): CSV Import (Re-measure), Render Map, the Edge Profiles list.
+mouse and key events (xdotool): CSV Import (Re-measure), Replication Report, Render Map, the
+Edge Profiles list.
 
 One GUI Blender per Debian suite (trixie: Blender 4.3, unstable: 5.2) on the 100° wedge of
 ``scene.py``, the tests in file order on that one window, as one user session: measure, save the
@@ -184,6 +185,34 @@ def test_import_remeasures_every_row_through_the_file_browser(gui, places):
     assert [m["exact"]["angle"] for m in again] == [m["exact"]["angle"] for m in before]
     assert [m["exact"]["center"] for m in again] == [m["exact"]["center"] for m in before]
     assert not any("import_csv" in op.lower() for op in gui.state()["modal_operators"])
+
+
+def test_replication_report_refuses_without_its_libraries(gui, places):
+    """Issue 23: Replication Report from the CSV panel in a distribution's Blender, whose Python
+    has NumPy only: refused when pressed, naming what to install and the vg_batch.py --report
+    command; nothing is written."""
+    if "import" not in places:  # run alone (-k): open the CSV panel as the tests before do
+        gui.open_goniometer_tab()
+        export = gui.open_panel_with("vg.export_csv", below=gui.state()["regions"]["UI"][1])
+        rows = range(export[1], export[1] + 60, 6)
+        places["import"] = gui.find_button("UI", "vg.import_csv", rows=rows)
+    rows = range(places["import"][1], places["import"][1] + 80, 6)  # just under Import
+    button = gui.find_button("UI", "vg.report", rows=rows)
+    gui.click(button)  # refused at once: no file browser to choose files in vain
+    gui.settle(2)
+    window_shot(gui, "report_refused")
+    assert gui.state()["file_browser"] is None
+    gui.key("Escape")  # the refusal's popup
+    seq = gui.state()["seq"]
+    Path(f"{gui.state_path}.reports").touch()  # the harness copies the Info log's reports
+    state = gui.wait_for(
+        lambda s: any(n >= seq and "report needs" in t for n, t in s["clipboard"]), 20, "reports"
+    )
+    reports = "\n".join(t for n, t in state["clipboard"] if n >= seq)
+    assert "The report needs scipy, statsmodels, matplotlib" in reports
+    assert "python vg_batch.py --report" in reports
+    assert not list(gui.tmp.rglob("report.html"))
+    assert not any("vg.report" in op.lower() for op in gui.state()["modal_operators"])
 
 
 def test_edge_profiles_list_shows_each_edge_and_picks_by_click(gui, places):
