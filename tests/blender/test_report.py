@@ -209,3 +209,17 @@ def test_report_refuses_an_output_that_is_an_input_and_measuring_options(study, 
     assert done.returncode == 2 and "--report takes session CSVs only, not --out" in done.stderr
     done = run(ROOT / "vg_batch.py", "--report", tmp_path / "r")
     assert done.returncode == 2 and "needs the session CSVs after it" in done.stderr
+
+
+def test_help_documents_the_report():
+    text = run(ROOT / "vg_batch.py", "--help").stdout
+    for needed in (
+        "--report DIR CSV...",
+        "--method M",
+        "--observer O",
+        "--compare A B",
+        "REPORT.md",
+    ):
+        assert needed in text, needed
+    done = run(ROOT / "vg_batch.py", "x.ply", "--at", "0", "0", "0", "--method", "drag")
+    assert done.returncode == 2 and "are for --report DIR CSV" in done.stderr
