@@ -109,6 +109,11 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
             if self.include_scene and measured:
                 os.makedirs(folder, exist_ok=True)
                 scene_csv = os.path.join(folder, SCENE_SESSION)
+                if any(os.path.realpath(p) == os.path.realpath(scene_csv) for p in sessions):
+                    raise GoniometerError(
+                        f"{scene_csv} is one of the sessions chosen; the scene's measurements "
+                        "would overwrite it. Choose another report folder."
+                    )
                 rows = measuring.export_rows(
                     sorted(measured, key=lambda o: o.name),
                     context.scene,

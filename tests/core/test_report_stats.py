@@ -89,9 +89,11 @@ def test_tukey_hsd_is_r_tukeyhsd_on_plant_growth():
     assert [p.reject for p in pairs] == [False, False, True]
 
 
-def test_tukey_refuses_a_group_of_one():
+def test_tukey_refuses_a_group_of_one_and_groups_without_variance():
     with pytest.raises(ValueError, match="two or more values"):
         stats.tukey_hsd({"a": [1.0, 2.0], "b": [3.0]})
+    with pytest.raises(ValueError, match="no variance"):
+        stats.tukey_hsd({"a": [0.0, 0.0], "b": [3.0, 3.0]})
 
 
 # NIST StRD, Longley (1967): the certified values of the linear regression of employment on six
@@ -125,6 +127,8 @@ def test_regression_is_nist_longley_certified():
 def test_regression_refuses_too_few_rows_and_collinear_predictors():
     with pytest.raises(ValueError, match="more breaks"):
         stats.ols([1.0, 2.0, 3.0], {"a": [1.0, 2.0, 3.0], "b": [0.0, 1.0, 0.0]})
+    with pytest.raises(ValueError, match="exact"):
+        stats.ols([1.0, 3.0, 5.0, 7.0, 9.0], {"a": [0.0, 1.0, 2.0, 3.0, 4.0], "b": [1, 0, 1, 0, 0]})
     with pytest.raises(ValueError, match="collinear"):
         stats.ols([1.0, 2.0, 3.0, 5.0, 4.0], {"a": [0.0] * 5, "b": [1.0, 2.0, 3.0, 4.0, 5.0]})
 

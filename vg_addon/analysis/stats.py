@@ -81,13 +81,17 @@ def tukey_hsd(groups: dict[str, list[float]], confidence: float = 0.95) -> list[
     Raises
     ------
     ValueError
-        Fewer than two groups, or a group with fewer than two values.
+        Fewer than two groups, a group with fewer than two values, or no variance at all.
     """
     from scipy import stats
 
     names = list(groups)
     if len(names) < 2 or any(len(groups[g]) < 2 for g in names):
         raise ValueError("Tukey's HSD needs at least two methods with two or more values each")
+    if all(Describe.of(groups[g]).sd == 0 for g in names):
+        raise ValueError(
+            "every method's values are all the same, so there is no variance to test against"
+        )
     result = stats.tukey_hsd(*(np.asarray(groups[g], dtype=np.float64) for g in names))
     interval = result.confidence_interval(confidence_level=confidence)
     out = []
@@ -140,7 +144,7 @@ def ols(y, predictors: dict[str, list[float]], response: str = "y") -> Regressio
     Raises
     ------
     ValueError
-        Fewer rows than coefficients plus one, or predictors that are collinear.
+        Fewer rows than coefficients plus one, predictors that are collinear, or an exact fit.
     """
     import statsmodels.api as sm
 
@@ -157,6 +161,9 @@ def ols(y, predictors: dict[str, list[float]], response: str = "y") -> Regressio
             "the predictors are collinear (one is constant or a combination of others)"
         )
     fit = sm.OLS(y, x).fit()
+    # Rounding leaves a residual of about 1e-30 where the fit is exact: none to speak of.
+    if not fit.ssr > 1e-20 * float(np.sum((y - y.mean()) ** 2)):
+        raise ValueError("the fit is exact (no residual), so it has no standard errors")
     coefficients = [
         Coefficient(name, float(b), float(se), float(t), float(p))
         for name, b, se, t, p in zip(
