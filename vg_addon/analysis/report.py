@@ -447,7 +447,9 @@ def _agreement_section(c: _Context) -> None:
         row = [m, len(observers), s.n, s.mean, s.median, s.sd, len(complete)]
         for value in (single, mean):
             row += [None] * 3 if value is None else [value.value, value.lower, value.upper]
-        row += [None] * 4 if single is None else [single.f, single.df1, single.df2, single.p]
+        # F is infinite where the observers agree exactly (no error variance): no number.
+        f = single.f if single is not None and math.isfinite(single.f) else None
+        row += [None] * 4 if single is None else [f, single.df1, single.df2, single.p]
         rows.append(row)
     if not rows:
         return
