@@ -34,6 +34,9 @@ POINTS = {
     "minus_in": face_point(0.15, 0.1, -1),
     "plus_out": face_point(0.15, 0.8, +1),
     "minus_out": face_point(0.15, 0.8, -1),
+    # Just off the crease on the + face: a small patch there barely reaches the edge (an
+    # unstable reading).
+    "off_crease": face_point(0.35, 0.1, +1),
     # Along the crease, for edge profiles clicked start to end.
     **{f"crease_{round(10 * x):+d}": [x, 0.0, 0.0] for x in (-0.7, -0.5, 0.0, 0.1, 0.5, 0.7)},
 }
