@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import GoniometerError
 from .fixed_order import acos_degrees, dot3, eigh3, moments, norm3, row_dot, total
-from .refinement import mean_edge_length, refine_sides
+from .refinement import NOISE_FLOOR, mean_edge_length, refine_sides
 from .result import Measurement
 from .withinss import withinss_split
 
@@ -302,8 +302,36 @@ def measure_patch(
     return fields
 
 
+def _check_shared_row(points, labels, spacing) -> None:
+    """Under the refined rule, refuse a side that is one row of vertices unless the row it
+    borrowed lies on the other side's face: on a crease through a row of vertices that row is on
+    both faces, and the borrowed plane is exact; where the crease runs between rows, the row
+    beside it lies on neither face (the triangles cut the corner), and a plane through it and the
+    one row would be a guess."""
+    for side in (labels, ~labels):
+        if _plane(points[side])[2]:
+            continue
+        lender = points[~side]
+        beside = _row_beside(points[side], lender)
+        rest = lender[~beside]
+        normal, _, spans = _plane(rest)
+        if not spans or rest.shape[0] < MIN_SIDE_VERTICES:
+            continue  # the other face is one row too: nothing tells the edge's row off it
+        off = np.abs(row_dot(lender[beside] - _column_means(rest), normal)).max()
+        if off <= NOISE_FLOOR * spacing:
+            continue
+        raise GoniometerError(
+            "One side of the patch holds a single row of vertices, and the row beside it across "
+            "the edge lies on neither face, so that side's plane is not determined: use a larger "
+            "radius (each side needs two rows of vertices on its face), or the 'oriented' rule to "
+            "replicate a reading taken with it."
+        )
+
+
 def _refine(points, normals, center, radius, fields) -> None:
     """Replace Algorithm 1's planes by :func:`refine_sides`' where it applies (in place)."""
+    if fields["n_shared"]:
+        _check_shared_row(points, fields["labels"], mean_edge_length(radius, points.shape[0]))
     refined = refine_sides(
         points,
         normals,

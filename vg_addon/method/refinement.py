@@ -40,15 +40,21 @@ OUTLIER_SPREADS = 3.0
 """A vertex near the other side is left out when it lies off its side's smooth surface by more
 than this many robust standard deviations (1.4826 × the median absolute residual)."""
 
-NOISE_FLOOR = 0.02
+NOISE_FLOOR = 1e-4
 """The smallest residual spread, in mesh spacings: on an exact plane the spread is rounding
-error, and no vertex should count as off the face for being 1e-15 away."""
+error (or a float32 file's 1e-7), and no vertex should count as off the face for that. Where
+Algorithm 1's planes already fit this well, there is nothing to refine."""
 
 MIN_IMPROVEMENT = 4.0
 """The refined planes are used only if they divide the summed plane-fit error by at least this.
 Vertices that sit off both faces near the crease inflate the error many times over (a hundred
 to a billion on marching-cubes wedges); a wall whose misfit is its own curvature or roughness
 improves by less than 2 when its vertices next to the crease are left out."""
+
+MIN_CURVATURE_SPREAD = 4.0
+"""The smooth surface bends across the crease (a ``u²`` term) only where the vertices it is
+fitted to reach this many mesh spacings across: two or three rows of vertices would let it bend
+to meet any vertex near the crease, and nothing would count as off the face."""
 
 CURVED_GAIN = 2.0
 """A side whose kept vertices a quadratic surface fits with less than half the mean squared
@@ -126,7 +132,7 @@ def _half_plane_distances(points, center, planes):
     return distances, (on_line, direction, outward)
 
 
-def _smooth_fit(points, fitted_on, plane, frame, radius):
+def _smooth_fit(points, fitted_on, plane, frame, spacing, radius):
     """Heights of every vertex over the side's plane, and their residuals from the quadratic
     surface fitted to the vertices ``fitted_on``; ``None`` when that fit is singular."""
     normal, centroid, _ = plane
@@ -135,13 +141,17 @@ def _smooth_fit(points, fitted_on, plane, frame, radius):
     u = row_dot(relative, into_face) / radius
     w = row_dot(relative, direction) / radius
     height = row_dot(points - centroid, normal)
-    basis = np.stack([np.ones_like(u), u, w, u * u, u * w, w * w])
+    terms = [np.ones_like(u), u, w, u * w, w * w]
+    spread = float(u[fitted_on].max() - u[fitted_on].min()) * radius
+    if spread >= MIN_CURVATURE_SPREAD * spacing:
+        terms.append(u * u)  # curvature across the crease: only where enough rows show it
+    basis = np.stack(terms)
     matrix, rhs = gram(np.ascontiguousarray(basis[:, fitted_on]), height[fitted_on])
     coefficients = solve(matrix, rhs)
     if coefficients is None:
         return None
     fitted = basis[0] * coefficients[0]
-    for k in range(1, 6):
+    for k in range(1, len(terms)):
         fitted = fitted + basis[k] * coefficients[k]
     return height, np.abs(height - fitted)
 
@@ -149,7 +159,11 @@ def _smooth_fit(points, fitted_on, plane, frame, radius):
 def _off_surface(points, side, near, plane, frame, spacing, radius):
     """Vertices of ``side`` near the other side that lie off the side's smooth surface."""
     far = side & ~near
-    fit = _smooth_fit(points, far, plane, frame, radius) if far.sum() >= MIN_FAR_VERTICES else None
+    fit = (
+        _smooth_fit(points, far, plane, frame, spacing, radius)
+        if far.sum() >= MIN_FAR_VERTICES
+        else None
+    )
     if fit is None:
         return np.zeros(points.shape[0], dtype=bool)
     residual = fit[1]
@@ -157,17 +171,21 @@ def _off_surface(points, side, near, plane, frame, spacing, radius):
     return side & near & (residual > OUTLIER_SPREADS * spread)
 
 
-def _curved(points, side, plane, frame, spacing, radius) -> bool:
-    """Whether a side's kept vertices follow a curved surface rather than its plane: the
-    quadratic surface fits them markedly better (:data:`CURVED_GAIN`)."""
-    fit = _smooth_fit(points, side, plane, frame, radius)
+def _planar(points, side, plane, frame, spacing, radius) -> bool:
+    """Whether a side's kept vertices are shown to lie on its plane: they reach far enough across
+    the crease (:data:`MIN_CURVATURE_SPREAD`) for a bend to show, and the quadratic surface fits
+    them no markedly better than the plane (:data:`CURVED_GAIN`)."""
+    across = row_dot(points[side] - frame[0], frame[2])
+    if float(across.max() - across.min()) < MIN_CURVATURE_SPREAD * spacing:
+        return False
+    fit = _smooth_fit(points, side, plane, frame, spacing, radius)
     if fit is None:
         return False
     height, residual = fit[0][side], fit[1][side]
     floor = (NOISE_FLOOR * spacing) ** 2
     return (
         total(height * height) / height.size
-        > CURVED_GAIN * (total(residual * residual) / height.size) + floor
+        <= CURVED_GAIN * (total(residual * residual) / height.size) + floor
     )
 
 
@@ -194,6 +212,8 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
         ``None`` where the refinement does not apply: nothing moved, a side ran out of vertices or
         no longer spans a plane, or the fit did not improve by :data:`MIN_IMPROVEMENT`.
     """
+    if split_error <= (NOISE_FLOOR * spacing) ** 2:
+        return None  # Algorithm 1's planes already fit to rounding error
     plus = labels
     used = np.ones(points.shape[0], dtype=bool)
     planes = None
@@ -226,11 +246,12 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
     if np.array_equal(plus, labels) and used.all():
         return None
     refined_error = planes[0][2] + planes[1][2]
-    if not split_error >= MIN_IMPROVEMENT * refined_error + (NOISE_FLOOR * spacing) ** 2:
+    if split_error < MIN_IMPROVEMENT * refined_error:
         return None
     on_line, direction, into_faces = frame
-    for side, plane, into_face in zip((plus & used, ~plus & used), planes, into_faces, strict=True):
-        if _curved(points, side, plane, (on_line, direction, into_face), spacing, radius):
+    for side, plane, into_face in zip((plus, ~plus), planes, into_faces, strict=True):
+        frame = (on_line, direction, into_face)
+        if (side & ~used).any() and not _planar(points, side & used, plane, frame, spacing, radius):
             return None
     return {
         "labels": plus,
