@@ -25,7 +25,9 @@ from mathutils import Matrix
 
 from ..vg_addon import palette
 
-PATCH_COLOR = (1.0, 1.0, 0.6, 0.9)
+# The patch before its sides are measured: white, like the radius circle (a pale yellow read as
+# the first break's yellow side).
+PATCH_COLOR = (1.0, 1.0, 1.0, 0.85)
 
 
 def side_colours(pair) -> tuple:
