@@ -156,3 +156,29 @@ def marched_wedge(
     offset = np.array([0.0123, 0.371, 0.6577]) * spacing  # no grid point on the crease
     points, triangles = march(inside, np.full(3, -1.25) + offset, np.full(3, 1.25), spacing)
     return points, triangles, np.zeros(3), turn[:, 2].copy()
+
+
+def stretched_wedge(angle_deg: float, spacing: float = 0.0106) -> tuple[np.ndarray, np.ndarray]:
+    """A wedge made the way the Virtual Goniometer's authors make their synthetic wedges: a
+    right-angled wedge marched on a grid, then stretched across the crease to ``angle_deg``.
+
+    The crease is the z axis; the faces are ``x = |y| / tan(angle / 2)`` for ``x ≤ 0.8``,
+    ``|z| ≤ 0.4``. Stretching keeps every vertex on its face but spreads the rows of vertices
+    apart across the crease (by ``tan(angle / 2)``), and the row the triangles cut the corner
+    through lies on neither face: near-flat wedges hold few rows per side.
+
+    Returns
+    -------
+    points, triangles : ndarray
+        The mesh, wound outward.
+    """
+
+    def inside(points):
+        x, y, z = points[:, 0], points[:, 1], points[:, 2]
+        return np.maximum.reduce([np.abs(y) - x, x - 0.8, np.abs(z) - 0.4])
+
+    offset = np.array([0.0123, 0.371, 0.6577]) * spacing  # no grid point on a face
+    lower = np.array([-0.1, -0.85, -0.45]) + offset
+    points, triangles = march(inside, lower, np.array([0.85, 0.85, 0.45]), spacing)
+    points[:, 1] *= math.tan(math.radians(angle_deg) / 2.0)
+    return points, triangles

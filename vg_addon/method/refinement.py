@@ -65,6 +65,9 @@ reason that is not the mesh's: the refinement is for faces that are planes."""
 MAX_ROUNDS = 20
 """Rounds of re-assignment; the sides settle within 2 to 4."""
 
+LTS_STEPS = 4
+"""Refits of a face's plane to the half of its vertices nearest the previous fit."""
+
 MIN_FAR_VERTICES = 12
 """A side needs this many vertices away from the other side to fit its smooth surface (six
 coefficients, twice over); with fewer, none of its vertices is left out."""
@@ -132,7 +135,7 @@ def _half_plane_distances(points, center, planes):
     return distances, (on_line, direction, outward)
 
 
-def _smooth_fit(points, fitted_on, plane, frame, spacing, radius):
+def _smooth_fit(points, fitted_on, plane, frame, spacing, radius, bend=True):
     """Heights of every vertex over the side's plane, and their residuals from the quadratic
     surface fitted to the vertices ``fitted_on``; ``None`` when that fit is singular."""
     normal, centroid, _ = plane
@@ -141,10 +144,12 @@ def _smooth_fit(points, fitted_on, plane, frame, spacing, radius):
     u = row_dot(relative, into_face) / radius
     w = row_dot(relative, direction) / radius
     height = row_dot(points - centroid, normal)
-    terms = [np.ones_like(u), u, w, u * w, w * w]
-    spread = float(u[fitted_on].max() - u[fitted_on].min()) * radius
-    if spread >= MIN_CURVATURE_SPREAD * spacing:
-        terms.append(u * u)  # curvature across the crease: only where enough rows show it
+    terms = [np.ones_like(u), u, w]
+    if bend:
+        terms += [u * w, w * w]
+        spread = float(u[fitted_on].max() - u[fitted_on].min()) * radius
+        if spread >= MIN_CURVATURE_SPREAD * spacing:
+            terms.append(u * u)  # curvature across the crease: only where enough rows show it
     basis = np.stack(terms)
     matrix, rhs = gram(np.ascontiguousarray(basis[:, fitted_on]), height[fitted_on])
     coefficients = solve(matrix, rhs)
@@ -156,19 +161,26 @@ def _smooth_fit(points, fitted_on, plane, frame, spacing, radius):
     return height, np.abs(height - fitted)
 
 
-def _off_surface(points, side, near, plane, frame, spacing, radius):
-    """Vertices of ``side`` near the other side that lie off the side's smooth surface."""
-    far = side & ~near
-    fit = (
-        _smooth_fit(points, far, plane, frame, spacing, radius)
-        if far.sum() >= MIN_FAR_VERTICES
-        else None
-    )
-    if fit is None:
+def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
+    """Vertices of ``side`` that lie off the face's plane, fitted robustly to ``fitted_on``.
+
+    Least trimmed squares: the plane is refitted to the half of the vertices nearest it, a few
+    times, so a strip of vertices that cuts the corner (up to half the side) cannot tilt it; the
+    residuals' spread is then that of the vertices on the face.
+    """
+    if fitted_on.sum() < MIN_FAR_VERTICES:
         return np.zeros(points.shape[0], dtype=bool)
-    residual = fit[1]
-    spread = max(1.4826 * float(np.median(residual[far])), NOISE_FLOOR * spacing)
-    return side & near & (residual > OUTLIER_SPREADS * spread)
+    subset = fitted_on
+    for _ in range(LTS_STEPS):
+        fit = _smooth_fit(points, subset, plane, frame, spacing, radius, bend=False)
+        if fit is None:
+            return np.zeros(points.shape[0], dtype=bool)
+        residual = fit[1]
+        subset = fitted_on & (residual <= float(np.median(residual[fitted_on])))
+        if subset.sum() < MIN_FAR_VERTICES:
+            break
+    spread = max(1.4826 * float(np.median(residual[fitted_on])), NOISE_FLOOR * spacing)
+    return side & (residual > OUTLIER_SPREADS * spread)
 
 
 def _planar(points, side, plane, frame, spacing, radius) -> bool:
@@ -231,8 +243,16 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
         near = np.where(new_plus, to_minus, to_plus) < limit
         plus_frame = (frame[0], frame[1], frame[2][0])
         minus_frame = (frame[0], frame[1], frame[2][1])
-        off = _off_surface(points, new_plus, near, planes[0], plus_frame, spacing, radius)
-        off |= _off_surface(points, ~new_plus, near, planes[1], minus_frame, spacing, radius)
+        # Each side's smooth surface is fitted away from the other face and from the vertices
+        # already left out; then any of its vertices may be found off it (the strip that cuts
+        # the corner can reach past the band on a mesh stretched across the crease).
+        away = used & ~near
+        off = _off_surface(
+            points, new_plus, new_plus & away, planes[0], plus_frame, spacing, radius
+        )
+        off |= _off_surface(
+            points, ~new_plus, ~new_plus & away, planes[1], minus_frame, spacing, radius
+        )
         new_used = ~off
         if np.array_equal(new_plus, plus) and np.array_equal(new_used, used):
             break
