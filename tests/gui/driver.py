@@ -343,6 +343,23 @@ class GuiBlender:
         self.scroll_sidebar(30)
         return self.find_button("UI", copied, upward=True, rows=range(bottom - 240, bottom - 4, 6))
 
+    def open_foot_panel(self, copied: str, from_end: int) -> tuple[float, float]:
+        """Open the closed panel ``from_end`` places from the sidebar's foot (1: the last; the
+        panels below a long Selected panel are only seen scrolled there) and return the position
+        of its button whose Ctrl+C copies ``copied`` (scrolled to the end again)."""
+        self.scroll_sidebar(30)
+        left, top, width, height = region = self.state()["regions"]["UI"]
+        bottom = top + height
+        shot = self.screenshot("panels")
+        headers = closed_headers(shot, region, bottom - 200)
+        if len(headers) < from_end:  # a short sidebar: its panels end above its foot
+            headers = closed_headers(shot, region, top)
+        if len(headers) < from_end:
+            raise LookupError(f"fewer than {from_end} panel headers at the sidebar's foot")
+        self.click((left + width // 3, headers[-from_end]))
+        self.scroll_sidebar(30)
+        return self.find_button("UI", copied, upward=True, rows=range(bottom - 300, bottom, 6))
+
     def list_span(self, copied: str, rows: range) -> list[int]:
         """The screen rows (y) of ``rows`` over which a UI list in the sidebar shows: where
         Ctrl+Shift+C copies the list's active-index property (``copied``, e.g.

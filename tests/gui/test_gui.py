@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 from conftest import POINTS
-from driver import GUEST_REPO, GUEST_TMP, closed_headers
+from driver import GUEST_REPO, GUEST_TMP
 
 OBJ = "Wedge"
 TOOL = "vg.measure_drag_tool"
@@ -237,21 +237,9 @@ def test_measure_at_cursor_after_shift_right_click(gui):
 def test_csv_export_through_the_file_browser(gui):
     """Open the CSV panel, press Export, name the file in the file browser, export."""
     items = gui.measurements(OBJ)
-    # The CSV panel is closed; it is one of the closed panels below the Selected panel, whose
-    # last field is the note. Their headers are found by their disclosure triangles.
-    left, top, width, height = gui.state()["regions"]["UI"]
-    note = gui.find_button("UI", ".note", step=10, key="ctrl+shift+c", upward=True)
-    export = None
-    for header in closed_headers(gui.screenshot("panels"), (left, top, width, height), note[1]):
-        if gui.copies((left + width // 3, header)):
-            continue  # a button with an icon there, not a panel header
-        gui.click((left + width // 3, header))
-        try:
-            export = gui.find_button("UI", "vg.export_csv", rows=range(header + 10, header + 70, 8))
-            break
-        except LookupError:
-            gui.click((left + width // 3, header))  # not this one: back as it was
-    assert export is not None, "no CSV panel with an Export button below the Selected panel"
+    # The CSV panel is closed, third from the sidebar's foot (then Radius Sweep, Measurement
+    # Map), below the long Selected panel.
+    export = gui.open_foot_panel("vg.export_csv", 3)
     gui.click(export)
     # The harness's preferences open the browser as a maximized area of the main window.
     browser = gui.wait_for(lambda s: s["file_browser"], 20, "the file browser")["file_browser"]

@@ -18,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from driver import closed_headers
 
 OBJ = "Wedge"
 WEDGE_ANGLE = 100.0
@@ -127,18 +126,8 @@ def test_save_the_blend_with_ctrl_s(gui):
 
 
 def test_export_through_the_file_browser(gui, places):
-    # The closed panels are at the foot of the sidebar (the Selected panel above is long):
-    # CSV, Radius Sweep, Measurement Map.
-    gui.scroll_sidebar(30)
-    left, top, width, height = region = gui.state()["regions"]["UI"]
-    headers = closed_headers(gui.screenshot("panels"), region, top + height - 200)
-    assert len(headers) >= 3, headers
-    gui.click((left + width // 3, headers[-3]))
-    gui.scroll_sidebar(30)
-    bottom = top + height
-    export = gui.find_button(
-        "UI", "vg.export_csv", upward=True, rows=range(bottom - 300, bottom, 6)
-    )
+    # The CSV panel: third from the sidebar's foot (the Selected panel above is long).
+    export = gui.open_foot_panel("vg.export_csv", 3)
     before = {p.name for p in home(gui).glob("*.csv")}
     press_browser_button(gui, open_browser(gui, export))
 

@@ -12,7 +12,6 @@ from __future__ import annotations
 import csv
 
 import pytest
-from driver import closed_headers
 from test_gui_buttons import (
     OBJ,
     WEDGE_ANGLE,
@@ -96,17 +95,8 @@ def test_an_unstable_reading_is_flagged_in_the_list(gui, places):
 
 def test_the_radius_sweep_writes_its_csv_and_plot_through_the_file_browser(gui, places):
     gui.click(point(gui, "crease"), button=3, modifier="shift")
-    # The closed panels are at the foot of the long sidebar: CSV, Radius Sweep, Measurement Map.
-    gui.scroll_sidebar(30)
-    left, top, width, height = region = gui.state()["regions"]["UI"]
-    headers = closed_headers(gui.screenshot("panels"), region, top + height - 200)
-    assert len(headers) >= 3, headers
-    gui.click((left + width // 3, headers[-2]))
-    gui.scroll_sidebar(30)
-    bottom = top + height
-    sweep = gui.find_button(
-        "UI", "vg.radius_sweep", upward=True, rows=range(bottom - 300, bottom, 6)
-    )
+    # Radius Sweep: second from the sidebar's foot (CSV, Radius Sweep, Measurement Map).
+    sweep = gui.open_foot_panel("vg.radius_sweep", 2)
     before = set(home(gui).glob("*.csv"))
     press_browser_button(gui, open_browser(gui, sweep))
     gui.wait_for(lambda s: set(home(gui).glob("*.csv")) - before, 60, "the sweep's CSV")
