@@ -65,6 +65,12 @@ reason that is not the mesh's: the refinement is for faces that are planes."""
 MAX_ROUNDS = 20
 """Rounds of re-assignment; the sides settle within 2 to 4."""
 
+MAX_LEFT_OUT = 0.5
+"""The most of a side that may be left out: the robust plane rests on the half of the side
+nearest it, so beyond half what is left out could be the face and what is kept a chance band
+(a plane cuts a curved wall in two strips); the side is then no plane with a strip at the
+crease, and Algorithm 1's planes are kept."""
+
 LTS_STEPS = 4
 """Refits of a face's plane to the half of its vertices nearest the previous fit."""
 
@@ -164,13 +170,16 @@ def _smooth_fit(points, fitted_on, plane, frame, spacing, radius, bend=True):
 def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
     """Vertices of ``side`` that lie off the face's plane, fitted robustly to ``fitted_on``.
 
-    Least trimmed squares: the plane is refitted to the half of the vertices nearest it, a few
-    times, so a strip of vertices that cuts the corner (up to half the side) cannot tilt it; the
-    residuals' spread is then that of the vertices on the face.
+    Least trimmed squares: the plane is fitted to the half of the vertices farthest from the
+    crease, then refitted to the half nearest it, a few times, so a strip of vertices that cuts
+    the corner (up to half the side) cannot tilt it; the residuals' spread is then that of the
+    vertices on the face.
     """
     if fitted_on.sum() < MIN_FAR_VERTICES:
         return np.zeros(points.shape[0], dtype=bool)
-    subset = fitted_on
+    # Start from the half farthest from the crease, where the face is least likely disturbed.
+    into_face = row_dot(points - frame[0], frame[2])
+    subset = fitted_on & (into_face >= float(np.median(into_face[fitted_on])))
     for _ in range(LTS_STEPS):
         fit = _smooth_fit(points, subset, plane, frame, spacing, radius, bend=False)
         if fit is None:
@@ -271,8 +280,10 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
     on_line, direction, into_faces = frame
     for side, plane, into_face in zip((plus, ~plus), planes, into_faces, strict=True):
         frame = (on_line, direction, into_face)
-        if (side & ~used).any() and not _planar(points, side & used, plane, frame, spacing, radius):
+        if (side & ~used).sum() > MAX_LEFT_OUT * side.sum():
             return None
+        if not _planar(points, side & used, plane, frame, spacing, radius):
+            return None  # a curved face: its plane is a secant, and stays Algorithm 1's
     return {
         "labels": plus,
         "used": used,
