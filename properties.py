@@ -121,7 +121,9 @@ def _stability_text(self):
     parts = exact_numbers(self).get("stability")
     if not parts:
         return "not computed"
-    return stability_text(parts["spread"])
+    return stability_text(
+        parts["spread"], int(parts.get("runs") or 0), int(parts.get("refused") or 0)
+    )
 
 
 def _stability_warning(self):

@@ -78,7 +78,8 @@ class Run:
             where = f"row {task.source_row}" if task.source_row else f"point {task.number}"
             self.say(
                 f"  flagged: {where} on {row.mesh_name!r}: {row.angle:.2f}° "
-                f"{stability_text(row.stability)}: {warning}"
+                f"{stability_text(row.stability, row.stability_runs or 0, row.stability_refused or 0)}"
+                f": {warning}"
             )
         if len(flagged) > 10:
             self.say(f"  ... and {len(flagged) - 10} more flagged rows (see the Stability columns)")

@@ -314,9 +314,9 @@ def _check_shared_row(points, labels, spacing) -> None:
         lender = points[~side]
         beside = _row_beside(points[side], lender)
         rest = lender[~beside]
-        normal, _, spans = _plane(rest)
-        if not spans or rest.shape[0] < MIN_SIDE_VERTICES:
+        if rest.shape[0] < MIN_SIDE_VERTICES or not _plane(rest)[2]:
             continue  # the other face is one row too: nothing tells the edge's row off it
+        normal = _plane(rest)[0]
         off = np.abs(row_dot(lender[beside] - _column_means(rest), normal)).max()
         if off <= NOISE_FLOOR * spacing:
             continue

@@ -36,8 +36,12 @@ UNDETERMINED_REFUSED = 0.1
 undetermined: the refused runs add nothing to it, so it may be far too small."""
 
 
-def stability_text(spread: float) -> str:
-    """The stability figure as shown: ``"± 0.4°"`` (two decimals below 0.1°)."""
+def stability_text(spread: float, runs: int = 0, refused: int = 0) -> str:
+    """The stability figure as shown: ``"± 0.4°"`` (two decimals below 0.1°), or ``"± ?"`` when
+    it is undetermined (see :func:`stability_undetermined`): a spread of the few runs that were
+    not refused says nothing, and printed as a number it would vouch for the reading."""
+    if stability_undetermined(runs, refused):
+        return "± ?"
     return f"± {spread:.2f}°" if spread < 0.1 else f"± {spread:.1f}°"
 
 
@@ -122,8 +126,8 @@ class Stability:
     n_failed: int
 
     def text(self) -> str:
-        """The figure as shown: ``"± 0.4°"`` (two decimals below 0.1°)."""
-        return stability_text(self.spread)
+        """The figure as shown: ``"± 0.4°"`` (two decimals below 0.1°), ``"± ?"`` when undetermined."""
+        return stability_text(self.spread, self.n_runs, self.n_failed)
 
     @property
     def warning(self) -> str:
