@@ -21,7 +21,9 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from vg_addon import GoniometerError, Surface  # noqa: E402
+from vg_addon.method.fixed_order import row_dot, rows_dot  # noqa: E402
 from vg_addon.method.sweep import radius_sweep  # noqa: E402
+from vg_addon.reference_shapes import marched_wedge  # noqa: E402
 from vg_addon.synthetic_meshes import bone_fragment, wedge  # noqa: E402
 
 
@@ -41,6 +43,8 @@ def measurement_record(m) -> dict:
         "labels": int(np.flatnonzero(m.labels).sum()),
         "convexity": m.convexity,
     }
+    if m.split_angle is not None:  # the refined rule replaced Algorithm 1's planes
+        entry["refined"] = [float(m.split_angle).hex(), m.n_left_out]
     if m.stability is not None:
         s = m.stability
         entry["stability"] = _hex([s.spread, s.center, s.radius, s.lam, s.bootstrap])
@@ -81,6 +85,13 @@ def probe() -> dict:
         out[f"noisy {k} stability"] = _measure(surface, center, 0.3, stability=True)
         out[f"noisy {k} geodesic"] = _measure(surface, center, 0.3, patch="geodesic", lam=1.5)
         out[f"noisy {k} cloud"] = _measure(cloud, center, 0.3, rule="paper")
+    for angle in (35.0, 100.0, 160.0):  # creases between vertex rows: the refinement applies
+        points, triangles, _, direction = marched_wedge(angle, 0.03, turn_seed=5)
+        marched = Surface(points, triangles)
+        along = np.abs(row_dot(points, direction))
+        off = np.sqrt(rows_dot(points, points) - along * along)
+        center = points[np.argmin(np.where(along < 0.06, off, np.inf))]
+        out[f"marched {angle:g}"] = _measure(marched, center, 0.25, stability=True)
     bone = bone_fragment(spacing=0.6, roughness=0.05, seed=1)
     bone_surface = Surface(bone.points, bone.triangles)
     for k, site in enumerate(bone.sites[:4]):
