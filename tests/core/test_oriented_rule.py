@@ -41,6 +41,7 @@ def test_creases_read_their_angle_and_convexity(angle, concave, irregular):
     assert m.convexity == ("concave" if concave else "convex")
     assert m.orientation == (-1 if concave else 1)
     assert m.rule == "refined"  # the default: the oriented rule, then the refinement
+    assert m.split_angle is None  # a crease on a vertex row: nothing to refine, the same bits
 
 
 @pytest.mark.parametrize("concave", [False, True])
