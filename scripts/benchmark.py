@@ -94,6 +94,51 @@ def main(argv=None) -> None:
     )
     core_figures(int(np.sqrt(args.vertices)))
     blas_path_comparison(int(np.sqrt(args.vertices)))
+    refinement_comparison(int(np.sqrt(args.vertices)))
+
+
+def refinement_comparison(side: int, rounds: int = 5) -> None:
+    """The refined rule (the default) against the oriented rule, side by side in one run: a
+    2,000-vertex measurement where the refinement has nothing to do (an exact ridge), where it
+    runs and declines (a noisy ridge, as on a scan), and where it applies (a marched crease)."""
+    from benchmark_drag import ridge_mesh
+
+    from vg_addon.reference_shapes import marched_wedge
+
+    points, triangles = ridge_mesh(side)
+    rng = np.random.default_rng(3)
+    spacing = float(np.ptp(points[:, 0])) / side
+    noisy = points + rng.normal(scale=0.05 * spacing, size=points.shape)
+    marched, marched_triangles, _, direction = marched_wedge(90.0, 0.0075, turn_seed=3)
+    along = np.abs(marched @ direction)
+    off = np.linalg.norm(marched - np.outer(marched @ direction, direction), axis=1)
+    cases = [
+        ("exact ridge", Surface(points, triangles), points),
+        ("noisy ridge", Surface(noisy, triangles), noisy),
+        ("marched crease", Surface(marched, marched_triangles), marched),
+    ]
+    print("\nrefined (default) against oriented rule, 2,000-vertex patches, best of rounds:")
+    for name, surface, where in cases:
+        if name == "marched crease":
+            center = where[np.argmin(np.where(along < 0.05, off, np.inf))]
+        else:
+            center = where[
+                np.argmin(np.abs(where[:, 1]) + np.abs(where[:, 2]) + np.abs(where[:, 0]))
+            ]
+        radius = radius_for(surface, center, 2_000)
+        times = {}
+        for rule in ("oriented", "refined"):
+            times[rule] = best_of(
+                lambda r=rule, s=surface, c=center, rad=radius: s.measure(c, rad, rule=r),
+                30 * rounds,
+            )
+        m = surface.measure(center, radius)
+        applied = "applied" if m.split_angle is not None else "kept Algorithm 1's"
+        print(
+            f"  {name:15s} ({surface.n_points:>9,} vertices): oriented {times['oriented'] * 1e3:6.2f} ms, "
+            f"refined {times['refined'] * 1e3:6.2f} ms, ratio {times['refined'] / times['oriented']:5.2f} "
+            f"({applied})"
+        )
 
 
 def core_figures(side: int, repeats: int = 3) -> None:

@@ -62,6 +62,16 @@ residual of its plane is curved. There the plane is a secant, the vertices next 
 pull it towards the tangent at the crease, and leaving any out would move the reading for a
 reason that is not the mesh's: the refinement is for faces that are planes."""
 
+CREASE_REACH = 0.5
+"""The refined planes must meet within this fraction of the radius of the centre. On a scan a
+patch can hold three faces; leaving one out may leave two others that fit planes well but meet
+away from where the user measured (a thin wall's two sides), and that is not the edge asked for."""
+
+EARLY_IMPROVEMENT = 2.0
+"""After its first round the refinement stops unless the fit error has already halved. Where a
+strip cuts the corner, the first round removes most of it (the error falls 10 to 10¹³-fold on
+marched wedges); on a noisy scan it falls a few percent, and more rounds only trim noise."""
+
 MAX_ROUNDS = 20
 """Rounds of re-assignment; the sides settle within 2 to 4."""
 
@@ -71,7 +81,13 @@ nearest it, so beyond half what is left out could be the face and what is kept a
 (a plane cuts a curved wall in two strips); the side is then no plane with a strip at the
 crease, and Algorithm 1's planes are kept."""
 
-LTS_STEPS = 4
+MAX_LEFT_OUT_OF_PATCH = 0.2
+"""The most of the whole patch that may be left out at a right or obtuse crease (at an acute
+one, ``1 / sin(angle)`` times this, at most :data:`MAX_LEFT_OUT`: the strip that cuts the corner
+reaches that much farther into each face). A strip a few spacings wide along the crease is a
+small part of a patch; on a scan, more left out is another face in the patch, not a strip."""
+
+LTS_STEPS = 2
 """Refits of a face's plane to the half of its vertices nearest the previous fit."""
 
 MIN_FAR_VERTICES = 12
@@ -88,6 +104,13 @@ def mean_edge_length(radius: float, n_vertices: int) -> float:
     ``h = r √(2π / (√3 n))``: an estimate from the patch itself, valid for meshes and point clouds.
     """
     return radius * math.sqrt(2.0 * math.pi / (math.sqrt(3.0) * n_vertices))
+
+
+def _distance_to_line(points, on_line, direction) -> np.ndarray:
+    """Each point's distance to the line through ``on_line`` along the unit ``direction``."""
+    relative = points - on_line
+    along = row_dot(relative, direction)
+    return np.sqrt(np.maximum(rows_dot(relative, relative) - along * along, 0.0))
 
 
 def _side_plane(points, normals, mask):
@@ -141,30 +164,28 @@ def _half_plane_distances(points, center, planes):
     return distances, (on_line, direction, outward)
 
 
-def _smooth_fit(points, fitted_on, plane, frame, spacing, radius, bend=True):
-    """Heights of every vertex over the side's plane, and their residuals from the quadratic
-    surface fitted to the vertices ``fitted_on``; ``None`` when that fit is singular."""
+def _face_coordinates(points, plane, frame, radius):
+    """Each point's coordinates over a face: across the crease into the face and along it (both
+    in radii, from the crease line), and its height over the face's plane."""
     normal, centroid, _ = plane
     on_line, direction, into_face = frame
     relative = points - on_line
     u = row_dot(relative, into_face) / radius
     w = row_dot(relative, direction) / radius
-    height = row_dot(points - centroid, normal)
-    terms = [np.ones_like(u), u, w]
-    if bend:
-        terms += [u * w, w * w]
-        spread = float(u[fitted_on].max() - u[fitted_on].min()) * radius
-        if spread >= MIN_CURVATURE_SPREAD * spacing:
-            terms.append(u * u)  # curvature across the crease: only where enough rows show it
-    basis = np.stack(terms)
+    return u, w, row_dot(points - centroid, normal)
+
+
+def _residuals(basis, height, fitted_on):
+    """``|height − fit|`` for the least-squares fit of ``height`` by the rows of ``basis`` over the
+    points ``fitted_on``; ``None`` when the fit is singular."""
     matrix, rhs = gram(np.ascontiguousarray(basis[:, fitted_on]), height[fitted_on])
     coefficients = solve(matrix, rhs)
     if coefficients is None:
         return None
     fitted = basis[0] * coefficients[0]
-    for k in range(1, len(terms)):
+    for k in range(1, basis.shape[0]):
         fitted = fitted + basis[k] * coefficients[k]
-    return height, np.abs(height - fitted)
+    return np.abs(height - fitted)
 
 
 def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
@@ -175,34 +196,38 @@ def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
     the corner (up to half the side) cannot tilt it; the residuals' spread is then that of the
     vertices on the face.
     """
+    off = np.zeros(points.shape[0], dtype=bool)
     if fitted_on.sum() < MIN_FAR_VERTICES:
-        return np.zeros(points.shape[0], dtype=bool)
+        return off
+    members = np.flatnonzero(side)
+    fit_here = fitted_on[members]
+    u, w, height = _face_coordinates(points[members], plane, frame, radius)
+    basis = np.stack([np.ones_like(u), u, w])
     # Start from the half farthest from the crease, where the face is least likely disturbed.
-    into_face = row_dot(points - frame[0], frame[2])
-    subset = fitted_on & (into_face >= float(np.median(into_face[fitted_on])))
+    subset = fit_here & (u >= float(np.median(u[fit_here])))
     for _ in range(LTS_STEPS):
-        fit = _smooth_fit(points, subset, plane, frame, spacing, radius, bend=False)
-        if fit is None:
-            return np.zeros(points.shape[0], dtype=bool)
-        residual = fit[1]
-        subset = fitted_on & (residual <= float(np.median(residual[fitted_on])))
+        residual = _residuals(basis, height, subset)
+        if residual is None:
+            return off
+        subset = fit_here & (residual <= float(np.median(residual[fit_here])))
         if subset.sum() < MIN_FAR_VERTICES:
             break
-    spread = max(1.4826 * float(np.median(residual[fitted_on])), NOISE_FLOOR * spacing)
-    return side & (residual > OUTLIER_SPREADS * spread)
+    spread = max(1.4826 * float(np.median(residual[fit_here])), NOISE_FLOOR * spacing)
+    off[members] = residual > OUTLIER_SPREADS * spread
+    return off
 
 
 def _planar(points, side, plane, frame, spacing, radius) -> bool:
     """Whether a side's kept vertices are shown to lie on its plane: they reach far enough across
-    the crease (:data:`MIN_CURVATURE_SPREAD`) for a bend to show, and the quadratic surface fits
+    the crease (:data:`MIN_CURVATURE_SPREAD`) for a bend to show, and a quadratic surface fits
     them no markedly better than the plane (:data:`CURVED_GAIN`)."""
-    across = row_dot(points[side] - frame[0], frame[2])
-    if float(across.max() - across.min()) < MIN_CURVATURE_SPREAD * spacing:
+    u, w, height = _face_coordinates(points[side], plane, frame, radius)
+    if float(u.max() - u.min()) * radius < MIN_CURVATURE_SPREAD * spacing:
         return False
-    fit = _smooth_fit(points, side, plane, frame, spacing, radius)
-    if fit is None:
+    basis = np.stack([np.ones_like(u), u, w, u * w, w * w, u * u])
+    residual = _residuals(basis, height, np.ones(u.size, dtype=bool))
+    if residual is None:
         return False
-    height, residual = fit[0][side], fit[1][side]
     floor = (NOISE_FLOOR * spacing) ** 2
     return (
         total(height * height) / height.size
@@ -238,10 +263,12 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
     plus = labels
     used = np.ones(points.shape[0], dtype=bool)
     planes = None
-    for _ in range(MAX_ROUNDS):
+    for round_number in range(MAX_ROUNDS):
         planes = [_side_plane(points, normals, side) for side in (plus & used, ~plus & used)]
         if planes[0] is None or planes[1] is None:
             return None
+        if round_number == 1 and split_error < EARLY_IMPROVEMENT * (planes[0][2] + planes[1][2]):
+            return None  # the first round found no corner-cutting strip: a scan's noise
         found = _half_plane_distances(points, center, planes)
         if found is None:
             return None
@@ -278,11 +305,22 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
     if split_error < MIN_IMPROVEMENT * refined_error:
         return None
     on_line, direction, into_faces = frame
+    # An acute corner's strip reaches 1 / sin(angle) times as far into each face.
+    opening = math.sqrt(max(0.0, 1.0 - dot3(planes[0][0], planes[1][0]) ** 2))
+    share = MAX_LEFT_OUT_OF_PATCH / max(opening, MAX_LEFT_OUT_OF_PATCH / MAX_LEFT_OUT)
+    if (~used).sum() > share * used.size:
+        return None
+    to_line = _distance_to_line(points, on_line, direction)
+    if _distance_to_line(center[None, :], on_line, direction)[0] > CREASE_REACH * radius:
+        return None  # the planes of two other faces: the crease is not where the user measured
     for side, plane, into_face in zip((plus, ~plus), planes, into_faces, strict=True):
         frame = (on_line, direction, into_face)
-        if (side & ~used).sum() > MAX_LEFT_OUT * side.sum():
+        left_out, kept = side & ~used, side & used
+        if left_out.sum() > MAX_LEFT_OUT * side.sum():
             return None
-        if not _planar(points, side & used, plane, frame, spacing, radius):
+        if left_out.any() and np.median(to_line[left_out]) > np.median(to_line[kept]):
+            return None  # what was left out is no strip along the crease (a face of its own)
+        if not _planar(points, kept, plane, frame, spacing, radius):
             return None  # a curved face: its plane is a secant, and stays Algorithm 1's
     return {
         "labels": plus,
