@@ -185,6 +185,16 @@ def measure_on_object(
         stability=stability,
         space=space,
     )
+    return record(obj, m, geometry, note=note, depsgraph=depsgraph)
+
+
+def record(obj, m: Measurement, geometry: Geometry, *, note="", depsgraph=None):
+    """Record ``m``, taken on ``geometry`` (``obj``'s evaluated mesh now), and repaint the
+    sides: the step after measuring that every way of measuring shares.
+
+    Returns the new ``VG_Measurement`` item (now the active one); the first measurement of an
+    object also shows the sides in the viewports (``colors.show_sides_once``).
+    """
     item = records.add_measurement(obj, m, geometry.fingerprint, note=note)
     keep_sides(obj, geometry, item, m)
     repaint(obj, depsgraph=depsgraph, geometry=geometry)

@@ -168,20 +168,26 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        spread = f" {item.stability_text}" if self.stability else ""
-        self.report(
-            {"INFO"},
-            f"Measurement {item.number} (break {item.break_number}) on '{obj.name}': "
-            f"{item.angle:.2f}°{spread}, {item.convexity} edge "
-            f"(fit error {fit_text(item.fit_error, item.radius)}, "
-            f"{item.n_vertices} vertices)",
-        )
-        if item.stability_warning:
-            self.report({"WARNING"}, f"Measurement {item.number}: {item.stability_warning}")
-        for warning in (_stale_warning(obj), non_uniform_scale_note(obj)):
-            if warning:
-                self.report({"WARNING"}, warning)
+        report_measurement(self, obj, item)
         return {"FINISHED"}
+
+
+def report_measurement(operator, obj, item) -> None:
+    """Say what a measuring operator just recorded (``item`` on ``obj``), and warn of stale
+    measurements, an unstable reading and a non-uniform scale."""
+    spread = f" {item.stability_text}" if operator.stability else ""
+    operator.report(
+        {"INFO"},
+        f"Measurement {item.number} (break {item.break_number}) on '{obj.name}': "
+        f"{item.angle:.2f}°{spread}, {item.convexity} edge "
+        f"(fit error {fit_text(item.fit_error, item.radius)}, "
+        f"{item.n_vertices} vertices)",
+    )
+    if item.stability_warning:
+        operator.report({"WARNING"}, f"Measurement {item.number}: {item.stability_warning}")
+    for warning in (_stale_warning(obj), non_uniform_scale_note(obj)):
+        if warning:
+            operator.report({"WARNING"}, warning)
 
 
 def _active_measurable(operator, context):
