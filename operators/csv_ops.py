@@ -15,7 +15,7 @@ from ..bridge.mesh_data import check_measurable
 from ..properties import set_unit
 from ..vg_addon import GoniometerError, units
 from ..vg_addon.formats import csvio
-from .measure import poll_measurable, typed_value
+from .common import poll_measurable, typed_value
 from .progress import Progress, own_timer_tick
 
 # The CSV this session last exported or imported: what the Import dialog offers (Blender's

@@ -31,14 +31,9 @@ from ..bridge.records import colours_as_painted, unit_symbol
 from ..vg_addon import GoniometerError
 from ..vg_addon.units import length_text
 from ..vg_addon.workflow.drag_state import DragMachine, Phase, surface_callbacks
+from .common import poll_measurable, typed_value
 from .drag_overlay import DragOverlay, patch_vertex_data
-from .measure import (
-    MeasureProperties,
-    VG_OT_measure_xyz,
-    poll_measurable,
-    report_measurement,
-    typed_value,
-)
+from .measure import MeasureProperties, VG_OT_measure_xyz, report_measurement
 
 TOOL_ID = "vg.measure_drag_tool"
 

@@ -17,16 +17,22 @@ import json
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy.props import EnumProperty, IntProperty, StringProperty
 
 from ..bridge import edges
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
-from ..properties import PATCH_ITEMS
 from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.edge_state import EdgeMachine, EdgePhase
+from .common import (
+    SPACE_ITEMS,
+    PatchProperties,
+    defaults_from_panel,
+    length_property,
+    poll_measurable,
+    typed_value,
+)
 from .drag import NAVIGATION_EVENTS, format_length, object_alive, ray_cast_object
 from .edge_overlay import EdgeOverlay
-from .measure import SPACE_ITEMS, defaults_from_panel, poll_measurable, typed_value
 
 # The drag tool's view navigation, and plain mouse moves (a click session has no drag).
 _NAVIGATION = NAVIGATION_EVENTS | {"MOUSEMOVE"}
@@ -197,7 +203,7 @@ def _draw_status_hints(header, context):
         row.separator(factor=2.0)
 
 
-class VG_OT_measure_edge(bpy.types.Operator):
+class VG_OT_measure_edge(PatchProperties, bpy.types.Operator):
     """Measure a whole break edge: click its start, any via points and its end on the active
     mesh, then Enter; every station is recorded as a measurement of one new break"""
 
@@ -216,26 +222,9 @@ class VG_OT_measure_edge(bpy.types.Operator):
         default="WORLD",
         description="The coordinates Points are given in (clicks are recorded in mesh coordinates)",
     )
-    spacing: FloatProperty(
-        name="Spacing",
-        description="Arc length between stations, in mesh units; default: the panel's",
-        min=0.0,
-        precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
+    spacing: length_property(
+        "Spacing", "Arc length between stations, in mesh units; default: the panel's"
     )
-    radius: FloatProperty(
-        name="Radius",
-        description="Patch radius of every station, in mesh units; default: the panel's",
-        min=0.0,
-        precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
-    )
-    seg_param: FloatProperty(
-        name="λ (SegParam)", description="Segmentation parameter; default: the panel's", min=0.0
-    )
-    patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
     note: StringProperty(name="Note", description="Free text stored with the edge")
 
     @classmethod
