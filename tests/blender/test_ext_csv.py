@@ -357,7 +357,7 @@ def test_replicating_rows_with_a_break_number_blender_cannot_store_records_nothi
     row = vg.vg_addon.formats.csvio.ReplicationRow
     rows = [row(2, "Wedge", x, y, z, radius=0.5), row(3, "Wedge", x, y, z, 0.5, break_number=2**31)]
     with pytest.raises(vg.vg_addon.GoniometerError, match=r"row 3: Break # 2147483648"):
-        vg.bridge.measuring.replicate_rows(obj, rows)
+        vg.bridge.replication.replicate_rows(obj, rows)
     assert snapshot(obj) == before
 
 
