@@ -11,10 +11,10 @@ from pathlib import Path
 import bpy
 
 from ..bridge import edges, records
-from ..properties import exact_numbers
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, profile_plot
+from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.edge_profile import check_station_count
 from .cli import UsageError
 

@@ -6,16 +6,15 @@ Each raises :class:`GoniometerError` for bad input before changing anything.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import bpy
 import numpy as np
 
-from ..properties import exact_numbers
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
-from ..vg_addon.formats import csvio, profile_plot
+from ..vg_addon.formats import csvio, profile_plot, record_codec
+from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.edge_profile import summarize
 from . import measuring, records
 from .mesh_data import (
@@ -281,7 +280,7 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
             item.edge_number = edge.number
             numbers = exact_numbers(item)
             numbers["plus_left"] = bool(left)
-            item.exact = json.dumps(numbers)
+            item.exact = record_codec.encode(numbers)
             records.stamp(item)
             item.colors = "/".join(records.station_colours(item.break_number, left))
         edge.plot = make_plot(obj, edge).name
