@@ -72,7 +72,7 @@ def edge_specs(args, sources) -> list[dict]:
             "points": [list(p) for p in points],
             "spacing": row.spacing,
             "radius": row.radius,
-            "lam": args.lam if row.seg_param is None else row.seg_param,
+            "lam": args.lam if row.lam is None else row.lam,
             "patch": row.patch or args.patch,
             "mesh_name": name,
             # Files of earlier versions hold world-space points (a mesh file's object is
@@ -116,7 +116,7 @@ def failed_edge_row(number: int, spec: dict, mesh_name: str, message: str, units
         mesh_name=mesh_name,
         date=csvio.now_iso(),
         radius=spec["radius"],
-        seg_param=spec["lam"],
+        lam=spec["lam"],
         patch=spec["patch"],
         requested=tuple(float(v) for v in spec["points"][0]),
         edge_number=number,

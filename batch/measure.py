@@ -74,7 +74,7 @@ def error_row(task, mesh_name: str, message: str, units: str):
         break_number=task.break_number,
         user_data=task.label,
         radius=task.radius,
-        seg_param=task.lam,
+        lam=task.lam,
         patch=task.patch,
         requested=tuple(task.center),
         units=units,

@@ -194,7 +194,7 @@ def import_edges_csv(
             settings = (
                 spacing,
                 radius,
-                lam if row.seg_param is None else row.seg_param,
+                lam if row.lam is None else row.lam,
                 row.patch or patch,
             )
             measure_edge(obj, points, *settings, depsgraph=depsgraph)  # checked before recording

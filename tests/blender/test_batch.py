@@ -151,7 +151,7 @@ def test_points_given_with_at_on_ply_obj_and_stl(meshes, tmp_path):
     for r in rows:
         assert not r.error
         assert abs(r.angle - 90.0) < 0.01
-        assert (r.radius, r.seg_param, r.patch) == (RADIUS, 2.0, "euclidean")
+        assert (r.radius, r.lam, r.patch) == (RADIUS, 2.0, "euclidean")
         assert r.units == "BU" and r.extension_version and r.blender_version
     # The same surface in three file formats: the same float32 vertices and faces in Blender,
     # hence the same numbers, bit for bit.

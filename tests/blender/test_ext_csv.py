@@ -60,7 +60,7 @@ def test_export_starts_with_the_meshlab_columns(vg, tmp_path):
         assert (row.number, row.break_number) == (item.number, item.break_number)
         assert row.angle == numbers["angle"] and row.radius == numbers["radius"]
         assert [row.x, row.y, row.z] == numbers["center"]
-        assert row.seg_param == numbers["lam"] and row.patch == item.patch
+        assert row.lam == numbers["lam"] and row.patch == item.patch
         assert (row.n_vertices, row.n_plus, row.n_minus) == (
             item.n_vertices,
             item.n_plus,

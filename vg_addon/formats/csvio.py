@@ -77,7 +77,7 @@ _SCHEMA = (
     ("y", "float", ("y",)),
     ("z", "float", ("z",)),
     ("fit", "float", ("fit",)),
-    ("seg_param", "float", ("SegParam",)),
+    ("lam", "float", ("SegParam",)),
     ("patch", "text", ("Patch Mode",)),
     ("n_plus", "int", ("Vertices +",)),
     ("n_minus", "int", ("Vertices -",)),
@@ -152,7 +152,7 @@ _EDGE_SCHEMA = (
     ("n_stations", "int", ("Stations",)),
     ("spacing", "float", ("Spacing",)),
     ("radius", "float", ("Radius",)),
-    ("seg_param", "float", ("SegParam",)),
+    ("lam", "float", ("SegParam",)),
     ("patch", "text", ("Patch Mode",)),
     ("length", "float", ("Length",)),
     ("mean", "float", ("Mean Angle",)),
@@ -245,7 +245,7 @@ class MeasurementRow:
         The centre the measurement snapped to (a mesh vertex).
     fit, fit_plus, fit_minus : float or None
         Fit errors of both planes, and of each.
-    seg_param : float or None
+    lam : float or None
         λ, the segmentation parameter.
     patch : str
         ``"euclidean"`` or ``"geodesic"``.
@@ -305,7 +305,7 @@ class MeasurementRow:
     y: float | None = None
     z: float | None = None
     fit: float | None = None
-    seg_param: float | None = None
+    lam: float | None = None
     patch: str = ""
     n_plus: int | None = None
     n_minus: int | None = None
@@ -349,7 +349,7 @@ class EdgeRow:
     edge_number, break_number : int or None
         The edge (its stations carry the same ``Edge #``) and its break.
     n_stations : int or None
-    spacing, radius, seg_param : float or None
+    spacing, radius, lam : float or None
         The settings every station was measured with; ``patch`` the patch mode.
     length : float or None
         Arc length of the traced path.
@@ -375,7 +375,7 @@ class EdgeRow:
     n_stations: int | None = None
     spacing: float | None = None
     radius: float | None = None
-    seg_param: float | None = None
+    lam: float | None = None
     patch: str = ""
     length: float | None = None
     mean: float | None = None
