@@ -127,15 +127,15 @@ def measure_edge_on_object(
     edge_number = obj.vg.next_edge_number
     sides = profile.figures.plus_left
     for m, arc, left in zip(profile.stations, profile.arc_lengths, sides, strict=True):
-        item = records.add_measurement(
+        measuring.record(
             obj,
             m,
-            geometry.fingerprint,
+            geometry,
             note=note,
             break_number=break_number,
             station=(edge_number, arc, profile.spacing, left),
+            paint=False,
         )
-        measuring.keep_sides(obj, geometry, item, m)
     edge = records.add_edge(
         obj, profile, clicks, geometry.fingerprint, break_number=break_number, note=note
     )

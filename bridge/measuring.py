@@ -185,17 +185,35 @@ def measure_on_object(
     return record(obj, m, geometry, note=note, depsgraph=depsgraph)
 
 
-def record(obj, m: Measurement, geometry: Geometry, *, note="", depsgraph=None):
-    """Record ``m``, taken on ``geometry`` (``obj``'s evaluated mesh now), and repaint the
-    sides: the step after measuring that every way of measuring shares.
+def record(
+    obj,
+    m: Measurement,
+    geometry: Geometry,
+    *,
+    note="",
+    break_number=None,
+    station=None,
+    depsgraph=None,
+    paint=True,
+):
+    """Record ``m``, taken on ``geometry`` (``obj``'s evaluated mesh now), and keep its sides
+    for painting: the one step after measuring that every way of measuring goes through (a
+    click, the drag tool, a CSV import, an edge profile's stations, a batch row).
+
+    ``note``, ``break_number`` and ``station`` are those of ``records.add_measurement``.
+    ``paint``: also repaint the sides now (a click); callers that record many measurements
+    repaint once at the end instead (:func:`repaint`).
 
     Returns the new ``VG_Measurement`` item (now the active one); the first measurement of an
-    object also shows the sides in the viewports (``colors.show_sides_once``).
+    object painted here also shows the sides in the viewports (``colors.show_sides_once``).
     """
-    item = records.add_measurement(obj, m, geometry.fingerprint, note=note)
+    item = records.add_measurement(
+        obj, m, geometry.fingerprint, note=note, break_number=break_number, station=station
+    )
     keep_sides(obj, geometry, item, m)
-    repaint(obj, depsgraph=depsgraph, geometry=geometry)
-    colors.show_sides_once(obj)
+    if paint:
+        repaint(obj, depsgraph=depsgraph, geometry=geometry)
+        colors.show_sides_once(obj)
     return obj.vg.measurements[obj.vg.active_index]
 
 

@@ -163,15 +163,15 @@ def replicate_steps(
         station = None
         if row.edge_number is not None:  # numbered and oriented when its edge is rebuilt
             station = (0, row.arc_length or 0.0, row.spacing or 0.0, True)
-        item = records.add_measurement(
+        item = measuring.record(
             obj,
             m,
-            geometry.fingerprint,
+            geometry,
             note=row.label or "",
             break_number=row.break_number,
             station=station,
+            paint=False,
         )
-        measuring.keep_sides(obj, geometry, item, m)
         numbers.append(item.number)
         if station is not None:
             stations.setdefault(row.edge_number, []).append(
