@@ -14,6 +14,7 @@ from ..bridge import edges, records
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, profile_plot
+from ..vg_addon.formats.png import encode_png
 from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.edge_profile import check_station_count
 from .cli import UsageError
@@ -184,4 +185,4 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
 
 def profile_png(arc_lengths, angles) -> bytes:
     """One edge profile's plot (angle against arc length) as PNG bytes."""
-    return profile_plot.png_bytes(profile_plot.render_profile(arc_lengths, angles))
+    return encode_png(profile_plot.render_profile(arc_lengths, angles), level=6)

@@ -36,7 +36,7 @@ __all__ = [
     "write_ply",
 ]
 
-MESH_EXTENSIONS = (".ply", ".obj", ".stl")
+MESH_EXTENSIONS = (".ply", ".obj", ".stl")  # the file types read (by extension, any case)
 
 
 @dataclass(frozen=True, eq=False)
