@@ -66,8 +66,9 @@ def translate_edge_event(event_type: str, value: str, *, ctrl=False, alt=False):
     return "ignore"
 
 
-def parse_points(text: str) -> np.ndarray:
-    """The ``points`` property: JSON ``[[x, y, z], ...]`` (float64, exactly as written)."""
+def parse_points_json(text: str) -> np.ndarray:
+    """The ``points`` property: JSON ``[[x, y, z], ...]`` (float64, exactly as written); not
+    the CSV's ``"x y z; ..."`` text (``csvio.parse_points``)."""
     try:
         points = np.array(json.loads(text), dtype=np.float64)
     except (ValueError, TypeError):
@@ -84,8 +85,9 @@ def parse_points(text: str) -> np.ndarray:
     return points
 
 
-def format_points(points) -> str:
-    """JSON text of ``points`` that :func:`parse_points` reads back bit for bit."""
+def format_points_json(points) -> str:
+    """JSON text of ``points`` that :func:`parse_points_json` reads back bit for bit (the
+    operator's property; the CSV's ``"x y z; ..."`` text is ``csvio.format_points``)."""
     return json.dumps([[float(v) for v in point] for point in np.asarray(points)])
 
 
@@ -246,7 +248,7 @@ class VG_OT_measure_edge(PatchProperties, bpy.types.Operator):
         try:
             edge = edges.measure_edge_on_object(
                 obj,
-                parse_points(self.points),
+                parse_points_json(self.points),
                 typed_value(self.spacing),
                 typed_value(self.radius),
                 typed_value(self.seg_param),
@@ -307,7 +309,7 @@ class VG_OT_measure_edge(PatchProperties, bpy.types.Operator):
         if machine.phase is not EdgePhase.CONFIRMED:
             self.report({"INFO"}, machine.message or "Nothing was recorded.")
             return {"CANCELLED"}
-        self.points = format_points(machine.clicks)  # stored for redo as well
+        self.points = format_points_json(machine.clicks)  # stored for redo as well
         self.space = "MESH"  # clicks are taken on the mesh, in its coordinates
         return self.execute(context)
 
