@@ -189,7 +189,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
 
     if result.measured:
         measuring.repaint(obj, geometry=geometry)
-        add_sides_material(obj, colors.ATTRIBUTE_NAME)
+        add_sides_material(obj)
         colors.show_sides_once(obj)
 
     profile_plots = []
