@@ -107,3 +107,18 @@ def poll_measured(cls, context) -> bool:
         cls.poll_message_set(f"'{context.active_object.name}' has no measurements yet.")
         return False
     return True
+
+
+def status_hints(hints):
+    """A status-bar draw function (for ``WorkSpace.status_text_set``) showing ``hints``, pairs
+    of (icons, text) such as ``(("MOUSE_LMB",), "Measure")``, as Blender's own modal tools do."""
+
+    def draw(header, context):
+        row = header.layout.row(align=True)
+        for icons, text in hints:
+            for icon in icons:
+                row.label(text="", icon=icon)
+            row.label(text=text)
+            row.separator(factor=2.0)
+
+    return draw

@@ -31,7 +31,7 @@ from ..bridge.records import colours_as_painted, unit_symbol
 from ..vg_addon import GoniometerError
 from ..vg_addon.units import length_text
 from ..vg_addon.workflow.drag_state import DragMachine, Phase, surface_callbacks
-from .common import poll_measurable, typed_value
+from .common import poll_measurable, status_hints, typed_value
 from .drag_overlay import DragOverlay, patch_vertex_data
 from .measure import MeasureProperties, VG_OT_measure_xyz, report_measurement
 
@@ -336,7 +336,7 @@ class DragSession:
             self._area.header_text_set(self.header_text(context.scene))
             self._area.tag_redraw()
         if self._workspace is not None:
-            self._workspace.status_text_set(draw_status_hints)
+            self._workspace.status_text_set(status_hints(HINTS))
 
     def header_text(self, scene) -> str:
         """The header line: radius, vertex count, λ, the angle after a λ change, and any hint."""
@@ -406,16 +406,6 @@ def record_drag(context, session: DragSession, note: str = ""):
         return None
     measuring.note_winding(obj, session.surface)
     return measuring.record(obj, record.measurement, geometry, note=note, depsgraph=depsgraph)
-
-
-def draw_status_hints(header, context):
-    """The status bar while dragging (called by Blender with the status bar's layout)."""
-    row = header.layout.row(align=True)
-    for icons, text in HINTS:
-        for icon in icons:
-            row.label(text="", icon=icon)
-        row.label(text=text)
-        row.separator(factor=2.0)
 
 
 class VG_OT_measure_drag(MeasureProperties, bpy.types.Operator):

@@ -29,6 +29,7 @@ from .common import (
     defaults_from_panel,
     length_property,
     poll_measurable,
+    status_hints,
     typed_value,
 )
 from .drag import NAVIGATION_EVENTS, format_length, object_alive, ray_cast_object
@@ -164,7 +165,7 @@ class EdgeSession:
             self._area.header_text_set(self.header_text(context.scene))
             self._area.tag_redraw()
         if self._workspace is not None:
-            self._workspace.status_text_set(_draw_status_hints)
+            self._workspace.status_text_set(status_hints(HINTS))
 
     def header_text(self, scene) -> str:
         """The header while tracing: short enough for a viewport's header (a longer line was
@@ -194,15 +195,6 @@ class EdgeSession:
         ):
             with contextlib.suppress(AttributeError, ReferenceError):
                 clear()
-
-
-def _draw_status_hints(header, context):
-    row = header.layout.row(align=True)
-    for icons, text in HINTS:
-        for icon in icons:
-            row.label(text="", icon=icon)
-        row.label(text=text)
-        row.separator(factor=2.0)
 
 
 class VG_OT_measure_edge(PatchProperties, bpy.types.Operator):
