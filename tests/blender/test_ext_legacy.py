@@ -151,9 +151,10 @@ BEFORE_RENAME = Path(__file__).resolve().parent / "data" / "before_lam_rename.bl
 
 def test_a_blend_saved_before_lam_was_one_name_loads_and_replays(vg, tmp_path):
     """tests/blender/data/before_lam_rename.blend was saved by bpy 4.2 with this extension as
-    it was before λ became ``lam`` in every Python name (commit 0e6697a): the scene's λ of 1.7,
-    measurements at λ 1.5 and 1.7 and an edge profile at λ 1.25 on an 80° wedge. The saved
-    properties still read, the CSV export says SegParam, and each record replays bit for bit."""
+    it was before λ became ``lam`` in every Python name (the tree of the record-codec commit):
+    the scene's λ of 1.7, measurements at λ 1.5 and 1.7 and an edge profile at λ 1.25 on an 80°
+    wedge. The saved properties still read, the CSV export says SegParam, and each record
+    replays bit for bit."""
     copy = tmp_path / "old.blend"
     shutil.copyfile(BEFORE_RENAME, copy)
     bpy.ops.wm.open_mainfile(filepath=str(copy))
