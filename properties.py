@@ -5,12 +5,10 @@ Blender's FloatProperty holds a 32-bit float, too coarse to replay a measurement
 recorded number lives, exactly as float64, in the JSON text of ``VG_Measurement.exact``
 (``json`` writes floats with ``repr``, which round-trips). The float properties of a measurement
 (angle, radius, centre, ...) are read-only views of that text for the panel; they are computed,
-not stored. Plain Python code should read the exact numbers with :func:`exact_numbers`.
+not stored. Code reads and writes that text with ``vg_addon.formats.record_codec``.
 """
 
 from __future__ import annotations
-
-import json
 
 import bpy
 from bpy.props import (
@@ -27,6 +25,7 @@ from bpy.types import PropertyGroup
 from mathutils import Vector
 
 from .vg_addon import palette, units
+from .vg_addon.formats.record_codec import exact_numbers
 from .vg_addon.method.result import (
     UNDETERMINED_REFUSED,
     UNSTABLE_DEGREES,
@@ -61,25 +60,6 @@ PATCH_ITEMS = (
     ("euclidean", "Euclidean", "All vertices within the radius (a ball around the centre)"),
     ("geodesic", "Geodesic", "Vertices reachable along mesh edges within the radius"),
 )
-
-
-def exact_numbers(item) -> dict:
-    """The float64 numbers of a measurement (or an edge profile), decoded from its ``exact`` JSON
-    text.
-
-    Keys: ``angle``, ``fit``, ``fit_plus``, ``fit_minus``, ``radius``, ``lam``, ``snap_distance``
-    (floats) and ``center``, ``requested``, ``normal_plus``, ``normal_minus`` (lists of 3 floats);
-    since the oriented rule also ``rule``, ``convexity``, ``correlation`` and ``stability`` (a
-    dict of its parts, or None). Records without ``rule`` were measured with the paper's rule.
-    A station of an edge profile adds ``arc_length``, ``spacing`` and ``plus_left``; a
-    measurement whose sides are painted the other way round ``painted_swapped`` (see
-    ``bridge.records``). Keys of
-    an edge profile: see ``bridge.edges``.
-    """
-    try:
-        return json.loads(item.exact) if item.exact else {}
-    except ValueError:
-        return {}
 
 
 def _number(key):

@@ -11,10 +11,11 @@ from pathlib import Path
 import bpy
 
 from ..bridge import edges, records
-from ..properties import exact_numbers
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, profile_plot
+from ..vg_addon.formats.png import encode_png
+from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.edge_profile import check_station_count
 from .cli import UsageError
 
@@ -72,7 +73,7 @@ def edge_specs(args, sources) -> list[dict]:
             "points": [list(p) for p in points],
             "spacing": row.spacing,
             "radius": row.radius,
-            "lam": args.lam if row.seg_param is None else row.seg_param,
+            "lam": args.lam if row.lam is None else row.lam,
             "patch": row.patch or args.patch,
             "mesh_name": name,
             # Files of earlier versions hold world-space points (a mesh file's object is
@@ -116,7 +117,7 @@ def failed_edge_row(number: int, spec: dict, mesh_name: str, message: str, units
         mesh_name=mesh_name,
         date=csvio.now_iso(),
         radius=spec["radius"],
-        seg_param=spec["lam"],
+        lam=spec["lam"],
         patch=spec["patch"],
         requested=tuple(float(v) for v in spec["points"][0]),
         edge_number=number,
@@ -184,4 +185,4 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
 
 def profile_png(arc_lengths, angles) -> bytes:
     """One edge profile's plot (angle against arc length) as PNG bytes."""
-    return profile_plot.png_bytes(profile_plot.render_profile(arc_lengths, angles))
+    return encode_png(profile_plot.render_profile(arc_lengths, angles), level=6)

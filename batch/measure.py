@@ -74,7 +74,7 @@ def error_row(task, mesh_name: str, message: str, units: str):
         break_number=task.break_number,
         user_data=task.label,
         radius=task.radius,
-        seg_param=task.lam,
+        lam=task.lam,
         patch=task.patch,
         requested=tuple(task.center),
         units=units,
@@ -97,9 +97,9 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
 
     The numbers come from the extension's own pipeline: the object's evaluated mesh in its own
     coordinates (``mesh_data.evaluated_geometry``), its cached ``Surface``
-    (``mesh_data.surface_for``) and ``records.add_measurement``; a mesh file whose float64
-    coordinates float32 would round is measured at the file's coordinates instead
-    (:func:`exact_surface`, ``Precision`` float64 in the CSV). The colours are painted once per
+    (``mesh_data.surface_for``) and ``measuring.record``, the step a click records through; a
+    mesh file whose float64 coordinates float32 would round is measured at the file's
+    coordinates instead (:func:`exact_surface`, ``Precision`` float64 in the CSV). The colours are painted once per
     mesh at the end by ``measuring.repaint``, the extension's own painter, from the sides kept
     while measuring.
     """
@@ -171,12 +171,12 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
                 result.failed += 1
                 continue
             data.next_number = base + task.number
-            item = records.add_measurement(
-                obj, m, geometry.fingerprint, note=task.label, break_number=task.break_number
+            # The bridge's one record step, as a click takes; painted once at the end.
+            item = measuring.record(
+                obj, m, geometry, note=task.label, break_number=task.break_number, paint=False
             )
             row = records.to_row(obj, item, stale=False, units=units, precision=precision)
             result.rows.append((task.index, dataclasses.replace(row, mesh_name=name)))
-            measuring.keep_sides(obj, geometry, item, m)
             result.measured += 1
     result.measure_seconds = time.perf_counter() - start
     stem = picture_stem(index, source, options)
@@ -189,7 +189,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
 
     if result.measured:
         measuring.repaint(obj, geometry=geometry)
-        add_sides_material(obj, colors.ATTRIBUTE_NAME)
+        add_sides_material(obj)
         colors.show_sides_once(obj)
 
     profile_plots = []

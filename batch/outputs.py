@@ -9,7 +9,7 @@ from pathlib import Path
 import bpy
 
 from ..vg_addon import GoniometerError
-from ..vg_addon.formats import csvio
+from ..vg_addon.formats import csvio, files
 from ..vg_addon.workflow import batchplan
 from .cli import UsageError
 
@@ -75,10 +75,10 @@ def _writable_folder(folder: Path, option: str, given: str) -> None:
 
 
 def _kind(out: str) -> str:
-    """How ``--out`` is written (see ``csvio.output_target``); a place that cannot be written
+    """How ``--out`` is written (see ``files.output_target``); a place that cannot be written
     (a folder, a read-only file, ...) is refused naming the option."""
     try:
-        return csvio.output_target(out)
+        return files.output_target(out)
     except GoniometerError as error:
         raise UsageError(f"--out {out}: {error}") from None
 
@@ -98,15 +98,15 @@ def check_outputs(args) -> None:
         Naming the option, the path and what to do; nothing has been read or written then.
     """
     outputs = [("--out", args.out), ("--save-blend", args.save_blend)]
-    outputs = [(option, path) for option, path in outputs if path and path != csvio.STDOUT]
+    outputs = [(option, path) for option, path in outputs if path and path != files.STDOUT]
     if (
         args.out
-        and args.out != csvio.STDOUT
+        and args.out != files.STDOUT
         and (getattr(args, "edge", None) or getattr(args, "edges_csv", None))
     ):
         outputs.append(("--out's edge summary", str(csvio.edges_path_for(args.out))))
     if args.sweep:
-        if args.out == csvio.STDOUT or (os.path.exists(args.out) and _kind(args.out) == "stream"):
+        if args.out == files.STDOUT or (os.path.exists(args.out) and _kind(args.out) == "stream"):
             raise UsageError(
                 f"--sweep writes <out>_sweep.csv and a plot folder beside --out, so --out "
                 f"{args.out} must be a file name, not standard output or a stream."
@@ -128,7 +128,7 @@ def check_outputs(args) -> None:
                 raise UsageError(
                     f"{option} and {other} are the same file ({path}): give them different names."
                 )
-    if args.out and args.out != csvio.STDOUT:
+    if args.out and args.out != files.STDOUT:
         if os.path.exists(args.out):
             if _kind(args.out) == "file":
                 _writable_folder(Path(args.out).resolve().parent, "--out", args.out)
@@ -159,7 +159,7 @@ def check_outputs(args) -> None:
 def make_folders(args) -> None:
     """Create the folders the outputs go into (after :func:`check_outputs`)."""
     folders = []
-    if args.out and args.out != csvio.STDOUT:
+    if args.out and args.out != files.STDOUT:
         folders.append(Path(args.out).resolve().parent)
     if args.save_blend:
         folders.append(Path(args.save_blend).resolve().parent)

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ..bridge.measurement_map import safe_file_name
 from ..vg_addon import GoniometerError
-from ..vg_addon.formats import csvio
+from ..vg_addon.formats import files
 from .outputs import refuse_input
 
 # Below this much free space a failed picture is reported as a full disk (Blender's own errors
@@ -80,7 +80,7 @@ def write_picture(path, data, inputs) -> None:
     refuse_input(path, inputs)
     if Path(path).is_dir():
         raise GoniometerError("a folder is in its place; move it away")
-    csvio.replace_atomically(os.fspath(path), data())
+    files.replace_atomically(os.fspath(path), data())
 
 
 def try_picture(failures: list[str], what: str, path, data, inputs) -> bool:

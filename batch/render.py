@@ -8,25 +8,17 @@ from pathlib import Path
 
 import bpy
 
-from ..bridge import measurement_map
+from ..bridge import colors, measurement_map
 from .outputs import refuse_input
 from .stdio import quiet_stdout
 
 
-def add_sides_material(obj, attribute: str):
-    """Give a mesh without materials one that shows the side colours (Color Attribute node)."""
-    material = bpy.data.materials.get("VG Sides")
-    if material is None:
-        material = bpy.data.materials.new("VG Sides")
-        if material.node_tree is None:  # Blender < 5: nodes are off by default
-            material.use_nodes = True
-        nodes = material.node_tree.nodes
-        shader = next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
-        shader.inputs["Roughness"].default_value = 0.6
-        colour = nodes.new("ShaderNodeVertexColor")
-        colour.layer_name = attribute
-        colour.location = (shader.location.x - 300, shader.location.y)
-        material.node_tree.links.new(colour.outputs["Color"], shader.inputs["Base Color"])
+def add_sides_material(obj):
+    """Give a mesh without materials one that shows the side colours ("VG Sides", shared by
+    the run's meshes and saved with the .blend)."""
+    material = bpy.data.materials.get("VG Sides") or colors.new_sides_material(
+        "VG Sides", roughness=0.6
+    )
     if not obj.data.materials:
         obj.data.materials.append(material)
     return material

@@ -15,7 +15,7 @@ import bpy
 
 from ..bridge import records
 from ..vg_addon import GoniometerError
-from ..vg_addon.formats import csvio
+from ..vg_addon.formats import csvio, files
 from ..vg_addon.method.result import stability_text, stability_warning
 from ..vg_addon.method.winding import winding_message
 from ..vg_addon.workflow import batchplan
@@ -53,7 +53,7 @@ class Run:
         self.units = records.units_label(bpy.context.scene)
         # A pipe or standard output gets the CSV once, at the end; a file is rewritten as the
         # meshes finish, so a run that is stopped keeps what it measured.
-        self.stream = csvio.output_target(args.out) == "stream"
+        self.stream = files.output_target(args.out) == "stream"
         self.failed_outputs: list[str] = []  # .blend or pictures that could not be written
         self.write_error = ""  # why the last write of the CSV failed ("" if it did not)
         for task in tasks:
@@ -163,10 +163,10 @@ class Run:
     def recover_csv(self, error) -> None:
         """The CSV could not be written at the end: write the rows into the temporary folder
         instead and say where, so nothing measured is lost."""
-        stem = Path(self.args.out).stem if self.args.out != csvio.STDOUT else "out"
+        stem = Path(self.args.out).stem if self.args.out != files.STDOUT else "out"
         handle, path = tempfile.mkstemp(prefix=f"vg_batch_{stem}_", suffix=".csv")
         os.close(handle)
-        where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+        where = "standard output" if self.args.out == files.STDOUT else self.args.out
         try:
             self.write_csv(path)
         except (OSError, GoniometerError) as second:
@@ -197,7 +197,7 @@ class Run:
         csv_path, plots = sweep_paths(self.args.out)
         rows = [cells for _, cells in sorted(self.sweep_rows, key=lambda pair: pair[0])]
         try:
-            csvio.replace_atomically(str(csv_path), csvio.format_sweep_rows(rows).encode("utf-8"))
+            files.replace_atomically(str(csv_path), csvio.format_sweep_rows(rows).encode("utf-8"))
         except (OSError, GoniometerError) as error:
             self.failed_outputs.append(f"sweep CSV {csv_path}: {reason(error, csv_path.parent)}")
             return
@@ -261,7 +261,7 @@ class Run:
             self.say(f"wrote {csvio.edges_path_for(self.args.out)}")
         for message in self.bad_files:
             self.say(f"  unreadable mesh: {message}")
-        where = "standard output" if self.args.out == csvio.STDOUT else self.args.out
+        where = "standard output" if self.args.out == files.STDOUT else self.args.out
         self.say(f"wrote the CSV to {where}")
         return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
 

@@ -129,17 +129,7 @@ def import_mesh(source: MeshSource):
     points = np.ascontiguousarray(data.points, dtype=np.float32)
     rounded = not np.array_equal(points.astype(np.float64), data.points)
     exact_points = data.points if rounded else None
-    mesh = bpy.data.meshes.new(source.name)
-    mesh.vertices.add(points.shape[0])
-    # The attribute arrays take plain copies: much faster than the per-vertex properties.
-    mesh.attributes["position"].data.foreach_set("vector", points.ravel())
-    if data.triangles is not None:
-        triangles = np.ascontiguousarray(data.triangles, dtype=np.int32)
-        mesh.loops.add(triangles.size)
-        mesh.attributes[".corner_vert"].data.foreach_set("value", triangles.ravel())
-        mesh.polygons.add(triangles.shape[0])
-        mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
-    mesh.update(calc_edges=True)
+    mesh = mesh_data.new_mesh(source.name, points, data.triangles)
     if data.triangles is not None and needs_validation(data.triangles):
         # Drop degenerate and duplicate faces as Blender's own importers do, so the object is
         # the one File > Import would make from the same file. (Indices are in range: the

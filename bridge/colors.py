@@ -19,6 +19,22 @@ ATTRIBUTE_NAME = "VG Sides"
 _CHUNK = 1024
 
 
+def new_sides_material(name: str, roughness: float):
+    """A new material showing the side colours (the "VG Sides" attribute through a Color
+    Attribute node into the Principled BSDF's base colour), ``roughness`` its roughness."""
+    material = bpy.data.materials.new(name)
+    if material.node_tree is None:  # Blender < 5: nodes are off by default
+        material.use_nodes = True
+    nodes = material.node_tree.nodes
+    shader = next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
+    shader.inputs["Roughness"].default_value = roughness
+    colour = nodes.new("ShaderNodeVertexColor")
+    colour.layer_name = ATTRIBUTE_NAME
+    colour.location = (shader.location.x - 300, shader.location.y)
+    material.node_tree.links.new(colour.outputs["Color"], shader.inputs["Base Color"])
+    return material
+
+
 def _nearest_labels(candidates: np.ndarray, patch_points: np.ndarray, labels: np.ndarray):
     """Side label of the nearest patch point to each candidate point (brute force, in chunks)."""
     out = np.empty(candidates.shape[0], dtype=bool)

@@ -6,16 +6,15 @@ Each raises :class:`GoniometerError` for bad input before changing anything.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import bpy
 import numpy as np
 
-from ..properties import exact_numbers
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
-from ..vg_addon.formats import csvio, profile_plot
+from ..vg_addon.formats import csvio, profile_plot, record_codec
+from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.edge_profile import summarize
 from . import measuring, records
 from .mesh_data import (
@@ -128,15 +127,15 @@ def measure_edge_on_object(
     edge_number = obj.vg.next_edge_number
     sides = profile.figures.plus_left
     for m, arc, left in zip(profile.stations, profile.arc_lengths, sides, strict=True):
-        item = records.add_measurement(
+        measuring.record(
             obj,
             m,
-            geometry.fingerprint,
+            geometry,
             note=note,
             break_number=break_number,
             station=(edge_number, arc, profile.spacing, left),
+            paint=False,
         )
-        measuring.keep_sides(obj, geometry, item, m)
     edge = records.add_edge(
         obj, profile, clicks, geometry.fingerprint, break_number=break_number, note=note
     )
@@ -195,7 +194,7 @@ def import_edges_csv(
             settings = (
                 spacing,
                 radius,
-                lam if row.seg_param is None else row.seg_param,
+                lam if row.lam is None else row.lam,
                 row.patch or patch,
             )
             measure_edge(obj, points, *settings, depsgraph=depsgraph)  # checked before recording
@@ -281,7 +280,7 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
             item.edge_number = edge.number
             numbers = exact_numbers(item)
             numbers["plus_left"] = bool(left)
-            item.exact = json.dumps(numbers)
+            item.exact = record_codec.encode(numbers)
             records.stamp(item)
             item.colors = "/".join(records.station_colours(item.break_number, left))
         edge.plot = make_plot(obj, edge).name

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..properties import exact_numbers
+from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.result import stability_undetermined
 from ..vg_addon.workflow.labels import label_text
 from . import records

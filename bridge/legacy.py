@@ -19,12 +19,11 @@ its CSV row says ``world`` in the Coordinates column.
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 
-from ..properties import exact_numbers
 from ..vg_addon import GoniometerError
+from ..vg_addon.formats import record_codec
+from ..vg_addon.formats.record_codec import exact_numbers
 from . import records
 from .mesh_data import Geometry, mesh_points, uniform_scale
 
@@ -82,9 +81,9 @@ def migrate(obj, geometry: Geometry, surface) -> list[int]:
                 float(numbers["spacing"]) / scale,
                 bool(numbers.get("plus_left", True)),
             )
-        new = records.exact_record(m, station)
+        new = record_codec.measurement_numbers(m, station)
         new["world_record"] = numbers
-        item.exact = json.dumps(new)
+        item.exact = record_codec.encode(new)
         item.n_vertices, item.n_plus, item.n_minus = (
             int(m.n_vertices),
             int(m.n_plus),

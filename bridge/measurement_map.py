@@ -35,7 +35,7 @@ from mathutils import Matrix, Vector
 
 from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, looks_at, place_labels, view_up
-from .colors import ATTRIBUTE_NAME
+from .colors import new_sides_material
 from .label_data import labels_of
 from .mesh_data import read_positions, world_points
 
@@ -210,16 +210,7 @@ class MapJob:
             return None
 
     def _sides_material(self):
-        material = self._keep(bpy.data.materials.new("VG Map sides"))
-        if material.node_tree is None:  # Blender < 5: nodes are off by default
-            material.use_nodes = True
-        nodes = material.node_tree.nodes
-        shader = next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
-        shader.inputs["Roughness"].default_value = 0.7
-        colour = nodes.new("ShaderNodeVertexColor")
-        colour.layer_name = ATTRIBUTE_NAME
-        material.node_tree.links.new(colour.outputs["Color"], shader.inputs["Base Color"])
-        return material
+        return self._keep(new_sides_material("VG Map sides", roughness=0.7))
 
     def _flat_material(self, name, rgba):
         """A material that shows ``rgba`` whatever the light (an emission)."""

@@ -1,19 +1,16 @@
 """The measuring pipeline shared by every way of measuring (operators, batch runs, the drag tool).
 
-``measure_on_object`` validates, measures, records and repaints; ``repaint`` redoes the colours
-from the recorded measurements; ``replicate_rows`` re-measures a CSV's rows, all or nothing. Each
-raises :class:`GoniometerError` for bad input before changing anything.
+``measure_on_object`` validates, measures, records and repaints (``measure`` then ``record``);
+``repaint`` redoes the colours from the recorded measurements. Each raises
+:class:`GoniometerError` for bad input before changing anything. Re-measuring a CSV and
+exporting one is ``replication``.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from ..vg_addon import GoniometerError, Measurement
-from ..vg_addon.errors import bounded_list
-from ..vg_addon.formats import csvio
 from ..vg_addon.method.algorithm import DEFAULT_RULE
 from ..vg_addon.method.sweep import radius_sweep
 from . import colors, legacy, painting, records
@@ -185,10 +182,38 @@ def measure_on_object(
         stability=stability,
         space=space,
     )
-    item = records.add_measurement(obj, m, geometry.fingerprint, note=note)
+    return record(obj, m, geometry, note=note, depsgraph=depsgraph)
+
+
+def record(
+    obj,
+    m: Measurement,
+    geometry: Geometry,
+    *,
+    note="",
+    break_number=None,
+    station=None,
+    depsgraph=None,
+    paint=True,
+):
+    """Record ``m``, taken on ``geometry`` (``obj``'s evaluated mesh now), and keep its sides
+    for painting: the one step after measuring that every way of measuring goes through (a
+    click, the drag tool, a CSV import, an edge profile's stations, a batch row).
+
+    ``note``, ``break_number`` and ``station`` are those of ``records.add_measurement``.
+    ``paint``: also repaint the sides now (a click); callers that record many measurements
+    repaint once at the end instead (:func:`repaint`).
+
+    Returns the new ``VG_Measurement`` item (now the active one); the first measurement of an
+    object painted here also shows the sides in the viewports (``colors.show_sides_once``).
+    """
+    item = records.add_measurement(
+        obj, m, geometry.fingerprint, note=note, break_number=break_number, station=station
+    )
     keep_sides(obj, geometry, item, m)
-    repaint(obj, depsgraph=depsgraph, geometry=geometry)
-    colors.show_sides_once(obj)
+    if paint:
+        repaint(obj, depsgraph=depsgraph, geometry=geometry)
+        colors.show_sides_once(obj)
     return obj.vg.measurements[obj.vg.active_index]
 
 
@@ -358,221 +383,9 @@ def from_world(location, radius, matrix, *, scale_radius=True):
     return location, (radius / scale if scale_radius and radius is not None else radius)
 
 
-def replicate_rows(
-    obj,
-    rows,
-    *,
-    ignore_mesh_names=False,
-    radius=None,
-    lam=2.0,
-    patch="euclidean",
-    depsgraph=None,
-    source="the CSV",
-    rule=DEFAULT_RULE,
-    stability=False,
-    progress=None,
-):
-    """Re-measure every replication row on ``obj`` and record them all, or nothing.
-
-    Parameters
-    ----------
-    rows : list of csvio.ReplicationRow
-    ignore_mesh_names : bool
-        Accept rows whose mesh name is neither this object's nor its mesh's.
-    radius, lam, patch, rule
-        Used for rows that do not give their own (a plain points CSV); a row without a radius
-        is an error when ``radius`` is None. Rows of MeshLab and earlier add-on files carry the
-        paper's rule (see ``csvio.ReplicationRow.rule``).
-    stability : bool
-        Also compute and record each measurement's stability figure.
-    source : str
-        How to name the rows' origin in messages (e.g. the file name).
-    progress : callable, optional
-        Called as ``progress(done, total)`` before each row is measured; returning False
-        cancels the import (a GoniometerError; nothing is recorded).
-
-    Rows in mesh coordinates (``row.coordinates == "mesh"``: every file but this extension's
-    exports from before it measured in mesh coordinates) are measured as they are. Rows in
-    world space are brought into mesh coordinates by the object's current transform, the radius
-    divided by its scale; that needs a transform that scales every direction alike.
-
-    Each new measurement keeps the row's break number when it has one (else the object's
-    current break) and takes the row's label or User Data as its note. Rows that are stations
-    of an edge profile (an ``Edge #``) are grouped back into one edge per edge number, with a
-    new edge record whose summary is recomputed from the re-measured stations.
-
-    Returns
-    -------
-    list of int
-        Numbers of the new measurements.
-
-    Raises
-    ------
-    GoniometerError
-        Listing every row that names another mesh or cannot be measured; nothing is recorded.
-    """
-    steps = replicate_steps(
-        obj,
-        rows,
-        ignore_mesh_names=ignore_mesh_names,
-        radius=radius,
-        lam=lam,
-        patch=patch,
-        depsgraph=depsgraph,
-        source=source,
-        rule=rule,
-        stability=stability,
-    )
-    try:
-        while True:
-            done, total = next(steps)
-            if progress is not None and progress(done, total) is False:
-                steps.close()
-                raise GoniometerError(
-                    f"Import of {source} cancelled after {done} of {total} rows: nothing was "
-                    "imported."
-                )
-    except StopIteration as finished:
-        return finished.value
-
-
-def replicate_steps(
-    obj,
-    rows,
-    *,
-    ignore_mesh_names=False,
-    radius=None,
-    lam=2.0,
-    patch="euclidean",
-    depsgraph=None,
-    source="the CSV",
-    rule=DEFAULT_RULE,
-    stability=False,
-):
-    """:func:`replicate_rows` a row at a time: a generator that yields ``(done, total)`` before
-    each row is measured and returns the new measurements' numbers (``StopIteration.value``)
-    once all are recorded. Closing it before the end records nothing; so does a mesh that
-    changed between steps (a GoniometerError)."""
-    check_measurable(obj)
-    if not rows:
-        raise GoniometerError(f"{source} has no measurement rows: nothing to import.")
-    if not ignore_mesh_names:
-        csvio.check_mesh_names(rows, (obj.name, obj.data.name), source=source)
-    geometry = evaluated_geometry(obj, depsgraph)
-    surface = surface_for(obj, geometry)
-    note_winding(obj, surface)
-    results, failures = [], []
-    for done, row in enumerate(rows):
-        yield done, len(rows)
-        try:
-            row_radius = radius if row.radius is None else row.radius
-            if row.break_number is not None and not (
-                1 <= row.break_number <= csvio.MAX_BREAK_NUMBER
-            ):
-                raise GoniometerError(
-                    f"Break # {row.break_number} is not from 1 to {csvio.MAX_BREAK_NUMBER}"
-                )
-            if row_radius is None:
-                raise GoniometerError("no radius (the CSV has no Radius for this row)")
-            location = (row.x, row.y, row.z)
-            if row.coordinates == records.WORLD:
-                location, row_radius = from_world(
-                    location, row_radius, geometry.matrix, scale_radius=row.radius is not None
-                )
-            m = surface.measure(
-                location,
-                row_radius,
-                lam if row.lam is None else row.lam,
-                row.patch or patch,
-                rule=row.rule or rule,
-                stability=stability,
-            )
-        except GoniometerError as error:
-            failures.append(f"row {row.row_number}: {error}")
-            continue
-        results.append((row, m))
-    if failures:
-        raise GoniometerError(
-            f"{len(failures)} of {len(rows)} rows of {source} could not be measured on "
-            f"'{obj.name}'; nothing was imported.\n" + bounded_list(failures, lines=True)
-        )
-    check_measurable(obj)
-    if evaluated_geometry(obj, depsgraph).fingerprint != geometry.fingerprint:
-        raise GoniometerError(
-            f"'{obj.name}' changed while {source} was being measured; nothing was imported."
-        )
-    numbers = []
-    stations: dict[int, list] = {}
-    for row, m in results:
-        station = None
-        if row.edge_number is not None:  # numbered and oriented when its edge is rebuilt
-            station = (0, row.arc_length or 0.0, row.spacing or 0.0, True)
-        item = records.add_measurement(
-            obj,
-            m,
-            geometry.fingerprint,
-            note=row.label or "",
-            break_number=row.break_number,
-            station=station,
-        )
-        keep_sides(obj, geometry, item, m)
-        numbers.append(item.number)
-        if station is not None:
-            stations.setdefault(row.edge_number, []).append(
-                (item.number, m, station[1], station[2])
-            )
-    if stations:
-        from . import edges  # edges records through this module: imported when needed
-
-        by_number = {item.number: item for item in obj.vg.measurements}
-        edges.edges_from_stations(
-            obj,
-            {
-                key: [(by_number[entry[0]], *entry[1:]) for entry in group]
-                for key, group in stations.items()
-            },
-            geometry,
-        )
-    records.continue_after_recorded_breaks(obj)
-    repaint(obj, depsgraph=depsgraph, geometry=geometry)
-    colors.show_sides_once(obj)
-    return numbers
-
-
-def read_rows(path) -> tuple[list, str]:
-    """The replication rows of the CSV at ``path`` and how messages name it."""
-    return csvio.read_replication_csv(Path(path)), f"'{Path(path).name}'"
-
-
-def import_csv(obj, path, *, depsgraph=None, **options) -> list[int]:
-    """Read a measurement CSV (ours, MeshLab's, the earlier add-on's or plain x, y, z points) and
-    replicate it on ``obj``; ``options`` as for :func:`replicate_rows`."""
-    rows, source = read_rows(path)
-    return replicate_rows(obj, rows, depsgraph=depsgraph, source=source, **options)
-
-
-def export_rows(objects, scene, *, depsgraph=None) -> list:
-    """CSV rows of every measurement of ``objects`` (stale ones flagged), in list order."""
-    rows = []
-    for obj in objects:
-        units = records.units_label(scene, obj)
-        stale = stale_numbers(obj, depsgraph=depsgraph)
-        rows.extend(
-            records.to_row(obj, item, stale=item.number in stale, units=units)
-            for item in obj.vg.measurements
-        )
-    return rows
-
-
 def forget_paint() -> None:
     """Forget what was painted and the kept sides (file load, unregister)."""
     painting.forget()
-
-
-def export_edge_rows(objects, scene) -> list:
-    """Edge summary CSV rows of every edge profile of ``objects``, in list order."""
-    units = records.units_label(scene)
-    return [records.edge_row(obj, edge, units=units) for obj in objects for edge in obj.vg.edges]
 
 
 def clear_cache() -> None:

@@ -204,6 +204,35 @@ def is_legacy(stored: str) -> bool:
     return len(stored) == 32 and not stored.startswith(FINGERPRINT_PREFIX)
 
 
+def new_mesh(name: str, points, triangles=None):
+    """A new Blender mesh of ``points`` (stored as float32, as Blender keeps positions) and
+    ``triangles`` (vertex indices; None for a point cloud), its edges computed: the one way
+    this extension builds a mesh from arrays. The attribute arrays take plain copies, much
+    faster than the per-vertex properties."""
+    points = np.ascontiguousarray(points, dtype=np.float32)
+    mesh = bpy.data.meshes.new(name)
+    mesh.vertices.add(points.shape[0])
+    mesh.attributes["position"].data.foreach_set("vector", points.ravel())
+    if triangles is not None:
+        triangles = np.ascontiguousarray(triangles, dtype=np.int32)
+        mesh.loops.add(triangles.size)
+        mesh.attributes[".corner_vert"].data.foreach_set("value", triangles.ravel())
+        mesh.polygons.add(triangles.shape[0])
+        mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
+    mesh.update(calc_edges=True)
+    return mesh
+
+
+def new_mesh_object(name: str, points, triangles=None):
+    """A new object of :func:`new_mesh`, linked to the scene's collection, made active and
+    selected."""
+    obj = bpy.data.objects.new(name, new_mesh(name, points, triangles))
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    return obj
+
+
 def read_positions(mesh) -> np.ndarray:
     """Vertex coordinates of a bpy mesh, float32 ``(n, 3)``, as stored."""
     co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)

@@ -4,7 +4,6 @@ a CSV row."""
 from __future__ import annotations
 
 import hashlib
-import json
 import tomllib
 from functools import cache, lru_cache
 from pathlib import Path
@@ -12,9 +11,10 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..properties import exact_numbers, set_unit
+from ..properties import set_unit
 from ..vg_addon import GoniometerError, palette, units
-from ..vg_addon.formats import csvio
+from ..vg_addon.formats import csvio, record_codec
+from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.break_sides import paint_swapped
 from .mesh_data import uniform_scale
 
@@ -35,55 +35,6 @@ def extension_version() -> str:
             return str(tomllib.load(handle)["version"])
     except (OSError, KeyError, tomllib.TOMLDecodeError):
         return "unknown"
-
-
-def _floats(vector) -> list[float]:
-    return [float(v) for v in np.asarray(vector, dtype=np.float64)]
-
-
-def _stability(stability) -> dict:
-    return {
-        "spread": float(stability.spread),
-        "center": float(stability.center),
-        "radius": float(stability.radius),
-        "lam": float(stability.lam),
-        "bootstrap": float(stability.bootstrap),
-        "orientation": float(stability.orientation),
-        "runs": int(stability.n_runs),
-        "refused": int(stability.n_failed),
-    }
-
-
-def exact_record(m, station=None) -> dict:
-    """The exact numbers stored for measurement ``m`` (taken in mesh coordinates); ``station``
-    as for :func:`add_measurement`."""
-    numbers = {}
-    if station is not None:
-        _, arc_length, spacing, plus_left = station
-        numbers = {
-            "arc_length": float(arc_length),
-            "spacing": float(spacing),
-            "plus_left": bool(plus_left),
-        }
-    return {
-        **numbers,
-        "angle": float(m.angle),
-        "fit": float(m.fit_error),
-        "fit_plus": float(m.fit_error_plus),
-        "fit_minus": float(m.fit_error_minus),
-        "radius": float(m.radius),
-        "lam": float(m.lam),
-        "snap_distance": float(m.snap_distance),
-        "center": _floats(m.center),
-        "requested": _floats(m.requested_center),
-        "normal_plus": _floats(m.normal_plus),
-        "normal_minus": _floats(m.normal_minus),
-        "rule": m.rule,
-        "convexity": m.convexity,
-        "correlation": float(m.correlation),
-        "stability": None if m.stability is None else _stability(m.stability),
-        "space": MESH,
-    }
 
 
 def add_measurement(
@@ -126,10 +77,10 @@ def add_measurement(
             f"Break # must be a whole number from 1 to {csvio.MAX_BREAK_NUMBER}; got "
             f"{break_number!r}. Nothing was recorded."
         )
-    numbers = exact_record(m, station)
+    numbers = record_codec.measurement_numbers(m, station)
     if station is None and _painted_swapped(data, m, break_number):
         numbers[SWAPPED] = True  # painted the other way round; the numbers are as measured
-    exact = json.dumps(numbers)
+    exact = record_codec.encode(numbers)
     # Everything that can fail is done: from here on the item is written whole.
     item = data.measurements.add()
     item.number = data.next_number
@@ -189,10 +140,7 @@ def station_colours(break_number: int, plus_left: bool = True) -> tuple[str, str
     return names if plus_left else names[::-1]
 
 
-# The key of a record's exact numbers that says its sides are painted the other way round (only
-# present when they are): its "+" side agreed better with the side its break's earlier
-# measurements painted in the second colour (see ``vg_addon.method.break_sides``).
-SWAPPED = "painted_swapped"
+SWAPPED = record_codec.SWAPPED
 
 # The earlier measurements of a break that orient a new one's colours: the latest this many
 # (each oriented by its own predecessors), so a click reads a bounded number of records.
@@ -222,10 +170,10 @@ def honour_colours(item, cell: str) -> bool:
         return False
     if wanted == mine or wanted != "/".join(reversed(mine.split("/"))):
         return False
-    numbers = json.loads(item.exact)
+    numbers = record_codec.decode(item.exact)
     if numbers.pop(SWAPPED, False) is False:
         numbers[SWAPPED] = True
-    item.exact = json.dumps(numbers)
+    item.exact = record_codec.encode(numbers)
     item.colors = "/".join(reversed(item.colors.split("/")))
     stamp(item)
     return True
@@ -241,9 +189,9 @@ def _painted_normals(exact: str):
     """(first-colour normal, second-colour normal, centre) of a record's exact numbers in mesh
     coordinates, or None (a world-space record of an earlier version, or numbers missing)."""
     try:
-        numbers = json.loads(exact)
+        numbers = record_codec.decode(exact)
         plus, minus, center = numbers["normal_plus"], numbers["normal_minus"], numbers["center"]
-    except (ValueError, KeyError, TypeError):
+    except (KeyError, TypeError):
         return None
     if numbers.get("space") != MESH:
         return None
@@ -413,7 +361,7 @@ def to_row(
         y=y,
         z=z,
         fit=numbers["fit"],
-        seg_param=numbers["lam"],
+        lam=numbers["lam"],
         patch=item.patch,
         n_plus=item.n_plus,
         n_minus=item.n_minus,
@@ -463,34 +411,10 @@ def add_edge(obj, profile, clicks, geometry_fingerprint: str, *, break_number: i
     -------
     The new ``VG_EdgeProfile`` item; its ``number`` is the stations' ``edge_number``.
     """
-    numbers = edge_numbers(profile, clicks)
+    numbers = record_codec.edge_numbers(profile, clicks)
     return _add_edge(
         obj, numbers, profile.patch, geometry_fingerprint, break_number=break_number, note=note
     )
-
-
-def edge_numbers(profile, clicks) -> dict:
-    """The exact numbers an edge record stores (JSON-ready) for ``profile`` and its ``clicks``."""
-    figures = profile.figures
-    spans = profile.path.flat_spans
-    return {
-        "points": [_floats(p) for p in clicks],
-        "path": [_floats(p) for p in profile.path.points],
-        "spacing": float(profile.spacing),
-        "radius": float(profile.radius),
-        "lam": float(profile.lam),
-        "length": float(profile.path.length),
-        "arc_lengths": [float(a) for a in profile.arc_lengths],
-        "angles": [float(a) for a in profile.angles],
-        "mean": float(figures.mean),
-        "std": float(figures.std),
-        "min": float(figures.min),
-        "max": float(figures.max),
-        "pooled_angle": float(figures.pooled_angle),
-        "pooled_fit": float(figures.pooled_fit_error),
-        "flat_spans": [[float(a), float(b)] for a, b in spans],
-        "space": MESH,
-    }
 
 
 def _add_edge(obj, numbers: dict, patch: str, fingerprint: str, *, break_number: int, note=""):
@@ -499,7 +423,7 @@ def _add_edge(obj, numbers: dict, patch: str, fingerprint: str, *, break_number:
     edge.number = data.next_edge_number
     data.next_edge_number += 1
     edge.break_number = int(break_number)
-    edge.exact = json.dumps(numbers)
+    edge.exact = record_codec.encode(numbers)
     edge.patch = patch
     edge.n_stations = len(numbers["angles"])
     edge.date = csvio.now_iso()
@@ -513,7 +437,7 @@ def _add_edge(obj, numbers: dict, patch: str, fingerprint: str, *, break_number:
 def add_edge_from_numbers(
     obj, numbers: dict, patch: str, fingerprint: str, *, break_number, note=""
 ):
-    """Append an edge record from ready numbers (see :func:`edge_numbers`); used when an edge is
+    """Append an edge record from ready numbers (see ``record_codec.edge_numbers``); used when an edge is
     rebuilt from re-measured stations."""
     return _add_edge(obj, numbers, patch, fingerprint, break_number=break_number, note=note)
 
@@ -532,7 +456,7 @@ def edge_row(obj, edge, *, units: str) -> csvio.EdgeRow:
         n_stations=edge.n_stations,
         spacing=numbers.get("spacing"),
         radius=numbers.get("radius"),
-        seg_param=numbers.get("lam"),
+        lam=numbers.get("lam"),
         patch=edge.patch,
         length=numbers.get("length"),
         mean=numbers.get("mean"),

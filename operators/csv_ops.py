@@ -10,12 +10,12 @@ import bpy
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from ..bridge import edges, measuring, records
+from ..bridge import edges, measuring, records, replication
 from ..bridge.mesh_data import check_measurable
 from ..properties import set_unit
 from ..vg_addon import GoniometerError, units
 from ..vg_addon.formats import csvio
-from .measure import poll_measurable, typed_value
+from .common import poll_measurable, typed_value
 from .progress import Progress, own_timer_tick
 
 # The CSV this session last exported or imported: what the Import dialog offers (Blender's
@@ -116,11 +116,11 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
                 return {"CANCELLED"}
             objects = [obj]
         try:
-            rows = measuring.export_rows(
+            rows = replication.export_rows(
                 objects, context.scene, depsgraph=context.evaluated_depsgraph_get()
             )
             csvio.write_measurements_csv(path, rows)
-            edge_rows = measuring.export_edge_rows(objects, context.scene)
+            edge_rows = replication.export_edge_rows(objects, context.scene)
             if edge_rows:
                 csvio.write_edges_csv(csvio.edges_path_for(path), edge_rows)
         except OSError as error:
@@ -213,8 +213,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                 )
                 _remember(path)
                 return {"FINISHED"}
-            rows, source = measuring.read_rows(path)
-            steps = measuring.replicate_steps(
+            rows, source = replication.read_rows(path)
+            steps = replication.replicate_steps(
                 obj,
                 rows,
                 ignore_mesh_names=self.ignore_mesh_names,

@@ -3,7 +3,8 @@
 Press on the active mesh, drag out the radius while the patch is previewed, release to measure.
 The interaction itself is :class:`~vg_addon.workflow.drag_state.DragMachine` (pure, tested without a
 screen); this module ray-casts, turns events into machine events, draws and records. A release
-records through the same ``execute`` as ``vg.measure_xyz``, with the snapped centre vertex, so
+records the measurement it took (not a second one) through the bridge's one recording step,
+``measuring.record``, as ``vg.measure_xyz`` does; with the snapped centre vertex stored, so
 ``vg.measure_xyz`` with the recorded numbers reproduces the measurement bit for bit.
 """
 
@@ -16,6 +17,7 @@ import numpy as np
 from bpy_extras import view3d_utils
 from mathutils import Matrix, Vector
 
+from ..bridge import measuring
 from ..bridge.mesh_data import (
     check_measurable,
     evaluated_geometry,
@@ -29,8 +31,9 @@ from ..bridge.records import colours_as_painted, unit_symbol
 from ..vg_addon import GoniometerError
 from ..vg_addon.units import length_text
 from ..vg_addon.workflow.drag_state import DragMachine, Phase, surface_callbacks
+from .common import poll_measurable, status_hints, typed_value
 from .drag_overlay import DragOverlay, patch_vertex_data
-from .measure import MeasureProperties, VG_OT_measure_xyz, poll_measurable, typed_value
+from .measure import MeasureProperties, VG_OT_measure_xyz, report_measurement
 
 TOOL_ID = "vg.measure_drag_tool"
 
@@ -194,14 +197,27 @@ class DragSession:
     call repeatedly) removes the drawing and the header and status texts on every way out.
     """
 
-    def __init__(self, obj, surface, patch: str, lam: float, rule: str = "refined", matrix=None):
+    def __init__(
+        self,
+        obj,
+        surface,
+        patch: str,
+        lam: float,
+        rule: str = "refined",
+        matrix=None,
+        *,
+        stability: bool = False,
+        fingerprint=None,
+    ):
         self.obj = obj
         self.surface = surface
         self.matrix = np.eye(4) if matrix is None else np.asarray(matrix, dtype=np.float64)
         self.patch = patch
         self.rule = rule
+        self.stability = stability
+        self.fingerprint = fingerprint  # of the geometry ``surface`` was made from
         self.machine = DragMachine(
-            **surface_callbacks(surface, patch, rule), lam=lam, quantize=typed_value
+            **surface_callbacks(surface, patch, rule, stability), lam=lam, quantize=typed_value
         )
         self.overlay = DragOverlay()
         self._area = None
@@ -246,6 +262,8 @@ class DragSession:
             typed_value(settings.seg_param),
             settings.rule,
             matrix=geometry.matrix,
+            stability=settings.stability,
+            fingerprint=geometry.fingerprint,
         )
         hit = ray_cast_object(obj, depsgraph, region, region_data, coord)
         if not session.machine.press(hit):
@@ -318,7 +336,7 @@ class DragSession:
             self._area.header_text_set(self.header_text(context.scene))
             self._area.tag_redraw()
         if self._workspace is not None:
-            self._workspace.status_text_set(draw_status_hints)
+            self._workspace.status_text_set(status_hints(HINTS))
 
     def header_text(self, scene) -> str:
         """The header line: radius, vertex count, λ, the angle after a λ change, and any hint."""
@@ -371,14 +389,23 @@ def record_properties(session: DragSession) -> dict | None:
     }
 
 
-def draw_status_hints(header, context):
-    """The status bar while dragging (called by Blender with the status bar's layout)."""
-    row = header.layout.row(align=True)
-    for icons, text in HINTS:
-        for icon in icons:
-            row.label(text="", icon=icon)
-        row.label(text=text)
-        row.separator(factor=2.0)
+def record_drag(context, session: DragSession, note: str = ""):
+    """Record the measurement a finished drag's release took (the preview's own result, not
+    a second measurement of the same patch); returns the new item, or None when the mesh
+    changed since the press (it is then measured again through ``vg.measure_xyz``'s way).
+
+    The result equals, bit for bit, what ``vg.measure_xyz`` records with
+    :func:`record_properties`: the same surface, snapped vertex, radius, λ, patch, rule and
+    stability setting.
+    """
+    record, obj = session.machine.record, session.obj
+    check_measurable(obj)
+    depsgraph = context.evaluated_depsgraph_get()
+    geometry = evaluated_geometry(obj, depsgraph)
+    if record is None or geometry.fingerprint != session.fingerprint:
+        return None
+    measuring.note_winding(obj, session.surface)
+    return measuring.record(obj, record.measurement, geometry, note=note, depsgraph=depsgraph)
 
 
 class VG_OT_measure_drag(MeasureProperties, bpy.types.Operator):
@@ -428,14 +455,25 @@ class VG_OT_measure_drag(MeasureProperties, bpy.types.Operator):
             session.finish(context)
 
     def commit(self, context, session: DragSession):
-        """Record the finished drag through :meth:`execute`, or report why nothing was."""
+        """Record the finished drag's measurement (:func:`record_drag`), or report why nothing
+        was; the values are stored for redo (Adjust Last Operation), which measures through
+        :meth:`execute`."""
         values = record_properties(session)
         if values is None:
             self.report({"INFO"}, session.machine.message or "Nothing was recorded.")
             return {"CANCELLED"}
         for name, value in values.items():
-            setattr(self, name, value)  # stored for redo (Adjust Last Operation) as well
-        return self.execute(context)
+            setattr(self, name, value)
+        self.stability = session.stability
+        try:
+            item = record_drag(context, session, self.note)
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        if item is None:
+            return self.execute(context)
+        report_measurement(self, session.obj, item)
+        return {"FINISHED"}
 
     def execute(self, context):
         return VG_OT_measure_xyz.execute(self, context)

@@ -68,21 +68,14 @@ def circle_points(center, radius: float, right, up, segments: int = CIRCLE_SEGME
     return (np.asarray(center, dtype=np.float64) + radius * ring).astype(np.float32)
 
 
-class DragOverlay:
-    """The viewport drawing of one drag: a draw handler plus the data it draws.
+class ViewOverlay:
+    """A drawing in every 3D viewport: a draw handler (``POST_VIEW``) plus the data it draws.
 
-    ``start`` adds the handler (once), ``stop`` removes it (safe to call any number of times).
+    ``start`` adds the handler (once), ``stop`` removes it and drops the data (:meth:`_drop`;
+    safe to call any number of times). A subclass draws in its ``_draw``.
     """
 
-    def __init__(self):
-        self._handle = None
-        self._coords: np.ndarray | None = None
-        self._labels: np.ndarray | None = None
-        self._batches = None
-        self.center: np.ndarray | None = None
-        self.radius = 0.0
-        self.matrix = np.eye(4)
-        self.side_colours = SIDE_COLORS
+    _handle = None
 
     @property
     def active(self) -> bool:
@@ -104,9 +97,30 @@ class DragOverlay:
     def stop(self) -> None:
         """Remove the draw handler and drop the data; safe to call more than once."""
         handle, self._handle = self._handle, None
-        self._coords = self._labels = self._batches = self.center = None
+        self._drop()
         if handle is not None:
             bpy.types.SpaceView3D.draw_handler_remove(handle, "WINDOW")
+
+    def _drop(self) -> None:
+        """Forget the data drawn (the handler is gone); each overlay drops its own."""
+
+
+class DragOverlay(ViewOverlay):
+    """The viewport drawing of one drag: the patch's points in their side colours, the radius
+    ring and the centre (``start``/``stop``: :class:`ViewOverlay`)."""
+
+    def __init__(self):
+        self._handle = None
+        self._coords: np.ndarray | None = None
+        self._labels: np.ndarray | None = None
+        self._batches = None
+        self.center: np.ndarray | None = None
+        self.radius = 0.0
+        self.matrix = np.eye(4)
+        self.side_colours = SIDE_COLORS
+
+    def _drop(self) -> None:
+        self._coords = self._labels = self._batches = self.center = None
 
     def update(
         self,

@@ -17,16 +17,23 @@ import json
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy.props import EnumProperty, IntProperty, StringProperty
 
 from ..bridge import edges
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
-from ..properties import PATCH_ITEMS
 from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.edge_state import EdgeMachine, EdgePhase
+from .common import (
+    SPACE_ITEMS,
+    PatchProperties,
+    defaults_from_panel,
+    length_property,
+    poll_measurable,
+    status_hints,
+    typed_value,
+)
 from .drag import NAVIGATION_EVENTS, format_length, object_alive, ray_cast_object
 from .edge_overlay import EdgeOverlay
-from .measure import SPACE_ITEMS, defaults_from_panel, poll_measurable, typed_value
 
 # The drag tool's view navigation, and plain mouse moves (a click session has no drag).
 _NAVIGATION = NAVIGATION_EVENTS | {"MOUSEMOVE"}
@@ -60,8 +67,9 @@ def translate_edge_event(event_type: str, value: str, *, ctrl=False, alt=False):
     return "ignore"
 
 
-def parse_points(text: str) -> np.ndarray:
-    """The ``points`` property: JSON ``[[x, y, z], ...]`` (float64, exactly as written)."""
+def parse_points_json(text: str) -> np.ndarray:
+    """The ``points`` property: JSON ``[[x, y, z], ...]`` (float64, exactly as written); not
+    the CSV's ``"x y z; ..."`` text (``csvio.parse_points``)."""
     try:
         points = np.array(json.loads(text), dtype=np.float64)
     except (ValueError, TypeError):
@@ -78,8 +86,9 @@ def parse_points(text: str) -> np.ndarray:
     return points
 
 
-def format_points(points) -> str:
-    """JSON text of ``points`` that :func:`parse_points` reads back bit for bit."""
+def format_points_json(points) -> str:
+    """JSON text of ``points`` that :func:`parse_points_json` reads back bit for bit (the
+    operator's property; the CSV's ``"x y z; ..."`` text is ``csvio.format_points``)."""
     return json.dumps([[float(v) for v in point] for point in np.asarray(points)])
 
 
@@ -156,7 +165,7 @@ class EdgeSession:
             self._area.header_text_set(self.header_text(context.scene))
             self._area.tag_redraw()
         if self._workspace is not None:
-            self._workspace.status_text_set(_draw_status_hints)
+            self._workspace.status_text_set(status_hints(HINTS))
 
     def header_text(self, scene) -> str:
         """The header while tracing: short enough for a viewport's header (a longer line was
@@ -188,16 +197,7 @@ class EdgeSession:
                 clear()
 
 
-def _draw_status_hints(header, context):
-    row = header.layout.row(align=True)
-    for icons, text in HINTS:
-        for icon in icons:
-            row.label(text="", icon=icon)
-        row.label(text=text)
-        row.separator(factor=2.0)
-
-
-class VG_OT_measure_edge(bpy.types.Operator):
+class VG_OT_measure_edge(PatchProperties, bpy.types.Operator):
     """Measure a whole break edge: click its start, any via points and its end on the active
     mesh, then Enter; every station is recorded as a measurement of one new break"""
 
@@ -216,26 +216,9 @@ class VG_OT_measure_edge(bpy.types.Operator):
         default="WORLD",
         description="The coordinates Points are given in (clicks are recorded in mesh coordinates)",
     )
-    spacing: FloatProperty(
-        name="Spacing",
-        description="Arc length between stations, in mesh units; default: the panel's",
-        min=0.0,
-        precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
+    spacing: length_property(
+        "Spacing", "Arc length between stations, in mesh units; default: the panel's"
     )
-    radius: FloatProperty(
-        name="Radius",
-        description="Patch radius of every station, in mesh units; default: the panel's",
-        min=0.0,
-        precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
-    )
-    seg_param: FloatProperty(
-        name="λ (SegParam)", description="Segmentation parameter; default: the panel's", min=0.0
-    )
-    patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
     note: StringProperty(name="Note", description="Free text stored with the edge")
 
     @classmethod
@@ -257,7 +240,7 @@ class VG_OT_measure_edge(bpy.types.Operator):
         try:
             edge = edges.measure_edge_on_object(
                 obj,
-                parse_points(self.points),
+                parse_points_json(self.points),
                 typed_value(self.spacing),
                 typed_value(self.radius),
                 typed_value(self.seg_param),
@@ -318,7 +301,7 @@ class VG_OT_measure_edge(bpy.types.Operator):
         if machine.phase is not EdgePhase.CONFIRMED:
             self.report({"INFO"}, machine.message or "Nothing was recorded.")
             return {"CANCELLED"}
-        self.points = format_points(machine.clicks)  # stored for redo as well
+        self.points = format_points_json(machine.clicks)  # stored for redo as well
         self.space = "MESH"  # clicks are taken on the mesh, in its coordinates
         return self.execute(context)
 

@@ -13,7 +13,7 @@ import numpy as np
 from gpu_extras.batch import batch_for_shader
 
 from ..bridge.mesh_data import world_points
-from .drag_overlay import point_shader
+from .drag_overlay import ViewOverlay, point_shader
 
 PATH_COLOR = (1.0, 0.85, 0.1, 1.0)
 CLICK_COLOR = (1.0, 1.0, 1.0, 1.0)
@@ -37,8 +37,8 @@ def path_segments(points: np.ndarray, arc_lengths: np.ndarray, flat_spans) -> tu
     return pairs[~flat].reshape(-1, 3), pairs[flat].reshape(-1, 3)
 
 
-class EdgeOverlay:
-    """The viewport drawing of one edge session; ``start``/``stop`` like ``DragOverlay``."""
+class EdgeOverlay(ViewOverlay):
+    """The viewport drawing of one edge session (``start``/``stop``: ``ViewOverlay``)."""
 
     def __init__(self):
         self._handle = None
@@ -46,24 +46,8 @@ class EdgeOverlay:
         self._ridge = self._flat = None
         self._batches = None
 
-    @property
-    def active(self) -> bool:
-        """Whether the draw handler is installed."""
-        return self._handle is not None
-
-    def start(self) -> None:
-        """Install the draw handler in every 3D viewport (a no-op when already installed)."""
-        if self._handle is None:
-            self._handle = bpy.types.SpaceView3D.draw_handler_add(
-                self._draw, (), "WINDOW", "POST_VIEW"
-            )
-
-    def stop(self) -> None:
-        """Remove the draw handler and drop the data; safe to call more than once."""
-        handle, self._handle = self._handle, None
+    def _drop(self) -> None:
         self._clicks = self._ridge = self._flat = self._batches = None
-        if handle is not None:
-            bpy.types.SpaceView3D.draw_handler_remove(handle, "WINDOW")
 
     def update(self, clicks, path, matrix) -> None:
         """New data: the clicked points and the traced ``EdgePath`` (or ``None``), in mesh

@@ -12,7 +12,7 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 from ..bridge import measurement_map
 from ..properties import BLEND_RELATIVE
 from ..vg_addon import GoniometerError
-from .measure import poll_measured
+from .common import poll_measured
 from .progress import Progress, own_timer_tick
 
 VIEW_ITEMS = (

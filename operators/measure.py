@@ -7,26 +7,23 @@ import numpy as np
 from bpy.props import (
     BoolProperty,
     EnumProperty,
-    FloatProperty,
-    FloatVectorProperty,
     IntProperty,
     StringProperty,
 )
 
 from ..bridge import measuring, records
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, uniform_scale
-from ..properties import PATCH_ITEMS, RULE_ITEMS
+from ..properties import RULE_ITEMS
 from ..vg_addon import GoniometerError
 from ..vg_addon.method.result import fit_text
-
-
-def typed_value(value: float) -> float:
-    """The float64 of the shortest decimal that a 32-bit operator property rounds to ``value``.
-
-    Operator properties are 32-bit, so a typed 0.1 arrives as 0.10000000149...; measuring with
-    0.1 instead keeps the recorded radius (and CSV) equal to what the user typed.
-    """
-    return float(str(np.float32(value)))
+from .common import (
+    LocationProperties,
+    PatchProperties,
+    defaults_from_panel,
+    poll_measurable,
+    poll_measured,
+    typed_value,
+)
 
 
 def _stale_warning(obj) -> str:
@@ -44,40 +41,6 @@ def _stale_warning(obj) -> str:
     )
 
 
-def defaults_from_panel(operator, context, settings_of: dict) -> None:
-    """Give each operator property the caller did not set (a key of ``settings_of``) the value
-    of its panel setting (the value); an unset ``location`` is the 3D cursor, in world space."""
-    given = operator.properties.is_property_set
-    settings = context.scene.vg_settings
-    for name, setting in settings_of.items():
-        if not given(name):
-            setattr(operator, name, getattr(settings, setting))
-    if "location" in operator.properties.bl_rna.properties and not given("location"):
-        operator.location = context.scene.cursor.location
-        operator.space = "WORLD"
-
-
-def poll_measurable(cls, context) -> bool:
-    """``poll()`` of operators that need a measurable active mesh; the reason it is not goes
-    to the button's tooltip."""
-    try:
-        check_measurable(context.active_object)
-    except GoniometerError as error:
-        cls.poll_message_set(str(error))
-        return False
-    return True
-
-
-def poll_measured(cls, context) -> bool:
-    """``poll()`` of operators that need a measurable active mesh with measurements."""
-    if not poll_measurable(cls, context):
-        return False
-    if not len(context.active_object.vg.measurements):
-        cls.poll_message_set(f"'{context.active_object.name}' has no measurements yet.")
-        return False
-    return True
-
-
 def non_uniform_scale_note(obj) -> str:
     """A warning for an object whose scale is not uniform, else ''."""
     if obj is None or uniform_scale(np.array(obj.matrix_world, dtype=np.float64)) is not None:
@@ -89,44 +52,10 @@ def non_uniform_scale_note(obj) -> str:
     )
 
 
-SPACE_ITEMS = (
-    ("WORLD", "World", "World space, where the object is now (the 3D cursor's coordinates)"),
-    ("MESH", "Mesh", "The mesh's own coordinates (object space: those of its file and the CSV)"),
-)
-
-
-class MeasureProperties:
+class MeasureProperties(LocationProperties, PatchProperties):
     """The inputs of a measurement, shared by every operator that records one (a mixin, so
     the drag tool's recorded values mean exactly what xyz entry's do)."""
 
-    location: FloatVectorProperty(
-        name="Location",
-        description="Centre to measure at (snaps to the nearest vertex), in the coordinates "
-        "chosen by Space; default: the 3D cursor",
-        size=3,
-        subtype="TRANSLATION",
-        unit="LENGTH",
-    )
-    space: EnumProperty(
-        name="Space",
-        items=SPACE_ITEMS,
-        default="WORLD",
-        description="The coordinates Location is given in",
-    )
-    radius: FloatProperty(
-        name="Radius",
-        description="Patch radius, in the mesh's own units; default: the panel's radius",
-        soft_min=0.0,  # not min: a negative radius is refused, not quietly made 0
-        precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
-    )
-    seg_param: FloatProperty(
-        name="λ (SegParam)",
-        description="Segmentation parameter; default: the panel's",
-        soft_min=0.0,  # not min: a negative λ is refused, as in a CSV, not quietly made 0
-    )
-    patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
     rule: EnumProperty(name="Rule", items=RULE_ITEMS, description="Default: the panel's")
     stability: BoolProperty(
         name="Stability", description="Compute the stability figure; default: the panel's"
@@ -168,20 +97,26 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        spread = f" {item.stability_text}" if self.stability else ""
-        self.report(
-            {"INFO"},
-            f"Measurement {item.number} (break {item.break_number}) on '{obj.name}': "
-            f"{item.angle:.2f}°{spread}, {item.convexity} edge "
-            f"(fit error {fit_text(item.fit_error, item.radius)}, "
-            f"{item.n_vertices} vertices)",
-        )
-        if item.stability_warning:
-            self.report({"WARNING"}, f"Measurement {item.number}: {item.stability_warning}")
-        for warning in (_stale_warning(obj), non_uniform_scale_note(obj)):
-            if warning:
-                self.report({"WARNING"}, warning)
+        report_measurement(self, obj, item)
         return {"FINISHED"}
+
+
+def report_measurement(operator, obj, item) -> None:
+    """Say what a measuring operator just recorded (``item`` on ``obj``), and warn of stale
+    measurements, an unstable reading and a non-uniform scale."""
+    spread = f" {item.stability_text}" if operator.stability else ""
+    operator.report(
+        {"INFO"},
+        f"Measurement {item.number} (break {item.break_number}) on '{obj.name}': "
+        f"{item.angle:.2f}°{spread}, {item.convexity} edge "
+        f"(fit error {fit_text(item.fit_error, item.radius)}, "
+        f"{item.n_vertices} vertices)",
+    )
+    if item.stability_warning:
+        operator.report({"WARNING"}, f"Measurement {item.number}: {item.stability_warning}")
+    for warning in (_stale_warning(obj), non_uniform_scale_note(obj)):
+        if warning:
+            operator.report({"WARNING"}, warning)
 
 
 def _active_measurable(operator, context):

@@ -15,7 +15,7 @@ from bpy.props import BoolProperty, CollectionProperty, EnumProperty, StringProp
 from bpy.types import OperatorFileListElement
 from bpy_extras.io_utils import ImportHelper
 
-from ..bridge import measuring
+from ..bridge import replication
 from ..vg_addon import GoniometerError
 from ..vg_addon.analysis import missing_message
 from ..vg_addon.analysis.report import write_report
@@ -114,7 +114,7 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
                         f"{scene_csv} is one of the sessions chosen; the scene's measurements "
                         "would overwrite it. Choose another report folder."
                     )
-                rows = measuring.export_rows(
+                rows = replication.export_rows(
                     sorted(measured, key=lambda o: o.name),
                     context.scene,
                     depsgraph=context.evaluated_depsgraph_get(),

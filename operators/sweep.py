@@ -7,9 +7,6 @@ from pathlib import Path
 
 import bpy
 from bpy.props import (
-    EnumProperty,
-    FloatProperty,
-    FloatVectorProperty,
     IntProperty,
     StringProperty,
 )
@@ -18,10 +15,16 @@ from bpy_extras.io_utils import ExportHelper
 from ..bridge import measuring
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio, sweep_plot
-from .measure import SPACE_ITEMS, defaults_from_panel, poll_measurable, typed_value
+from .common import (
+    LocationProperties,
+    defaults_from_panel,
+    length_property,
+    poll_measurable,
+    typed_value,
+)
 
 
-class VG_OT_radius_sweep(bpy.types.Operator, ExportHelper):
+class VG_OT_radius_sweep(LocationProperties, bpy.types.Operator, ExportHelper):
     """Measure at the 3D cursor over a range of radii (the MeshLab plugin's burst) and write the
     angles and fit errors to a CSV, with a plot of them as a PNG of the same name"""
 
@@ -31,22 +34,8 @@ class VG_OT_radius_sweep(bpy.types.Operator, ExportHelper):
 
     filename_ext = ".csv"
     filter_glob: StringProperty(default="*.csv", options={"HIDDEN"})
-    location: FloatVectorProperty(
-        name="Location",
-        description="Centre to measure at, in the coordinates chosen by Space; default: the 3D "
-        "cursor",
-        size=3,
-        subtype="TRANSLATION",
-        unit="LENGTH",
-    )
-    space: EnumProperty(
-        name="Space",
-        items=SPACE_ITEMS,
-        default="WORLD",
-        description="The coordinates Location is given in",
-    )
-    start: FloatProperty(name="From", description="First radius; default: the panel's", min=0.0)
-    stop: FloatProperty(name="To", description="Last radius; default: the panel's", min=0.0)
+    start: length_property("From", "First radius, in mesh units; default: the panel's")
+    stop: length_property("To", "Last radius, in mesh units; default: the panel's")
     count: IntProperty(name="Radii", description="Default: the panel's", min=2, max=1000)
 
     @classmethod

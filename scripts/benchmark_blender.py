@@ -81,23 +81,6 @@ def stats(times) -> dict:
     return {"min": float(times.min()), "median": float(np.median(times)), "n": int(times.size)}
 
 
-def make_object(bpy, points, triangles, name="Scan"):
-    mesh = bpy.data.meshes.new(name)
-    mesh.vertices.add(len(points))
-    mesh.vertices.foreach_set("co", points.astype(np.float32).ravel())
-    mesh.loops.add(triangles.size)
-    mesh.loops.foreach_set("vertex_index", triangles.astype(np.int32).ravel())
-    mesh.polygons.add(len(triangles))
-    mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
-    mesh.update(calc_edges=True)
-    obj = bpy.data.objects.new(name, mesh)
-    bpy.context.scene.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
-    obj.select_set(True)
-    bpy.context.view_layer.update()
-    return obj
-
-
 def crease_centers(count, seed=0):
     """Points on the ridge's crease (the x axis), where there is an edge to measure."""
     x = np.random.default_rng(seed).uniform(-0.8, 0.8, count)
@@ -118,7 +101,8 @@ def run_size(label: str, stored: int, repeats: int) -> dict:
     points, triangles = ridge_mesh(side)
     out["vertices"] = len(points)
     start = time.perf_counter()
-    obj = make_object(bpy, points, triangles)
+    obj = mesh_data.new_mesh_object("Scan", points, triangles)
+    bpy.context.view_layer.update()
     out["mesh_build_s"] = time.perf_counter() - start
     if label != "1M":  # only the 1M run writes them to a file again: free the memory now
         del points, triangles

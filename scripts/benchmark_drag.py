@@ -130,17 +130,7 @@ def extension_costs(points, triangles, center, radius) -> None:
     extension = load_extension()
     from virtual_goniometer.bridge import measuring, mesh_data
 
-    mesh = bpy.data.meshes.new("Benchmark")
-    mesh.vertices.add(len(points))
-    mesh.vertices.foreach_set("co", points.astype(np.float32).ravel())
-    mesh.loops.add(triangles.size)
-    mesh.loops.foreach_set("vertex_index", triangles.astype(np.int32).ravel())
-    mesh.polygons.add(len(triangles))
-    mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
-    mesh.update(calc_edges=True)
-    obj = bpy.data.objects.new("Benchmark", mesh)
-    bpy.context.scene.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
+    obj = mesh_data.new_mesh_object("Benchmark", points, triangles)
     depsgraph = bpy.context.evaluated_depsgraph_get()
     for label in ("first press (evaluate mesh, build Surface)", "later press (Surface cached)"):
         start = time.perf_counter()

@@ -1,7 +1,9 @@
-"""Shared test setup: the repository root on sys.path, and the reference data folder."""
+"""Shared test setup: the repository root on sys.path, the reference data folder, and the
+extension zip the Blender and GUI tests install."""
 
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -37,3 +39,17 @@ def user_folder():
     folder.chmod(0o755)
     yield folder
     shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.fixture(scope="session")
+def extension_zip(tmp_path_factory) -> Path:
+    """The extension zip, built and validated by scripts/build_extension.py."""
+    out = tmp_path_factory.mktemp("dist")
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "scripts" / "build_extension.py"), "--output-dir", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    return out / Path(result.stdout.strip().splitlines()[-1]).name

@@ -4,7 +4,7 @@ import bpy
 
 from ..bridge.records import unit_symbol, units_label
 from ..operators.measure import non_uniform_scale_note
-from ..properties import exact_numbers
+from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.winding import winding_message
 from .text import fits_beside, region_width, text_width, ui_scale, wrapped_label
 

@@ -1,8 +1,13 @@
-"""Small helpers for the Blender tests: meshes from NumPy, world coordinates, state snapshots."""
+"""Small helpers for the Blender tests: meshes from NumPy, world coordinates, state snapshots,
+and the batch run as a user runs it."""
 
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import bpy
 import numpy as np
@@ -10,6 +15,23 @@ import numpy as np
 from vg_addon import Surface
 
 COLOUR_ATTRIBUTE = "VG Sides"
+BATCH_SCRIPT = Path(__file__).resolve().parents[2] / "vg_batch.py"
+
+
+def batch(*args, cwd=None, env=None, timeout=600) -> subprocess.CompletedProcess:
+    """Run ``python vg_batch.py ARGS`` with this test's Python (the one with bpy), as a user
+    would; arguments may be paths, numbers or bytes (file names that are not UTF-8)."""
+    return subprocess.run(
+        [sys.executable, str(BATCH_SCRIPT),
+         *(os.fsdecode(a) if isinstance(a, bytes) else str(a) for a in args)],
+        capture_output=True,
+        text=True,
+        errors="replace",
+        timeout=timeout,
+        cwd=cwd,
+        env=None if env is None else {**os.environ, **env},
+        check=False,
+    )  # fmt: skip
 
 
 def mesh_object(

@@ -9,7 +9,6 @@ import atexit
 import importlib
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -31,20 +30,6 @@ import addon_utils  # noqa: E402  (Blender's, importable once bpy is)
 
 REPO = "user_default"
 MODULE = f"bl_ext.{REPO}.virtual_goniometer"
-
-
-@pytest.fixture(scope="session")
-def extension_zip(tmp_path_factory) -> Path:
-    """The extension zip, built and validated by scripts/build_extension.py."""
-    out = tmp_path_factory.mktemp("dist")
-    result = subprocess.run(
-        [sys.executable, str(ROOT / "scripts" / "build_extension.py"), "--output-dir", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    assert result.returncode == 0, result.stdout + result.stderr
-    return Path(result.stdout.strip().splitlines()[-1])
 
 
 @pytest.fixture(scope="session")

@@ -7,39 +7,23 @@ from __future__ import annotations
 import csv
 import dataclasses
 import importlib
-import os
 import struct
 import subprocess
-import sys
 from pathlib import Path
 from types import SimpleNamespace
 
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import colours, exact, expected_colours, mesh_object
+from bpy_helpers import batch, colours, exact, expected_colours, mesh_object
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
 from vg_addon.synthetic_meshes import bone_fragment, wedge
 
-ROOT = Path(__file__).resolve().parents[2]
-SCRIPT = ROOT / "vg_batch.py"
 RADIUS = 0.3
 # Points on the crease (the x axis) of the synthetic wedges, as the decimals a user would type.
 CREASE = [("-0.4", "0", "0"), ("0.05", "0", "0"), ("0.35", "0", "0")]
-
-
-def batch(*args, env=None, timeout=600) -> subprocess.CompletedProcess:
-    """Run ``python vg_batch.py ARGS`` with this test's Python (the one with bpy)."""
-    return subprocess.run(
-        [sys.executable, str(SCRIPT), *(str(a) for a in args)],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        env=None if env is None else {**os.environ, **env},
-        check=False,
-    )
 
 
 def ok(result: subprocess.CompletedProcess, code: int = 0) -> subprocess.CompletedProcess:
@@ -151,7 +135,7 @@ def test_points_given_with_at_on_ply_obj_and_stl(meshes, tmp_path):
     for r in rows:
         assert not r.error
         assert abs(r.angle - 90.0) < 0.01
-        assert (r.radius, r.seg_param, r.patch) == (RADIUS, 2.0, "euclidean")
+        assert (r.radius, r.lam, r.patch) == (RADIUS, 2.0, "euclidean")
         assert r.units == "BU" and r.extension_version and r.blender_version
     # The same surface in three file formats: the same float32 vertices and faces in Blender,
     # hence the same numbers, bit for bit.

@@ -17,7 +17,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import arguments, outcome_of_check
+from bpy_helpers import arguments, batch, outcome_of_check
 from unprivileged import as_user
 
 from vg_addon.formats import csvio, meshio
@@ -29,19 +29,6 @@ SCRIPT = ROOT / "vg_batch.py"
 AT = ("--at", "0.05", "0", "0", "--radius", "0.3")
 EDGE = ("--edge", "-0.4", "0", "0", "0.4", "0", "0", "--radius", "0.3")
 SMALL_MAP = ("--render-size", "16", "16", "--render-samples", "1")
-
-
-def batch(*args, cwd=None) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, str(SCRIPT), *(os.fsdecode(a) if isinstance(a, bytes) else str(a)
-                                        for a in args)],
-        capture_output=True,
-        text=True,
-        errors="replace",
-        timeout=600,
-        cwd=cwd,
-        check=False,
-    )  # fmt: skip
 
 
 def ok(result, code=0) -> subprocess.CompletedProcess:

@@ -7,33 +7,17 @@ from __future__ import annotations
 
 import importlib
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import bpy
 import pytest
-from bpy_helpers import arguments, outcome_of_check
+from bpy_helpers import arguments, batch, outcome_of_check
 from unprivileged import as_user
 
 from vg_addon.formats import csvio, meshio
 from vg_addon.synthetic_meshes import wedge
 
-ROOT = Path(__file__).resolve().parents[2]
-SCRIPT = ROOT / "vg_batch.py"
 AT = ("--at", "0.05", "0", "0", "--radius", "0.3")
-
-
-def batch(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, str(SCRIPT), *(str(a) for a in args)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=cwd,
-        env=None if env is None else {**os.environ, **env},
-        check=False,
-    )
 
 
 def ocio_set() -> dict:

@@ -3,29 +3,13 @@ mesh would round them), and the CSV's Precision column says which coordinates we
 
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
+from bpy_helpers import batch
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
 from vg_addon.synthetic_meshes import wedge
-
-ROOT = Path(__file__).resolve().parents[2]
-SCRIPT = ROOT / "vg_batch.py"
-
-
-def batch(*args) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, str(SCRIPT), *(str(a) for a in args)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
 
 
 @pytest.mark.parametrize(

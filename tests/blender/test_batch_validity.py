@@ -5,26 +5,17 @@ from __future__ import annotations
 
 import csv
 import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
+from bpy_helpers import batch as run_batch
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
 from vg_addon.synthetic_meshes import bone_fragment, wedge
 
-ROOT = Path(__file__).resolve().parents[2]
-
 
 def batch(*args) -> subprocess.CompletedProcess:
-    result = subprocess.run(
-        [sys.executable, str(ROOT / "vg_batch.py"), *(str(a) for a in args)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
+    result = run_batch(*args)
     assert result.returncode == 0, result.stdout + result.stderr
     return result
 

@@ -290,6 +290,30 @@ def test_drag_and_release_records_exactly_what_measure_xyz_records(drag, view):
     assert abs(numbers["angle"] - 90.0) < 1e-3
 
 
+@pytest.mark.parametrize("stability", [False, True])
+def test_the_release_records_its_own_measurement_equal_to_measure_xyz(drag, view, stability):
+    """A finished drag records the measurement its release took (no second measurement), and
+    it equals bit for bit what vg.measure_xyz records with the drag's stored values."""
+    bpy.context.scene.vg_settings.stability = stability
+    try:
+        session = start(drag, view, ridge_vertex(view))
+        far = pixel(view, view.points[ridge_vertex(view)] + 0.6 * view.right)
+        send(drag, session, "MOUSEMOVE", "NOTHING", far)
+        assert send(drag, session, "LEFTMOUSE", "RELEASE", far) == drag.DONE
+        session.finish(bpy.context)
+        released = session.machine.record.measurement
+        dragged = drag.record_drag(bpy.context, session)
+        assert exact(dragged)["angle"] == released.angle
+        assert (released.stability is not None) == stability
+        values = drag.record_properties(session)
+        assert bpy.ops.vg.measure_xyz("EXEC_DEFAULT", stability=stability, **values) == {"FINISHED"}
+        first, typed = view.obj.vg.measurements
+        assert record_fields(first) == record_fields(typed)
+        assert exact(first) | {"date": None} == exact(typed) | {"date": None}
+    finally:
+        bpy.context.scene.vg_settings.stability = False
+
+
 def test_typed_radius_is_recorded_exactly(drag, view):
     session = start(drag, view, ridge_vertex(view))
     far = pixel(view, view.points[ridge_vertex(view)] + 0.2 * view.right)

@@ -216,3 +216,31 @@ def test_negative_operator_values_are_refused_as_given(vg, kwargs, match):
     before = snapshot(obj)
     assert_refused(match, location=(0, 0, 0), **({"radius": 0.5} | kwargs))
     assert snapshot(obj) == before
+
+
+EDGE = {"points": "[[-0.4, 0, 0], [0.4, 0, 0]]", "space": "MESH", "radius": 0.3, "spacing": 0.2}
+
+
+@pytest.mark.parametrize(
+    ("operator", "kwargs", "match"),
+    [
+        ("measure_edge", EDGE | {"radius": -1.0}, r"radius .*got -1\.0"),
+        ("measure_edge", EDGE | {"seg_param": -1.0}, r"λ \(SegParam\) must be a number .*got -1"),
+        ("measure_edge", EDGE | {"spacing": -1.0}, r"spacing .*-1"),
+        ("radius_sweep", {"start": -1.0, "stop": 0.5, "count": 3}, r"-1"),
+        ("radius_sweep", {"start": 0.1, "stop": -1.0, "count": 3}, r"-1"),
+    ],
+    ids=["edge radius", "edge λ", "edge spacing", "sweep from", "sweep to"],
+)
+def test_every_operator_refuses_negative_values_as_given(vg, tmp_path, operator, kwargs, match):
+    """The measuring operators share one property set (operators/common.py): a negative length
+    or λ reaches the measuring code and is refused naming it, never clamped to 0."""
+    obj = measured_wedge()
+    before = snapshot(obj)
+    if operator == "radius_sweep":
+        kwargs = kwargs | {"filepath": str(tmp_path / "sweep.csv"), "location": (0, 0, 0)}
+    with pytest.raises(RuntimeError, match=match) as error:
+        getattr(bpy.ops.vg, operator)(**kwargs)
+    assert "Traceback" not in str(error.value)
+    assert snapshot(obj) == before
+    assert not list(tmp_path.iterdir())

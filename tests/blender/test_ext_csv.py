@@ -60,7 +60,7 @@ def test_export_starts_with_the_meshlab_columns(vg, tmp_path):
         assert (row.number, row.break_number) == (item.number, item.break_number)
         assert row.angle == numbers["angle"] and row.radius == numbers["radius"]
         assert [row.x, row.y, row.z] == numbers["center"]
-        assert row.seg_param == numbers["lam"] and row.patch == item.patch
+        assert row.lam == numbers["lam"] and row.patch == item.patch
         assert (row.n_vertices, row.n_plus, row.n_minus) == (
             item.n_vertices,
             item.n_plus,
@@ -357,7 +357,7 @@ def test_replicating_rows_with_a_break_number_blender_cannot_store_records_nothi
     row = vg.vg_addon.formats.csvio.ReplicationRow
     rows = [row(2, "Wedge", x, y, z, radius=0.5), row(3, "Wedge", x, y, z, 0.5, break_number=2**31)]
     with pytest.raises(vg.vg_addon.GoniometerError, match=r"row 3: Break # 2147483648"):
-        vg.bridge.measuring.replicate_rows(obj, rows)
+        vg.bridge.replication.replicate_rows(obj, rows)
     assert snapshot(obj) == before
 
 

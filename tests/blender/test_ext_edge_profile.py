@@ -184,7 +184,7 @@ def test_edge_session_event_translation(vg):
     assert translate("ESC", "PRESS") == "cancel"
     assert translate("MIDDLEMOUSE", "PRESS") == "pass"
     assert translate("MOUSEMOVE", "NOTHING") == "pass"
-    points = edge_module.parse_points(edge_module.format_points(np.array(POINTS) / 3.0))
+    points = edge_module.parse_points_json(edge_module.format_points_json(np.array(POINTS) / 3.0))
     assert points.tolist() == (np.array(POINTS) / 3.0).tolist()
 
 

@@ -4,9 +4,12 @@ exported as such) where they do not."""
 
 import hashlib
 import json
+import shutil
+from pathlib import Path
 
 import bpy
 import numpy as np
+import pytest
 from bpy_helpers import colours, exact, expected_colours, local_points, wedge_object, world
 
 from vg_addon import Surface
@@ -141,3 +144,43 @@ def test_file_load_clears_the_caches(vg, tmp_path):
     assert not vg.bridge.mesh_data._surfaces and not vg.bridge.mesh_data._geometries
     assert not painting._kept and not painting._states
     assert len(bpy.data.objects["Wedge"].vg.measurements) == 1
+
+
+BEFORE_RENAME = Path(__file__).resolve().parent / "data" / "before_lam_rename.blend"
+
+
+def test_a_blend_saved_before_lam_was_one_name_loads_and_replays(vg, tmp_path):
+    """tests/blender/data/before_lam_rename.blend was saved by bpy 4.2 with this extension as
+    it was before λ became ``lam`` in every Python name (the tree of the record-codec commit):
+    the scene's λ of 1.7, measurements at λ 1.5 and 1.7 and an edge profile at λ 1.25 on an 80°
+    wedge. The saved properties still read, the CSV export says SegParam, and each record
+    replays bit for bit."""
+    copy = tmp_path / "old.blend"
+    shutil.copyfile(BEFORE_RENAME, copy)
+    bpy.ops.wm.open_mainfile(filepath=str(copy))
+    settings = bpy.context.scene.vg_settings
+    assert settings.seg_param == pytest.approx(1.7, abs=1e-6)
+    obj = bpy.data.objects["OldWedge"]
+    items = list(obj.vg.measurements)
+    assert len(items) == 7 and len(obj.vg.edges) == 1
+    assert [exact(item)["lam"] for item in items] == [1.5, 1.7] + [1.25] * 5
+    assert items[0].seg_param == pytest.approx(1.5)
+    assert all(not item.stale for item in items)
+    assert exact(obj.vg.edges[0])["lam"] == 1.25
+    bpy.context.view_layer.objects.active = obj
+    out = tmp_path / "old.csv"
+    assert bpy.ops.vg.export_csv(filepath=str(out)) == {"FINISHED"}
+    rows = csvio.read_measurements_csv(out)
+    assert [row.lam for row in rows] == [1.5, 1.7] + [1.25] * 5
+    assert "SegParam" in out.read_text(encoding="utf-8").splitlines()[0].split(",")
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    triangles = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", triangles)
+    surface = Surface(local_points(obj).astype(np.float64), triangles.reshape(-1, 3))
+    for item in items:
+        numbers = exact(item)
+        again = surface.measure(
+            numbers["center"], numbers["radius"], numbers["lam"], rule=numbers["rule"]
+        )
+        assert again.angle == numbers["angle"] and abs(again.angle - 80.0) < 1e-4

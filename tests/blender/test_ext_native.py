@@ -105,12 +105,12 @@ def test_csv_import_reports_progress_and_can_be_cancelled(vg, tmp_path):
         seen.append((done, total))
         return True
 
-    numbers = vg.bridge.measuring.import_csv(obj, path, radius=0.3, progress=progress)
+    numbers = vg.bridge.replication.import_csv(obj, path, radius=0.3, progress=progress)
     assert seen == [(i, 25) for i in range(25)] and len(numbers) == 25
 
     def stop_at_ten(done, total):
         return done < 10
 
     with pytest.raises(vg.vg_addon.GoniometerError, match="cancelled after 10 of 25 rows"):
-        vg.bridge.measuring.import_csv(obj, path, radius=0.3, progress=stop_at_ten)
+        vg.bridge.replication.import_csv(obj, path, radius=0.3, progress=stop_at_ten)
     assert len(obj.vg.measurements) == 25  # nothing of the cancelled import was recorded

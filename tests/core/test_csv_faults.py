@@ -21,7 +21,7 @@ def edge_row(**given) -> csvio.EdgeRow:
         "n_stations": 3,
         "spacing": 0.5,
         "radius": 0.3,
-        "seg_param": 2.0,
+        "lam": 2.0,
         "patch": "euclidean",
         "points": "0.0 0.0 0.0; 1.0 0.0 0.0",
     }

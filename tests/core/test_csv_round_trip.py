@@ -44,7 +44,7 @@ def _row(mesh_name: str, user_data: str) -> csvio.MeasurementRow:
         y=-2.5,
         z=0.1,
         fit=0.0123,
-        seg_param=2.0,
+        lam=2.0,
         patch="euclidean",
         units="mm",
     )

@@ -15,7 +15,7 @@ import pytest
 from unprivileged import as_user
 
 from vg_addon import GoniometerError
-from vg_addon.formats import csvio
+from vg_addon.formats import csvio, files
 from vg_addon.formats.csvio import MeasurementRow
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -203,15 +203,15 @@ def test_unprivileged_dev_stdout_into_a_pipe_and_a_file(user_folder):
 
 
 def test_output_target_names_the_kind():
-    assert csvio.output_target("-") == "stream"
+    assert files.output_target("-") == "stream"
 
 
 @posix_only
 def test_output_target_of_files_and_streams(tmp_path):
-    assert csvio.output_target(tmp_path / "new.csv") == "file"
+    assert files.output_target(tmp_path / "new.csv") == "file"
     (tmp_path / "old.csv").write_text("x\n")
-    assert csvio.output_target(tmp_path / "old.csv") == "file"
-    assert csvio.output_target("/dev/null") == "stream"
+    assert files.output_target(tmp_path / "old.csv") == "file"
+    assert files.output_target("/dev/null") == "stream"
 
 
 # --------------------------------------------------------------------------- as a normal user

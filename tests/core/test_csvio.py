@@ -79,7 +79,7 @@ def good_row(**changes) -> MeasurementRow:
         y=-2.5,
         z=0.1,
         fit=0.0123,
-        seg_param=2.0,
+        lam=2.0,
         patch="euclidean",
         n_plus=400,
         n_minus=412,
@@ -193,7 +193,7 @@ def test_every_float_round_trips_bit_identical(values, blank):
         y=next(floats),
         z=next(floats),
         fit=next(floats),
-        seg_param=next(floats),
+        lam=next(floats),
         fit_plus=next(floats),
         fit_minus=next(floats),
         normal_plus=(next(floats), next(floats), next(floats)),
@@ -203,7 +203,7 @@ def test_every_float_round_trips_bit_identical(values, blank):
     )
     (back,) = csvio.read_measurements_csv(csvio.format_measurements_csv([row]))
     assert back == row
-    for name in ("angle", "radius", "x", "y", "z", "fit", "seg_param", "fit_plus", "fit_minus"):
+    for name in ("angle", "radius", "x", "y", "z", "fit", "lam", "fit_plus", "fit_minus"):
         assert bits(getattr(back, name)) == bits(getattr(row, name)), name
     for name in ("normal_plus", "normal_minus", "requested"):
         assert [bits(v) for v in getattr(back, name)] == [bits(v) for v in getattr(row, name)]
@@ -217,7 +217,7 @@ def test_every_float_round_trips_bit_identical(values, blank):
 )
 def test_replication_reads_back_the_written_floats_exactly(xyz, radius, lam):
     x, y, z = xyz
-    text = csvio.format_measurements_csv([good_row(x=x, y=y, z=z, radius=radius, seg_param=lam)])
+    text = csvio.format_measurements_csv([good_row(x=x, y=y, z=z, radius=radius, lam=lam)])
     (row,) = csvio.read_replication_csv(text)
     assert [bits(v) for v in (row.x, row.y, row.z)] == [bits(v) for v in xyz]
     assert bits(row.radius) == bits(radius)
@@ -805,7 +805,7 @@ def test_edge_summary_file_round_trips_beside_the_export(tmp_path):
         n_stations=12,
         spacing=0.5,
         radius=3.0,
-        seg_param=2.0,
+        lam=2.0,
         patch="euclidean",
         length=5.75,
         mean=101.25,

@@ -104,3 +104,58 @@ def test_vg_batch_is_a_thin_entry():
     assert len(text.splitlines()) < 150
     for line, target in imports(ROOT / "vg_batch.py"):
         assert target not in LAYERS, f"vg_batch.py line {line} imports {target} directly"
+
+
+def module_imports(path: Path) -> set[Path]:
+    """The extension's own source files that ``path`` imports, at run time (also inside
+    functions; not under ``if TYPE_CHECKING:``)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    checking_only = {
+        id(node)
+        for branch in ast.walk(tree)
+        if isinstance(branch, ast.If) and getattr(branch.test, "id", "") == "TYPE_CHECKING"
+        for statement in branch.body
+        for node in ast.walk(statement)
+    }
+
+    def source(base: Path) -> Path | None:
+        for candidate in (base.with_suffix(".py"), base / "__init__.py"):
+            if candidate.is_file():
+                return candidate
+        return None
+
+    found = set()
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.ImportFrom) or node.level == 0 or id(node) in checking_only:
+            continue
+        package = path.parent
+        for _ in range(node.level - 1):
+            package = package.parent
+        base = package.joinpath(*node.module.split(".")) if node.module else package
+        for alias in node.names:
+            target = source(base / alias.name) or source(base)
+            if target is not None and target != path:
+                found.add(target)
+    return found
+
+
+def test_no_import_cycle():
+    """Following the extension's imports from any module never leads back to it."""
+    graph = {path: module_imports(path) for path in extension_sources()}
+    cycles = []
+
+    done: set = set()
+
+    def visit(path, trail):
+        for target in sorted(graph.get(path, ())):
+            if target in trail:
+                cycles.append([*trail[trail.index(target) :], target])
+            elif target not in done:
+                visit(target, [*trail, target])
+        done.add(path)
+
+    for path in sorted(graph):
+        if path not in done:
+            visit(path, [path])
+    named = {" -> ".join(str(p.relative_to(ROOT)) for p in cycle) for cycle in cycles}
+    assert not named, sorted(named)

@@ -135,7 +135,7 @@ def export_csv() -> bytes:
         y=-2.5,
         z=0.1,
         fit=0.0123,
-        seg_param=2.0,
+        lam=2.0,
         patch="euclidean",
         n_plus=400,
         n_minus=412,

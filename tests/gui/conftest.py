@@ -11,7 +11,6 @@ import math
 import os
 import shutil
 import subprocess
-import sys
 
 import pytest
 from driver import REPO, GuiBlender
@@ -40,19 +39,6 @@ POINTS = {
     # Along the crease, for edge profiles clicked start to end.
     **{f"crease_{round(10 * x):+d}": [x, 0.0, 0.0] for x in (-0.7, -0.5, 0.0, 0.1, 0.5, 0.7)},
 }
-
-
-@pytest.fixture(scope="session")
-def extension_zip(tmp_path_factory):
-    out = tmp_path_factory.mktemp("dist")
-    result = subprocess.run(
-        [sys.executable, str(REPO / "scripts" / "build_extension.py"), "--output-dir", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    assert result.returncode == 0, result.stdout + result.stderr
-    return out / result.stdout.strip().splitlines()[-1].rsplit("/", 1)[-1]
 
 
 _provisioned: dict[str, str | None] = {}

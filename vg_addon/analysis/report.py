@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import GoniometerError, bounded_list
-from ..formats import csvio
+from ..formats import csvio, files
 from . import missing_message
 from .html_page import Page
 from .iov import QUANTITIES, BreakStats, break_stats, methods_of
@@ -703,5 +703,5 @@ def write_report(
         "CSV and figures as PNG and SVG beside this file.",
         note=True,
     )
-    csvio.replace_atomically(folder / "report.html", c.page.text().encode("utf-8"))
+    files.replace_atomically(folder / "report.html", c.page.text().encode("utf-8"))
     return outcome

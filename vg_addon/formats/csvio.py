@@ -23,7 +23,6 @@ rows (a spreadsheet shows them as empty rows); a quoted cell that spans lines st
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import dataclasses
 import io
@@ -31,8 +30,6 @@ import math
 import operator
 import os
 import re
-import secrets
-import stat
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from datetime import datetime
@@ -42,6 +39,7 @@ from ..errors import GoniometerError, bounded_list
 from ..method.algorithm import RULES
 from ..method.surface import PATCH_MODES
 from ..palette import OKABE_ITO
+from .files import replace_atomically
 
 #: The MeshLab Virtual Goniometer plugin's header, exactly (``SegParam`` is λ).
 MESHLAB_COLUMNS = (
@@ -77,7 +75,7 @@ _SCHEMA = (
     ("y", "float", ("y",)),
     ("z", "float", ("z",)),
     ("fit", "float", ("fit",)),
-    ("seg_param", "float", ("SegParam",)),
+    ("lam", "float", ("SegParam",)),
     ("patch", "text", ("Patch Mode",)),
     ("n_plus", "int", ("Vertices +",)),
     ("n_minus", "int", ("Vertices -",)),
@@ -152,7 +150,7 @@ _EDGE_SCHEMA = (
     ("n_stations", "int", ("Stations",)),
     ("spacing", "float", ("Spacing",)),
     ("radius", "float", ("Radius",)),
-    ("seg_param", "float", ("SegParam",)),
+    ("lam", "float", ("SegParam",)),
     ("patch", "text", ("Patch Mode",)),
     ("length", "float", ("Length",)),
     ("mean", "float", ("Mean Angle",)),
@@ -245,7 +243,7 @@ class MeasurementRow:
         The centre the measurement snapped to (a mesh vertex).
     fit, fit_plus, fit_minus : float or None
         Fit errors of both planes, and of each.
-    seg_param : float or None
+    lam : float or None
         λ, the segmentation parameter.
     patch : str
         ``"euclidean"`` or ``"geodesic"``.
@@ -305,7 +303,7 @@ class MeasurementRow:
     y: float | None = None
     z: float | None = None
     fit: float | None = None
-    seg_param: float | None = None
+    lam: float | None = None
     patch: str = ""
     n_plus: int | None = None
     n_minus: int | None = None
@@ -349,7 +347,7 @@ class EdgeRow:
     edge_number, break_number : int or None
         The edge (its stations carry the same ``Edge #``) and its break.
     n_stations : int or None
-    spacing, radius, seg_param : float or None
+    spacing, radius, lam : float or None
         The settings every station was measured with; ``patch`` the patch mode.
     length : float or None
         Arc length of the traced path.
@@ -375,7 +373,7 @@ class EdgeRow:
     n_stations: int | None = None
     spacing: float | None = None
     radius: float | None = None
-    seg_param: float | None = None
+    lam: float | None = None
     patch: str = ""
     length: float | None = None
     mean: float | None = None
@@ -772,143 +770,12 @@ def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
 
 
 #: The path that means standard output.
-STDOUT = "-"
-
-
 def format_edges_csv(rows: Iterable[EdgeRow]) -> str:
     """The text of an edge summary file: the :data:`EDGE_COLUMNS` header and one line per edge,
     written like :func:`format_measurements_csv`."""
     lines = [_csv_line(EDGE_COLUMNS)]
     lines.extend(_csv_line(_row_cells(index, row, _EDGE_SCHEMA)) for index, row in enumerate(rows))
     return "".join(lines)
-
-
-def _replace_atomically(path: str, data: bytes) -> None:
-    folder = os.path.dirname(os.path.abspath(path)) or "."
-    if not os.path.isdir(folder):
-        raise GoniometerError(
-            f"The folder {folder!r} does not exist: choose an existing folder to write to."
-        )
-    try:
-        mode = stat.S_IMODE(os.stat(path).st_mode)
-    except OSError:
-        mode = None
-    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
-    base = os.path.basename(path)
-    while True:
-        temp = os.path.join(folder, f".{base}.{secrets.token_hex(4)}.tmp")
-        try:
-            handle = os.open(temp, flags, 0o666)
-            break
-        except FileExistsError:
-            continue
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            stream.write(data)
-            stream.flush()
-            os.fsync(stream.fileno())
-        if mode is not None:
-            with contextlib.suppress(OSError):
-                os.chmod(temp, mode)
-        try:
-            os.replace(temp, path)
-        except OSError as error:
-            raise GoniometerError(
-                f"Could not replace {path!r}: {error.strerror or error}. Is it open in another "
-                "program (e.g. a spreadsheet)? Close it and try again; the old file is unchanged."
-            ) from error
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(temp)
-        raise
-
-
-def _write_into(path: str, data: bytes) -> None:
-    """Write ``data`` into an open-ended target (a pipe, a terminal, standard output), in place."""
-    try:
-        if path == STDOUT:
-            handle = os.dup(1)
-        else:
-            # No O_CREAT and no O_TRUNC: the target exists and is never replaced or emptied;
-            # O_APPEND keeps what a shell's ">>" already put in a file behind /dev/stdout.
-            handle = os.open(path, os.O_WRONLY | os.O_APPEND | getattr(os, "O_BINARY", 0))
-        with os.fdopen(handle, "wb") as stream:
-            stream.write(data)
-            stream.flush()
-    except OSError as error:
-        where = "standard output" if path == STDOUT else repr(path)
-        raise GoniometerError(
-            f"Could not write the CSV to {where}: {error.strerror or error}."
-        ) from error
-
-
-def _is_descriptor_alias(path: str) -> bool:
-    """Whether ``path`` reaches, through its symbolic links, a name of an open file descriptor
-    (``/dev/stdout`` -> ``/proc/self/fd/1``, ``/dev/fd/1``): writing to it means writing into
-    the file this process already has open, never replacing it."""
-    current = os.path.abspath(path)
-    for _ in range(40):  # the kernel's own limit on links followed
-        if current.startswith(("/proc/", "/dev/fd/")):
-            return True
-        if not os.path.islink(current):
-            return False
-        current = os.path.normpath(os.path.join(os.path.dirname(current), os.readlink(current)))
-    return False
-
-
-def output_target(path) -> str:
-    """How :func:`write_measurements_csv` will write to ``path``, or why it cannot.
-
-    Returns
-    -------
-    str
-        ``"file"``: a regular file (new, or replaced atomically; through a symbolic link, its
-        target is replaced and the link kept). ``"stream"``: ``"-"`` (standard output), a pipe,
-        a terminal or another character device such as ``/dev/null``, or a name of an open file
-        descriptor such as ``/dev/stdout``: the text is written into it, once, never replacing
-        it.
-
-    Raises
-    ------
-    GoniometerError
-        A folder, a block device or a socket, or a folder that does not exist.
-    """
-    path = os.fspath(path)
-    if path == STDOUT:
-        return "stream"
-    try:
-        info = os.stat(path)  # follows symbolic links
-    except FileNotFoundError:
-        target = os.path.realpath(path)  # a dangling link is created at its target
-        folder = os.path.dirname(target) or "."
-        if not os.path.isdir(folder):
-            raise GoniometerError(
-                f"The folder {folder!r} does not exist: choose an existing folder to write "
-                f"{os.path.basename(path)!r} to."
-            ) from None
-        return "file"
-    except OSError as error:
-        raise GoniometerError(f"Cannot write to {path!r}: {error.strerror or error}.") from None
-    if stat.S_ISDIR(info.st_mode):
-        raise GoniometerError(
-            f"{path!r} is a folder: give a file name for the CSV, e.g. "
-            f"{os.path.join(path, 'measurements.csv')!r}."
-        )
-    if stat.S_ISREG(info.st_mode):
-        if _is_descriptor_alias(path):
-            return "stream"
-        if not os.access(path, os.W_OK):
-            raise GoniometerError(
-                f"{path!r} is read-only: it is left as it is. Choose another file name, or make "
-                "it writable first."
-            )
-        return "file"
-    if stat.S_ISCHR(info.st_mode) or stat.S_ISFIFO(info.st_mode):
-        return "stream"
-    kind = "a block device" if stat.S_ISBLK(info.st_mode) else "a socket or other special file"
-    raise GoniometerError(
-        f"{path!r} is {kind}, not a file: choose a file name, or '-' for standard output."
-    )
 
 
 def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
@@ -920,7 +787,7 @@ def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
     temporary file is removed. An existing file's permissions are kept; through a symbolic link,
     the link's target is replaced and the link stays. ``"-"``, a pipe, a terminal, a character
     device (``/dev/null``) or a name of an open descriptor (``/dev/stdout``) is written into,
-    never replaced (see :func:`output_target`).
+    never replaced (see ``files.output_target``).
 
     Raises
     ------
@@ -933,21 +800,6 @@ def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
     """
     data = format_measurements_csv(rows).encode("utf-8")
     replace_atomically(path, data)
-
-
-def replace_atomically(path, data: bytes) -> None:
-    """Write ``data`` to ``path``, the way every output file of the project is written.
-
-    A regular file (or a new one) is replaced in one step, through a temporary file beside it,
-    so it holds its old content or the new one, never part of it; a symbolic link keeps its link
-    and its target is replaced. ``-`` (standard output), devices and pipes are written into,
-    never replaced. See :func:`output_target` for what is refused.
-    """
-    path = os.fspath(path)
-    if output_target(path) == "stream":
-        _write_into(path, data)
-    else:
-        _replace_atomically(os.path.realpath(path), data)
 
 
 def edges_path_for(path) -> Path:

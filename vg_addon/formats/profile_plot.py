@@ -9,12 +9,11 @@ middle.
 from __future__ import annotations
 
 import os
-import struct
-import zlib
 
 import numpy as np
 
 from ..errors import GoniometerError
+from .png import encode_png
 
 BACKGROUND = (255, 255, 255, 255)
 AXES = (60, 60, 60, 255)
@@ -165,32 +164,13 @@ def render_profile(arc_lengths, angles, *, width: int = 480, height: int = 240) 
     return image
 
 
-def png_bytes(image: np.ndarray) -> bytes:
-    """An 8-bit RGBA PNG of ``image`` (``(h, w, 4)`` uint8, row 0 at the top)."""
-    image = np.ascontiguousarray(image, dtype=np.uint8)
-    height, width = image.shape[:2]
-    raw = np.concatenate([np.zeros((height, 1), dtype=np.uint8), image.reshape(height, -1)], axis=1)
-
-    def chunk(kind: bytes, data: bytes) -> bytes:
-        body = kind + data
-        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
-
-    header = struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)
-    return (
-        b"\x89PNG\r\n\x1a\n"
-        + chunk(b"IHDR", header)
-        + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6))
-        + chunk(b"IEND", b"")
-    )
-
-
 def write_png(path, image: np.ndarray, *, overwrite: bool = False) -> None:
     """Write ``image`` as a PNG file at ``path``: a new file, unless ``overwrite`` (an output
     being regenerated, like a batch run's); an existing one is refused otherwise."""
     path = os.fspath(path)
     try:
         with open(path, "wb" if overwrite else "xb") as handle:
-            handle.write(png_bytes(image))
+            handle.write(encode_png(image, level=6))
     except FileExistsError:
         raise GoniometerError(
             f"{path} already exists: choose another output folder or remove the old plot."

@@ -17,11 +17,9 @@ from pathlib import Path
 
 from ..errors import GoniometerError, bounded_list
 from ..formats.csvio import ReplicationRow, mesh_name_match
+from ..formats.meshio import MESH_EXTENSIONS
 from ..method.algorithm import DEFAULT_RULE, as_center, as_lambda, as_radius
 from ..method.surface import check_patch_mode
-
-#: Mesh file types a batch run reads (by file name extension, case-insensitive).
-MESH_SUFFIXES = (".ply", ".obj", ".stl")
 
 
 @dataclass(frozen=True)
@@ -124,7 +122,7 @@ def find_mesh_files(paths: Iterable[str | os.PathLike]) -> list[Path]:
                     (
                         p
                         for p in path.iterdir()
-                        if p.suffix.lower() in MESH_SUFFIXES and p.is_file()
+                        if p.suffix.lower() in MESH_EXTENSIONS and p.is_file()
                     ),
                     key=lambda p: p.name,
                 )
@@ -133,14 +131,14 @@ def find_mesh_files(paths: Iterable[str | os.PathLike]) -> list[Path]:
                 continue
             if not found:
                 problems.append(
-                    f"{given}: a folder with no {', '.join(MESH_SUFFIXES)} files directly in it"
+                    f"{given}: a folder with no {', '.join(MESH_EXTENSIONS)} files directly in it"
                 )
             files.extend(found)
         elif not path.exists():
             problems.append(f"{given}: no such file or folder")
-        elif path.suffix.lower() not in MESH_SUFFIXES:
+        elif path.suffix.lower() not in MESH_EXTENSIONS:
             problems.append(
-                f"{given}: not a mesh file this script reads (use {', '.join(MESH_SUFFIXES)}, "
+                f"{given}: not a mesh file this script reads (use {', '.join(MESH_EXTENSIONS)}, "
                 "or a .blend with --object)"
             )
         elif not os.access(path, os.R_OK):

@@ -101,6 +101,9 @@ class DragMachine:
         Turns typed digits into a radius (default ``float``; Blender passes a unit-aware parser).
     min_vertices : int, optional
         The fewest patch vertices a release records (default :data:`MIN_PATCH_VERTICES`).
+    measure_release : callable ``(center, radius, lam) -> Measurement``, optional
+        What the release measures with, when it takes more than the previews (e.g. the
+        stability figure); default ``measure``. Its result is the one recorded.
 
     Notes
     -----
@@ -120,9 +123,11 @@ class DragMachine:
         quantize: Callable[[float], float] = _identity,
         parse: Callable[[str], float] = _parse_number,
         min_vertices: int = MIN_PATCH_VERTICES,
+        measure_release: Callable | None = None,
     ):
         self._query = query
         self._measure = measure
+        self._measure_release = measure_release or measure
         self._snap = snap
         self._quantize = quantize
         self._parse = parse
@@ -240,7 +245,7 @@ class DragMachine:
             self._back_to_idle()
             return None
         try:
-            measurement = self._measure(self.center, self.radius, self.lam)
+            measurement = self._measure_release(self.center, self.radius, self.lam)
         except GoniometerError as error:
             self.message = f"{error} Nothing was recorded."
             self._back_to_idle()
@@ -295,11 +300,16 @@ class DragMachine:
         self.measurement = None
 
 
-def surface_callbacks(surface, patch: str = "euclidean", rule: str = DEFAULT_RULE) -> dict:
-    """The ``snap``, ``query`` and ``measure`` callables of a :class:`DragMachine` on a Surface.
+def surface_callbacks(
+    surface, patch: str = "euclidean", rule: str = DEFAULT_RULE, stability: bool = False
+) -> dict:
+    """The ``snap``, ``query``, ``measure`` and ``measure_release`` callables of a
+    :class:`DragMachine` on a Surface.
 
     ``snap`` moves a point to its nearest measurable vertex (however far), ``query`` returns the
-    patch ``surface.measure`` would use, and ``measure`` is ``surface.measure`` itself.
+    patch ``surface.measure`` would use, and ``measure`` is ``surface.measure`` itself; so is
+    ``measure_release``, with the stability figure when ``stability`` is asked for (the
+    previews go without it: it costs about ten measurements).
 
     Parameters
     ----------
@@ -307,6 +317,8 @@ def surface_callbacks(surface, patch: str = "euclidean", rule: str = DEFAULT_RUL
     patch : {"euclidean", "geodesic"}, optional
     rule : {"refined", "oriented", "paper"}, optional
         The rule the measurement (and so the preview) uses.
+    stability : bool, optional
+        Whether the release's measurement (the one recorded) has the stability figure.
     """
 
     def snap(point):
@@ -322,4 +334,7 @@ def surface_callbacks(surface, patch: str = "euclidean", rule: str = DEFAULT_RUL
     def measure(center, radius, lam):
         return surface.measure(center, radius, lam, patch, rule=rule)
 
-    return {"snap": snap, "query": query, "measure": measure}
+    def measure_release(center, radius, lam):
+        return surface.measure(center, radius, lam, patch, rule=rule, stability=stability)
+
+    return {"snap": snap, "query": query, "measure": measure, "measure_release": measure_release}

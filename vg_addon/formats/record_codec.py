@@ -1,0 +1,128 @@
+"""The exact numbers of a stored measurement or edge profile, written and read in one place.
+
+Blender's FloatProperty holds a 32-bit float, too coarse to replay a measurement, so a record
+keeps every number as float64 in one JSON text (``VG_Measurement.exact``, ``VG_Edge.exact``):
+Python's ``json`` writes floats with ``repr``, which reads back exactly. This module turns a
+:class:`~vg_addon.method.result.Measurement` into those numbers (:func:`measurement_numbers`),
+numbers into the text (:func:`encode`) and the text back (:func:`decode`, :func:`exact_numbers`).
+Pure Python and NumPy: no Blender.
+
+Keys of a measurement: ``angle``, ``fit``, ``fit_plus``, ``fit_minus``, ``radius``, ``lam``,
+``snap_distance`` (floats); ``center``, ``requested``, ``normal_plus``, ``normal_minus`` (lists
+of 3 floats); ``rule``, ``convexity``, ``correlation`` and ``stability`` (a dict of its parts, or
+None), absent from records of versions before the oriented rule (measured with the paper's
+rule); ``space`` (:data:`MESH`, ``"mesh"``; absent from world-space records of earlier versions). A station
+of an edge profile adds ``arc_length``, ``spacing`` and ``plus_left``; a measurement whose sides
+are painted the other way round ``painted_swapped`` (:data:`SWAPPED`). Keys of an edge profile:
+see :func:`edge_numbers`.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from .csvio import MESH_COORDINATES as MESH  # a record's coordinates: the mesh's own
+
+# Present (True) when a record's sides are painted the other way round: its "+" side agreed
+# better with the side its break's earlier measurements painted in the second colour (see
+# ``vg_addon.method.break_sides``); its numbers are as measured.
+SWAPPED = "painted_swapped"
+
+
+def _floats(vector) -> list[float]:
+    return [float(v) for v in np.asarray(vector, dtype=np.float64)]
+
+
+def _stability(stability) -> dict:
+    return {
+        "spread": float(stability.spread),
+        "center": float(stability.center),
+        "radius": float(stability.radius),
+        "lam": float(stability.lam),
+        "bootstrap": float(stability.bootstrap),
+        "orientation": float(stability.orientation),
+        "runs": int(stability.n_runs),
+        "refused": int(stability.n_failed),
+    }
+
+
+def measurement_numbers(m, station=None) -> dict:
+    """The exact numbers stored for measurement ``m`` (taken in mesh coordinates).
+
+    ``station``: ``(edge_number, arc_length, spacing, plus_left)`` for a station of an edge
+    profile, else None.
+    """
+    numbers = {}
+    if station is not None:
+        _, arc_length, spacing, plus_left = station
+        numbers = {
+            "arc_length": float(arc_length),
+            "spacing": float(spacing),
+            "plus_left": bool(plus_left),
+        }
+    return {
+        **numbers,
+        "angle": float(m.angle),
+        "fit": float(m.fit_error),
+        "fit_plus": float(m.fit_error_plus),
+        "fit_minus": float(m.fit_error_minus),
+        "radius": float(m.radius),
+        "lam": float(m.lam),
+        "snap_distance": float(m.snap_distance),
+        "center": _floats(m.center),
+        "requested": _floats(m.requested_center),
+        "normal_plus": _floats(m.normal_plus),
+        "normal_minus": _floats(m.normal_minus),
+        "rule": m.rule,
+        "convexity": m.convexity,
+        "correlation": float(m.correlation),
+        "stability": None if m.stability is None else _stability(m.stability),
+        "space": MESH,
+    }
+
+
+def edge_numbers(profile, clicks) -> dict:
+    """The exact numbers an edge record stores for ``profile`` (an ``EdgeProfile``) and its
+    ``clicks`` (the points that define its path)."""
+    figures = profile.figures
+    spans = profile.path.flat_spans
+    return {
+        "points": [_floats(p) for p in clicks],
+        "path": [_floats(p) for p in profile.path.points],
+        "spacing": float(profile.spacing),
+        "radius": float(profile.radius),
+        "lam": float(profile.lam),
+        "length": float(profile.path.length),
+        "arc_lengths": [float(a) for a in profile.arc_lengths],
+        "angles": [float(a) for a in profile.angles],
+        "mean": float(figures.mean),
+        "std": float(figures.std),
+        "min": float(figures.min),
+        "max": float(figures.max),
+        "pooled_angle": float(figures.pooled_angle),
+        "pooled_fit": float(figures.pooled_fit_error),
+        "flat_spans": [[float(a), float(b)] for a, b in spans],
+        "space": MESH,
+    }
+
+
+def encode(numbers: dict) -> str:
+    """The text a record stores for ``numbers`` (every float exactly)."""
+    return json.dumps(numbers)
+
+
+def decode(text: str) -> dict:
+    """The numbers of a record's text; ``{}`` for an empty or unreadable text (a record
+    damaged outside the extension shows no numbers rather than failing)."""
+    try:
+        numbers = json.loads(text) if text else {}
+    except ValueError:
+        return {}
+    return numbers if isinstance(numbers, dict) else {}
+
+
+def exact_numbers(record) -> dict:
+    """The numbers of a stored measurement or edge profile (anything with an ``exact`` text)."""
+    return decode(record.exact)
