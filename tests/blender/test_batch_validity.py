@@ -37,7 +37,7 @@ def test_concave_wedge_rules_stability_and_sweep(tmp_path):
     # float64 coordinates agrees to rounding.
     m = core_surface(path).measure([0.01, 0, 0], 0.5, stability=True)
     assert abs(row.angle - m.angle) < 1e-5 and abs(m.angle - 110) < 0.1
-    assert (row.rule, row.convexity) == ("oriented", "concave")
+    assert (row.rule, row.convexity) == ("refined", "concave")
     assert abs(row.stability - m.stability.spread) < 1e-5
     assert row.stability_runs == m.stability.n_runs
     with open(tmp_path / "angles_sweep.csv", newline="", encoding="utf-8") as handle:
@@ -90,7 +90,15 @@ def test_inward_wound_closed_mesh_is_named_once(tmp_path):
 
 def test_help_documents_the_new_options():
     text = batch("--help").stdout
-    for needed in ("--rule", "oriented", "paper", "--stability", "--sweep R0 R1 N", "_sweep.csv"):
+    for needed in (
+        "--rule",
+        "refined",
+        "oriented",
+        "paper",
+        "--stability",
+        "--sweep R0 R1 N",
+        "_sweep.csv",
+    ):
         assert needed in text, needed
 
 

@@ -83,7 +83,9 @@ def test_scene_settings_defaults(vg):
     assert settings.seg_param == 2.0
     assert settings.patch == "euclidean"
     assert settings.radius > 0
-    assert settings.bl_rna.properties["radius"].unit == "LENGTH"
+    # In the mesh's own units, labelled with the object's Scan Units: never converted by the
+    # scene's unit system (a millimetre scan in a metre scene would read 1000 times off).
+    assert settings.bl_rna.properties["radius"].unit == "NONE"
 
 
 def test_panels_live_in_the_goniometer_tab(vg):

@@ -29,7 +29,7 @@ def test_concave_edge_is_measured_labelled_and_given_a_stability_figure(vg):
     m = surface.measure([0.01, 0, 0], 0.5, stability=True)
     numbers = exact(item)
     assert numbers["angle"] == m.angle and abs(m.angle - 120.0) < 0.1
-    assert (item.convexity, item.rule, numbers["rule"]) == ("concave", "oriented", "oriented")
+    assert (item.convexity, item.rule, numbers["rule"]) == ("concave", "refined", "refined")
     assert numbers["stability"]["spread"] == m.stability.spread
     assert numbers["stability"]["bootstrap"] == m.stability.bootstrap
     assert item.stability_text == m.stability.text()
