@@ -10,17 +10,19 @@ The refinement takes Algorithm 1's planes as a start and repeats, until nothing 
 
 1. the line where the two planes meet, and each side as the half-plane from it;
 2. every vertex near the other side's half-plane goes to the half-plane it is nearer to;
-3. on each side, a smooth surface (quadratic in the two directions of the face) is fitted to the
-   vertices away from the other side, which curved walls follow too; vertices near the other
-   side that lie off that surface by more than :data:`OUTLIER_SPREADS` times its residual spread
-   are left out of the plane fits;
+3. each side's plane is fitted robustly (least trimmed squares) to its vertices away from the
+   other face, and the side's vertices that lie off it by more than :data:`OUTLIER_SPREADS`
+   robust standard deviations are left out of the plane fits;
 4. the two planes are fitted again to the vertices kept on each side.
 
-The result replaces Algorithm 1's only where it explains the patch much better: where the summed
-plane-fit error falls by :data:`MIN_IMPROVEMENT` or more. A curved or rough wall, whose misfit
-is its own shape, keeps Algorithm 1's planes bit for bit; so do creases on a row of vertices,
-where nothing moves. Everything runs in a fixed order (:mod:`.fixed_order`), so the same inputs
-give the same bits on every machine.
+The result replaces Algorithm 1's only where it explains the patch much better and is the edge
+the user measured: the summed plane-fit error falls by :data:`MIN_IMPROVEMENT` or more, both
+faces are shown to be planes (:data:`CURVED_GAIN`), the crease passes near the centre
+(:data:`CREASE_REACH`), and what is left out is a strip along the crease, not a face
+(:data:`MAX_LEFT_OUT`, :data:`MAX_LEFT_OUT_OF_PATCH`). A curved or rough wall keeps Algorithm
+1's planes bit for bit; so do creases on a row of vertices, where nothing moves. Everything runs
+in a fixed order (:mod:`.fixed_order`), so the same inputs give the same bits on every machine.
+The reasons and the measurements are in docs/METHOD.md.
 """
 
 from __future__ import annotations
@@ -37,8 +39,8 @@ left out. Triangles can cut the corner only where both faces are within a cell o
 acute crease that band reaches farther from the crease line itself, which this measure follows."""
 
 OUTLIER_SPREADS = 3.0
-"""A vertex near the other side is left out when it lies off its side's smooth surface by more
-than this many robust standard deviations (1.4826 × the median absolute residual)."""
+"""A vertex is left out when it lies off its face's robust plane by more than this many robust
+standard deviations (1.4826 × the median absolute residual)."""
 
 NOISE_FLOOR = 1e-4
 """The smallest residual spread, in mesh spacings: on an exact plane the spread is rounding
@@ -52,9 +54,8 @@ to a billion on marching-cubes wedges); a wall whose misfit is its own curvature
 improves by less than 2 when its vertices next to the crease are left out."""
 
 MIN_CURVATURE_SPREAD = 4.0
-"""The smooth surface bends across the crease (a ``u²`` term) only where the vertices it is
-fitted to reach this many mesh spacings across: two or three rows of vertices would let it bend
-to meet any vertex near the crease, and nothing would count as off the face."""
+"""A face is shown to be a plane only where its kept vertices reach this many mesh spacings
+across the crease: over two or three rows a curved wall and a plane look alike."""
 
 CURVED_GAIN = 2.0
 """A side whose kept vertices a quadratic surface fits with less than half the mean squared
@@ -91,8 +92,8 @@ LTS_STEPS = 2
 """Refits of a face's plane to the half of its vertices nearest the previous fit."""
 
 MIN_FAR_VERTICES = 12
-"""A side needs this many vertices away from the other side to fit its smooth surface (six
-coefficients, twice over); with fewer, none of its vertices is left out."""
+"""A side needs this many vertices away from the other face for its robust plane; with fewer,
+none of its vertices is left out."""
 
 _RANK_TOLERANCE = 1e-10
 
@@ -256,7 +257,7 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
     dict or None
         The refined fields (``labels``, ``used``, the two planes' normals and fit errors), or
         ``None`` where the refinement does not apply: nothing moved, a side ran out of vertices or
-        no longer spans a plane, or the fit did not improve by :data:`MIN_IMPROVEMENT`.
+        no longer spans a plane, or one of the conditions in the module's description fails.
     """
     if split_error <= (NOISE_FLOOR * spacing) ** 2:
         return None  # Algorithm 1's planes already fit to rounding error
@@ -299,6 +300,10 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
         planes = [_side_plane(points, normals, side) for side in (plus & used, ~plus & used)]
         if planes[0] is None or planes[1] is None:
             return None
+        found = _half_plane_distances(points, center, planes)
+        if found is None:
+            return None
+        frame = found[1]
     if np.array_equal(plus, labels) and used.all():
         return None
     refined_error = planes[0][2] + planes[1][2]
