@@ -38,6 +38,11 @@ def batch(*args) -> int:
     return run.returncode
 
 
+def _next_second() -> None:
+    """Wait until the wall clock turns to its next second (the CSV's Date is to the second)."""
+    time.sleep(1.0 - time.time() % 1.0 + 0.01)
+
+
 def write_plan(path: Path, plan) -> None:
     with open(path, "w", encoding="utf-8", newline="") as handle:
         writer = csv.writer(handle, lineterminator="\n")
@@ -74,6 +79,9 @@ def main(argv=None) -> int:
         batch(*plys, "--points", points, "--units", "mm", "--out", sessions[-1], "--quiet")
         if plan.name.endswith("_drag_1"):
             for rep in range(1, args.xyz_repetitions + 1):
+                # Each repetition is a session of its own, taken later: its Date (to the second)
+                # must differ, or the report rightly takes two identical files as one session.
+                _next_second()
                 sessions.append(out / f"{plan.observer}_xyz_{rep}.csv")
                 first = out / f"{plan.name}.csv"
                 batch(*plys, "--points", first, "--units", "mm", "--out", sessions[-1], "--quiet")
