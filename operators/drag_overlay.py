@@ -25,9 +25,9 @@ from mathutils import Matrix
 
 from ..vg_addon import palette
 
-# The patch before its sides are measured: white, like the radius circle (a pale yellow read as
-# the first break's yellow side).
-PATCH_COLOR = (1.0, 1.0, 1.0, 0.85)
+# The patch before its sides are measured: a neutral light grey (a pale yellow read as the first
+# break's yellow side; white would hide the radius circle that runs through it).
+PATCH_COLOR = (0.72, 0.72, 0.72, 0.85)
 
 
 def side_colours(pair) -> tuple:

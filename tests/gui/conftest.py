@@ -35,7 +35,7 @@ POINTS = {
     "minus_out": face_point(0.15, 0.8, -1),
     # Just off the crease on the + face: a small patch there barely reaches the edge (an
     # unstable reading).
-    "off_crease": face_point(0.35, 0.1, +1),
+    "off_crease": face_point(0.35, 0.08, +1),
     # Along the crease, for edge profiles clicked start to end.
     **{f"crease_{round(10 * x):+d}": [x, 0.0, 0.0] for x in (-0.7, -0.5, 0.0, 0.1, 0.5, 0.7)},
 }
