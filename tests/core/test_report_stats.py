@@ -6,6 +6,9 @@ from __future__ import annotations
 
 import math
 import statistics
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 
@@ -163,3 +166,23 @@ def test_summary_quartiles_and_intervals():
     assert s.ci99 == pytest.approx((4 - t99 * half, 4 + t99 * half), rel=1e-6)
     one = stats.summarise([7.0])
     assert (one.n, one.mean, one.sd, one.ci95) == (1, 7.0, None, None)
+
+
+def test_the_statistics_run_without_a_deprecation_warning():
+    # statsmodels 0.14 with pandas 3 printed about 130 deprecation warnings on import; a fresh
+    # interpreter that turns every warning into an error runs the regression, Tukey and the ICC.
+    code = (
+        "from vg_addon.analysis import icc, stats\n"
+        "stats.ols([1.0, 2.1, 2.9, 4.2, 5.1], {'x': [1.0, 2.0, 3.0, 4.0, 5.5]})\n"
+        "stats.tukey_hsd({'a': [1.0, 2.0, 3.0], 'b': [2.0, 3.5, 4.0]})\n"
+        f"icc.icc_absolute({SHROUT_FLEISS!r})\n"
+    )
+    run = subprocess.run(
+        [sys.executable, "-W", "error", "-c", code],
+        cwd=Path(__file__).resolve().parents[2],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stderr == ""

@@ -146,7 +146,8 @@ def ols(y, predictors: dict[str, list[float]], response: str = "y") -> Regressio
     ValueError
         Fewer rows than coefficients plus one, predictors that are collinear, or an exact fit.
     """
-    import statsmodels.api as sm
+    from statsmodels.regression.linear_model import OLS
+    from statsmodels.tools.tools import add_constant
 
     y = np.asarray(y, dtype=np.float64)
     names = list(predictors)
@@ -155,12 +156,12 @@ def ols(y, predictors: dict[str, list[float]], response: str = "y") -> Regressio
             f"the regression needs more breaks ({len(y)}) than coefficients ({len(names) + 1})"
         )
     x = np.column_stack([np.asarray(predictors[n], dtype=np.float64) for n in names])
-    x = sm.add_constant(x, has_constant="add")
+    x = add_constant(x, has_constant="add")
     if np.linalg.matrix_rank(x) < x.shape[1]:
         raise ValueError(
             "the predictors are collinear (one is constant or a combination of others)"
         )
-    fit = sm.OLS(y, x).fit()
+    fit = OLS(y, x).fit()
     # Rounding leaves a residual of about 1e-30 where the fit is exact: none to speak of.
     if not fit.ssr > 1e-20 * float(np.sum((y - y.mean()) ** 2)):
         raise ValueError("the fit is exact (no residual), so it has no standard errors")
