@@ -13,9 +13,13 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 cache=${VG_BLENDER_CACHE:-/var/cache/vg-blender}
-packages=(blender python3-numpy xvfb xauth xdotool x11-apps netpbm
+# python3-cattr and python3-requests: Blender 5.x's bundled extensions add-on (bl_pkg) imports them
+# at startup, and Debian's blender package does not pull them in (without them Blender prints a
+# traceback on every start).
+packages=(blender python3-numpy python3-cattr python3-requests xvfb xauth xdotool x11-apps netpbm
     libgl1-mesa-dri libglx-mesa0 libegl-mesa0 libgl1 mesa-utils)
 stamp_text="vg-blender-root v1: ${packages[*]}"
+install_packages="apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ${packages[*]} && apt-get clean"
 
 die() { # die STATUS MESSAGE
     echo "provision_blender: $2" >&2
@@ -76,6 +80,16 @@ build_root() { # build_root SUITE
         echo "provision_blender: $suite: cached in $root" >&2
         return 0
     fi
+    if [ -f "$root/.vg-root" ]; then
+        # A root made for an older package list: add what is missing rather than rebuild it.
+        echo "provision_blender: $suite: adding packages to $root" >&2
+        if "$here/blender_root.sh" "$suite" -- sh -c "$install_packages" >>"$cache/$suite.log" 2>&1; then
+            echo "$stamp_text" >"$root/.vg-root"
+            echo "provision_blender: $suite: ready in $root" >&2
+            return 0
+        fi
+        echo "provision_blender: $suite: adding packages failed; rebuilding the root" >&2
+    fi
     echo "provision_blender: $suite: building in $work from $mirror (several minutes)" >&2
     rm -rf "$work"
     # minbase keeps the root small; apt inside the root then resolves blender's dependencies.
@@ -89,8 +103,7 @@ build_root() { # build_root SUITE
     # An archive snapshot's Release file may be past its Valid-Until date (unstable's is short).
     echo 'Acquire::Check-Valid-Until "false";' >"$work/etc/apt/apt.conf.d/99vg-snapshot"
     echo 'APT::Install-Recommends "false";' >"$work/etc/apt/apt.conf.d/99vg-no-recommends"
-    if ! VG_BLENDER_ROOT="$work" "$here/blender_root.sh" "$suite" -- sh -c \
-        "apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ${packages[*]} && apt-get clean" \
+    if ! VG_BLENDER_ROOT="$work" "$here/blender_root.sh" "$suite" -- sh -c "$install_packages" \
         >>"$cache/$suite.log" 2>&1; then
         echo "provision_blender: $suite: installing ${packages[*]} failed; last lines of $cache/$suite.log:" >&2
         tail -n 15 "$cache/$suite.log" >&2

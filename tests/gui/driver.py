@@ -182,14 +182,14 @@ class GuiBlender:
         return path.stat().st_size if path.exists() else 0
 
     def console_errors(self, since: int = 0) -> list[str]:
-        """The extension's complaints in Blender's console after byte ``since``
-        (:func:`extension_errors`)."""
+        """The complaints in Blender's console after byte ``since``
+        (:func:`console_complaints`)."""
         path = self.tmp / "blender.log"
         if not path.exists():
             return []
         with path.open("rb") as handle:
             handle.seek(since)
-            return extension_errors(handle.read().decode(errors="replace"))
+            return console_complaints(handle.read().decode(errors="replace"))
 
     # -- reading Blender's state -------------------------------------------------------------
     def state(self) -> dict:
@@ -451,9 +451,10 @@ _EXTENSION_NAME = re.compile(rf"{EXTENSION_PACKAGE}|\bVG_[A-Z]+_\w+|\bvg\.[a-z_]
 _SOURCE_LINE = re.compile(rf"{EXTENSION_PACKAGE}/\S+\.py:\d+")
 
 
-def extension_errors(text: str) -> list[str]:
-    """Blender's console complaints about the extension in ``text``: each Python traceback
-    with a frame in the extension's package (with its exception line), each line naming the
+def console_complaints(text: str) -> list[str]:
+    """Blender's console complaints in ``text``: every Python traceback, the extension's or
+    Blender's own (a traceback in Blender's bundled add-ons means the root lacks a module
+    Blender needs, and hides what the test would see), with its exception line; each line naming the
     extension (its package, a ``VG_*`` class, a ``vg.*(`` call) that says error, warning,
     traceback, exception or "not found", and each bare ``file.py:line`` of the extension that
     Blender prints under an RNA warning (with the warning line before it)."""
@@ -465,9 +466,7 @@ def extension_errors(text: str) -> list[str]:
             end = index + 1
             while end < len(lines) and (lines[end].startswith((" ", "\t")) or not lines[end]):
                 end += 1
-            block = lines[index : end + 1]
-            if any(EXTENSION_PACKAGE in row for row in block):
-                found.append("\n".join(block))
+            found.append("\n".join(lines[index : end + 1]))
             index = end + 1
             continue
         if _SOURCE_LINE.search(line) and not line.lstrip().startswith("File "):
