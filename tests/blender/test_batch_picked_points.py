@@ -1,0 +1,102 @@
+"""vg_batch.py --edges with MeshLab picked-points files, run as a user runs it: each .pp file's
+active points are an edge on the mesh its file name names, measured as the core measures them.
+
+The .pp files are written here as MeshLab writes them (text), the oracle is the core's
+``Surface.measure_along`` on the file's coordinates.
+"""
+
+from __future__ import annotations
+
+from bpy_helpers import batch
+
+from vg_addon import Surface
+from vg_addon.formats import csvio, meshio
+from vg_addon.synthetic_meshes import varying_wedge
+
+
+def ok(result, code=0):
+    assert result.returncode == code, result.stdout + result.stderr
+    return result
+
+
+def write_pp(path, points, inactive=()):
+    """A picked-points file as MeshLab's PickPoints tool saves it; ``inactive`` points are
+    listed with ``active="0"`` after the first point."""
+    lines = [
+        "<!DOCTYPE PickedPoints>",
+        "<PickedPoints>",
+        " <DocumentData>",
+        '  <DateTime time="10:00:00" date="2021-05-06"/>',
+        f'  <DataFileName name="{path.stem}.ply"/>',
+        " </DocumentData>",
+    ]
+    listed = [(points[0], 1), *((p, 0) for p in inactive), *((p, 1) for p in points[1:])]
+    lines += [
+        f' <point x="{x!r}" y="{y!r}" z="{z!r}" name="{n}" active="{a}"/>'
+        for n, ((x, y, z), a) in enumerate(listed)
+    ]
+    path.write_text("\n".join([*lines, "</PickedPoints>", ""]), encoding="utf-8")
+    return path
+
+
+def test_a_folder_of_pp_files_measures_each_on_the_mesh_its_name_names(tmp_path):
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+    scans = tmp_path / "scans"
+    scans.mkdir()
+    mesh = scans / "ramp.ply"
+    meshio.write_ply(mesh, shape.points, shape.triangles)
+    picks = {
+        "ramp_break1.pp": [[-1.5, 0.01, 0.0], [0.0, -0.01, 0.0], [1.5, 0.0, 0.0]],
+        "ramp.pp": [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]],
+    }
+    write_pp(scans / "ramp_break1.pp", picks["ramp_break1.pp"], inactive=[[9.0, 9.0, 9.0]])
+    write_pp(scans / "ramp.pp", picks["ramp.pp"])
+    write_pp(scans / "other.pp", picks["ramp.pp"])  # names no mesh given: passed over
+    out = tmp_path / "out.csv"
+    result = ok(batch(mesh, "--edges", scans, "--spacing", 0.5, "--radius", 0.3, "--out", out))
+    assert "1 file(s) name no mesh given and are passed over: other.pp" in result.stderr
+
+    rows = csvio.read_measurements_csv(out)
+    edges = csvio.read_edges_csv(out.with_name("out_edges.csv"))
+    surface = Surface(meshio.read_mesh(mesh).points, shape.triangles)
+    assert [e.user_data for e in edges] == ["ramp.pp", "ramp_break1.pp"]  # sorted by file name
+    for edge in edges:
+        points = picks[edge.user_data]
+        assert csvio.parse_points(edge.points) == [tuple(p) for p in points]
+        profile = surface.measure_along(points, 0.5, 0.3)
+        stations = [row for row in rows if row.edge_number == edge.edge_number]
+        assert [r.angle for r in stations] == profile.angles.tolist()
+        assert [r.arc_length for r in stations] == profile.arc_lengths.tolist()
+        assert (edge.mean, edge.n_stations) == (profile.mean, len(profile.stations))
+        assert {r.mesh_name for r in stations} == {"ramp"}
+
+    # One .pp file named directly, on the one mesh whatever its name with --ignore-mesh-names.
+    single = tmp_path / "single.csv"
+    ok(batch(mesh, "--edges", scans / "other.pp", "--spacing", 0.5, "--radius", 0.3,
+             "--ignore-mesh-names", "--out", single))  # fmt: skip
+    again = csvio.read_measurements_csv(single)
+    first = [r.angle for r in rows if r.edge_number == edges[0].edge_number]
+    assert [r.angle for r in again] == first
+
+
+def test_bad_pp_files_stop_the_run_before_anything_is_measured(tmp_path):
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=10)
+    mesh = tmp_path / "ramp.ply"
+    meshio.write_ply(mesh, shape.points, shape.triangles)
+    out = tmp_path / "out.csv"
+    bad = tmp_path / "ramp_a.pp"
+    bad.write_text('<PickedPoints>\n<point x="1" y="2"/>\n</PickedPoints>\n', encoding="utf-8")
+    one = write_pp(tmp_path / "ramp_b.pp", [[0.0, 0.0, 0.0]])
+    result = ok(batch(mesh, "--edges", tmp_path, "--spacing", 0.5, "--radius", 0.3,
+                      "--out", out), 2)  # fmt: skip
+    assert "2 picked-points file(s) cannot be measured" in result.stderr
+    assert "line 2: <point> no z" in result.stderr
+    assert f"'{one}' has 1 picked point(s)" in result.stderr
+    assert not out.exists()
+
+    result = ok(batch(mesh, "--edges", one, "--radius", 0.3, "--out", out), 2)
+    assert "--spacing D and --radius R" in result.stderr
+    stray = write_pp(tmp_path / "flake.pp", [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    result = ok(batch(mesh, "--edges", stray, "--spacing", 0.5, "--radius", 0.3, "--out", out), 2)
+    assert "flake.pp: no mesh given is named by it" in result.stderr
+    assert not out.exists()
