@@ -56,8 +56,11 @@ edges:
   points, with Edge #, Arc Length and Spacing), its summary a row of OUT_edges.csv, and its
   profile plot OUT_<mesh>_edge<N>.png beside --out. --edges CSV re-measures the edges of an
   edge summary file (an export's NAME_edges.csv): each row's Points with its own Spacing,
-  Radius, SegParam and Patch Mode, on the mesh its Mesh Name names. Edges run in this process
-  (not with --jobs or --shard).
+  Radius, SegParam and Patch Mode, on the mesh its Mesh Name names. --edges also takes MeshLab
+  picked-points files, a .pp file or a folder of them: each file's active points in order
+  (start, via points, end) are an edge, measured with --spacing and --radius on the mesh its
+  file name names (NAME.pp or NAME_*.pp for the mesh NAME). Edges run in this process (not
+  with --jobs or --shard).
 
 output:
   --out CSV gets one row per requested point, in input order, in the extension's export
@@ -176,7 +179,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--edges",
         dest="edges_csv",
         metavar="CSV",
-        help="an edge summary CSV (NAME_edges.csv): re-measure each of its edges on its mesh",
+        help="an edge summary CSV (NAME_edges.csv): re-measure each of its edges on its mesh; "
+        "or MeshLab picked-points files (a .pp file or a folder of them): each file's points "
+        "are an edge on the mesh its name names (NAME.pp, NAME_*.pp)",
     )
     edges.add_argument(
         "--spacing",

@@ -13,11 +13,12 @@ import bpy
 from ..bridge import edges, records
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
-from ..vg_addon.formats import csvio, profile_plot
+from ..vg_addon.formats import csvio, picked_points, profile_plot
 from ..vg_addon.formats.png import encode_png
 from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.edge_profile import check_station_count
 from .cli import UsageError
+from .stdio import say
 
 
 def edge_specs(args, sources) -> list[dict]:
@@ -31,17 +32,7 @@ def edge_specs(args, sources) -> list[dict]:
         An unreadable edges CSV, a row without Points, Spacing or Radius, or naming no mesh
         given; a spacing that would make more than ``edge_profile.MAX_STATIONS`` stations.
     """
-    specs = [
-        {
-            "points": [spec["start"], *spec["via"], spec["end"]],
-            "spacing": args.spacing,
-            "radius": args.radius,
-            "lam": args.lam,
-            "patch": args.patch,
-            "mesh_name": "",
-        }
-        for spec in args.edge
-    ]
+    specs = [args_spec(args, [spec["start"], *spec["via"], spec["end"]]) for spec in args.edge]
     for number, spec in enumerate(specs, start=1):
         try:
             check_spacing(spec)
@@ -49,6 +40,8 @@ def edge_specs(args, sources) -> list[dict]:
             raise UsageError(f"--edge {number} with --spacing {args.spacing:g}: {error}") from None
     if not args.edges_csv:
         return specs
+    if is_picked_points(args.edges_csv):
+        return specs + picked_point_specs(args, sources)
     try:
         rows = csvio.read_edges_csv(Path(args.edges_csv))
     except OSError as error:
@@ -80,16 +73,102 @@ def edge_specs(args, sources) -> list[dict]:
             # untransformed: the same numbers).
             "space": "world" if row.coordinates == csvio.WORLD_COORDINATES else "mesh",
         }
-        try:
-            check_spacing(spec)
-        except GoniometerError as error:
-            problems.append(f"row {number}: {error}")
-            continue
-        specs.append(spec)
+        add_checked(specs, problems, spec, f"row {number}")
     if problems:
         raise UsageError(
             f"{args.edges_csv}: {len(problems)} edge row(s) cannot be measured:\n"
             + bounded_list(problems, lines=True)
+        )
+    return specs
+
+
+def args_spec(args, points, *, mesh_name: str = "", note: str = "") -> dict:
+    """An edge through ``points`` measured with the command line's spacing, radius, λ and patch
+    mode, on the mesh ``mesh_name`` ("" for every mesh); ``note`` is stored as its User Data."""
+    return {
+        "points": points,
+        "spacing": args.spacing,
+        "radius": args.radius,
+        "lam": args.lam,
+        "patch": args.patch,
+        "mesh_name": mesh_name,
+        "note": note,
+    }
+
+
+def add_checked(specs: list, problems: list, spec: dict, where: str) -> None:
+    """Append ``spec`` to ``specs``, or, if its spacing makes too many stations, the reason
+    (after ``where``) to ``problems``."""
+    try:
+        check_spacing(spec)
+    except GoniometerError as error:
+        problems.append(f"{where}: {error}")
+    else:
+        specs.append(spec)
+
+
+def is_picked_points(path: str) -> bool:
+    """Whether ``--edges`` names MeshLab picked-points files: a ``.pp`` file or a folder."""
+    return Path(path).is_dir() or Path(path).suffix.lower() == picked_points.SUFFIX
+
+
+def picked_point_specs(args, sources) -> list[dict]:
+    """The edges of ``--edges`` given as a ``.pp`` file or a folder of them: each file's active
+    points in order (start, via points, end), measured with ``--spacing``, ``--radius``,
+    ``--lambda`` and ``--patch`` on the mesh its file name names (``NAME.pp`` or
+    ``NAME_*.pp`` for the mesh ``NAME``; any single mesh with ``--ignore-mesh-names``). In a
+    folder, files that name no mesh given are passed over (said in one line); a file named
+    directly must name one.
+
+    Raises
+    ------
+    UsageError
+        No ``--spacing`` or ``--radius``, an unreadable or malformed file, a file with fewer
+        than two active points, or one naming no mesh given: every problem listed at once.
+    """
+    given = args.edges_csv
+    if args.spacing is None or args.radius is None:
+        raise UsageError(
+            f"--edges {given}: picked points are measured with --spacing D and --radius R (in "
+            "the mesh's units); give both."
+        )
+    folder = Path(given).is_dir()
+    try:
+        paths = picked_points.files_in(given) if folder else [Path(given)]
+    except GoniometerError as error:
+        raise UsageError(str(error)) from None
+    if not paths:
+        raise UsageError(f"--edges {given}: the folder has no {picked_points.SUFFIX} files.")
+    single = args.ignore_mesh_names and len(sources) == 1
+    names = [source.name for source in sources]
+    specs, problems, passed_over = [], [], []
+    for path in paths:
+        name = sources[0].name if single else picked_points.mesh_for_file(path, names)
+        if name is None:
+            if folder:
+                passed_over.append(path.name)
+            else:
+                problems.append(
+                    f"{path.name}: no mesh given is named by it (NAME.pp or NAME_*.pp belongs "
+                    "to the mesh NAME)"
+                )
+            continue
+        try:
+            points = picked_points.edge_points(picked_points.read_picked_points(path))
+        except GoniometerError as error:
+            problems.append(str(error))
+            continue
+        spec = args_spec(args, points.tolist(), mesh_name=name, note=path.name)
+        add_checked(specs, problems, spec, path.name)
+    if problems:
+        raise UsageError(
+            f"--edges {given}: {len(problems)} picked-points file(s) cannot be measured:\n"
+            + bounded_list(problems, lines=True)
+        )
+    if passed_over and not args.quiet:
+        say(
+            f"--edges {given}: {len(passed_over)} file(s) name no mesh given and are passed "
+            f"over: {bounded_list(passed_over)}"
         )
     return specs
 
@@ -160,6 +239,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
                 spec["patch"],
                 space=spec.get("space", "mesh"),
                 surface=surface,
+                note=spec.get("note", ""),
             )
         except GoniometerError as error:
             obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
