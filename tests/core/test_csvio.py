@@ -319,7 +319,7 @@ def test_failed_replace_keeps_the_old_file_and_removes_the_temp(tmp_path, monkey
         assert os.path.exists(source)
         raise PermissionError(13, "Permission denied")
 
-    monkeypatch.setattr(csvio.os, "replace", refuse)
+    monkeypatch.setattr(os, "replace", refuse)
     with pytest.raises(GoniometerError) as info:
         csvio.write_measurements_csv(path, [good_row(number=2), good_row(number=3)])
     assert "old file is unchanged" in str(info.value)
@@ -335,7 +335,7 @@ def test_failed_write_removes_the_temp(tmp_path, monkeypatch):
     def disk_full(fd):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(csvio.os, "fsync", disk_full)
+    monkeypatch.setattr(os, "fsync", disk_full)
     with pytest.raises(OSError, match="No space left"):
         csvio.write_measurements_csv(path, [good_row(number=2)])
     assert path.read_bytes() == before

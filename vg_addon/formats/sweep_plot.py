@@ -8,7 +8,7 @@ import os
 
 import numpy as np
 
-from .csvio import replace_atomically
+from .files import replace_atomically
 from .png import encode_png
 
 WIDTH, HEIGHT = 640, 430

@@ -1,0 +1,350 @@
+"""The rows to re-measure (the paper's "xyz method"), read from any CSV that has x, y and z.
+
+:func:`read_replication_csv` accepts this extension's exports, the MeshLab plugin's file, the
+earlier Blender add-on's file and a plain points CSV (``x,y,z`` with optional radius, lambda,
+patch mode, label and mesh columns). It checks every row first and raises one
+:class:`GoniometerError` listing every problem, or returns every row: never part of a file.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ...errors import GoniometerError
+from ...method.algorithm import RULES
+from ...method.surface import PATCH_MODES
+from .measurements import EXPORT_COLUMNS, MESHLAB_COLUMNS
+from .text import (
+    COORDINATE_SPACES,
+    INTEGER,
+    MESH_COORDINATES,
+    NUMBER,
+    WORLD_COORDINATES,
+    XYZ_ALIASES,
+    header_of,
+    is_blank,
+    load,
+    normalise,
+    number_cell,
+    optional_text,
+    problems_error,
+    read_records,
+    resolve_columns,
+    text_cell,
+)
+
+#: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
+SOURCE_FORMATS = ("extension", "meshlab", "points")
+
+
+@dataclass(frozen=True)
+class ReplicationRow:
+    """One row to re-measure, as read by :func:`read_replication_csv`.
+
+    Attributes
+    ----------
+    row_number : int
+        The row a spreadsheet shows for it (the header is row 1, the first data row 2).
+    mesh_name : str or None
+        The mesh the row was measured on; ``None`` when the file has no mesh column or the cell
+        is blank.
+    x, y, z : float
+        The centre to measure at.
+    radius : float or None
+        Patch radius (> 0); ``None`` when the file has no radius column or the cell is blank.
+    lam : float or None
+        λ (≥ 0), from ``SegParam`` / ``lambda`` / ...; ``None`` when absent or blank.
+    patch : str or None
+        ``"euclidean"`` or ``"geodesic"``; ``None`` when absent or blank.
+    label : str or None
+        From ``label`` (preferred) or ``User Data``; ``None`` when absent or blank.
+    number : int or float or None
+        The original ``Measurement #`` (MeshLab's burst measurements are fractional, e.g. 3.05);
+        ``None`` when absent, blank or not a number.
+    break_number : int or None
+        The original ``Break #`` (1 to :data:`MAX_BREAK_NUMBER`); ``None`` when absent or blank.
+    edge_number : int or None
+        The ``Edge #`` of an edge profile's station; ``None`` for a single measurement.
+    arc_length, spacing : float or None
+        A station's ``Arc Length`` and its edge's ``Spacing`` (kept with the re-measured station).
+    source_format : str
+        ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
+        columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
+        else with x, y, z columns).
+    coordinates : str
+        ``"mesh"`` (the mesh's own coordinates: MeshLab's files, points files, exports with
+        ``Coordinates`` = mesh) or ``"world"`` (Blender world space: exports of this extension
+        written before the ``Coordinates`` column existed, or with ``Coordinates`` = world).
+    rule : str or None
+        The rule to replicate with: the ``Rule`` cell of an export; ``"paper"`` for MeshLab and
+        earlier add-on files and for exports written before the ``Rule`` column existed (they
+        were all measured with the paper's rule); a points file's ``rule`` column, else ``None``
+        (the current default).
+    """
+
+    row_number: int
+    mesh_name: str | None
+    x: float
+    y: float
+    z: float
+    radius: float | None = None
+    lam: float | None = None
+    patch: str | None = None
+    label: str | None = None
+    number: int | float | None = None
+    break_number: int | None = None
+    edge_number: int | None = None
+    arc_length: float | None = None
+    spacing: float | None = None
+    source_format: str = "points"
+    coordinates: str = MESH_COORDINATES
+    rule: str | None = None
+
+
+# Header aliases of the replication reader, normalised (case-folded, "_" as space, whitespace
+# collapsed). The first alias found in a header wins.
+_REPLICATION_ALIASES = {
+    "mesh_name": ("mesh name", "mesh", "object", "object name", "meshname", "mesh file"),
+    **XYZ_ALIASES,
+    "radius": ("radius", "patch radius", "r"),
+    "lam": ("segparam", "seg param", "lambda", "λ", "lam", "segmentation parameter"),
+    "patch": ("patch mode", "patch", "patchmode"),
+    "label": ("label", "user data", "note", "notes"),
+    "number": ("measurement #", "measurement number", "measurement", "number"),
+    "break_number": ("break #", "break number", "break"),
+    "coordinates": ("coordinates", "coordinate space"),
+    "rule": ("rule",),
+    "edge_number": ("edge #", "edge number", "edge"),
+    "arc_length": ("arc length", "arc"),
+    "spacing": ("spacing",),
+    "error": ("error",),
+}
+
+
+_REQUIRED = ("x", "y", "z")
+
+
+#: The largest ``Break #`` (Blender stores it as a 32-bit signed integer).
+MAX_BREAK_NUMBER = 2**31 - 1
+
+
+def break_number_cell(raw: str) -> int | str | None:
+    """The break number of a cell, ``None`` when blank, or why it is not one (a str)."""
+    text = raw.strip()
+    if not text:
+        return None
+    if INTEGER.fullmatch(text) and 1 <= int(text) <= MAX_BREAK_NUMBER:
+        return int(text)
+    return f"must be a whole number from 1 to {MAX_BREAK_NUMBER} (got {text!r})"
+
+
+def _lenient_number(raw: str) -> int | float | None:
+    text = raw.strip()
+    if INTEGER.fullmatch(text):
+        return int(text)
+    if NUMBER.fullmatch(text):
+        value = float(text)
+        return value if math.isfinite(value) else None
+    return None
+
+
+def _parse_name(raw: str) -> str | None:
+    """A mesh name as written, surrounding spaces kept (a file " lead.ply" is the mesh
+    " lead"); ``None`` when blank."""
+    return text_cell(raw) if raw.strip() else None
+
+
+def _source_format(header: list[str]) -> str:
+    names = [normalise(name) for name in header]
+    if names[: len(MESHLAB_COLUMNS)] == [normalise(c) for c in MESHLAB_COLUMNS]:
+        ours = {normalise(c) for c in EXPORT_COLUMNS[len(MESHLAB_COLUMNS) :]}
+        return "extension" if ours & set(names) else "meshlab"
+    return "points"
+
+
+def parse_replication_csv(text: str, source: str = "The CSV text") -> list[ReplicationRow]:
+    """Parse CSV text into replication rows; see :func:`read_replication_csv`.
+
+    ``source`` names the text in error messages (e.g. ``"'points.csv'"``).
+    """
+    records = read_records(text, source)
+    header_at, header = header_of(records, source)
+    problems: list[str] = []
+    columns = resolve_columns(header, _REPLICATION_ALIASES, problems)
+    missing = [field for field in _REQUIRED if field not in columns]
+    if missing:
+        found = ", ".join(repr(name.strip()) for name in header if name.strip()) or "none"
+        problems.insert(
+            0,
+            f"header: missing the required column(s) {', '.join(missing)} (found: {found}). "
+            "A replication CSV needs x, y and z columns (names are case-insensitive; radius, "
+            "lambda/SegParam, patch mode, label/User Data and mesh name are optional)",
+        )
+    if problems:
+        raise problems_error(source, problems)
+
+    fmt = _source_format(header)
+    width = len(header)
+    data = [(number, cells) for number, cells in records[header_at + 1 :] if not is_blank(cells)]
+    if not data:
+        raise GoniometerError(
+            f"{source} has a header but no data rows: add one row per measurement "
+            "(x, y, z and optionally radius, lambda, ...) below the header."
+        )
+
+    def name_of(field: str) -> str:
+        return header[columns[field]].strip()
+
+    rows, skipped = [], 0
+    for number, cells in data:
+
+        def cell(field: str, cells=cells) -> str:
+            index = columns.get(field)
+            return cells[index] if index is not None and index < len(cells) else ""
+
+        extra = cells[width:]
+        if not is_blank(extra):
+            problems.append(
+                f"row {number}: {len(cells)} cells but the header has {width} columns (a comma "
+                "inside an unquoted name or note, or a decimal comma?)"
+            )
+            continue
+        if cell("error").strip() and all(not cell(f).strip() for f in _REQUIRED):
+            skipped += 1
+            continue
+        values: dict[str, float | None] = {}
+        for field in ("x", "y", "z", "radius", "lam", "arc_length", "spacing"):
+            raw = cell(field)
+            if not raw.strip():
+                values[field] = None
+                if field in _REQUIRED:
+                    problems.append(f"row {number}: {name_of(field)} is empty")
+                continue
+            value, why = number_cell(raw)
+            values[field] = value
+            if why:
+                problems.append(f"row {number}: {name_of(field)} {why}")
+        if values["radius"] is not None and values["radius"] <= 0:
+            problems.append(
+                f"row {number}: {name_of('radius')} must be greater than 0 "
+                f"(got {cell('radius').strip()})"
+            )
+        if values["lam"] is not None and values["lam"] < 0:
+            problems.append(
+                f"row {number}: {name_of('lam')} (λ) must be 0 or more (got {cell('lam').strip()})"
+            )
+        break_number = break_number_cell(cell("break_number"))
+        if isinstance(break_number, str):
+            problems.append(f"row {number}: {name_of('break_number')} {break_number}")
+        patch = optional_text(cell("patch"))
+        if patch is not None:
+            patch = patch.casefold()
+            if patch not in PATCH_MODES:
+                problems.append(
+                    f"row {number}: unknown patch mode {cell('patch').strip()!r} "
+                    f"(use {' or '.join(PATCH_MODES)})"
+                )
+        coordinates = optional_text(cell("coordinates"))
+        if coordinates is None:
+            # This extension wrote world coordinates until it wrote the column; every other
+            # tool writes the mesh's own.
+            coordinates = WORLD_COORDINATES if fmt == "extension" else MESH_COORDINATES
+        coordinates = coordinates.casefold()
+        if coordinates not in COORDINATE_SPACES:
+            problems.append(
+                f"row {number}: unknown coordinates {cell('coordinates').strip()!r} "
+                f"(use {' or '.join(COORDINATE_SPACES)})"
+            )
+        rule = optional_text(cell("rule"))
+        if rule is not None:
+            rule = rule.casefold()
+            if rule not in RULES:
+                problems.append(
+                    f"row {number}: unknown rule {cell('rule').strip()!r} (use {' or '.join(RULES)})"
+                )
+        elif fmt != "points":
+            rule = "paper"  # MeshLab, the earlier add-on, exports from before the Rule column
+        if problems:
+            continue  # nothing is returned anyway; keep collecting
+        edge_number = _lenient_number(cell("edge_number"))
+        rows.append(
+            ReplicationRow(
+                row_number=number,
+                mesh_name=_parse_name(cell("mesh_name")),
+                x=values["x"],
+                y=values["y"],
+                z=values["z"],
+                radius=values["radius"],
+                lam=values["lam"],
+                patch=patch,
+                label=optional_text(cell("label")),
+                number=_lenient_number(cell("number")),
+                break_number=break_number,
+                edge_number=edge_number if isinstance(edge_number, int) else None,
+                arc_length=values["arc_length"],
+                spacing=values["spacing"],
+                source_format=fmt,
+                coordinates=coordinates,
+                rule=rule,
+            )
+        )
+    if problems:
+        raise problems_error(source, problems)
+    if not rows:
+        raise GoniometerError(
+            f"{source} has no rows to replicate: all {skipped} data row(s) are failed rows "
+            "(their error column is filled and they have no coordinates)."
+        )
+    return rows
+
+
+def read_replication_csv(path_or_text) -> list[ReplicationRow]:
+    """Read the rows to re-measure (the paper's xyz method) from a CSV file or text.
+
+    Parameters
+    ----------
+    path_or_text : str, os.PathLike or bytes
+        A path, or the CSV content itself: a ``str`` containing a line break, or ``bytes``
+        (UTF-8). A ``str`` without a line break is taken as a path.
+
+    Returns
+    -------
+    list of ReplicationRow
+        In file order. ``row_number`` is the spreadsheet row: the header is row 1 (or later, if
+        blank lines come first), so the first data row is normally 2.
+
+    Accepted files: this extension's export; the MeshLab plugin's CSV and the earlier AMAAZE
+    Blender add-on's (both have the 14 MeshLab columns; the add-on writes the text ``fill`` in
+    ``fit``, which is not read); and a plain points CSV. Header names are matched
+    case-insensitively, ignoring surrounding whitespace and with ``_`` read as a space, with
+    aliases: ``Mesh Name``/``Mesh``/``Object``; ``x``/``Center x``; ``Radius``/``r``;
+    ``SegParam``/``Seg Param``/``lambda``/``λ``/``Segmentation Parameter``;
+    ``Patch Mode``/``patch``; ``label``/``User Data``/``note`` (``label`` wins over
+    ``User Data``); ``Measurement #``; ``Break #``; ``Rule`` (``oriented`` or ``paper``);
+    ``Coordinates`` (``mesh`` or ``world``; absent or blank: ``world`` in an export of this
+    extension, which wrote world coordinates before it had the column, ``mesh`` in every other
+    file); ``error``. Only x, y and z are required. Rows of MeshLab and earlier add-on files, and
+    of exports without a ``Rule`` column, replicate with the paper's rule (see
+    :attr:`ReplicationRow.rule`).
+    A UTF-8 byte-order mark is ignored; cells are read without surrounding whitespace, and the
+    apostrophe the writer puts before formula-like text is removed.
+
+    Skipped: fully blank lines, and rows whose ``error`` cell is filled *and* whose x, y and z
+    are all blank (a batch run's failed rows). A failed row that has coordinates is kept.
+
+    Raises
+    ------
+    GoniometerError
+        One error listing every problem (the first 20, then "and N more") with its row number
+        and column name: missing x/y/z columns (naming those found), duplicate columns, a blank,
+        non-numeric or non-finite x/y/z/radius/lambda, radius ≤ 0, λ < 0, an unknown patch
+        mode, a ``Break #`` that is not a whole number from 1 to :data:`MAX_BREAK_NUMBER`, a row
+        with more cells than the header; or: an empty file, a header without data
+        rows, only failed rows, a ``;`` or tab delimiter, text that is not UTF-8. Nothing is
+        returned then.
+    OSError
+        The file cannot be read.
+    """
+    text, source = load(path_or_text)
+    return parse_replication_csv(text, source)
