@@ -277,6 +277,15 @@ class Surface:
 
         return measure_along(self, path, spacing, radius, lam, patch)
 
+    def find_break_edges(self, **parameters):
+        """Find the break edges of this mesh: a ``BreakEdgeResult`` of candidates and regions.
+
+        Keyword arguments are fields of ``BreakEdgeParameters``; see
+        :func:`vg_addon.method.break_edges.find_break_edges`."""
+        from .break_edges import find_break_edges
+
+        return find_break_edges(self, **parameters)
+
 
 def _too_far(center: np.ndarray, radius: float) -> GoniometerError:
     return GoniometerError(

@@ -1,0 +1,117 @@
+"""Finding break edges: candidates along the known rims of synthetic fragments.
+
+Oracles: the generators' own labels of which vertices lie on a rim (the exact geometry), and
+``trace_edge`` for replication (a candidate's waypoints retrace its path).
+"""
+
+import numpy as np
+import pytest
+
+from vg_addon import GoniometerError, Surface
+from vg_addon.method.break_edges import (
+    BreakEdgeFinder,
+    BreakEdgeParameters,
+    find_break_edges,
+    trim,
+)
+from vg_addon.synthetic_meshes import REGION_RIM, bone_fragment
+
+
+@pytest.fixture(scope="module")
+def bone():
+    fragment = bone_fragment(spacing=1.0)
+    surface = Surface(fragment.points, fragment.triangles)
+    return fragment, surface, surface.find_break_edges()
+
+
+def test_the_four_rims_of_the_bone_shaft_are_found_as_closed_loops(bone):
+    fragment, _, result = bone
+    assert len(result.candidates) == 4
+    rim = fragment.region == REGION_RIM
+    for candidate in result.candidates:
+        assert candidate.closed
+        assert candidate.path.vertices[0] == candidate.path.vertices[-1]
+        on_rim = rim[candidate.path.vertices].mean()
+        assert on_rim >= 0.9, on_rim
+        assert 0.5 < candidate.confidence <= 1.0
+        assert candidate.mean_bend_deg == pytest.approx(90.0, abs=8.0)
+    # Every rim vertex lies within one mesh edge of a candidate.
+    found = np.vstack([c.path.points for c in result.candidates])
+    h = result.candidates[0].path.mean_edge_length
+    rim_points = fragment.points[rim]
+    nearest = np.min(np.linalg.norm(rim_points[:, None, :] - found[None, :, :], axis=2), axis=1)
+    assert (nearest <= h).mean() >= 0.95
+
+
+def test_numbers_follow_confidence(bone):
+    _, _, result = bone
+    assert [c.number for c in result.candidates] == list(range(1, len(result.candidates) + 1))
+    confidences = [c.confidence for c in result.candidates]
+    assert confidences == sorted(confidences, reverse=True)
+
+
+def test_regions_are_the_four_surfaces(bone):
+    fragment, _, result = bone
+    assert result.region.dtype == np.int32 and result.region.shape == (len(fragment.points),)
+    assert result.region_kind.shape == (4,)
+    for label in range(4):  # outer, inner, transverse, oblique
+        truth = fragment.region == label
+        found = np.unique(result.region[truth])
+        assert found.size == 1 and found[0] >= 0, found
+    assert (result.region[fragment.region == REGION_RIM] == -1).mean() > 0.9
+
+
+def test_waypoints_retrace_each_candidate(bone):
+    _, surface, result = bone
+    for candidate in result.candidates:
+        points = candidate.waypoint_points
+        again = surface.trace_edge(points[0], points[-1], via=points[1:-1])
+        assert np.array_equal(again.vertices, candidate.path.vertices)
+
+
+def test_trim_keeps_a_part_that_retraces(bone):
+    _, surface, result = bone
+    candidate = result.candidates[0]
+    part = trim(candidate, 10.0, 30.0)
+    arc = candidate.path.arc_lengths
+    first = int(np.argmin(np.abs(arc - 10.0)))
+    last = int(np.argmin(np.abs(arc - 30.0)))
+    assert np.array_equal(part.path.vertices, candidate.path.vertices[first : last + 1])
+    assert not part.closed
+    assert part.length == pytest.approx(arc[last] - arc[first])
+    points = part.waypoint_points
+    again = surface.trace_edge(points[0], points[-1], via=points[1:-1])
+    assert np.array_equal(again.vertices, part.path.vertices)
+    with pytest.raises(GoniometerError, match="before the end"):
+        trim(candidate, 30.0, 10.0)
+
+
+def test_steps_report_progress_and_leave_the_result(bone):
+    _, surface, result = bone
+    finder = BreakEdgeFinder(surface)
+    assert finder.result is None
+    progress = list(finder.steps())
+    assert progress == sorted(progress) and progress[0] >= 0 and progress[-1] == 1.0
+    assert [c.path.vertices.tolist() for c in finder.result.candidates] == [
+        c.path.vertices.tolist() for c in result.candidates
+    ]
+    # Derived parameters are filled in, in the mesh's units.
+    used = finder.result.parameters
+    assert used.scale == pytest.approx(3 * result.candidates[0].path.mean_edge_length)
+    assert used.min_length > 0 and used.min_region_area > 0
+
+
+def test_bad_input_is_refused():
+    fragment = bone_fragment(spacing=2.0)
+    cloud = Surface(fragment.points)
+    with pytest.raises(GoniometerError, match="point cloud"):
+        find_break_edges(cloud)
+    surface = Surface(fragment.points, fragment.triangles)
+    with pytest.raises(GoniometerError, match="min_bend_deg"):
+        find_break_edges(surface, min_bend_deg=200)
+    with pytest.raises(GoniometerError, match="scale"):
+        find_break_edges(surface, scale=-1.0)
+    with pytest.raises(GoniometerError, match="Unknown break-edge parameter"):
+        find_break_edges(surface, bend=3)
+    with pytest.raises(GoniometerError):
+        BreakEdgeFinder(surface, BreakEdgeParameters(max_candidates=0))
