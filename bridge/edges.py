@@ -259,12 +259,7 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
             "length": float(group[-1][2] - group[0][2]),
             "arc_lengths": [float(g[2]) for g in group],
             "angles": [float(m.angle) for m in measurements],
-            "mean": figures.mean,
-            "std": figures.std,
-            "min": figures.min,
-            "max": figures.max,
-            "pooled_angle": figures.pooled_angle,
-            "pooled_fit": figures.pooled_fit_error,
+            **record_codec.figure_numbers(figures),
             "flat_spans": [],
             "space": records.MESH,
         }

@@ -465,6 +465,7 @@ def edge_row(obj, edge, *, units: str) -> csvio.EdgeRow:
         max=numbers.get("max"),
         pooled_angle=numbers.get("pooled_angle"),
         pooled_fit=numbers.get("pooled_fit"),
+        **{name: numbers.get(name) for name in record_codec.STUDY_FIGURES},
         points=csvio.format_points(numbers.get("points", [])),
         flat_spans="; ".join(f"{a!r}-{b!r}" for a, b in spans),
         units=units,

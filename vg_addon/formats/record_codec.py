@@ -83,10 +83,33 @@ def measurement_numbers(m, station=None) -> dict:
     }
 
 
+def _optional(value) -> float | None:
+    return None if value is None else float(value)
+
+
+#: The break-agent study's figures an edge record keeps (see ``vg_addon.method.break_figures``);
+#: records of earlier versions lack them (their CSV cells stay blank).
+STUDY_FIGURES = ("median", "range", "arc_length", "chord_length", "arc_angle")
+
+
+def figure_numbers(figures) -> dict:
+    """The summary numbers an edge record stores for ``figures`` (an ``EdgeSummary``):
+    ``mean``, ``std``, ``min``, ``max``, ``pooled_angle``, ``pooled_fit`` and the
+    :data:`STUDY_FIGURES` (``arc_angle`` may be None: undefined)."""
+    return {
+        "mean": float(figures.mean),
+        "std": float(figures.std),
+        "min": float(figures.min),
+        "max": float(figures.max),
+        "pooled_angle": float(figures.pooled_angle),
+        "pooled_fit": float(figures.pooled_fit_error),
+        **{name: _optional(getattr(figures, name)) for name in STUDY_FIGURES},
+    }
+
+
 def edge_numbers(profile, clicks) -> dict:
     """The exact numbers an edge record stores for ``profile`` (an ``EdgeProfile``) and its
     ``clicks`` (the points that define its path)."""
-    figures = profile.figures
     spans = profile.path.flat_spans
     return {
         "points": [_floats(p) for p in clicks],
@@ -97,12 +120,7 @@ def edge_numbers(profile, clicks) -> dict:
         "length": float(profile.path.length),
         "arc_lengths": [float(a) for a in profile.arc_lengths],
         "angles": [float(a) for a in profile.angles],
-        "mean": float(figures.mean),
-        "std": float(figures.std),
-        "min": float(figures.min),
-        "max": float(figures.max),
-        "pooled_angle": float(figures.pooled_angle),
-        "pooled_fit": float(figures.pooled_fit_error),
+        **figure_numbers(profile.figures),
         "flat_spans": [[float(a), float(b)] for a, b in spans],
         "space": MESH,
     }

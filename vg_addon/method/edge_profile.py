@@ -34,6 +34,7 @@ import numpy as np
 
 from ..errors import GoniometerError, bounded_list
 from .algorithm import as_center, as_radius
+from .break_figures import break_figures, fragment_axis
 from .fixed_order import acos_degrees, dot3, eigh3, in_frame, moments, norm3
 from .normals import face_normals
 from .ranges import expand_ranges
@@ -538,6 +539,11 @@ class EdgeSummary:
         outside, along the mean normal). A station's "+" side follows its own binormal, which can
         turn over along a curved edge; painting the left side in one colour keeps the sides of
         the whole edge consistent.
+    median, range, arc_length, chord_length, arc_angle : float or None
+        The break-agent study's figures (see :mod:`.break_figures`): the stations' median angle
+        and range (degrees), the length of the polyline through their centres and from the
+        first to the last, and the angle between the edge's and the fragment's principal axes
+        (degrees; None where undefined).
     """
 
     n_stations: int
@@ -548,6 +554,11 @@ class EdgeSummary:
     pooled_angle: float
     pooled_fit_error: float
     plus_left: tuple = ()
+    median: float | None = None
+    range: float | None = None
+    arc_length: float | None = None
+    chord_length: float | None = None
+    arc_angle: float | None = None
 
 
 def _frame(m: Measurement, direction: np.ndarray) -> np.ndarray:
@@ -596,6 +607,7 @@ def summarize(surface, stations) -> EdgeSummary:
         for key in (True, False)
     )
     pooled = 180.0 - acos_degrees(dot3(left, right))
+    study = break_figures(angles, centers, fragment_axis(surface))
     return EdgeSummary(
         n_stations=len(stations),
         mean=float(angles.mean()),
@@ -605,6 +617,11 @@ def summarize(surface, stations) -> EdgeSummary:
         pooled_angle=pooled,
         pooled_fit_error=left_error + right_error,
         plus_left=tuple(plus_left),
+        median=study.median,
+        range=study.range,
+        arc_length=study.arc_length,
+        chord_length=study.chord_length,
+        arc_angle=study.arc_angle,
     )
 
 

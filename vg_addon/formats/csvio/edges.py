@@ -45,6 +45,11 @@ EDGE_SCHEMA = (
     ("max", "float", ("Max Angle",)),
     ("pooled_angle", "float", ("Pooled Angle",)),
     ("pooled_fit", "float", ("Pooled Fit",)),
+    ("median", "float", ("Median Angle",)),
+    ("range", "float", ("Angle Range",)),
+    ("arc_length", "float", ("Arc Length",)),
+    ("chord_length", "float", ("Chord Length",)),
+    ("arc_angle", "float", ("Arc Angle",)),
     ("points", "text", ("Points",)),
     ("flat_spans", "text", ("Flat Spans",)),
     ("units", "text", ("Units",)),
@@ -59,8 +64,12 @@ EDGE_SCHEMA = (
 EDGE_COLUMNS = tuple(column for _, _, columns in EDGE_SCHEMA for column in columns)
 
 
-#: Columns added to the edge summary file after its first version.
-LATER_EDGE_COLUMNS = ("Coordinates",)
+#: The break-agent study's per-break figures (``vg_addon.method.break_figures``).
+STUDY_COLUMNS = ("Median Angle", "Angle Range", "Arc Length", "Chord Length", "Arc Angle")
+
+#: Columns added to the edge summary file after its first version: files without them read,
+#: their cells blank.
+LATER_EDGE_COLUMNS = ("Coordinates", *STUDY_COLUMNS)
 
 
 @dataclass
@@ -82,6 +91,14 @@ class EdgeRow:
         Of the stations' angles (degrees); ``std`` is the sample standard deviation.
     pooled_angle, pooled_fit : float or None
         One plane pair fitted to all stations' sides (the whole-edge angle), and its fit error.
+    median, range : float or None
+        The stations' median angle and range (max − min), degrees.
+    arc_length, chord_length : float or None
+        Length of the polyline through the station centres, and from the first to the last.
+    arc_angle : float or None
+        Angle (degrees, 0 to 90) between the edge's principal axis and the fragment's; blank
+        where undefined (fewer than two stations, a ring). None for all five in files and
+        records of earlier versions.
     points : str
         The clicked points that define the path, ``"x y z; x y z; ..."`` (start, via, end).
     coordinates : str
@@ -109,6 +126,11 @@ class EdgeRow:
     max: float | None = None
     pooled_angle: float | None = None
     pooled_fit: float | None = None
+    median: float | None = None
+    range: float | None = None
+    arc_length: float | None = None
+    chord_length: float | None = None
+    arc_angle: float | None = None
     points: str = ""
     flat_spans: str = ""
     units: str = ""
