@@ -123,6 +123,32 @@ def measure_edge_on_object(
     profile, geometry, clicks = measure_edge(
         obj, points, spacing, radius, lam, patch, depsgraph=depsgraph, space=space, surface=surface
     )
+    edge = record_profile(obj, profile, geometry, clicks, note=note)
+    measuring.repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    return edge
+
+
+def record_profile(obj, profile, geometry, clicks, *, note=""):
+    """Record a measured ``profile`` on ``obj``: every station as a measurement of one new
+    break, and the edge's record with its summary and plot; the colours are not repainted
+    (``measuring.repaint`` once after several edges).
+
+    Parameters
+    ----------
+    profile : EdgeProfile
+        Measured on ``geometry``'s surface from ``clicks``
+        (``Surface.measure_along(clicks, ...)``), so the edge replays from its record.
+    geometry : Geometry
+        The object's evaluated geometry (``evaluated_geometry``).
+    clicks : ndarray, shape (k, 3)
+        The start, via points and end the profile was traced through, in mesh coordinates.
+    note : str
+        Free text stored with the edge and each station.
+
+    Returns
+    -------
+    The new ``VG_EdgeProfile`` item (now the active edge).
+    """
     break_number = free_break(obj)
     edge_number = obj.vg.next_edge_number
     sides = profile.figures.plus_left
@@ -141,7 +167,6 @@ def measure_edge_on_object(
     )
     obj.vg.break_number = break_number + 1  # the next measurement starts a new break
     edge.plot = make_plot(obj, edge).name
-    measuring.repaint(obj, depsgraph=depsgraph, geometry=geometry)
     return edge
 
 

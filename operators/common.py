@@ -8,6 +8,8 @@ so every such property has a ``soft_min`` (the slider's floor), never a ``min``.
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 from bpy.props import EnumProperty, FloatProperty, FloatVectorProperty
 
@@ -86,6 +88,28 @@ def defaults_from_panel(operator, context, settings_of: dict) -> None:
     if "location" in operator.properties.bl_rna.properties and not given("location"):
         operator.location = context.scene.cursor.location
         operator.space = "WORLD"
+
+
+#: The panel settings an edge-measuring operator takes by default: ``defaults_from_panel``'s
+#: ``settings_of`` for ``spacing`` and the patch properties.
+EDGE_SETTINGS = {
+    "spacing": "edge_spacing",
+    "radius": "radius",
+    "seg_param": "seg_param",
+    "patch": "patch",
+}
+
+
+def clear_texts(area, workspace) -> None:
+    """Remove a modal session's header text (``area``) and status-bar hints (``workspace``);
+    either may be None or already gone."""
+    for clear in (
+        lambda: area.header_text_set(None),
+        lambda: area.tag_redraw(),
+        lambda: workspace.status_text_set(None),
+    ):
+        with contextlib.suppress(AttributeError, ReferenceError):  # None, or already gone
+            clear()
 
 
 def poll_measurable(cls, context) -> bool:

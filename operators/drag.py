@@ -10,8 +10,6 @@ records the measurement it took (not a second one) through the bridge's one reco
 
 from __future__ import annotations
 
-import contextlib
-
 import bpy
 import numpy as np
 from bpy_extras import view3d_utils
@@ -31,7 +29,7 @@ from ..bridge.records import colours_as_painted, unit_symbol
 from ..vg_addon import GoniometerError
 from ..vg_addon.units import length_text
 from ..vg_addon.workflow.drag_state import DragMachine, Phase, surface_callbacks
-from .common import poll_measurable, status_hints, typed_value
+from .common import clear_texts, poll_measurable, status_hints, typed_value
 from .drag_overlay import DragOverlay, patch_vertex_data
 from .measure import MeasureProperties, VG_OT_measure_xyz, report_measurement
 
@@ -361,13 +359,7 @@ class DragSession:
         self.overlay.stop()
         area, self._area = self._area, None
         workspace, self._workspace = self._workspace, None
-        for clear in (
-            lambda: area.header_text_set(None),
-            lambda: area.tag_redraw(),
-            lambda: workspace.status_text_set(None),
-        ):
-            with contextlib.suppress(AttributeError, ReferenceError):  # already gone
-                clear()
+        clear_texts(area, workspace)
 
 
 def record_properties(session: DragSession) -> dict | None:

@@ -12,7 +12,6 @@ whole profile.
 
 from __future__ import annotations
 
-import contextlib
 import json
 
 import bpy
@@ -24,6 +23,7 @@ from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
 from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.edge_state import EdgeMachine, EdgePhase
 from .common import (
+    EDGE_SETTINGS,
     SPACE_ITEMS,
     PatchProperties,
     defaults_from_panel,
@@ -34,6 +34,7 @@ from .common import (
 )
 from .drag import NAVIGATION_EVENTS, format_length, object_alive, ray_cast_object
 from .edge_overlay import EdgeOverlay
+from .view_session import ViewSession
 
 # The drag tool's view navigation, and plain mouse moves (a click session has no drag).
 _NAVIGATION = NAVIGATION_EVENTS | {"MOUSEMOVE"}
@@ -92,30 +93,15 @@ def format_points_json(points) -> str:
     return json.dumps([[float(v) for v in point] for point in np.asarray(points)])
 
 
-class EdgeSession:
+class EdgeSession(ViewSession):
     """One edge-picking session on one object: the machine, the overlay and the texts."""
 
     def __init__(self, context, obj):
-        self.obj = obj
-        area = context.area
-        # Started from the sidebar's button, the context's region is the sidebar: clicks are
-        # taken in the area's main (WINDOW) region, with its view.
-        self._region = next((r for r in area.regions if r.type == "WINDOW"), None)
-        self._region_data = getattr(area.spaces.active, "region_3d", None)
-        if self._region is None or self._region_data is None:
-            raise GoniometerError("Edge profiles are picked in a 3D viewport.")
+        super().__init__(context, obj, EdgeOverlay(), "Edge profiles are picked in a 3D viewport.")
         depsgraph = context.evaluated_depsgraph_get()
         self.machine = EdgeMachine(surface_for(obj, evaluated_geometry(obj, depsgraph)))
-        self.overlay = EdgeOverlay()
-        self._area, self._workspace = area, context.workspace
         self.overlay.start()
         self.refresh(context)
-
-    def region_coord(self, mouse) -> tuple | None:
-        """Window-pixel ``mouse`` relative to the viewport's main region, or None if outside."""
-        x, y = mouse[0] - self._region.x, mouse[1] - self._region.y
-        inside = 0 <= x < self._region.width and 0 <= y < self._region.height
-        return (x, y) if inside else None
 
     def handle(self, context, action: str, mouse=None) -> str:
         """Apply one translated event (``mouse``: window pixel coordinates); returns
@@ -183,19 +169,6 @@ class EdgeSession:
             parts.append(machine.message.splitlines()[0])
         return " · ".join(parts)
 
-    def finish(self) -> None:
-        """Remove the drawing and the texts; safe to call more than once."""
-        self.overlay.stop()
-        area, self._area = self._area, None
-        workspace, self._workspace = self._workspace, None
-        for clear in (
-            lambda: area.header_text_set(None),
-            lambda: area.tag_redraw(),
-            lambda: workspace.status_text_set(None),
-        ):
-            with contextlib.suppress(AttributeError, ReferenceError):
-                clear()
-
 
 class VG_OT_measure_edge(PatchProperties, bpy.types.Operator):
     """Measure a whole break edge: click its start, any via points and its end on the active
@@ -229,12 +202,7 @@ class VG_OT_measure_edge(PatchProperties, bpy.types.Operator):
         defaults_from_panel(
             self,
             context,
-            {
-                "spacing": "edge_spacing",
-                "radius": "radius",
-                "seg_param": "seg_param",
-                "patch": "patch",
-            },
+            EDGE_SETTINGS,
         )
         obj = context.active_object
         try:

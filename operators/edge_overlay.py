@@ -67,37 +67,45 @@ class EdgeOverlay(ViewOverlay):
         batches = []
         for pairs, color in ((self._ridge, PATH_COLOR), (self._flat, FLAT_COLOR)):
             if pairs is not None and len(pairs):
-                batches.append(("LINES", batch_for_shader(lines, "LINES", {"pos": pairs}), color))
+                batch = batch_for_shader(lines, "LINES", {"pos": pairs})
+                batches.append(("LINES", batch, color, LINE_WIDTH))
         if self._clicks is not None and len(self._clicks):
-            batches.append(
-                ("POINTS", batch_for_shader(points, "POINTS", {"pos": self._clicks}), CLICK_COLOR)
-            )
+            batch = batch_for_shader(points, "POINTS", {"pos": self._clicks})
+            batches.append(("POINTS", batch, CLICK_COLOR, CLICK_SIZE))
         return batches
 
     def _draw(self) -> None:
-        region = bpy.context.region
-        if bpy.context.region_data is None or region is None or self._clicks is None:
-            return
-        # Line width and point size as shader uniforms (Metal and Vulkan ignore
-        # line_width_set); points fall back to UNIFORM_COLOR on 4.2, as in the drag overlay.
-        lines = gpu.shader.from_builtin("POLYLINE_UNIFORM_COLOR")
-        points, sized = point_shader()
-        if self._batches is None:
-            self._batches = self._build(lines, points)
-        gpu.state.blend_set("ALPHA")
-        gpu.state.depth_test_set("NONE")
-        if not sized:
-            gpu.state.point_size_set(CLICK_SIZE)
-        for kind, batch, color in self._batches:
-            shader = lines if kind == "LINES" else points
-            shader.bind()
-            if kind == "LINES":
-                shader.uniform_float("viewportSize", (region.width, region.height))
-                shader.uniform_float("lineWidth", LINE_WIDTH)
-            elif sized:
-                shader.uniform_float("size", CLICK_SIZE)
-            shader.uniform_float("color", color)
-            batch.draw(shader)
-        if not sized:
-            gpu.state.point_size_set(1.0)
-        gpu.state.blend_set("NONE")
+        if self._clicks is not None:
+            draw_batches(self)
+
+
+def draw_batches(overlay) -> None:
+    """Draw ``overlay._batches``, built by ``overlay._build(lines, points)`` when None: each
+    ``(kind, batch, colour, size)``, kind ``"LINES"`` (size: the width) or ``"POINTS"``, over
+    everything (no depth test), in the region being drawn."""
+    region = bpy.context.region
+    if bpy.context.region_data is None or region is None:
+        return
+    # Line width and point size as shader uniforms (Metal and Vulkan ignore line_width_set);
+    # points fall back to UNIFORM_COLOR on 4.2, as in the drag overlay.
+    lines = gpu.shader.from_builtin("POLYLINE_UNIFORM_COLOR")
+    points, sized = point_shader()
+    if overlay._batches is None:
+        overlay._batches = overlay._build(lines, points)
+    gpu.state.blend_set("ALPHA")
+    gpu.state.depth_test_set("NONE")
+    for kind, batch, color, size in overlay._batches:
+        shader = lines if kind == "LINES" else points
+        shader.bind()
+        if kind == "LINES":
+            shader.uniform_float("viewportSize", (region.width, region.height))
+            shader.uniform_float("lineWidth", size)
+        elif sized:
+            shader.uniform_float("size", size)
+        else:
+            gpu.state.point_size_set(size)
+        shader.uniform_float("color", color)
+        batch.draw(shader)
+    if not sized:
+        gpu.state.point_size_set(1.0)
+    gpu.state.blend_set("NONE")
