@@ -245,7 +245,8 @@ def _text_fitted(layout, context, label, value) -> None:
 
 
 class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
-    """Whole edges: spacing, the Edge Profile button, the list, and the selected one's plot."""
+    """Whole edges: spacing, Find Break Edges and the .pp import, the Edge Profile button, the
+    list, and the selected one's plot."""
 
     bl_label = "Edge Profiles"
     bl_parent_id = "VIEW3D_PT_vg_measure"
@@ -264,6 +265,9 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         unit = unit_symbol(obj, context.scene)
         column.prop(settings, "edge_spacing", text=f"Spacing ({unit})")
         column.prop(settings, "radius", text=f"Radius ({unit})")
+        row = layout.row(align=True)
+        row.operator("vg.find_break_edges", text="Find Break Edges", icon="VIEWZOOM")
+        row.operator("vg.import_picked_points", text="Import .pp", icon="IMPORT")
         layout.operator("vg.measure_edge", text="Edge Profile", icon="CURVE_PATH")
         wrapped_label(layout, context, "Click start, via points, end; Enter measures", "INFO")
         if not len(obj.vg.edges):

@@ -1,0 +1,122 @@
+"""``vg.import_picked_points``: edges from MeshLab picked-points files (``.pp``).
+
+Each file's active points, in order, are an edge's start, via points and end (the break-agent
+study kept each break's endpoints this way); the edge is traced between them and measured with
+the panel's Spacing, Radius, λ and Patch, as an Edge Profile. A file belongs to the mesh it is
+named after (``NAME.pp`` or ``NAME_anything.pp``: ``formats.picked_points.mesh_for_file``);
+several files are imported together, all of them or none, in one undo step.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import bpy
+from bpy.props import BoolProperty, CollectionProperty, StringProperty
+from bpy_extras.io_utils import ImportHelper
+
+from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
+from ..vg_addon import GoniometerError
+from ..vg_addon.errors import bounded_list
+from ..vg_addon.formats import picked_points
+from .common import poll_measurable, typed_value
+from .csv_ops import _path
+from .find_edges import measure_all, record_all
+
+
+def picked_edges(paths, names, *, ignore_mesh_names=False) -> list:
+    """``(path, points)`` of every file of ``paths``, its points in mesh coordinates; each file
+    must be named after one of ``names`` (the object's and its mesh's) unless
+    ``ignore_mesh_names``.
+
+    Raises
+    ------
+    GoniometerError
+        Listing every file that cannot be read or names another mesh.
+    """
+    found, failures = [], []
+    for path in paths:
+        try:
+            picked = picked_points.read_picked_points(path)
+            if not ignore_mesh_names and picked_points.mesh_for_file(path, names) is None:
+                raise GoniometerError(
+                    f"'{Path(path).name}' is not named after '{names[0]}' (NAME.pp or "
+                    "NAME_*.pp; tick Ignore Names to measure it here)"
+                )
+            found.append((path, picked_points.edge_points(picked)))
+        except GoniometerError as error:
+            failures.append(str(error))
+    if failures:
+        raise GoniometerError(
+            f"{len(failures)} of {len(paths)} picked-points files cannot be used; nothing was "
+            "imported.\n" + bounded_list(failures, lines=True)
+        )
+    return found
+
+
+class VG_OT_import_picked_points(bpy.types.Operator, ImportHelper):
+    """Make an Edge Profile from each MeshLab picked-points file (.pp): its points, in order,
+    are the edge's start, via points and end, measured every Spacing with the panel's
+    settings"""
+
+    bl_idname = "vg.import_picked_points"
+    bl_label = "Import Picked Points (.pp)"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
+
+    filename_ext = picked_points.SUFFIX
+    filter_glob: StringProperty(default="*.pp", options={"HIDDEN"})
+    files: CollectionProperty(type=bpy.types.OperatorFileListElement, options={"HIDDEN"})
+    directory: StringProperty(subtype="DIR_PATH", options={"HIDDEN"})
+    ignore_mesh_names: BoolProperty(
+        name="Ignore Names",
+        description="Measure files named after another mesh on this object too",
+        default=False,
+    )
+
+    @classmethod
+    def poll(cls, context):
+        return poll_measurable(cls, context)
+
+    def paths(self) -> list[str]:
+        """The chosen files: every selected one in the browser, else ``filepath``."""
+        names = [f.name for f in self.files if f.name]
+        if names and self.directory:
+            return [str(Path(bpy.path.abspath(self.directory)) / name) for name in names]
+        path = _path(self)
+        if not path:
+            raise GoniometerError("No file name given: choose the .pp file(s) to import.")
+        return [path]
+
+    def execute(self, context):
+        obj = context.active_object
+        settings = context.scene.vg_settings
+        spacing, radius = typed_value(settings.edge_spacing), typed_value(settings.radius)
+        lam, patch = typed_value(settings.seg_param), settings.patch
+        try:
+            check_measurable(obj)
+            found = picked_edges(
+                self.paths(),
+                (obj.name, obj.data.name),
+                ignore_mesh_names=self.ignore_mesh_names,
+            )
+            geometry = evaluated_geometry(obj, context.evaluated_depsgraph_get())
+            surface = surface_for(obj, geometry)
+            measured = measure_all(
+                surface,
+                [points for _, points in found],
+                (spacing, radius, lam, patch),
+                [f"'{Path(path).name}'" for path, _ in found],
+            )
+        except GoniometerError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        made = record_all(obj, measured, geometry, note=[Path(path).name for path, _ in found])
+        self.report(
+            {"INFO"},
+            f"Made {len(made)} edge profile(s) on '{obj.name}' from picked points: "
+            + ", ".join(f"{e.number} ({e.n_stations} stations, mean {e.mean:.1f}°)" for e in made),
+        )
+        return {"FINISHED"}
+
+
+classes = (VG_OT_import_picked_points,)
