@@ -14,10 +14,9 @@ from ..bridge import colors, measuring, mesh_data, records
 from ..bridge.measurement_map import safe_file_name
 from ..vg_addon import GoniometerError, Surface
 from ..vg_addon.formats import csvio, sweep_plot
-from ..vg_addon.formats.png import encode_png
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
-from .edges import failed_edge_row, measure_edges, spec_applies
+from .edges import failed_edge_row, measure_edges, not_found_row, spec_applies
 from .map_process import draw_map
 from .pictures import reason, try_picture
 from .render import add_sides_material
@@ -32,8 +31,8 @@ class MeshResult:
 
     mesh: int
     rows: list = dataclasses.field(default_factory=list)  # [(task index, MeasurementRow)]
-    station_rows: list = dataclasses.field(default_factory=list)  # --edge stations (in-process)
-    edge_rows: list = dataclasses.field(default_factory=list)  # --edge summaries (in-process)
+    station_rows: list = dataclasses.field(default_factory=list)  # edges' stations
+    edge_rows: list = dataclasses.field(default_factory=list)  # edges' summaries
     object_name: str = ""
     bad_file: str = ""  # why the mesh file could not be read
     n_vertices: int = 0
@@ -56,13 +55,16 @@ class MeshResult:
 
     @classmethod
     def from_json(cls, data: dict, row_type) -> MeshResult:
-        rows = []
-        for index, fields in data.pop("rows"):
+        def row(fields):
             for key in ("normal_plus", "normal_minus", "requested"):
                 if fields.get(key) is not None:
                     fields[key] = tuple(fields[key])
-            rows.append((index, row_type(**fields)))
-        return cls(rows=rows, **data)
+            return row_type(**fields)
+
+        rows = [(index, row(fields)) for index, fields in data.pop("rows")]
+        stations = [row(fields) for fields in data.pop("station_rows")]
+        edges = [csvio.EdgeRow(**fields) for fields in data.pop("edge_rows")]
+        return cls(rows=rows, station_rows=stations, edge_rows=edges, **data)
 
 
 def error_row(task, mesh_name: str, message: str, units: str):
@@ -115,6 +117,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
             failed_edge_row(number, spec, name, message, units)
             for number, spec in enumerate(applying, start=1)
         ]
+        if options.get("find_edges"):
+            result.station_rows.append(not_found_row(options, name, message, units))
         if rows_ready is not None:
             rows_ready(result)
         return result
@@ -182,7 +186,9 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     stem = picture_stem(index, source, options)
     sweep_plots = []
     if options.get("sweep"):
-        sweep_plots = sweep_sites(result, surface, name, stem, tasks, options, geometry.matrix)
+        sweep_plots = sweep_sites(
+            result, surface, name, stem, tasks, options, geometry.matrix, units
+        )
     if len(data.measurements):
         data.next_number = max(item.number for item in data.measurements) + 1
         records.continue_after_recorded_breaks(obj)
@@ -193,7 +199,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
         colors.show_sides_once(obj)
 
     profile_plots = []
-    if options.get("edges"):
+    if options.get("edges") or options.get("find_edges"):
         result.station_rows, result.edge_rows, profile_plots = measure_edges(
             obj, source, options, units, stem, surface, precision
         )
@@ -243,10 +249,10 @@ def _measure_task(surface, geometry, task, options):
         return error
 
 
-def sweep_sites(result: MeshResult, surface, name: str, stem: str, tasks, options, matrix):
+def sweep_sites(result: MeshResult, surface, name: str, stem: str, tasks, options, matrix, units):
     """``--sweep``: each task's site at the sweep's radii, as CSV cells, and the plot of each
     site to draw (``(what, path, png bytes function)``). ``matrix`` is the object's
-    ``matrix_world`` (for world-space rows of older exports)."""
+    ``matrix_world`` (for world-space rows of older exports); ``units`` labels the plot's axes."""
     start, stop, count = options["sweep"]
     folder = Path(options["sweep_plots"])
     plots = []
@@ -264,15 +270,16 @@ def sweep_sites(result: MeshResult, surface, name: str, stem: str, tasks, option
             ]
         else:
             path = folder / f"{stem}_{task.number}.png"
-            plots.append(("sweep plot", path, _sweep_png(points)))
+            title = f"Radius sweep: {name}, site {task.number}"
+            plots.append(("sweep plot", path, _sweep_png(points, units, title)))
         result.sweep_rows.extend(
             (task.index, csvio.sweep_cells(name, task.number, point)) for point in points
         )
     return plots
 
 
-def _sweep_png(points):
-    return lambda: encode_png(sweep_plot.sweep_image(points))
+def _sweep_png(points, units: str, title: str):
+    return lambda: sweep_plot.sweep_png(points, units=units, title=title)
 
 
 def exact_surface(source: MeshSource, points: np.ndarray, geometry) -> Surface:

@@ -12,9 +12,9 @@ from bpy.props import (
 )
 from bpy_extras.io_utils import ExportHelper
 
-from ..bridge import measuring
+from ..bridge import measuring, records
 from ..vg_addon import GoniometerError
-from ..vg_addon.formats import csvio, sweep_plot
+from ..vg_addon.formats import csvio, mpl_plots, sweep_plot
 from .common import (
     LocationProperties,
     defaults_from_panel,
@@ -66,7 +66,12 @@ class VG_OT_radius_sweep(LocationProperties, bpy.types.Operator, ExportHelper):
             )
             image = str(Path(path).with_suffix(".png"))
             csvio.write_sweep_csv(path, obj.name, points)
-            sweep_plot.write_sweep_png(image, points)
+            sweep_plot.write_sweep_png(
+                image,
+                points,
+                units=records.unit_symbol(obj, context.scene),
+                title=f"Radius sweep: {obj.name}",
+            )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
@@ -77,7 +82,8 @@ class VG_OT_radius_sweep(LocationProperties, bpy.types.Operator, ExportHelper):
         self.report(
             {"INFO"},
             f"Sweep of {len(points)} radii on '{obj.name}' ({len(measured)} measured, "
-            f"{min(measured):.2f}° to {max(measured):.2f}°): {path} and {image}",
+            f"{min(measured):.2f}° to {max(measured):.2f}°): {path} and {image}"
+            + ("" if mpl_plots.available() else f" ({mpl_plots.MISSING})"),
         )
         return {"FINISHED"}
 

@@ -101,11 +101,9 @@ def test_png_round_trip():
         encode_png(image.astype(np.float32))
 
 
-def test_plot_marks_every_measured_radius_in_both_panels(surface, tmp_path):
+def test_the_numpy_drawing_marks_every_measured_radius_in_both_panels(surface):
     points = radius_sweep(surface, [0.01, 0.0, 0.0], 0.02, 0.6, 9)
-    path = tmp_path / "sweep.png"
-    sweep_plot.write_sweep_png(path, points)
-    image = read_png(path.read_bytes())
+    image = read_png(encode_png(sweep_plot.draw_sweep(*sweep_plot.sweep_series(points))))
     assert image.shape == (sweep_plot.HEIGHT, sweep_plot.WIDTH, 3)
     span = sweep_plot.WIDTH - sweep_plot._RIGHT - sweep_plot._LEFT
     for point in points:
@@ -115,3 +113,35 @@ def test_plot_marks_every_measured_radius_in_both_panels(surface, tmp_path):
         has_angle = (angle_panel == sweep_plot._ANGLE_COLOUR).all(axis=1).any()
         has_fit = (fit_panel == sweep_plot._FIT_COLOUR).all(axis=1).any()
         assert has_angle == has_fit == (point.measurement is not None)
+
+
+def test_matplotlib_plot_has_both_panels_labels_and_the_refused_radii(surface, tmp_path):
+    pytest.importorskip("matplotlib", reason="requirements/report.txt")
+    from vg_addon.formats import mpl_plots
+
+    points = radius_sweep(surface, [0.01, 0.0, 0.0], 0.02, 0.6, 9)
+    radii, angles, fits = (np.array(v) for v in sweep_plot.sweep_series(points))
+    refused = np.isnan(angles)
+    assert 0 < refused.sum() < len(points)
+    figure = mpl_plots.sweep_figure(
+        radii, angles, fits, width=800, height=560, dpi=120, units="mm", title="Wedge, site 1"
+    )
+    top, bottom = figure.axes
+    assert figure.get_suptitle() == "Wedge, site 1"
+    assert (top.get_ylabel(), bottom.get_ylabel()) == ("angle (°)", "fit error (mm²)")
+    assert bottom.get_xlabel() == "radius (mm)" and bottom.get_yscale() == "log"
+    angle_line, crosses = top.get_lines()
+    assert np.array_equal(angle_line.get_xdata(), radii)
+    assert np.array_equal(angle_line.get_ydata(), angles, equal_nan=True)  # a gap where refused
+    assert np.array_equal(crosses.get_xdata(), radii[refused])
+    legend = [t.get_text() for t in top.get_legend().get_texts()]
+    assert legend == ["angle", f"refused ({refused.sum()})"]
+    # Fits of 0 (rounding-exact on this wedge) have no place on the log axis: marks at its foot.
+    exact = ~refused & (fits == 0)
+    fit_line, exact_marks = bottom.get_lines()
+    assert exact.any()
+    assert np.array_equal(fit_line.get_ydata(), np.where(exact, np.nan, fits), equal_nan=True)
+    assert np.array_equal(exact_marks.get_xdata(), radii[exact])
+    path = tmp_path / "sweep.png"
+    sweep_plot.write_sweep_png(path, points, units="mm", title="Wedge, site 1")
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

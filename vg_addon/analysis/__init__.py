@@ -20,7 +20,14 @@ REPORT_LIBRARIES = {"scipy": "scipy", "statsmodels": "statsmodels", "matplotlib"
 
 def missing_libraries() -> list[str]:
     """The pip names of the report's libraries this Python cannot import (empty: all there)."""
-    return [pip for name, pip in REPORT_LIBRARIES.items() if importlib.util.find_spec(name) is None]
+    return [pip for name, pip in REPORT_LIBRARIES.items() if not _found(name)]
+
+
+def _found(name: str) -> bool:
+    try:
+        return importlib.util.find_spec(name) is not None
+    except (ImportError, ValueError):  # a finder that refuses it, a broken entry in sys.modules
+        return False
 
 
 def missing_message(command: str = "python vg_batch.py --report DIR SESSION.csv ...") -> str:

@@ -1,18 +1,18 @@
-"""An edge profile's plot (angle against arc length) as an RGBA image, and a PNG writer.
+"""An edge profile's plot: the angle at each station against its arc length along the edge.
 
-Pure NumPy and the standard library, so the Blender panel and the headless batch draw the same
-picture without a plotting library. The image has axes with labelled ticks, a line through the
-stations and a dot at each; the y range is padded so a constant profile is a flat line in the
-middle.
+Drawn with matplotlib where it is installed (:mod:`.mpl_plots`: axis labels with units, a title,
+a legend and the whole-edge angle); where it is not (a Blender whose Python has NumPy only), by
+:func:`draw_profile` here, in pure NumPy, so the Blender panel and the headless batch always get
+a picture: axes with labelled ticks, a line through the stations and a dot at each, the y range
+padded so a constant profile is a flat line in the middle.
 """
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from ..errors import GoniometerError
+from . import mpl_plots
 from .png import encode_png
 
 BACKGROUND = (255, 255, 255, 255)
@@ -94,7 +94,7 @@ def _segments(image, xs: np.ndarray, ys: np.ndarray, color, thickness: int = 2) 
 
 
 def plot_frame(arc_lengths, angles, width: int, height: int):
-    """The pixel mapping of :func:`render_profile`: ``(to_x, to_y, x_range, y_range)``.
+    """The pixel mapping of :func:`draw_profile`: ``(to_x, to_y, x_range, y_range)``.
 
     ``to_x(arc)`` and ``to_y(angle)`` give (float) pixel columns and rows, row 0 at the top.
     """
@@ -118,16 +118,7 @@ def plot_frame(arc_lengths, angles, width: int, height: int):
     return to_x, to_y, (x_low, x_high), (y_low, y_high)
 
 
-def render_profile(arc_lengths, angles, *, width: int = 480, height: int = 240) -> np.ndarray:
-    """The profile plot as an ``(height, width, 4)`` uint8 RGBA image, row 0 at the top.
-
-    Parameters
-    ----------
-    arc_lengths, angles : array_like, shape (s,)
-        The stations: arc length along the edge and angle (degrees).
-    width, height : int
-        Image size in pixels (at least 160 x 100).
-    """
+def _checked(arc_lengths, angles, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     arc = np.asarray(arc_lengths, dtype=np.float64).ravel()
     angle = np.asarray(angles, dtype=np.float64).ravel()
     if arc.size == 0 or arc.size != angle.size or not np.isfinite(np.r_[arc, angle]).all():
@@ -138,6 +129,53 @@ def render_profile(arc_lengths, angles, *, width: int = 480, height: int = 240) 
         raise GoniometerError(
             f"A profile plot needs at least 160 x 100 pixels; got {width} x {height}."
         )
+    return arc, angle
+
+
+def render_profile(
+    arc_lengths, angles, *, width: int = 480, height: int = 240, units="", title="", pooled=None
+) -> np.ndarray:
+    """The profile plot as an ``(height, width, 4)`` uint8 RGBA image, row 0 at the top: drawn
+    by matplotlib where it is installed, else by :func:`draw_profile`.
+
+    Parameters
+    ----------
+    arc_lengths, angles : array_like, shape (s,)
+        The stations: arc length along the edge and angle (degrees).
+    width, height : int
+        Image size in pixels (at least 160 x 100).
+    units : str
+        The mesh's length unit for the arc-length axis (``"mm"``); empty: "mesh units".
+    title : str
+        The plot's title (matplotlib only), e.g. "Fragment 3, edge 1".
+    pooled : float, optional
+        The whole-edge angle, drawn as a dashed line (matplotlib only).
+    """
+    arc, angle = _checked(arc_lengths, angles, width, height)
+    if not mpl_plots.available():
+        return draw_profile(arc, angle, width=width, height=height)
+    figure = mpl_plots.profile_figure(
+        arc, angle, width=width, height=height, dpi=100, units=units, title=title, pooled=pooled
+    )
+    return mpl_plots.rgba(figure)
+
+
+def profile_png(arc_lengths, angles, *, units="", title="", pooled=None) -> bytes:
+    """The profile plot as the bytes of a PNG file, for the batch: 768 x 408 pixels by
+    matplotlib where it is installed, else :func:`draw_profile`'s 480 x 240."""
+    arc, angle = _checked(arc_lengths, angles, 480, 240)
+    if not mpl_plots.available():
+        return encode_png(draw_profile(arc, angle), level=6)
+    figure = mpl_plots.profile_figure(
+        arc, angle, width=768, height=408, dpi=120, units=units, title=title, pooled=pooled
+    )
+    return mpl_plots.png(figure)
+
+
+def draw_profile(arc_lengths, angles, *, width: int = 480, height: int = 240) -> np.ndarray:
+    """The NumPy drawing of the profile plot (no plotting library): an ``(height, width, 4)``
+    uint8 RGBA image with tick labels in a 3x5 pixel font (arguments as :func:`render_profile`)."""
+    arc, angle = _checked(arc_lengths, angles, width, height)
     image = np.empty((height, width, 4), dtype=np.uint8)
     image[:] = BACKGROUND
     to_x, to_y, x_range, y_range = plot_frame(arc, angle, width, height)
@@ -162,16 +200,3 @@ def render_profile(arc_lengths, angles, *, width: int = 480, height: int = 240) 
     for x, y in zip(np.round(xs).astype(int), np.round(ys).astype(int), strict=True):
         image[max(y - 2, 0) : y + 3, max(x - 2, 0) : x + 3] = DOTS
     return image
-
-
-def write_png(path, image: np.ndarray, *, overwrite: bool = False) -> None:
-    """Write ``image`` as a PNG file at ``path``: a new file, unless ``overwrite`` (an output
-    being regenerated, like a batch run's); an existing one is refused otherwise."""
-    path = os.fspath(path)
-    try:
-        with open(path, "wb" if overwrite else "xb") as handle:
-            handle.write(encode_png(image, level=6))
-    except FileExistsError:
-        raise GoniometerError(
-            f"{path} already exists: choose another output folder or remove the old plot."
-        ) from None

@@ -1,5 +1,10 @@
-"""The radius sweep drawn as a small image: angle (top) and fit error (bottom, log scale) against
-the radius, with tick labels in a built-in 3x5 pixel font, so no plotting library is needed."""
+"""The radius sweep's plot: angle (top) and fit error (bottom, log scale) against the radius.
+
+Drawn with matplotlib where it is installed (:mod:`.mpl_plots`: axis labels with units, a title,
+a legend); where it is not (a Blender whose Python has NumPy only), by :func:`draw_sweep` here,
+with tick labels in a built-in 3x5 pixel font, so the Sweep operator and the batch always write
+a picture.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +13,7 @@ import os
 
 import numpy as np
 
+from . import mpl_plots
 from .files import replace_atomically
 from .png import encode_png
 
@@ -132,8 +138,9 @@ def _panel(image, top, bottom, radii, values, x_of, low, high, colour, title, ti
         image[max(y - 3, 0) : y + 4, max(x - 3, 0) : x + 4] = colour
 
 
-def render_sweep(radii, angles, fit_errors) -> np.ndarray:
-    """An ``(HEIGHT, WIDTH, 3)`` uint8 image of a radius sweep.
+def draw_sweep(radii, angles, fit_errors) -> np.ndarray:
+    """The NumPy drawing of a radius sweep (no plotting library): an ``(HEIGHT, WIDTH, 3)``
+    uint8 image.
 
     Parameters
     ----------
@@ -202,16 +209,36 @@ def render_sweep(radii, angles, fit_errors) -> np.ndarray:
     return image
 
 
-def sweep_image(points) -> np.ndarray:
-    """:func:`render_sweep` of ``vg_addon.method.sweep`` points."""
+def sweep_series(points) -> tuple[list, list, list]:
+    """The radii, angles and fit errors of ``vg_addon.method.sweep`` points (NaN: refused)."""
     measured = [point.measurement for point in points]
-    return render_sweep(
+    return (
         [point.radius for point in points],
         [np.nan if m is None else m.angle for m in measured],
         [np.nan if m is None else m.fit_error for m in measured],
     )
 
 
-def write_sweep_png(path, points) -> None:
-    """Draw a sweep and write it to ``path`` as a PNG, atomically."""
-    replace_atomically(os.fspath(path), encode_png(sweep_image(points)))
+def sweep_png(points, *, units: str = "", title: str = "") -> bytes:
+    """The plot of ``vg_addon.method.sweep`` points as the bytes of a PNG file: 800 x 560 pixels
+    by matplotlib where it is installed, else :func:`draw_sweep`'s picture.
+
+    Parameters
+    ----------
+    units : str
+        The mesh's length unit (``"mm"``); empty: "mesh units".
+    title : str
+        The plot's title (matplotlib only), e.g. "Fragment 3, site 2".
+    """
+    radii, angles, fits = sweep_series(points)
+    if not mpl_plots.available():
+        return encode_png(draw_sweep(radii, angles, fits))
+    figure = mpl_plots.sweep_figure(
+        radii, angles, fits, width=800, height=560, dpi=120, units=units, title=title
+    )
+    return mpl_plots.png(figure)
+
+
+def write_sweep_png(path, points, *, units: str = "", title: str = "") -> None:
+    """Draw a sweep (:func:`sweep_png`) and write it to ``path``, atomically."""
+    replace_atomically(os.fspath(path), sweep_png(points, units=units, title=title))
