@@ -462,6 +462,28 @@ class VG_SceneSettings(PropertyGroup):
         description="Import rows whose Mesh Name is not this object's (e.g. a renamed scan)",
         default=False,
     )
+    # The Replication Report's choices (its file browser shows them), kept with the scene.
+    report_include_scene: BoolProperty(
+        name="This scene's measurements",
+        description="Add the measurements of every mesh in this scene as one more session",
+        default=True,
+    )
+    report_scene_method: EnumProperty(
+        name="Their method",
+        description="The method of this scene's measurements as a session",
+        items=(
+            ("drag", "Drag", "Centres placed and radii dragged by hand"),
+            ("xyz", "xyz", "Re-measured at given centres (CSV import)"),
+        ),
+        default="drag",
+    )
+    report_folder: StringProperty(
+        name="Report folder",
+        description="Where report.html, the CSV tables and figures/ go (default: a folder "
+        "'vg_report' beside the first CSV, or beside the .blend file)",
+        subtype="DIR_PATH",
+        default="",
+    )
 
 
 classes = (VG_Measurement, VG_EdgeProfile, VG_ObjectData, VG_SceneSettings)

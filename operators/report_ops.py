@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 
 import bpy
-from bpy.props import BoolProperty, CollectionProperty, EnumProperty, StringProperty
+from bpy.props import CollectionProperty, StringProperty
 from bpy.types import OperatorFileListElement
 from bpy_extras.io_utils import ImportHelper
 
@@ -33,7 +33,8 @@ def batch_command(folder: str, paths: list[str]) -> str:
 class VG_OT_report(bpy.types.Operator, ImportHelper):
     """Write the replication report (IOV per break and method, inter-observer ICC, Tukey HSD,
     regression, Bland-Altman, figures) over the chosen session CSVs and, if ticked, this
-    scene's measurements: report.html and CSV tables in the report folder"""
+    scene's measurements: report.html and CSV tables in the report folder (the scene's report
+    settings, ``Scene.vg_settings.report_*``)"""
 
     bl_idname = "vg.report"
     bl_label = "Replication Report"
@@ -43,27 +44,6 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
     filter_glob: StringProperty(default="*.csv", options={"HIDDEN"})
     files: CollectionProperty(type=OperatorFileListElement, options={"HIDDEN", "SKIP_SAVE"})
     directory: StringProperty(subtype="DIR_PATH", options={"HIDDEN", "SKIP_SAVE"})
-    include_scene: BoolProperty(
-        name="This scene's measurements",
-        description="Add the measurements of every mesh in this scene as one more session",
-        default=True,
-    )
-    scene_method: EnumProperty(
-        name="Their method",
-        description="The method of this scene's measurements as a session",
-        items=(
-            ("drag", "Drag", "Centres placed and radii dragged by hand"),
-            ("xyz", "xyz", "Re-measured at given centres (CSV import)"),
-        ),
-        default="drag",
-    )
-    report_folder: StringProperty(
-        name="Report folder",
-        description="Where report.html, the CSV tables and figures/ go (default: a folder "
-        "'vg_report' beside the first CSV, or beside the .blend file)",
-        subtype="DIR_PATH",
-        default="",
-    )
 
     def _sessions(self) -> list[str]:
         folder = bpy.path.abspath(self.directory) if self.directory else ""
@@ -72,9 +52,21 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
             return [bpy.path.abspath(self.filepath)]
         return [os.path.join(folder, name) for name in names]
 
-    def _folder(self, sessions: list[str]) -> str:
-        if self.report_folder:
-            return bpy.path.abspath(self.report_folder)
+    def draw(self, context):
+        """The file browser's side panel: the scene's report settings (one home, saved in the
+        .blend), so the next report starts from the same choices."""
+        settings = context.scene.vg_settings
+        layout = self.layout
+        layout.prop(settings, "report_include_scene")
+        row = layout.row()
+        row.active = settings.report_include_scene
+        row.prop(settings, "report_scene_method")
+        layout.prop(settings, "report_folder")
+
+    def _folder(self, context, sessions: list[str]) -> str:
+        folder = context.scene.vg_settings.report_folder
+        if folder:
+            return bpy.path.abspath(folder)
         if sessions:
             return os.path.join(os.path.dirname(sessions[0]), "vg_report")
         if bpy.data.filepath:
@@ -84,7 +76,7 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
     def invoke(self, context, event):
         """Refuse at once where the libraries are missing (no files to choose in vain), else
         open the file browser on CSV files."""
-        missing = missing_message(batch_command(self.report_folder, []))
+        missing = missing_message(batch_command(context.scene.vg_settings.report_folder, []))
         if missing:
             self.report({"ERROR"}, missing)
             return {"CANCELLED"}
@@ -93,8 +85,9 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
         return {"RUNNING_MODAL"}
 
     def execute(self, context):
+        settings = context.scene.vg_settings
         sessions = self._sessions()
-        folder = self._folder(sessions)
+        folder = self._folder(context, sessions)
         missing = missing_message(batch_command(folder, sessions))
         if missing:
             self.report({"ERROR"}, missing)
@@ -106,7 +99,7 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
             return {"CANCELLED"}
         measured = [o for o in context.scene.objects if o.type == "MESH" and len(o.vg.measurements)]
         try:
-            if self.include_scene and measured:
+            if settings.report_include_scene and measured:
                 os.makedirs(folder, exist_ok=True)
                 scene_csv = os.path.join(folder, SCENE_SESSION)
                 if any(os.path.realpath(p) == os.path.realpath(scene_csv) for p in sessions):
@@ -122,8 +115,8 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
                 csvio.write_measurements_csv(scene_csv, rows)
                 sessions = [*sessions, scene_csv]
             methods = [None] * len(sessions)
-            if self.include_scene and measured:
-                methods[-1] = self.scene_method
+            if settings.report_include_scene and measured:
+                methods[-1] = settings.report_scene_method
             if not sessions:
                 raise GoniometerError(
                     "No sessions: choose session CSVs, or measure in this scene and tick "

@@ -23,12 +23,13 @@ def test_report_operator_over_the_scene_and_csv_sessions(vg, tmp_path):
             f"Mesh,Break #,Angle\nWedge,1,{a}\nWedge,2,{b}\n", encoding="utf-8"
         )
     folder = tmp_path / "report"
+    settings = bpy.context.scene.vg_settings  # the report's choices live with the scene
+    settings.report_include_scene = True
+    settings.report_scene_method = "xyz"
+    settings.report_folder = str(folder)
     result = bpy.ops.vg.report(
         directory=str(tmp_path),
         files=[{"name": n} for n in ("obs1_drag_1.csv", "obs1_manual_1.csv", "obs1_manual_2.csv")],
-        include_scene=True,
-        scene_method="xyz",
-        report_folder=str(folder),
     )
     assert result == {"FINISHED"}
     assert (folder / "report.html").is_file()
@@ -49,7 +50,8 @@ def test_report_operator_over_the_scene_and_csv_sessions(vg, tmp_path):
 
 def test_report_operator_without_sessions_says_what_to_choose(vg, tmp_path):
     with pytest.raises(RuntimeError, match="No sessions: choose session CSVs, or measure"):
-        bpy.ops.vg.report(
-            directory=str(tmp_path), files=[], include_scene=True, report_folder=str(tmp_path / "r")
-        )
+        settings = bpy.context.scene.vg_settings
+        settings.report_include_scene = True
+        settings.report_folder = str(tmp_path / "r")
+        bpy.ops.vg.report(directory=str(tmp_path), files=[])
     assert not (tmp_path / "r" / "report.html").exists()
