@@ -239,10 +239,17 @@ def import_edges_csv(
 
 
 def make_plot(obj, edge):
-    """The profile plot of ``edge`` as a packed image (saved inside the .blend)."""
+    """The profile plot of ``edge`` as a packed image (saved inside the .blend): matplotlib's
+    where Blender's Python has it, else the extension's NumPy drawing."""
     numbers = exact_numbers(edge)
     rgba = profile_plot.render_profile(
-        numbers["arc_lengths"], numbers["angles"], width=PLOT_SIZE[0], height=PLOT_SIZE[1]
+        numbers["arc_lengths"],
+        numbers["angles"],
+        width=PLOT_SIZE[0],
+        height=PLOT_SIZE[1],
+        units=records.unit_symbol(obj, bpy.context.scene),
+        title=f"{obj.name}, edge {edge.number}",
+        pooled=numbers.get("pooled_angle"),
     )
     width, height = PLOT_SIZE
     image = bpy.data.images.new(f"VG {obj.name} edge {edge.number}", width, height, alpha=True)

@@ -78,6 +78,7 @@ def test_stations_replay_with_measure_xyz(vg):
 
 
 def test_plot_image_is_made_packed_and_saved(vg, tmp_path):
+    from vg_addon import units
     from vg_addon.formats import profile_plot
 
     obj, _ = ramp_object()
@@ -86,7 +87,13 @@ def test_plot_image_is_made_packed_and_saved(vg, tmp_path):
     image = bpy.data.images[edge.plot]
     assert tuple(image.size) == (480, 240) and image.packed_file is not None
     numbers = exact(edge)
-    expected = profile_plot.render_profile(numbers["arc_lengths"], numbers["angles"])
+    expected = profile_plot.render_profile(
+        numbers["arc_lengths"],
+        numbers["angles"],
+        units=units.SYMBOLS.get(obj.vg.unit, "m"),  # the Scan Units, else the scene's metre
+        title="Ramp, edge 1",
+        pooled=numbers["pooled_angle"],
+    )
     path = tmp_path / "edge.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.read_homefile(use_empty=True)
