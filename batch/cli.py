@@ -61,6 +61,11 @@ edges:
   (start, via points, end) are an edge, measured with --spacing and --radius on the mesh its
   file name names (NAME.pp or NAME_*.pp for the mesh NAME). Edges run in this process (not
   with --jobs or --shard).
+  --find-edges finds every break edge of each mesh (ridges between smooth faces; see
+  docs/EDGE_DETECTION.md) and profiles each like an --edge, with --spacing D and --radius R:
+  stations in --out, summaries in OUT_edges.csv (each row re-measures with --edges), a plot
+  per edge, and with --render the map with the edges drawn. --min-length L drops edges
+  shorter than L (default: from the mesh's resolution). It works with --jobs (not --shard).
 
 output:
   --out CSV gets one row per requested point, in input order, in the extension's export
@@ -121,7 +126,8 @@ def build_parser() -> argparse.ArgumentParser:
         usage="blender -b [file.blend] --python vg_batch.py -- ARGS\n"
         "       python vg_batch.py ARGS\n\n"
         "ARGS:  MESH... [--object NAME] (--at X Y Z ... | --points CSV) [--radius R]\n"
-        "       [--edge X1 Y1 Z1 X2 Y2 Z2 [--via X Y Z]... --spacing D]... [--edges CSV]\n"
+        "       [--edge X1 Y1 Z1 X2 Y2 Z2 [--via X Y Z]... --spacing D]... [--edges CSV|PP]\n"
+        "       [--find-edges --spacing D [--min-length L]]\n"
         "       [--lambda L] [--patch euclidean|geodesic] [--rule oriented|paper]\n"
         "       [--stability] [--sweep R0 R1 N] --out CSV [--save-blend PATH]\n"
         "       [--render DIR] [--jobs N] [--shard K/N]\n"
@@ -182,6 +188,17 @@ def build_parser() -> argparse.ArgumentParser:
         help="an edge summary CSV (NAME_edges.csv): re-measure each of its edges on its mesh; "
         "or MeshLab picked-points files (a .pp file or a folder of them): each file's points "
         "are an edge on the mesh its name names (NAME.pp, NAME_*.pp)",
+    )
+    edges.add_argument(
+        "--find-edges",
+        action="store_true",
+        help="find every break edge of each mesh and profile each (needs --spacing and --radius)",
+    )
+    edges.add_argument(
+        "--min-length",
+        type=float,
+        metavar="L",
+        help="with --find-edges: drop edges shorter than L (mesh units; default: from the mesh)",
     )
     edges.add_argument(
         "--spacing",
@@ -368,6 +385,25 @@ def check_edge_points(edges) -> None:
             )
 
 
+def check_find_edges(args) -> None:
+    """Refuse ``--find-edges`` without a spacing and radius, with ``--shard``, and a
+    ``--min-length`` that is not a positive number or comes without ``--find-edges``."""
+    if args.min_length is not None and not args.find_edges:
+        raise UsageError("--min-length L is for --find-edges.")
+    if not args.find_edges:
+        return
+    if args.spacing is None or args.radius is None:
+        raise UsageError("--find-edges needs --spacing D and --radius R (in the mesh's units).")
+    if args.shard:
+        raise UsageError(
+            "--find-edges profiles every edge of each mesh, which does not split into shares of "
+            "rows: drop --shard (--jobs N measures N meshes at a time)."
+        )
+    length = args.min_length
+    if length is not None and not (math.isfinite(length) and length > 0):
+        raise UsageError(f"--min-length must be a positive number (got {length:g}).")
+
+
 def check_args(args) -> None:
     if args.demo:
         extra = [
@@ -379,6 +415,7 @@ def check_args(args) -> None:
                 ("--points", args.points),
                 ("--edge", args.edge),
                 ("--edges", args.edges_csv),
+                ("--find-edges", args.find_edges),
                 ("--out", args.out),
                 ("--shard", args.shard),
             )
@@ -395,15 +432,16 @@ def check_args(args) -> None:
         raise UsageError(
             "give the points to measure with --at X Y Z (repeatable) or --points CSV, not both."
         )
-    if not (args.at or args.points or args.edge or args.edges_csv):
+    if not (args.at or args.points or args.edge or args.edges_csv or args.find_edges):
         raise UsageError(
             "give what to measure: --at X Y Z (repeatable), --points CSV, --edge "
-            "X1 Y1 Z1 X2 Y2 Z2 (repeatable) or --edges CSV."
+            "X1 Y1 Z1 X2 Y2 Z2 (repeatable), --edges CSV or --find-edges."
         )
     if args.edge and (args.spacing is None or args.radius is None):
         raise UsageError("--edge needs --spacing D and --radius R (in the mesh's units).")
     if (args.edge or args.edges_csv) and (args.jobs > 1 or args.shard):
         raise UsageError("edges are measured in this process: drop --jobs and --shard.")
+    check_find_edges(args)
     if not args.out:
         raise UsageError("--out CSV is required: the measurements CSV to write.")
     if args.jobs < 1:

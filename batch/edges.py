@@ -18,6 +18,7 @@ from ..vg_addon.formats.png import encode_png
 from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.edge_profile import check_station_count
 from .cli import UsageError
+from .find_edges import found_edge_specs
 from .stdio import say
 
 
@@ -190,15 +191,23 @@ def spec_applies(spec: dict, source) -> bool:
     return csvio.mesh_name_matches(spec["mesh_name"], source.names)
 
 
-def failed_edge_row(number: int, spec: dict, mesh_name: str, message: str, units):
+def not_found_row(options: dict, mesh_name: str, message: str, units):
+    """The output row of a mesh whose edges ``--find-edges`` could not look for."""
+    spec = {key: options["find_edges"][key] for key in ("spacing", "radius", "lam", "patch")}
+    row = failed_edge_row(None, {**spec, "points": [None]}, mesh_name, message, units)
+    return dataclasses.replace(row, error=f"edges not found: {message}")
+
+
+def failed_edge_row(number: int | None, spec: dict, mesh_name: str, message: str, units):
     """The output row of an edge that could not be measured."""
+    first = spec["points"][0]
     return csvio.MeasurementRow(
         mesh_name=mesh_name,
         date=csvio.now_iso(),
         radius=spec["radius"],
         lam=spec["lam"],
         patch=spec["patch"],
-        requested=tuple(float(v) for v in spec["points"][0]),
+        requested=None if first is None else tuple(float(v) for v in first),
         edge_number=number,
         spacing=spec["spacing"],
         units=units,
@@ -225,9 +234,13 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
     """
     station_rows, edge_rows, plots = [], [], []
     name = source.name
-    for spec in options["edges"]:
-        if not spec_applies(spec, source):
-            continue
+    specs = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
+    if options.get("find_edges"):
+        try:
+            specs += found_edge_specs(surface, options, name)
+        except GoniometerError as error:
+            station_rows.append(not_found_row(options, name, str(error), units))
+    for spec in specs:
         number = obj.vg.next_edge_number
         try:
             edge = edges.measure_edge_on_object(

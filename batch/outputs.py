@@ -102,7 +102,7 @@ def check_outputs(args) -> None:
     if (
         args.out
         and args.out != files.STDOUT
-        and (getattr(args, "edge", None) or getattr(args, "edges_csv", None))
+        and any(getattr(args, name, None) for name in ("edge", "edges_csv", "find_edges"))
     ):
         outputs.append(("--out's edge summary", str(csvio.edges_path_for(args.out))))
     if args.sweep:

@@ -23,6 +23,7 @@ from . import extension
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
 from .edges import edge_specs, spec_applies
+from .find_edges import find_options
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
 from .outputs import check_outputs, input_files, make_folders, sweep_paths
 from .pictures import picture_names, reason
@@ -40,8 +41,9 @@ class Run:
         self.jobs = 1  # processes measuring at once
         self.rows: dict[int, object] = {}
         self.sweep_rows: list = []  # (task index, cells), --sweep
-        self.station_rows: list = []  # edge profiles' stations (and failed edges), after the rows
-        self.edge_rows: list = []  # one summary per edge profile, for OUT_edges.csv
+        # Per mesh: edge profiles' stations (and failed edges), written after the rows, and one
+        # summary per edge for OUT_edges.csv; in mesh order however the workers finish.
+        self.edges_by_mesh: dict[int, tuple[list, list]] = {}
         self.results: list[MeshResult] = []
         self.bad_files: list[str] = []
         self.lock = threading.Lock()
@@ -59,6 +61,16 @@ class Run:
         for task in tasks:
             if task.mesh < 0:
                 self.rows[task.index] = error_row(task, task.mesh_name, task.error, self.units)
+
+    @property
+    def station_rows(self) -> list:
+        """Every edge's station rows (and failed edges' rows), mesh after mesh."""
+        return [row for mesh in sorted(self.edges_by_mesh) for row in self.edges_by_mesh[mesh][0]]
+
+    @property
+    def edge_rows(self) -> list:
+        """Every edge's summary row, mesh after mesh."""
+        return [row for mesh in sorted(self.edges_by_mesh) for row in self.edges_by_mesh[mesh][1]]
 
     @property
     def done_points(self) -> int:
@@ -110,8 +122,10 @@ class Run:
             for index, row in result.rows:
                 self.rows[index] = csvio.writable_row(row)
             self.sweep_rows.extend(result.sweep_rows)
-            self.station_rows.extend(csvio.writable_row(row) for row in result.station_rows)
-            self.edge_rows.extend(csvio.writable_row(row) for row in result.edge_rows)
+            self.edges_by_mesh[result.mesh] = (
+                [csvio.writable_row(row) for row in result.station_rows],
+                [csvio.writable_row(row) for row in result.edge_rows],
+            )
             if result.bad_file:
                 self.bad_files.append(result.bad_file)
             # Each write costs more as rows accumulate; finish() always writes.
@@ -187,7 +201,7 @@ class Run:
         start = time.perf_counter()
         rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
         csvio.write_measurements_csv(out, rows)
-        if self.args.edge or self.args.edges_csv:
+        if self.args.edge or self.args.edges_csv or self.args.find_edges:
             csvio.write_edges_csv(csvio.edges_path_for(out), self.edge_rows)
         self.last_write = time.perf_counter()
         self.write_seconds = self.last_write - start
@@ -337,11 +351,13 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         raise UsageError(str(error)) from None
     edges = edge_specs(args, sources)
     groups = {mesh: ts for mesh, ts in bp.by_mesh(tasks).items() if mesh >= 0}
-    if edges:  # every mesh with edges is measured, whether or not it has points
+    if edges or args.find_edges:  # every mesh with edges is measured, with or without points
         groups = {
             mesh: groups.get(mesh, [])
             for mesh in range(len(sources))
-            if mesh in groups or any(spec_applies(spec, sources[mesh]) for spec in edges)
+            if mesh in groups
+            or args.find_edges
+            or any(spec_applies(spec, sources[mesh]) for spec in edges)
         }
     stems, renamed = picture_names([source.name for source in sources])
     units = args.units or ("none" if not blend else None)
@@ -359,9 +375,12 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "sweep": list(args.sweep) if args.sweep else None,
         "sweep_plots": str(sweep_paths(args.out)[1]) if args.sweep else "",
         "edges": edges,
+        "find_edges": find_options(args),
         "picture_names": stems,
         "inputs": input_files(args),
-        "plots": str(Path(args.out).resolve().parent / Path(args.out).stem) if edges else "",
+        "plots": str(Path(args.out).resolve().parent / Path(args.out).stem)
+        if edges or args.find_edges
+        else "",
     }
     if args.sweep:
         sweep_paths(args.out)[1].mkdir(parents=True, exist_ok=True)
@@ -381,7 +400,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         run.say("a .blend input is measured in this process (--jobs applies to mesh files only)")
     folder = tempfile.mkdtemp(prefix="vg-batch-") if parallel else ""
     kept = []  # objects measured in this process, kept for --save-blend
-    pictures = bool(args.render or args.sweep or edges)  # drawn after each mesh's rows
+    pictures = bool(args.render or args.sweep or edges or args.find_edges)  # after the rows
     try:
         try:
             if parallel:

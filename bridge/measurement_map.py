@@ -18,7 +18,8 @@ onto its surface along its mean normal (or tilted from it, or from the other sid
 reaches its centre). One that no direction sees (inside a closed cavity) is listed on a last
 picture, "not shown", which the contact sheet includes. The labels are set in DejaVu Sans Mono,
 which Blender ships: its "1" has a flag and a foot, so "11" never reads "II".
-Everything made for the render is removed afterwards, whatever happens.
+Each edge profile's traced path is drawn as a thin magenta line (``map_edges``). Everything made
+for the render is removed afterwards, whatever happens.
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, looks_at, place_labels, view_up
 from .colors import new_sides_material
 from .label_data import labels_of
+from .map_edges import LINE_COLOUR, add_edge_lines
 from .mesh_data import read_positions, world_points
 
 MAP_VIEWS = ("SIX", "FLAKE")
@@ -195,6 +197,8 @@ class MapJob:
         scene.view_settings.view_transform = "Standard"
         self._white = self._flat_material("VG Map label", (1.0, 1.0, 1.0, 1.0))
         self._black = self._flat_material("VG Map outline", (0.0, 0.0, 0.0, 1.0))
+        line = self._flat_material("VG Map edge", LINE_COLOUR)
+        add_edge_lines(scene, self.obj, line, self._size, self._keep)
         self._copy = copy
         self._font = self._label_font()
 
@@ -529,6 +533,7 @@ class MapJob:
                 bpy.types.Object: bpy.data.objects,
                 bpy.types.Mesh: bpy.data.meshes,
                 bpy.types.TextCurve: bpy.data.curves,
+                bpy.types.Curve: bpy.data.curves,
                 bpy.types.Camera: bpy.data.cameras,
                 bpy.types.SunLight: bpy.data.lights,
                 bpy.types.World: bpy.data.worlds,

@@ -1,0 +1,71 @@
+"""The measurement map's edge lines: each edge profile's traced path drawn as a thin magenta tube.
+
+A map of a fragment whose edges were profiled (clicked, imported from a CSV or ``.pp`` file, or
+found by ``--find-edges``) shows where each edge runs; the stations' numbered labels stay as
+they are. The tubes are curve objects of the map's throwaway scene, made here and removed with
+it.
+"""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+from mathutils import Matrix
+
+from ..vg_addon.formats import record_codec
+
+LINE_WIDTH = 0.003
+"""The tube's radius, as a fraction of the object's bounding-box diagonal."""
+
+LINE_COLOUR = (0.9, 0.0, 0.9, 1.0)
+"""Magenta: in no side colour pair (Okabe-Ito), so it stands out on every side and the sky."""
+
+
+def edge_paths(obj) -> list[tuple[np.ndarray, bool]]:
+    """Each edge record's traced path, ``(points, in_mesh_coordinates)``, skipping records
+    without one (damaged outside the extension)."""
+    paths = []
+    for edge in obj.vg.edges:
+        numbers = record_codec.exact_numbers(edge)
+        points = np.asarray(numbers.get("path", []), dtype=np.float64)
+        if points.ndim == 2 and points.shape[0] >= 2 and points.shape[1] == 3:
+            paths.append((points, numbers.get("space") == record_codec.MESH))
+    return paths
+
+
+def add_edge_lines(scene, obj, material, size: float, keep) -> int:
+    """Draw every edge of ``obj`` into ``scene`` as a tube of radius ``LINE_WIDTH * size``.
+
+    Parameters
+    ----------
+    scene : bpy.types.Scene
+        The map's throwaway scene.
+    obj : bpy.types.Object
+        The measured object (its edges' paths are in its mesh coordinates).
+    material : bpy.types.Material
+        What the tubes show.
+    size : float
+        The object's bounding-box diagonal (world units).
+    keep : callable
+        Called with every data-block made, so the map removes it afterwards.
+
+    Returns
+    -------
+    int
+        How many edges were drawn.
+    """
+    paths = edge_paths(obj)
+    for number, (points, in_mesh) in enumerate(paths, start=1):
+        curve = keep(bpy.data.curves.new(f"VG Map edge {number}", type="CURVE"))
+        curve.dimensions = "3D"
+        curve.bevel_depth = LINE_WIDTH * size
+        curve.bevel_resolution = 2
+        curve.materials.append(material)
+        spline = curve.splines.new("POLY")
+        spline.points.add(points.shape[0] - 1)
+        homogeneous = np.column_stack([points, np.ones(points.shape[0])])
+        spline.points.foreach_set("co", homogeneous.astype(np.float32).ravel())
+        line = keep(bpy.data.objects.new(f"VG Map edge {number}", curve))
+        line.matrix_world = obj.matrix_world if in_mesh else Matrix.Identity(4)
+        scene.collection.objects.link(line)
+    return len(paths)

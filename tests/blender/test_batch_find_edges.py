@@ -1,0 +1,187 @@
+"""vg_batch.py --find-edges, run as a user runs it: every break edge the finder sees is profiled
+into the CSV, the edges CSV (with the study's per-break figures), a plot per edge and the map
+with the edges drawn; each edge re-measures identically with --edges; --jobs gives the serial
+run's rows.
+
+Oracles: the core (``find_break_edges`` and ``Surface.measure_along`` on the file's own
+coordinates) for the numbers, the standard library and NumPy's SVD for the per-break figures,
+and the map's pixels for the drawn edges (a map of the same mesh without edges has none).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+import statistics
+from pathlib import Path
+
+import bpy
+import numpy as np
+import pytest
+from bpy_helpers import batch
+
+from vg_addon import Surface
+from vg_addon.formats import csvio, meshio
+from vg_addon.method.break_edges import find_break_edges
+from vg_addon.synthetic_meshes import bone_fragment
+
+SPACING, RADIUS = 6.0, 2.5
+
+
+def ok(result, code=0):
+    assert result.returncode == code, result.stdout + result.stderr
+    return result
+
+
+def magenta_pixels(path: Path) -> int:
+    """Pixels of the edge lines' colour (strong red and blue, no green: no side colour, label,
+    mesh grey or sky has it)."""
+    image = bpy.data.images.load(str(path), check_existing=False)
+    try:
+        rgba = np.empty(image.size[0] * image.size[1] * 4, dtype=np.float32)
+        image.pixels.foreach_get(rgba)
+    finally:
+        bpy.data.images.remove(image)
+    r, g, b = (rgba.reshape(-1, 4)[:, k] for k in range(3))
+    return int(((r > 0.6) & (b > 0.6) & (g < 0.2)).sum())
+
+
+def first_axis(points) -> np.ndarray:
+    points = np.asarray(points, dtype=np.float64)
+    return np.linalg.svd(points - points.mean(axis=0), full_matrices=False)[2][0]
+
+
+def write_bone(path: Path, **options) -> Path:
+    shape = bone_fragment(spacing=0.8, **options)
+    meshio.write_ply(path, shape.points, shape.triangles)
+    return path
+
+
+@pytest.fixture(scope="module")
+def found(tmp_path_factory):
+    """One --find-edges run with a map, on the bone shaft fragment (its two fracture faces' four
+    rims are the break edges)."""
+    folder = tmp_path_factory.mktemp("find")
+    mesh = write_bone(folder / "bone.ply")
+    out = folder / "out.csv"
+    result = ok(batch(mesh, "--find-edges", "--spacing", SPACING, "--radius", RADIUS,
+                      "--out", out, "--render", folder / "maps", "--render-size", 160, 120,
+                      "--render-samples", 1))  # fmt: skip
+    return mesh, out, result
+
+
+def test_every_edge_found_is_profiled_as_the_core_profiles_it(found):
+    mesh, out, result = found
+    data = meshio.read_mesh(mesh)
+    surface = Surface(data.points, data.triangles)
+    candidates = find_break_edges(surface).candidates
+    assert len(candidates) == 4  # the oblique and transverse faces' outer and inner rims
+    assert "bone: found 4 break edge(s)" in result.stderr
+    rows = csvio.read_measurements_csv(out)
+    edges = csvio.read_edges_csv(csvio.edges_path_for(out))
+    assert [e.edge_number for e in edges] == [1, 2, 3, 4]
+    for edge, candidate in zip(edges, candidates, strict=True):
+        points = candidate.waypoint_points
+        assert csvio.parse_points(edge.points) == [tuple(p) for p in points.tolist()]
+        assert edge.user_data.startswith(f"found edge {candidate.number}: confidence ")
+        profile = surface.measure_along(points, SPACING, RADIUS)
+        np.testing.assert_array_equal(profile.path.vertices, candidate.path.vertices)
+        stations = [r for r in rows if r.edge_number == edge.edge_number]
+        assert [r.angle for r in stations] == profile.angles.tolist()
+        assert [r.arc_length for r in stations] == profile.arc_lengths.tolist()
+        assert (edge.mean, edge.std, edge.pooled_angle) == (
+            profile.mean, profile.std, profile.pooled_angle
+        )  # fmt: skip
+        assert (mesh.parent / f"out_bone_edge{edge.edge_number}.png").stat().st_size > 1000
+
+        # The study's per-break figures, from the station rows alone.
+        angles = [r.angle for r in stations]
+        centres = [(r.x, r.y, r.z) for r in stations]
+        assert edge.n_stations == len(stations)
+        assert edge.mean == pytest.approx(statistics.fmean(angles), rel=1e-12)
+        assert edge.std == pytest.approx(statistics.stdev(angles), rel=1e-9)
+        assert edge.median == pytest.approx(statistics.median(angles), rel=1e-12)
+        assert edge.range == pytest.approx(max(angles) - min(angles), rel=1e-12)
+        arc = sum(math.dist(a, b) for a, b in itertools.pairwise(centres))
+        assert edge.arc_length == pytest.approx(arc, rel=1e-12)
+        assert edge.chord_length == pytest.approx(math.dist(centres[0], centres[-1]), abs=1e-9)
+        cosine = abs(float(np.dot(first_axis(centres), first_axis(data.points))))
+        assert edge.arc_angle == pytest.approx(math.degrees(math.acos(min(cosine, 1.0))), abs=1e-6)
+
+
+def test_each_found_edge_re_measures_identically_from_the_edges_csv(found, tmp_path):
+    mesh, out, _ = found
+    again = tmp_path / "again.csv"
+    ok(batch(mesh, "--edges", csvio.edges_path_for(out), "--out", again))
+    first = [r for r in csvio.read_measurements_csv(out) if r.edge_number]
+    second = csvio.read_measurements_csv(again)
+    keys = ("edge_number", "angle", "arc_length", "x", "y", "z", "fit", "n_vertices")
+    assert [[getattr(r, k) for k in keys] for r in second] == [
+        [getattr(r, k) for k in keys] for r in first
+    ]
+    skip = {"date", "user_data"}
+
+    def summaries(path):
+        rows = csvio.read_edges_csv(csvio.edges_path_for(path))
+        return [{k: v for k, v in dataclasses.asdict(e).items() if k not in skip} for e in rows]
+
+    assert summaries(again) == summaries(out)
+
+
+def test_the_map_draws_the_edges(found, tmp_path):
+    mesh, _, _ = found
+    maps = mesh.parent / "maps"
+    drawn = {view: magenta_pixels(maps / f"bone_map_{view}.png") for view in ("top", "front")}
+    assert drawn["top"] > 200 and drawn["front"] > 10, drawn  # rings from above, rims edge-on
+    assert magenta_pixels(maps / "bone_map.png") > 200  # the contact sheet too
+    # The same mesh measured at one point, no edges: no pixel of that colour.
+    plain = tmp_path / "plain"
+    ok(batch(mesh, "--at", 12, 0, 30, "--radius", RADIUS, "--out", tmp_path / "p.csv",
+             "--render", plain, "--render-size", 160, 120, "--render-samples", 1))  # fmt: skip
+    assert magenta_pixels(plain / "bone_map_top.png") == 0
+
+
+def test_find_edges_with_jobs_writes_the_serial_runs_rows(tmp_path):
+    meshes = [write_bone(tmp_path / "a.ply"), write_bone(tmp_path / "b.ply", oblique_deg=20.0)]
+    common = ("--find-edges", "--spacing", SPACING, "--radius", RADIUS)
+    ok(batch(*meshes, *common, "--out", tmp_path / "serial.csv"))
+    ok(batch(*meshes, *common, "--jobs", 2, "--out", tmp_path / "jobs.csv"))
+
+    def dated(rows):
+        return [{k: v for k, v in dataclasses.asdict(r).items() if k != "date"} for r in rows]
+
+    serial, jobs = (csvio.read_measurements_csv(tmp_path / f"{n}.csv") for n in ("serial", "jobs"))
+    assert {r.mesh_name for r in serial} == {"a", "b"}
+    assert dated(jobs) == dated(serial)
+    edges = [csvio.read_edges_csv(tmp_path / f"{n}_edges.csv") for n in ("serial", "jobs")]
+    assert len(edges[0]) == 8 and dated(edges[1]) == dated(edges[0])
+    assert all((tmp_path / f"jobs_{m}_edge{n}.png").exists() for m in "ab" for n in range(1, 5))
+
+
+def test_a_min_length_longer_than_every_edge_finds_none(tmp_path):
+    mesh = write_bone(tmp_path / "bone.ply")
+    out = tmp_path / "out.csv"
+    result = ok(batch(mesh, "--find-edges", "--spacing", SPACING, "--radius", RADIUS,
+                      "--min-length", 1000, "--out", out))  # fmt: skip
+    assert (
+        "bone: found 0 break edge(s)" in result.stderr and "length at least 1000" in result.stderr
+    )
+    assert csvio.read_measurements_csv(out) == []
+    assert csvio.read_edges_csv(csvio.edges_path_for(out)) == []
+
+
+@pytest.mark.parametrize(
+    ("arguments", "words"),
+    [
+        (("--find-edges", "--radius", 1), "--find-edges needs --spacing D and --radius R"),
+        (("--find-edges", "--spacing", 1, "--radius", 1, "--shard", "1/2"), "drop --shard"),
+        (("--find-edges", "--spacing", 1, "--radius", 1, "--min-length", -1), "positive"),
+        (("--at", 0, 0, 0, "--radius", 1, "--min-length", 2), "--min-length L is for"),
+    ],
+)
+def test_bad_find_edges_arguments_are_refused_before_anything_runs(tmp_path, arguments, words):
+    out = tmp_path / "out.csv"
+    result = ok(batch(tmp_path / "none.ply", *arguments, "--out", out), 2)
+    assert words in result.stderr
+    assert not out.exists()
