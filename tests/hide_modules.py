@@ -4,7 +4,10 @@ them; the shipped code has no switch for it."""
 
 from __future__ import annotations
 
+import json
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 SITECUSTOMIZE = '''
@@ -31,3 +34,19 @@ def environment(folder: Path, names: tuple[str, ...]) -> dict:
     )
     path = os.pathsep.join(p for p in (str(folder), os.environ.get("PYTHONPATH", "")) if p)
     return {**os.environ, "PYTHONPATH": path}
+
+
+def run_reporting(code: str, *args, env: dict) -> tuple[subprocess.CompletedProcess, dict]:
+    """Run ``code`` with this Python (``-c``, then ``args``) in ``env``; it must exit 0 and print
+    one line ``REPORT <json>``. Returns the run and that JSON."""
+    result = subprocess.run(
+        [sys.executable, "-c", code, *map(str, args)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+        check=False,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    line = next(line for line in result.stdout.splitlines() if line.startswith("REPORT "))
+    return result, json.loads(line[len("REPORT ") :])

@@ -5,15 +5,12 @@ and write nothing, and measuring goes on as before.
 
 The harness hides the packages (``tests/hide_modules.py``); the shipped code has no switch."""
 
-import json
 import struct
-import subprocess
-import sys
 import textwrap
 
 from bpy_helpers import batch
 from conftest import MODULE, REPO, ROOT
-from hide_modules import environment
+from hide_modules import environment, run_reporting
 
 from vg_addon.formats import meshio
 from vg_addon.synthetic_meshes import wedge
@@ -81,19 +78,8 @@ def test_in_blender_the_plots_fall_back_and_the_report_says_what_to_install(
     env = environment(tmp_path / "hide", HIDDEN)
     env["PYTHONPATH"] += f":{ROOT}"  # vg_addon for the test's wedge
     env["BLENDER_USER_RESOURCES"] = str(tmp_path / "user")
-    result = subprocess.run(
-        [sys.executable, "-c", SCENE, str(extension_zip), REPO, str(out)],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=300,
-        check=False,
-    )
+    result, report = run_reporting(SCENE, extension_zip, REPO, out, env=env)
     output = result.stdout + result.stderr
-    assert result.returncode == 0, output
-    report = json.loads(
-        next(line for line in result.stdout.splitlines() if line.startswith("REPORT "))[7:]
-    )
     assert report["measured"] == report["edge"] == report["sweep"] == ["FINISHED"], report
     assert report["edge_plot"] == [480, 240]
     assert png_size(out / "sweep.png") == (640, 430)  # the NumPy drawing's size

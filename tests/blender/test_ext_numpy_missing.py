@@ -5,13 +5,13 @@ The harness, not the extension, hides NumPy: a ``sitecustomize`` on the subproce
 every ``import numpy`` fail as it fails where NumPy is not installed.
 """
 
-import json
 import os
 import subprocess
 import sys
 import textwrap
 
 from conftest import MODULE, REPO, ROOT
+from hide_modules import run_reporting
 
 HIDE_NUMPY = textwrap.dedent(
     """
@@ -67,19 +67,8 @@ def test_enabling_without_numpy_explains_the_fix(extension_zip, tmp_path):
         "PYTHONPATH": str(harness),
         "BLENDER_USER_RESOURCES": str(user),
     }
-    result = subprocess.run(
-        [sys.executable, "-c", ENABLE, str(extension_zip), REPO, MODULE],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=300,
-        check=False,
-    )
+    result, report = run_reporting(ENABLE, extension_zip, REPO, MODULE, env=env)
     output = result.stdout + result.stderr
-    assert result.returncode == 0, output
-    report = json.loads(
-        next(line for line in result.stdout.splitlines() if line.startswith("REPORT "))[7:]
-    )
     assert report["enabled"] and not report["numpy_imported"], report
     assert report["explanation_panel"] and report["preferences"], report
     assert not report["measure_operator"], report
