@@ -40,6 +40,8 @@ def missing_message(command: str = "python vg_batch.py --report DIR SESSION.csv 
         f"The report needs {', '.join(missing)}, which this Python does not have\n"
         "(Blender's own Python has NumPy only). Install them into it:\n"
         f"  python -m pip install {' '.join(missing)}\n"
+        "(a Linux distribution's Blender: its packages, e.g.\n"
+        f"  sudo apt install {' '.join('python3-' + m for m in missing)})\n"
         "or run the same report from the repository's environment:\n"
         f"  {command}"
     )
