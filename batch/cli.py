@@ -96,6 +96,9 @@ examples:
   blender -b study.blend --python vg_batch.py -- --object Bone_12 --points p.csv --out a.csv
   python vg_batch.py scan.ply --edge 0 0 0 10 2 0 --via 5 1.5 0.2 --spacing 1 --radius 2 \
       --out edge.csv
+  python vg_batch.py scans/ --edges scans/ --spacing 2 --radius 2.5 --out picked.csv
+  python vg_batch.py scans/ --find-edges --spacing 2 --radius 2.5 --jobs 2 --out found.csv \
+      --render maps/
   python vg_batch.py --report report/ obs1_drag_1.csv obs1_drag_2.csv obs1_xyz_1.csv manual.csv
   python vg_batch.py --demo
 """
@@ -204,7 +207,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--spacing",
         type=float,
         metavar="D",
-        help="arc length between the stations of every --edge (needed with --edge)",
+        help="arc length between the stations of every --edge, .pp edge and found edge (needed "
+        "with them)",
     )
     how = parser.add_argument_group("measuring")
     how.add_argument(
