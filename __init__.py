@@ -20,12 +20,12 @@ if numpy_import_error is None:
     from . import operators, properties, ui
     from .bridge import measuring, mesh_data, watch
 
-    classes = (*properties.classes, *operators.classes, *ui.classes)
+    classes = (*operators.classes, *ui.classes)  # besides properties.classes
 
     def register():
+        properties.register()
         for cls in classes:
             bpy.utils.register_class(cls)
-        properties.register_properties()
         operators.drag.register_tool()
         watch.register()
         ui.labels.register()
@@ -34,9 +34,9 @@ if numpy_import_error is None:
         ui.labels.unregister()
         operators.drag.unregister_tool()
         watch.unregister()
-        properties.unregister_properties()
         for cls in reversed(classes):
             bpy.utils.unregister_class(cls)
+        properties.unregister()
         mesh_data.clear_cache()
         measuring.clear_cache()
 

@@ -489,14 +489,19 @@ class VG_SceneSettings(PropertyGroup):
 classes = (VG_Measurement, VG_EdgeProfile, VG_ObjectData, VG_SceneSettings)
 
 
-def register_properties() -> None:
-    """Attach the settings and measurement groups to Scene and Object (classes already registered)."""
+def register() -> None:
+    """Register the groups and attach them to Scene and Object: all the extension and the batch
+    need to read and write measurements."""
+    for cls in classes:
+        bpy.utils.register_class(cls)
     bpy.types.Scene.vg_settings = PointerProperty(type=VG_SceneSettings)
     bpy.types.Object.vg = PointerProperty(type=VG_ObjectData)
 
 
-def unregister_properties() -> None:
-    """Remove what :func:`register_properties` attached (the data stays in the .blend)."""
+def unregister() -> None:
+    """Undo :func:`register` (the data stays in the .blend)."""
     for owner, name in ((bpy.types.Object, "vg"), (bpy.types.Scene, "vg_settings")):
         if hasattr(owner, name):
             delattr(owner, name)
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)
