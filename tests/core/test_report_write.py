@@ -55,3 +55,20 @@ def test_nothing_usable_writes_nothing(tmp_path):
     blocker.write_text("x", encoding="utf-8")
     with pytest.raises(GoniometerError, match="is not a folder"):
         write_report([bad], blocker)
+
+
+def test_an_iov_of_exactly_zero_is_drawn_without_an_axis_below_zero():
+    # The xyz method's IOV is 0 at every break: its histogram is one bar on 0 and its CI plot a
+    # point on 0, neither with an axis reaching negative IOVs (which cannot be).
+    from vg_addon.analysis import figures, stats
+
+    histogram = figures.iov_histograms({"drag": [0.4, 1.2, 0.9], "xyz": [0.0] * 5}, "angle", "°")
+    drag, xyz = histogram.axes
+    assert xyz.get_xlim()[0] == 0.0 and drag.get_xlim()[0] < 0.4
+    assert [p.get_height() for p in xyz.patches] == [5]
+    assert abs(xyz.patches[0].get_x()) < 1e-12  # the bar starts on 0
+    drag = [0.9, 1.1, 1.0, 1.2, 0.95, 1.05]
+    summaries = {"drag": stats.summarise(drag), "xyz": stats.summarise([0.0] * 5)}
+    ci = figures.ci_plot(summaries, "°")
+    drag, xyz = ci.axes
+    assert xyz.get_ylim()[0] == 0.0 and drag.get_ylim()[0] > 0.0

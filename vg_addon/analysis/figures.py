@@ -48,13 +48,18 @@ def iov_histograms(values: dict[str, list[float]], quantity: str, unit: str):
     figure, axes = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.2), squeeze=False)
     for i, (ax, name) in enumerate(zip(axes[0], names, strict=True)):
         data = np.asarray(values[name], dtype=np.float64)
+        same = bool(len(data)) and np.ptp(data) == 0
+        # All equal (the xyz method's 0): one narrow bar on the value, not a bin of width 1
+        # reaching below 0, where an IOV cannot be.
+        width = max(abs(float(data[0])) * 0.05, 0.05) if same else 0.0
         ax.hist(
             data,
-            bins="auto" if len(data) and np.ptp(data) > 0 else 1,
+            bins=[data[0], data[0] + width] if same else "auto",
             color=colour(i),
             edgecolor="black",
         )
-        same = len(data) and np.ptp(data) == 0
+        if same:
+            ax.set_xlim(max(0.0, data[0] - 10 * width), data[0] + 10 * width)
         ax.set_title(f"{name} (n={len(data)}" + (f", all {data[0]:g})" if same else ")"))
         ax.set_xlabel(f"{quantity} IOV ({unit})")
         ax.set_ylabel("breaks")
@@ -74,9 +79,11 @@ def ci_plot(summaries: dict[str, object], unit: str):
         for ci, width, label in ((s.ci99, 1.0, "99% CI"), (s.ci95, 3.0, "95% CI")):
             if ci is not None:
                 ax.plot([0, 0], ci, color=colour(i), linewidth=width, label=label)
-        ax.plot([0], [s.mean], "o", color="black", label="mean")
+        ax.plot([0], [s.mean], "o", color="black", label="mean", clip_on=False)
         ax.set_xticks([0], [name])
         ax.set_xlim(-1, 1)
+        if s.ci99 is None or s.ci99[0] == s.ci99[1]:  # no spread (xyz: all 0): no axis below 0
+            ax.set_ylim(max(0.0, s.mean - 1.0), s.mean + 1.0)
         ax.set_ylabel(f"mean angle IOV ({unit})")
         ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4), useOffset=False)
         ax.set_title(name)
@@ -99,8 +106,10 @@ def bland_altman_plot(ba, unit: str):
         (ba.lower, ba.lower_ci, f"lower limit {ba.lower:.3g}", "--"),
     ):
         ax.axhline(value, color="black", linestyle=style, linewidth=1, label=label)
-        ax.axhspan(ci[0], ci[1], color="grey", alpha=0.15)
-    ax.set_xlim(*(span if span[0] < span[1] else (span[0] - 1, span[1] + 1)))
+        shade = "95% CIs" if label.startswith("bias") else None
+        ax.axhspan(ci[0], ci[1], color="grey", alpha=0.15, label=shade)
+    pad = (span[1] - span[0]) * 0.04 if span[0] < span[1] else 1.0  # no point cut at the edge
+    ax.set_xlim(span[0] - pad, span[1] + pad)
     ax.set_xlabel(f"mean of {ba.first} and {ba.second} ({unit})")
     ax.set_ylabel(f"{ba.second} − {ba.first} ({unit})")
     ax.set_title(f"Bland–Altman: {ba.second} against {ba.first} (n={ba.n})")
