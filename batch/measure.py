@@ -176,10 +176,15 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
                 continue
             data.next_number = base + task.number
             # The bridge's one record step, as a click takes; painted once at the end.
-            item = measuring.record(
-                obj, m, geometry, note=task.label, break_number=task.break_number, paint=False
+            row = measuring.record_row(
+                obj,
+                m,
+                geometry,
+                units=units,
+                precision=precision,
+                note=task.label,
+                break_number=task.break_number,
             )
-            row = records.to_row(obj, item, stale=False, units=units, precision=precision)
             result.rows.append((task.index, dataclasses.replace(row, mesh_name=name)))
             result.measured += 1
     result.measure_seconds = time.perf_counter() - start

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..vg_addon import GoniometerError, Measurement
+from ..vg_addon.formats import record_codec
 from ..vg_addon.method.algorithm import DEFAULT_RULE
 from ..vg_addon.method.sweep import radius_sweep
 from . import colors, legacy, painting, records
@@ -215,6 +216,27 @@ def record(
         repaint(obj, depsgraph=depsgraph, geometry=geometry)
         colors.show_sides_once(obj)
     return obj.vg.measurements[obj.vg.active_index]
+
+
+def record_row(
+    obj,
+    m: Measurement,
+    geometry: Geometry,
+    *,
+    units: str,
+    precision: str = "float32",
+    note="",
+    break_number=None,
+):
+    """:func:`record` ``m`` without painting (the caller repaints once at the end) and return
+    its CSV row (``records.measurement_row``), made from the numbers just recorded rather than
+    read back from the record's text: a batch row.
+    """
+    item = record(obj, m, geometry, note=note, break_number=break_number, paint=False)
+    numbers = record_codec.measurement_numbers(m)
+    return records.measurement_row(
+        obj, item, numbers, stale=False, units=units, precision=precision
+    )
 
 
 # Per measurement, what changes whenever it is replaced by another one; read for the whole list

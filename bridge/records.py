@@ -341,9 +341,20 @@ def units_label(scene, obj=None) -> str:
 def to_row(
     obj, item, *, stale: bool, units: str, precision: str = "float32"
 ) -> csvio.MeasurementRow:
-    """The CSV row of ``item``, measured on ``obj``; ``precision``: the coordinates measured
-    (``"float32"``, Blender's mesh, unless a batch run measured a file's float64 ones)."""
-    numbers = numbers_of(item)
+    """The CSV row of a stored ``item``, measured on ``obj``, its numbers read from the item
+    (see :func:`measurement_row`)."""
+    return measurement_row(
+        obj, item, numbers_of(item), stale=stale, units=units, precision=precision
+    )
+
+
+def measurement_row(
+    obj, item, numbers: dict, *, stale: bool, units: str, precision: str = "float32"
+) -> csvio.MeasurementRow:
+    """The CSV row of ``item``, measured on ``obj``, with its exact ``numbers``
+    (``record_codec.measurement_numbers``: those ``item.exact`` holds); ``precision``: the
+    coordinates measured (``"float32"``, Blender's mesh, unless a batch run measured a file's
+    float64 ones)."""
     x, y, z = numbers["center"]
     stability = numbers.get("stability") or {}
     station = item.edge_number > 0
