@@ -6,10 +6,9 @@ every ``import numpy`` fail as it fails where NumPy is not installed.
 """
 
 import os
-import subprocess
-import sys
 import textwrap
 
+from bpy_helpers import batch
 from conftest import MODULE, REPO, ROOT
 from hide_modules import run_reporting
 
@@ -91,11 +90,9 @@ def test_batch_without_numpy_says_why_and_exits_2(tmp_path):
     mesh = tmp_path / "tri.obj"
     mesh.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", encoding="ascii")
     out = tmp_path / "out.csv"
-    result = subprocess.run(
-        [sys.executable, str(ROOT / "vg_batch.py"), str(mesh), "--at", "0", "0", "0",
-         "--radius", "1", "--out", str(out)],
-        capture_output=True, text=True, timeout=300, check=False,
-        env={**os.environ, "PYTHONPATH": str(harness)},
+    result = batch(
+        mesh, "--at", "0", "0", "0", "--radius", "1", "--out", out,
+        env={"PYTHONPATH": str(harness)}, timeout=300,
     )  # fmt: skip
     assert result.returncode == 2, result.stdout + result.stderr
     assert "vg_batch: error: Virtual Goniometer needs NumPy" in result.stderr

@@ -2,14 +2,11 @@
 counter after recorded breaks arrive from a CSV import or a batch run."""
 
 import importlib
-import subprocess
-import sys
 
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import exact, wedge_object
-from conftest import ROOT
+from bpy_helpers import batch, exact, wedge_object
 from test_ext_csv import MESHLAB_HEADER, meshlab_row
 
 # A centre with many digits: a wedge moved so its crease point is at these (inexact) coordinates.
@@ -142,11 +139,9 @@ def test_batch_blend_continues_after_its_breaks(vg, tmp_path):
         encoding="ascii",
     )
     saved = tmp_path / "study.blend"
-    result = subprocess.run(
-        [sys.executable, str(ROOT / "vg_batch.py"), str(ply), "--at", "0", "0", "0",
-         "--at", "0.2", "0", "0", "--at", "-0.2", "0", "0", "--radius", "0.3",
-         "--out", str(tmp_path / "out.csv"), "--save-blend", str(saved)],
-        capture_output=True, text=True, timeout=600, check=False,
+    result = batch(
+        ply, "--at", "0", "0", "0", "--at", "0.2", "0", "0", "--at", "-0.2", "0", "0",
+        "--radius", "0.3", "--out", tmp_path / "out.csv", "--save-blend", saved,
     )  # fmt: skip
     assert result.returncode == 0, result.stdout + result.stderr
     bpy.ops.wm.open_mainfile(filepath=str(saved))
