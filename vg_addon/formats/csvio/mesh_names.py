@@ -6,30 +6,27 @@ import re
 from collections.abc import Iterable, Sequence
 
 from ...errors import GoniometerError, bounded_list
+from ..meshio import MESH_EXTENSIONS
 from .replication import ReplicationRow
 
-# File extensions a CSV's mesh name may carry (MeshLab writes the scan's file name).
-_MESH_FILE_SUFFIXES = frozenset(
-    [
-        ".ply",
-        ".obj",
-        ".stl",
-        ".off",
-        ".glb",
-        ".gltf",
-        ".fbx",
-        ".dae",
-        ".x3d",
-        ".wrl",
-        ".3ds",
-        ".abc",
-        ".usd",
-        ".usda",
-        ".usdc",
-        ".usdz",
-        ".vtk",
-    ]
-)
+# File extensions a CSV's mesh name may carry (MeshLab writes the scan's file name): those this
+# package reads (meshio's registry) and the other mesh formats MeshLab and Blender open.
+_MESH_FILE_SUFFIXES = frozenset(MESH_EXTENSIONS) | {
+    ".off",
+    ".glb",
+    ".gltf",
+    ".fbx",
+    ".dae",
+    ".x3d",
+    ".wrl",
+    ".3ds",
+    ".abc",
+    ".usd",
+    ".usda",
+    ".usdc",
+    ".usdz",
+    ".vtk",
+}
 
 
 def _split_names(names) -> tuple[str, ...]:
