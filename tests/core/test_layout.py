@@ -159,3 +159,25 @@ def test_no_import_cycle():
             visit(path, [path])
     named = {" -> ".join(str(p.relative_to(ROOT)) for p in cycle) for cycle in cycles}
     assert not named, sorted(named)
+
+
+MAX_LINES = 700  # issue 21: small modules with one job; a longer file is split by topic
+
+
+def python_files() -> list[Path]:
+    """Every Python file of the repository, tests and scripts included (not the environments)."""
+    return [
+        path
+        for path in sorted(ROOT.rglob("*.py"))
+        if not any(
+            part.startswith(".") or part in {"__pycache__", "build", "dist"}
+            for part in path.relative_to(ROOT).parts[:-1]
+        )
+    ]
+
+
+def test_no_source_file_is_longer_than_700_lines():
+    lengths = {path: len(path.read_text(encoding="utf-8").splitlines()) for path in python_files()}
+    assert len(lengths) > 100  # the walk found the tree
+    long = {str(p.relative_to(ROOT)): n for p, n in lengths.items() if n > MAX_LINES}
+    assert not long, f"split these by topic (at most {MAX_LINES} lines): {long}"
