@@ -14,7 +14,6 @@ from ..bridge import edges, records
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, picked_points, profile_plot
-from ..vg_addon.formats.png import encode_png
 from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.edge_profile import check_station_count
 from .cli import UsageError
@@ -271,11 +270,13 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         )
         numbers = exact_numbers(edge)
         path = f"{options['plots']}_{safe_name}_edge{edge.number}.png"
-        data = functools.partial(profile_png, numbers["arc_lengths"], numbers["angles"])
+        data = functools.partial(
+            profile_plot.profile_png,
+            numbers["arc_lengths"],
+            numbers["angles"],
+            units=units,
+            title=f"{name}, edge {edge.number}",
+            pooled=numbers["pooled_angle"],
+        )
         plots.append(("profile plot", path, data))
     return station_rows, edge_rows, plots
-
-
-def profile_png(arc_lengths, angles) -> bytes:
-    """One edge profile's plot (angle against arc length) as PNG bytes."""
-    return encode_png(profile_plot.render_profile(arc_lengths, angles), level=6)

@@ -18,8 +18,12 @@ import pytest
 from bpy_helpers import batch, colours, exact, expected_colours, mesh_object
 
 from vg_addon import Surface
-from vg_addon.formats import csvio, meshio
+from vg_addon.formats import csvio, meshio, mpl_plots
 from vg_addon.synthetic_meshes import bone_fragment, wedge
+
+#: A batch profile plot's size: matplotlib's where it runs, else the NumPy drawing's
+#: (test_ext_no_matplotlib.py runs the batch without matplotlib).
+PROFILE_PNG = (768, 408) if mpl_plots.available() else (480, 240)
 
 RADIUS = 0.3
 # Points on the crease (the x axis) of the synthetic wedges, as the decimals a user would type.
@@ -465,7 +469,7 @@ def test_demo_measures_the_bone_fragment_and_writes_its_outputs(tmp_path):
     assert edge.n_stations == len(stations)
     assert edge.mean == pytest.approx(np.mean([row.angle for row in stations]), abs=1e-12)
     assert "Whole edge" in result.stdout and f"pooled {edge.pooled_angle:.2f}°" in result.stdout
-    assert png_size(out / "measurements_bone_fragment_edge1.png") == (480, 240)
+    assert png_size(out / "measurements_bone_fragment_edge1.png") == PROFILE_PNG
     assert meshio.read_mesh(out / "bone_fragment.ply").n_vertices > 200_000
 
 
@@ -577,7 +581,7 @@ def test_edges_write_station_rows_summaries_and_plots_equal_to_the_core(tmp_path
             ).max()
             < 1.0
         )
-        assert png_size(tmp_path / f"out_ramp_edge{number}.png") == (480, 240)
+        assert png_size(tmp_path / f"out_ramp_edge{number}.png") == PROFILE_PNG
         assert f"edge {number} on 'ramp'" in result.stderr + result.stdout
 
     # The edge file replicates: --edges re-measures every edge with its own settings.
