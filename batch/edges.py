@@ -275,7 +275,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
             numbers["arc_lengths"],
             numbers["angles"],
             units=units,
-            title=f"{name}, edge {edge.number}",
+            title=f"Edge profile: {name}, edge {edge.number}",
             pooled=numbers["pooled_angle"],
         )
         plots.append(("profile plot", path, data))

@@ -212,6 +212,7 @@ def test_replication_report_refuses_without_its_libraries(gui, places):
     reports = "\n".join(t for n, t in state["clipboard"] if n >= seq)
     assert "The report needs scipy, statsmodels, matplotlib" in reports
     assert "python vg_batch.py --report" in reports
+    assert "sudo apt install python3-scipy python3-statsmodels python3-matplotlib" in reports
     assert not list(gui.tmp.rglob("report.html"))
     assert not any("vg.report" in op.lower() for op in gui.state()["modal_operators"])
 
