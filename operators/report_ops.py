@@ -19,6 +19,7 @@ from ..bridge import replication
 from ..vg_addon import GoniometerError
 from ..vg_addon.analysis import missing_message
 from ..vg_addon.analysis.report import write_report
+from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
 
 SCENE_SESSION = "scene_measurements.csv"
@@ -129,7 +130,9 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
         except OSError as error:
             self.report({"ERROR"}, f"Could not write the report into {folder}: {error}")
             return {"CANCELLED"}
-        left = f"; {len(outcome.left_out)} left out (listed in the report)"
+        left = f"; {len(outcome.left_out)} left out (all listed in the report):\n" + bounded_list(
+            outcome.left_out, lines=True
+        )
         self.report(
             {"WARNING"} if outcome.left_out else {"INFO"},
             f"Wrote {os.path.join(folder, 'report.html')}: {outcome.sessions} sessions, "

@@ -55,3 +55,35 @@ def test_report_operator_without_sessions_says_what_to_choose(vg, tmp_path):
         settings.report_folder = str(tmp_path / "r")
         bpy.ops.vg.report(directory=str(tmp_path), files=[])
     assert not (tmp_path / "r" / "report.html").exists()
+
+
+def test_report_operator_names_what_it_left_out(vg, tmp_path, capfd):
+    # Bad input from the file browser: a non-numeric cell, a break in one session only, a file
+    # without a Break # column, the same session twice. The report is written; the operator's
+    # warning names each one, as the batch's exit message does.
+    for rep, rows in enumerate(("1,98\nm,2,n/a", "1,101\nm,2,99\nm,3,90"), start=1):
+        (tmp_path / f"obs1_manual_{rep}.csv").write_text(
+            f"Mesh,Break #,Angle\nm,{rows}\n", encoding="utf-8"
+        )
+    (tmp_path / "obs1_manual_3.csv").write_text("Mesh,Angle\nm,90\n", encoding="utf-8")
+    (tmp_path / "copy_manual.csv").write_bytes((tmp_path / "obs1_manual_1.csv").read_bytes())
+    settings = bpy.context.scene.vg_settings
+    settings.report_include_scene = False
+    settings.report_folder = str(tmp_path / "report")
+    names = ("obs1_manual_1.csv", "obs1_manual_2.csv", "obs1_manual_3.csv", "copy_manual.csv")
+    capfd.readouterr()
+    result = bpy.ops.vg.report(directory=str(tmp_path), files=[{"name": n} for n in names])
+    assert result == {"FINISHED"}
+    out = capfd.readouterr()
+    said = out.out + out.err
+    # Break 1 in both sessions is used; break 2's n/a leaves it in one session, like break 3.
+    assert "2 sessions, 2 of 5 rows used; 5 left out" in said
+    for line in (
+        "obs1_manual_1.csv: row 3: Angle is not a number ('n/a')",
+        "m break 2: only in obs1_manual_2.csv; no IOV",
+        "m break 3: only in obs1_manual_2.csv; no IOV",
+        "'obs1_manual_3.csv': left out, it has no Break # column",
+        "copy_manual.csv: left out, its rows (numbers and dates) are those of obs1_manual_1.csv",
+    ):
+        assert line in said, said
+    assert (tmp_path / "report" / "report.html").is_file()
