@@ -151,6 +151,7 @@ class Run:
             self.say(
                 f"{source.name}: {result.measured:,} measured, {result.failed:,} failed"
                 + (f" ({result.n_vertices:,} vertices, {rate:,.0f}/s)" if result.n_vertices else "")
+                + (f", {len(result.edge_rows)} edge(s) profiled" if result.edge_rows else "")
                 + note
             )
         elif note:

@@ -80,6 +80,7 @@ def test_every_edge_found_is_profiled_as_the_core_profiles_it(found):
     # tests/core/test_break_edges*.py measure it against the true edges).
     assert len(candidates) >= 4
     assert f"bone: found {len(candidates)} break edge(s)" in result.stderr
+    assert f", {len(candidates)} edge(s) profiled" in result.stderr
     rows = csvio.read_measurements_csv(out)
     edges = csvio.read_edges_csv(csvio.edges_path_for(out))
     assert [e.edge_number for e in edges] == list(range(1, len(candidates) + 1))
