@@ -11,6 +11,7 @@ from pathlib import Path
 
 import bpy
 import numpy as np
+from bpy_mesh import linked_mesh_object
 
 from vg_addon import Surface
 
@@ -38,21 +39,8 @@ def mesh_object(
     name, points, triangles, *, location=(0, 0, 0), rotation=(0, 0, 0), scale=(1, 1, 1)
 ):
     """A new mesh object in the scene, made active and selected, with the given transform."""
-    points = np.asarray(points, dtype=np.float32)
-    triangles = np.asarray(triangles, dtype=np.int32)
-    mesh = bpy.data.meshes.new(name)
-    mesh.vertices.add(points.shape[0])
-    mesh.vertices.foreach_set("co", points.ravel())
-    mesh.loops.add(triangles.size)
-    mesh.loops.foreach_set("vertex_index", triangles.ravel())
-    mesh.polygons.add(triangles.shape[0])
-    mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
-    mesh.update(calc_edges=True)
-    obj = bpy.data.objects.new(name, mesh)
-    bpy.context.scene.collection.objects.link(obj)
+    obj = linked_mesh_object(name, points, triangles)
     obj.location, obj.rotation_euler, obj.scale = location, rotation, scale
-    bpy.context.view_layer.objects.active = obj
-    obj.select_set(True)
     bpy.context.view_layer.update()
     return obj
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import arguments, batch, outcome_of_check
+from bpy_helpers import arguments, batch, mesh_object, outcome_of_check
 from unprivileged import as_user
 
 from vg_addon.formats import csvio, meshio
@@ -179,9 +179,7 @@ def test_rows_name_the_mesh_file_a_blend_already_has_an_object_of(vg, tmp_path):
     scan = write_wedge(tmp_path / "w90.ply")
     for name in ("w90", "other"):
         shape = wedge(70.0, n=12)
-        mesh = bpy.data.meshes.new(name)
-        mesh.from_pydata(shape.points.tolist(), [], shape.triangles.tolist())
-        bpy.context.scene.collection.objects.link(bpy.data.objects.new(name, mesh))
+        mesh_object(name, shape.points, shape.triangles)
     blend = tmp_path / "study.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend), copy=True)
     out = tmp_path / "o.csv"

@@ -10,9 +10,14 @@ from __future__ import annotations
 
 import importlib
 import math
+import os
+import sys
 
 import bpy
-import numpy as np
+
+# The tests' own mesh builder (tests/bpy_mesh.py), shared with the Blender lane.
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from bpy_mesh import linked_mesh_object
 
 OBJECT_NAME = "Wedge"
 WEDGE_ANGLE = 100.0
@@ -31,21 +36,7 @@ def replace_meshes_with(name: str, points, triangles):
     for obj in list(bpy.data.objects):
         if obj.type == "MESH":
             bpy.data.objects.remove(obj)
-    points = np.asarray(points, dtype=np.float32)
-    triangles = np.asarray(triangles, dtype=np.int32)
-    mesh = bpy.data.meshes.new(name)
-    mesh.vertices.add(points.shape[0])
-    mesh.vertices.foreach_set("co", points.ravel())
-    mesh.loops.add(triangles.size)
-    mesh.loops.foreach_set("vertex_index", triangles.ravel())
-    mesh.polygons.add(triangles.shape[0])
-    mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
-    mesh.update(calc_edges=True)
-    obj = bpy.data.objects.new(name, mesh)
-    bpy.context.scene.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
-    obj.select_set(True)
-    return obj
+    return linked_mesh_object(name, points, triangles)
 
 
 def build_wedge():
