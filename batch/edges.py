@@ -10,7 +10,7 @@ from pathlib import Path
 
 import bpy
 
-from ..bridge import edges, records
+from ..bridge import edges, measuring, records
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, picked_points, profile_plot
@@ -233,6 +233,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
     """
     station_rows, edge_rows, plots = [], [], []
     name = source.name
+    painted = None  # the geometry the edges were measured on, once one is recorded
     specs = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
     if options.get("find_edges"):
         try:
@@ -242,7 +243,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
     for spec in specs:
         number = obj.vg.next_edge_number
         try:
-            edge = edges.measure_edge_on_object(
+            profile, geometry, clicks = edges.measure_edge(
                 obj,
                 spec["points"],
                 spec["spacing"],
@@ -251,8 +252,10 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
                 spec["patch"],
                 space=spec.get("space", "mesh"),
                 surface=surface,
-                note=spec.get("note", ""),
             )
+            # Recorded without repainting: the colours are painted once, after every edge.
+            edge = edges.record_profile(obj, profile, geometry, clicks, note=spec.get("note", ""))
+            painted = geometry
         except GoniometerError as error:
             obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
             station_rows.append(failed_edge_row(number, spec, name, str(error), units))
@@ -279,4 +282,6 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
             pooled=numbers["pooled_angle"],
         )
         plots.append(("profile plot", path, data))
+    if painted is not None:
+        measuring.repaint(obj, geometry=painted)
     return station_rows, edge_rows, plots
