@@ -19,7 +19,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import batch
+from bpy_helpers import batch, colours, exact, expected_colours
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
@@ -67,7 +67,7 @@ def found(tmp_path_factory):
     out = folder / "out.csv"
     result = ok(batch(mesh, "--find-edges", "--spacing", SPACING, "--radius", RADIUS,
                       "--out", out, "--render", folder / "maps", "--render-size", 160, 120,
-                      "--render-samples", 1))  # fmt: skip
+                      "--render-samples", 1, "--save-blend", folder / "found.blend"))  # fmt: skip
     return mesh, out, result
 
 
@@ -130,6 +130,24 @@ def test_each_found_edge_re_measures_identically_from_the_edges_csv(found, tmp_p
         return [{k: v for k, v in dataclasses.asdict(e).items() if k not in skip} for e in rows]
 
     assert summaries(again) == summaries(out)
+
+
+def test_found_edges_are_painted_as_the_extension_paints_stations(vg, found):
+    """Every station's sides in its break's colours, later over earlier, a station whose "+"
+    side lies right of the path with its pair the other way round (painted once per mesh)."""
+    mesh, _, _ = found
+    bpy.ops.wm.open_mainfile(filepath=str(mesh.parent / "found.blend"))
+    obj = bpy.data.objects["bone"]
+    data = meshio.read_mesh(mesh)
+    surface = Surface(data.points, data.triangles)
+    sides = []
+    for item in obj.vg.measurements:
+        numbers = exact(item)
+        m = surface.measure(numbers["center"], RADIUS)
+        labels = m.labels if numbers["plus_left"] else ~m.labels
+        sides.append((m.indices, labels, item.break_number))
+    assert len(sides) == sum(edge.n_stations for edge in obj.vg.edges) > 20
+    np.testing.assert_array_equal(colours(obj), expected_colours(len(obj.data.vertices), sides))
 
 
 def test_the_map_draws_the_edges(found, tmp_path):
