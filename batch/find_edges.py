@@ -9,6 +9,8 @@ Each candidate of ``vg_addon.method.break_edges.find_break_edges`` becomes an ed
 
 from __future__ import annotations
 
+import time
+
 from ..vg_addon.method.break_edges import find_break_edges
 from .stdio import say
 
@@ -25,7 +27,9 @@ def found_edge_specs(surface, options: dict, name: str) -> list[dict]:
     """
     found = options["find_edges"]
     overrides = {} if found["min_length"] is None else {"min_length": found["min_length"]}
+    start = time.perf_counter()
     result = find_break_edges(surface, **overrides)
+    seconds = time.perf_counter() - start
     specs = [
         {
             "points": candidate.waypoint_points.tolist(),
@@ -45,8 +49,9 @@ def found_edge_specs(surface, options: dict, name: str) -> list[dict]:
     if not options.get("quiet"):
         used = result.parameters
         say(
-            f"{name}: found {len(specs)} break edge(s) (scale {used.scale:.4g}, bend at least "
-            f"{used.min_bend_deg:g}°, length at least {used.min_length:.4g})"
+            f"{name}: found {len(specs)} break edge(s) in {seconds:.1f} s (scale "
+            f"{used.scale:.4g}, bend at least {used.min_bend_deg:g}°, length at least "
+            f"{used.min_length:.4g})"
         )
     return specs
 
