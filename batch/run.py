@@ -271,7 +271,8 @@ class Run:
                 )
             )
         for row in failed_edges:
-            self.say(f"  failed: edge {row.edge_number} on {row.mesh_name!r}: {row.error}")
+            what = "finding edges" if row.edge_number is None else f"edge {row.edge_number}"
+            self.say(f"  failed: {what} on {row.mesh_name!r}: {row.error}")
         if self.edge_rows or failed_edges:
             self.say(f"wrote {csvio.edges_path_for(self.args.out)}")
         for message in self.bad_files:

@@ -194,6 +194,20 @@ def test_a_min_length_longer_than_every_edge_finds_none(tmp_path):
     assert csvio.read_edges_csv(csvio.edges_path_for(out)) == []
 
 
+def test_a_point_cloud_is_one_failed_row_saying_why(tmp_path):
+    shape = bone_fragment(spacing=2.0)
+    cloud = tmp_path / "cloud.ply"
+    meshio.write_ply(cloud, shape.points, np.zeros((0, 3), dtype=np.int64))
+    out = tmp_path / "out.csv"
+    result = ok(batch(cloud, "--find-edges", "--spacing", SPACING, "--radius", RADIUS,
+                      "--out", out), 1)  # fmt: skip
+    (row,) = csvio.read_measurements_csv(out)
+    assert row.error.startswith("edges not found: ") and "point cloud" in row.error
+    assert (row.mesh_name, row.spacing, row.radius, row.angle) == ("cloud", SPACING, RADIUS, None)
+    assert "failed: finding edges on 'cloud': edges not found" in result.stderr
+    assert csvio.read_edges_csv(csvio.edges_path_for(out)) == []
+
+
 @pytest.mark.parametrize(
     ("arguments", "words"),
     [
