@@ -66,7 +66,7 @@ HINTS = (
     (("EVENT_ESC",), "Cancel"),
     (("MOUSE_MMB",), "Navigate"),
 )
-KEYS = "click select · A accept · X reject · T trim · Tab next · Enter record · Esc cancel"
+KEYS = "Click select · A accept · X reject · T trim · Tab next · Enter record · Esc cancel"
 
 _KEYS = {
     "A": "accept",
@@ -295,14 +295,13 @@ class FindEdgesSession(ViewSession):
         if machine.phase is FindPhase.MEASURING:
             return f"Measuring the accepted edges… {machine.progress:.0%} · Esc back to review"
         parts = [
-            f"Break edges: {len(machine.candidates)} found, "
-            f"{machine.count(Decision.ACCEPTED)} accepted, "
+            f"{len(machine.candidates)} candidates, {machine.count(Decision.ACCEPTED)} accepted, "
             f"{machine.count(Decision.REJECTED)} rejected"
         ]
         if machine.selected is not None:
             c = machine.candidates[machine.selected]
             parts.append(
-                f"#{c.number}: {c.confidence:.0%}, {format_length(scene, c.length, self.obj)}, "
+                f"#{c.number} {c.confidence:.0%} {format_length(scene, c.length, self.obj)} "
                 f"bend {c.mean_bend_deg:.0f}°"
             )
         if machine.phase is FindPhase.TRIMMING:

@@ -28,13 +28,14 @@ CONFIDENCE_STOPS = (
     (0.5, (1.0, 0.72, 0.05)),
     (1.0, (0.15, 0.9, 0.25)),
 )
-REJECTED_COLOR = (0.35, 0.35, 0.35, 0.8)
+REJECTED_COLOR = (0.08, 0.08, 0.08, 0.9)  # dark: seen on the grey mesh, not in the way
 HALO_COLOR = (1.0, 1.0, 1.0, 1.0)  # under the selected candidate
 TRIM_COLOR = (0.2, 0.75, 1.0, 1.0)  # the first trim click
-WIDTH = {"pending": 3.0, "accepted": 5.0, "rejected": 1.5}
+WIDTH = {"pending": 3.0, "accepted": 5.0, "rejected": 2.0}
 HALO_EXTRA = 4.0
 TEXT_SIZE = 15
 POINT_SIZE = 10.0
+LABEL_SPOTS = 48
 
 
 def confidence_color(confidence: float) -> tuple:
@@ -47,17 +48,28 @@ def confidence_color(confidence: float) -> tuple:
     return (*CONFIDENCE_STOPS[-1][1], 1.0)
 
 
-def line_pairs(points: np.ndarray) -> np.ndarray:
-    """A polyline as float32 segment endpoints for the ``LINES`` primitive, ``(2(k-1), 3)``."""
-    points = np.asarray(points, dtype=np.float32)
-    return np.stack([points[:-1], points[1:]], axis=1).reshape(-1, 3)
-
-
 def label_text(number: int, confidence: float, decision: str) -> str:
     """What is written beside a candidate: its number, then its confidence or its verdict."""
     if decision == "pending":
         return f"{number} ({confidence:.0%})"
     return f"{number} {decision}"
+
+
+def label_spots(points: np.ndarray, count: int = LABEL_SPOTS) -> np.ndarray:
+    """Where a candidate's label may go: ``count`` of its points, the middle one first, then
+    outwards (the first one in view and clear of other labels is used)."""
+    k = len(points)
+    order = np.argsort(np.abs(np.arange(k) - (k - 1) / 2.0), kind="stable")
+    return points[order[:: max(k // count, 1)]]
+
+
+def view_right(region) -> float:
+    """The region's right edge left of a sidebar drawn over it (region overlap)."""
+    area = bpy.context.area
+    ui = next((r for r in area.regions if r.type == "UI"), None) if area else None
+    if ui is not None and ui.width > 1 and region.x <= ui.x < region.x + region.width:
+        return float(ui.x - region.x)
+    return float(region.width)
 
 
 class FindEdgesOverlay(ViewOverlay):
@@ -99,12 +111,13 @@ class FindEdgesOverlay(ViewOverlay):
         items = []
         for candidate, decision in zip(candidates, decisions, strict=True):
             points = world_points(candidate.path.points, matrix)
-            middle = points[int(np.searchsorted(candidate.path.arc_lengths, candidate.length / 2))]
             colour = (
                 REJECTED_COLOR if decision == "rejected" else confidence_color(candidate.confidence)
             )
             text = label_text(candidate.number, candidate.confidence, str(decision))
-            items.append((line_pairs(points), colour, WIDTH[str(decision)], middle, text))
+            items.append(
+                (points.astype(np.float32), colour, WIDTH[str(decision)], label_spots(points), text)
+            )
         self._items = items
         self._selected = selected
         self._trim_point = (
@@ -116,10 +129,11 @@ class FindEdgesOverlay(ViewOverlay):
 
     def _build(self, lines, points) -> list:
         batches = []
-        for index, (pairs, colour, width, _middle, _text) in enumerate(self._items):
-            if not len(pairs):
+        for index, (strip, colour, width, _spots, _text) in enumerate(self._items):
+            if len(strip) < 2:
                 continue
-            batch = batch_for_shader(lines, "LINES", {"pos": pairs})
+            # One strip per candidate: its segments join without the gaps of separate lines.
+            batch = batch_for_shader(lines, "LINE_STRIP", {"pos": strip})
             if index == self._selected:
                 batches.append(("LINES", batch, HALO_COLOR, width + HALO_EXTRA))
             batches.append(("LINES", batch, colour, width))
@@ -142,10 +156,18 @@ class FindEdgesOverlay(ViewOverlay):
         blf.enable(font, blf.SHADOW)
         blf.shadow(font, 5, 0.0, 0.0, 0.0, 1.0)
         blf.shadow_offset(font, 1, -1)
-        for index, (_pairs, colour, _width, middle, text) in enumerate(self._items):
-            xy = view3d_utils.location_3d_to_region_2d(region, region_data, middle)
-            if xy is None:
-                continue
+        right, top = view_right(region) - 110 * scale, region.height - 30 * scale
+        placed = []
+        for index, (_pairs, colour, _width, spots, text) in enumerate(self._items):
+            for spot in spots:
+                xy = view3d_utils.location_3d_to_region_2d(region, region_data, spot)
+                if xy is None or not (10 < xy.x < right and 10 < xy.y < top):
+                    continue
+                if all(abs(xy.x - x) > 90 * scale or abs(xy.y - y) > 22 * scale for x, y in placed):
+                    break
+            else:
+                continue  # not in view
+            placed.append((xy.x, xy.y))
             shown = HALO_COLOR if index == self._selected else colour
             blf.color(font, *shown[:3], 1.0)
             blf.position(font, xy.x + 8 * scale, xy.y + 6 * scale, 0.0)

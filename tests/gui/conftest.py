@@ -87,10 +87,12 @@ def console_stays_clean(request):
 
 @pytest.fixture(scope="module", params=SUITES)
 def gui(request, extension_zip):
-    """A GUI Blender of one Debian suite, extension installed, the wedge scene set up."""
+    """A GUI Blender of one Debian suite, extension installed, the wedge scene set up (or the
+    scene a test module names in ``GUI_SCENE``: ``"fragment"``, the bone fragment)."""
     blender_root(request.param)
     failed_before = request.session.testsfailed
-    session = GuiBlender(request.param, extension_zip, POINTS)
+    scene = getattr(request.module, "GUI_SCENE", "wedge")
+    session = GuiBlender(request.param, extension_zip, POINTS, scene=scene)
     try:
         yield session
     finally:

@@ -6,7 +6,8 @@ bone fragment of the README's pictures, its break sites written to ``$VG_GUI_POI
 writes what the test needs to read to ``$VG_GUI_STATE`` (JSON, replaced atomically): the
 measurements of every mesh object with their exact numbers, the active tool, the 3D view's
 regions in X screen pixels, the sidebar's tab, the 3D cursor, the running drag (found by
-looking, read-only, at the live ``DragSession`` objects), what a Ctrl+Shift+C copied, the
+looking, read-only, at the live ``DragSession`` objects), the running Find Break Edges review
+(its ``FindEdgesSession``, likewise), what a Ctrl+Shift+C copied, the
 regions of an open file browser and what it offers (folder, file name, filter), the screen
 positions of the 3D points listed in ``$VG_GUI_POINTS``, each mesh's edge profiles and active
 list rows, the scenes and every "VG Map" data-block in the file, the window's running modal
@@ -122,6 +123,55 @@ def _drag(window, area):
     return None
 
 
+def _find_edges(window, area):
+    """The running Find Break Edges review (found, read-only, among the live
+    ``FindEdgesSession`` objects): its phase, selection and message, and each candidate's
+    number, confidence, decision and 24 points along it on screen (None: not in view)."""
+    from bpy_extras import view3d_utils
+    from mathutils import Matrix, Vector
+
+    find_edges = scene.extension().operators.find_edges
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    region_3d = area.spaces.active.region_3d
+    for obj in gc.get_objects():
+        if type(obj) is not find_edges.FindEdgesSession:
+            continue
+        machine = obj.machine
+        if machine.phase.name in ("DONE", "CANCELLED"):
+            continue
+        matrix = Matrix(obj.obj.matrix_world)
+        candidates = []
+        for candidate, decision in zip(machine.candidates, machine.decisions, strict=True):
+            path = candidate.path
+            picks = [round(f * (len(path.points) - 1)) for f in [(k + 0.5) / 24 for k in range(24)]]
+            screen = []
+            for index in picks:
+                xy = view3d_utils.location_3d_to_region_2d(
+                    region, region_3d, matrix @ Vector(path.points[index])
+                )
+                inside = xy is not None and 0 <= xy.x < region.width and 0 <= xy.y < region.height
+                screen.append(
+                    _to_screen(window, region.x + xy.x, region.y + xy.y) if inside else None
+                )
+            candidates.append(
+                {
+                    "number": candidate.number,
+                    "confidence": candidate.confidence,
+                    "length": candidate.length,
+                    "decision": str(decision),
+                    "screen": screen,
+                }
+            )
+        return {
+            "phase": machine.phase.name,
+            "progress": machine.progress,
+            "selected": machine.selected,
+            "message": machine.message,
+            "candidates": candidates,
+        }
+    return None
+
+
 def _objects(scene_) -> dict:
     objects = {}
     for obj in scene_.objects:
@@ -234,6 +284,7 @@ def _tick():
             "active": getattr(window.view_layer.objects.active, "name", None),
             "objects": _objects(window.scene),
             "drag": _drag(window, area) if area else None,
+            "find_edges": _find_edges(window, area) if area else None,
             "points": _projections(window, area) if area else {},
             "clipboard": _status["clipboard"][-20:],
             "blend": bpy.data.filepath,

@@ -1,0 +1,206 @@
+"""Find Break Edges in a real Blender window, pressed with real mouse and key events (xdotool).
+
+One GUI Blender per Debian suite (trixie: Blender 4.3, unstable: 5.2) on the synthetic bone
+fragment of ``scene.py`` (its rims are the break edges the finder finds), the tests in file
+order on that one window: Esc at the review records nothing; a candidate accepted with a click
+and A, another rejected with a click and X, Enter: one Edge Profile with its stations; Ctrl+Z
+removes all of it in one step. The harness reports the running review (phase, candidates on
+screen, decisions). ``VG_GUI_PICTURES=DIR`` keeps the screenshots; ``VG_GUI_DOC_PICTURE=PATH``
+writes the review's picture, one candidate accepted and one rejected
+(docs/images/find_edges.png).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vg_addon.formats.png import encode_png
+
+OBJ = "BoneFragment"
+GUI_SCENE = "fragment"  # conftest's gui fixture builds this scene
+
+
+@pytest.fixture(scope="module")
+def places(gui):
+    """Screen places found once per window and shared by the tests. Next Break is pressed
+    first: an undo step of its own, so the undo test below finds the file as it was before the
+    review (the scene is built by the harness, not by an undo step)."""
+    gui.open_goniometer_tab()
+    gui.click(gui.find_button("UI", "vg.next_break"))
+    gui.wait_for(lambda s: s["objects"][OBJ]["break_number"] == 2, 20, "Next Break")
+    return {"button": gui.find_button("UI", "vg.find_break_edges", upward=True)}
+
+
+# -- helpers -------------------------------------------------------------------------------------
+def edges(gui) -> list[dict]:
+    return gui.state()["objects"][OBJ]["edges"]
+
+
+def review(state):
+    found = state.get("find_edges")
+    return found if found and found["phase"] == "REVIEW" else None
+
+
+def running(state) -> bool:
+    return any("find_break_edges" in op.lower() for op in state["modal_operators"])
+
+
+def start_review(gui, places) -> dict:
+    gui.click(places["button"])
+    return review(gui.wait_for(review, 60, "the candidates"))
+
+
+def clear_spot(found, index) -> tuple[float, float]:
+    """A screen point on candidate ``index`` as far as can be from every other candidate."""
+    others = [
+        xy for k, c in enumerate(found["candidates"]) if k != index for xy in c["screen"] if xy
+    ]
+    best, gap = None, -1.0
+    for xy in found["candidates"][index]["screen"]:
+        if xy is None:
+            continue
+        d = min((np.hypot(xy[0] - o[0], xy[1] - o[1]) for o in others), default=1e9)
+        if d > gap:
+            best, gap = xy, d
+    assert best is not None and gap > 25, f"candidate {index + 1} is not clear of the others"
+    return tuple(best)
+
+
+def decide(gui, found, index: int, key: str, decision: str) -> dict:
+    """Click candidate ``index`` (a real click on its line), press ``key``; the review after."""
+    gui.click(clear_spot(found, index))
+    assert review(gui.settle())["selected"] == index
+    gui.key(key)
+    return review(
+        gui.wait_for(lambda s: review(s)["candidates"][index]["decision"] == decision, 10, key)
+    )
+
+
+def keep_picture(path: Path) -> None:
+    folder = os.environ.get("VG_GUI_PICTURES")
+    if folder:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        shutil.copy(path, Path(folder) / path.name)
+
+
+def overlay_shot(gui, name: str) -> Path:
+    """The viewport left of the sidebar, below the header, as PNG."""
+    regions = gui.state()["regions"]
+    left, top, width, height = regions["WINDOW"]
+    width = regions["UI"][0] - left
+    path = gui.tmp / f"{name}_{gui.suite}.png"
+    gui.save_png(name, path, crop=(left, top, width, height))
+    keep_picture(path)
+    return path
+
+
+def review_picture(gui, found, name: str) -> Path:
+    """The viewport's header rows (the review's counts and keys) over the part of the viewport
+    the candidates are drawn in, as one PNG (kept like the screenshots)."""
+    regions = gui.state()["regions"]
+    shot = gui.screenshot(name)
+    left, right = regions["WINDOW"][0], regions["UI"][0]
+    headers = [regions[k] for k in ("HEADER", "TOOL_HEADER") if k in regions]
+    top = min(r[1] for r in headers)
+    bottom = max(r[1] + r[3] for r in headers)
+    spots = np.array([xy for c in found["candidates"] for xy in c["screen"] if xy])
+    y0, y1 = spots[:, 1].min() - 70, spots[:, 1].max() + 70
+    view = shot[max(int(y0), bottom) : int(y1), left:right]
+    head = shot[top:bottom, left:right]
+    path = gui.tmp / f"{name}_{gui.suite}.png"
+    path.write_bytes(encode_png(np.vstack([head, view])))
+    keep_picture(path)
+    return path
+
+
+def coloured(shot: np.ndarray, box) -> int:
+    """Pixels in ``box`` drawn in a saturated colour (the candidates' lines: red to green)."""
+    left, top, width, height = (int(v) for v in box)
+    cut = shot[top : top + height, left : left + width].astype(int)
+    return int(((cut.max(axis=2) - cut.min(axis=2)) > 120).sum())
+
+
+# -- the session ---------------------------------------------------------------------------------
+def test_esc_at_the_review_records_nothing(gui, places):
+    before = gui.state()["objects"][OBJ]
+    found = start_review(gui, places)
+    assert len(found["candidates"]) >= 2
+    confidences = [c["confidence"] for c in found["candidates"]]
+    assert confidences == sorted(confidences, reverse=True)
+    assert [c["number"] for c in found["candidates"]] == list(range(1, len(confidences) + 1))
+    gui.move(clear_spot(found, 0))
+    gui.key("Escape")
+    state = gui.wait_for(lambda s: not running(s), 20, "the review to end")
+    assert state["find_edges"] is None
+    after = state["objects"][OBJ]
+    assert after["edges"] == before["edges"] == []
+    assert after["measurements"] == before["measurements"]
+
+
+def test_candidates_are_drawn_numbered_and_coloured(gui, places):
+    """The overlay over the viewport: the lines in their confidence colours where the
+    candidates are (none before the review, none after it)."""
+    region = gui.state()["regions"]["WINDOW"]
+    plain = coloured(gui.screenshot("plain"), region)
+    found = start_review(gui, places)
+    gui.settle(3)
+    shot = gui.screenshot("overlay")
+    picture = overlay_shot(gui, "find_edges")
+    assert coloured(shot, region) > plain + 500, f"no candidate lines drawn ({picture})"
+    # Along each candidate, a coloured pixel close by on screen.
+    for candidate in found["candidates"]:
+        near = 0
+        for xy in candidate["screen"]:
+            if xy is not None:
+                near += coloured(shot, (xy[0] - 4, xy[1] - 4, 9, 9)) > 0
+        assert near >= 12, f"candidate {candidate['number']} is not drawn ({picture})"
+    gui.key("Escape")
+    gui.wait_for(lambda s: not running(s), 20, "the review to end")
+    gui.settle(3)
+    assert coloured(gui.screenshot("after"), region) <= plain + 50, "the overlay is removed"
+
+
+def test_accept_one_reject_one_and_enter_records_one_edge_profile(gui, places):
+    found = start_review(gui, places)
+    n = len(found["candidates"])
+    decide(gui, found, 1, "a", "accepted")
+    found = decide(gui, found, 0, "x", "rejected")
+    assert [c["decision"] for c in found["candidates"]] == (
+        ["rejected", "accepted"] + ["pending"] * (n - 2)
+    )
+    gui.settle(3)
+    picture = review_picture(gui, found, "find_edges_review")
+    target = os.environ.get("VG_GUI_DOC_PICTURE")
+    if target:
+        shutil.copy(picture, target)
+    accepted_length = found["candidates"][1]["length"]
+    gui.key("Return")
+    state = gui.wait_for(lambda s: not running(s) and s["objects"][OBJ]["edges"], 120, "the edge")
+    (edge,) = state["objects"][OBJ]["edges"]
+    stations = [m for m in state["objects"][OBJ]["measurements"] if "arc_length" in m["exact"]]
+    spacing = stations[0]["exact"]["spacing"]
+    assert edge["n_stations"] == len(stations) >= accepted_length / spacing - 1
+    assert {m["break_number"] for m in stations} == {edge["break_number"]}
+    assert np.isfinite(edge["mean"]) and 0.0 < edge["mean"] < 180.0
+    assert len(state["objects"][OBJ]["measurements"]) == len(stations)
+    assert state["objects"][OBJ]["break_number"] == edge["break_number"] + 1 == 3
+
+
+def test_ctrl_z_undoes_the_whole_acceptance_in_one_step(gui, places):
+    before = gui.state()["objects"][OBJ]
+    assert len(before["edges"]) == 1 and len(before["measurements"]) > 2
+    assert before["break_number"] == 3
+    left, top, width, height = gui.state()["regions"]["WINDOW"]
+    gui.move((left + width // 2, top + height // 2))
+    gui.key("ctrl+z")
+    state = gui.wait_for(lambda s: not s["objects"][OBJ]["edges"], 20, "the undo")
+    after = state["objects"][OBJ]
+    assert after["measurements"] == [] and after["break_number"] == 2, "as after Next Break"
+    gui.key("ctrl+shift+z")
+    state = gui.wait_for(lambda s: s["objects"][OBJ]["edges"], 20, "the redo")
+    assert state["objects"][OBJ]["measurements"] == before["measurements"]
