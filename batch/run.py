@@ -202,7 +202,7 @@ class Run:
         start = time.perf_counter()
         rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
         csvio.write_measurements_csv(out, rows)
-        if self.args.edge or self.args.edges_csv or self.args.find_edges:
+        if any(getattr(self.args, name, None) for name in ("edge", "edges_csv", "find_edges")):
             csvio.write_edges_csv(csvio.edges_path_for(out), self.edge_rows)
         self.last_write = time.perf_counter()
         self.write_seconds = self.last_write - start
