@@ -18,6 +18,8 @@ MEASURING_OPTIONS = (
     ("--points", "points"),
     ("--edge", "edge"),
     ("--edges", "edges_csv"),
+    ("--find-edges", "find_edges"),
+    ("--min-length", "min_length"),
     ("--out", "out"),
     ("--save-blend", "save_blend"),
     ("--render", "render"),
