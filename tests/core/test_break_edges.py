@@ -19,7 +19,9 @@ from vg_addon.synthetic_meshes import REGION_RIM, bone_fragment
 
 @pytest.fixture(scope="module")
 def bone():
-    fragment = bone_fragment(spacing=1.0)
+    # Edges 0.3 mm long: a scan's resolution, fine enough for the default scale (five edge
+    # lengths) to see the 5 mm wide fracture faces as faces.
+    fragment = bone_fragment(spacing=0.3)
     surface = Surface(fragment.points, fragment.triangles)
     return fragment, surface, surface.find_break_edges()
 
@@ -34,13 +36,14 @@ def test_the_four_rims_of_the_bone_shaft_are_found_as_closed_loops(bone):
         on_rim = rim[candidate.path.vertices].mean()
         assert on_rim >= 0.9, on_rim
         assert 0.5 < candidate.confidence <= 1.0
-        assert candidate.mean_bend_deg == pytest.approx(90.0, abs=8.0)
+        # The true bends: 90° on the transverse rims, 55° to 125° round the oblique ones.
+        assert 60.0 <= candidate.mean_bend_deg <= 100.0
     # Every rim vertex lies within one mesh edge of a candidate.
     found = np.vstack([c.path.points for c in result.candidates])
     h = result.candidates[0].path.mean_edge_length
     rim_points = fragment.points[rim]
-    nearest = np.min(np.linalg.norm(rim_points[:, None, :] - found[None, :, :], axis=2), axis=1)
-    assert (nearest <= h).mean() >= 0.95
+    nearest = [np.linalg.norm(found - p, axis=1).min() for p in rim_points]
+    assert (np.array(nearest) <= h).mean() >= 0.95
 
 
 def test_numbers_follow_confidence(bone):
@@ -54,11 +57,16 @@ def test_regions_are_the_four_surfaces(bone):
     fragment, _, result = bone
     assert result.region.dtype == np.int32 and result.region.shape == (len(fragment.points),)
     assert result.region_kind.shape == (4,)
+    seen = set()
     for label in range(4):  # outer, inner, transverse, oblique
         truth = fragment.region == label
-        found = np.unique(result.region[truth])
-        assert found.size == 1 and found[0] >= 0, found
-    assert (result.region[fragment.region == REGION_RIM] == -1).mean() > 0.9
+        found = result.region[truth]
+        assert (found >= 0).mean() > 0.3  # the band near the rims is no region
+        regions = np.unique(found[found >= 0])
+        assert regions.size == 1, regions  # one region per face, and one face per region
+        seen.add(int(regions[0]))
+    assert len(seen) == 4
+    assert (result.region[fragment.region == REGION_RIM] == -1).all()
 
 
 def test_waypoints_retrace_each_candidate(bone):
@@ -76,6 +84,7 @@ def test_trim_keeps_a_part_that_retraces(bone):
     arc = candidate.path.arc_lengths
     first = int(np.argmin(np.abs(arc - 10.0)))
     last = int(np.argmin(np.abs(arc - 30.0)))
+    assert part.bend_deg.shape == part.path.vertices.shape
     assert np.array_equal(part.path.vertices, candidate.path.vertices[first : last + 1])
     assert not part.closed
     assert part.length == pytest.approx(arc[last] - arc[first])
@@ -97,7 +106,7 @@ def test_steps_report_progress_and_leave_the_result(bone):
     ]
     # Derived parameters are filled in, in the mesh's units.
     used = finder.result.parameters
-    assert used.scale == pytest.approx(3 * result.candidates[0].path.mean_edge_length)
+    assert used.scale == pytest.approx(5 * result.candidates[0].path.mean_edge_length)
     assert used.min_length > 0 and used.min_region_area > 0
 
 

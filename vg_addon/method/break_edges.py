@@ -18,7 +18,6 @@ The method, in four steps (docs/EDGE_DETECTION.md shows it at work):
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field, fields, replace
@@ -26,16 +25,31 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from ..errors import GoniometerError
-from .edge_profile import EdgePath, assemble_path, ridge_graph, trace_leg
-from .fixed_order import eigh3, moments
-from .mesh_regions import connected_parts, flood_labels
-from .ranges import expand_ranges
+from .edge_pieces import (
+    retraced_legs,
+    ridge_pieces,
+    smooth_regions,
+    trace_piece,
+    vertex_areas,
+)
+from .edge_profile import EdgePath, assemble_path, ridge_graph
+from .ridge_field import (
+    anisotropy_of_bend,
+    bend_of_anisotropy,
+    blurred,
+    cell_spread,
+    ring_spread,
+    vertex_moments,
+)
 
-SCALE_EDGES = 3.0
+SCALE_EDGES = 5.0
 """Default ``scale``: this many mean edge lengths."""
 
 MIN_LENGTH_SCALES = 5.0
 """Default ``min_length``: this many times ``scale``."""
+
+FINE_RINGS = 2
+"""Rings of neighbours of the fine bend field, whose crests the edges are traced along."""
 
 MIN_REGION_SCALES = 2.0
 """Default ``min_region_area``: a disc of this many times ``scale`` in radius."""
@@ -61,6 +75,10 @@ class BreakEdgeParameters:
         Smooth parts smaller than this (mesh units squared) are not regions of their own (noise,
         small scars); their vertices join the band. None: the area of a disc of radius
         :data:`MIN_REGION_SCALES` times ``scale``.
+    noise_factor : float
+        On a noisy scan a ridge must also bend more than this many times the typical (median)
+        bend of the whole surface at ``scale``, in the field's terms (see
+        :mod:`.ridge_field`); the bar actually used is ``BreakEdgeResult.ridge_min_deg``.
     max_candidates : int
         At most this many candidates are returned (the most confident).
     """
@@ -69,10 +87,13 @@ class BreakEdgeParameters:
     min_bend_deg: float = 30.0
     min_length: float | None = None
     min_region_area: float | None = None
+    noise_factor: float = 4.0
     max_candidates: int = 200
 
     def check(self) -> BreakEdgeParameters:
         """The parameters, or a :class:`GoniometerError` naming the first bad one."""
+        if not (_is_number(self.noise_factor) and 0 <= self.noise_factor < math.inf):
+            raise GoniometerError(f"noise_factor must be a number ≥ 0; got {self.noise_factor!r}.")
         for name in ("scale", "min_length", "min_region_area"):
             value = getattr(self, name)
             if value is not None and not (_is_number(value) and math.isfinite(value) and value > 0):
@@ -104,14 +125,19 @@ class BreakEdgeParameters:
             min_region_area=float(area),
             max_candidates=int(self.max_candidates),
             min_bend_deg=float(self.min_bend_deg),
+            noise_factor=float(self.noise_factor),
         )
+
+
+def _median(values: np.ndarray) -> float:
+    return float(np.median(values)) if values.size else 0.0
 
 
 def _is_number(value) -> bool:
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class BreakEdgeCandidate:
     """One break edge found: a traced path with how sure the finder is of it.
 
@@ -126,13 +152,17 @@ class BreakEdgeCandidate:
         In [0, 1]: the share of the path on a ridge times how far its bend clears
         ``min_bend_deg`` (see :func:`confidence`).
     mean_bend_deg : float
-        Mean bend (180° minus the angle) along the path, in degrees.
+        Mean bend (180° minus the angle) along the path at ``scale``, in degrees.
     closed : bool
         The edge is a loop (its start and end are one vertex).
     regions : tuple of int
-        The regions on either side (-1 for a ridge inside one region).
+        The regions on either side (-1, -1 for a ridge inside one region).
+    bend_deg : ndarray, shape (k,)
+        The bend at ``scale`` at each path vertex (degrees; see :mod:`.ridge_field`).
+    ridge_min_deg : float
+        The bend a path vertex needed to count as on a ridge.
     min_bend_deg : float
-        The ``min_bend_deg`` it was found with (the confidence of a trimmed part uses it).
+        The ``min_bend_deg`` it was found with (the confidence of a trimmed part uses both).
     surface : Surface
         The surface it lies on (:func:`trim` retraces parts on it).
     """
@@ -142,9 +172,11 @@ class BreakEdgeCandidate:
     confidence: float
     mean_bend_deg: float
     closed: bool
-    regions: tuple = field(default=(-1, -1))
+    regions: tuple = (-1, -1)
+    bend_deg: np.ndarray = field(default=None, repr=False)
+    ridge_min_deg: float = field(default=30.0, repr=False)
     min_bend_deg: float = field(default=30.0, repr=False)
-    surface: object = field(default=None, repr=False, compare=False)
+    surface: object = field(default=None, repr=False)
 
     @property
     def length(self) -> float:
@@ -172,27 +204,37 @@ class BreakEdgeResult:
         :func:`region_kinds`).
     parameters : BreakEdgeParameters
         The parameters used, derived ones filled in.
+    ridge_min_deg : float
+        The bend at ``scale`` a vertex needed to be on a ridge: ``min_bend_deg``, or more on a
+        noisy scan (see ``BreakEdgeParameters.noise_factor``).
     """
 
     candidates: tuple
     region: np.ndarray
     region_kind: np.ndarray
     parameters: BreakEdgeParameters
-
-
-def vertex_areas(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """A third of the area of each vertex's triangles (the vertex's share of the surface)."""
-    a = points[triangles[:, 1]] - points[triangles[:, 0]]
-    b = points[triangles[:, 2]] - points[triangles[:, 0]]
-    cross = np.cross(a, b)
-    area = np.sqrt(np.einsum("ij,ij->i", cross, cross)) / 6.0
-    return np.bincount(triangles.ravel(), np.repeat(area, 3), minlength=points.shape[0])
+    ridge_min_deg: float = 0.0
 
 
 def confidence(ridge_fraction: float, mean_bend_deg: float, min_bend_deg: float) -> float:
-    """How sure a candidate is: ``ridge_fraction * (1 - exp(-(mean - min) / min))`` (0 below)."""
+    """How sure a candidate is: ``ridge_fraction * (1 - exp(-2 (mean - min) / min))``, 0 when
+    the mean bend is below ``min_bend_deg``."""
     clear = max(0.0, mean_bend_deg - min_bend_deg) / min_bend_deg
     return float(ridge_fraction * (1.0 - math.exp(-2.0 * clear)))
+
+
+def rated(candidate: BreakEdgeCandidate, path: EdgePath, bend_deg: np.ndarray, **changes):
+    """``candidate`` with ``path`` and its bends, mean bend and confidence worked out anew."""
+    mean_bend = float(bend_deg.mean())
+    on_ridge = float(np.mean(bend_deg >= candidate.ridge_min_deg))
+    return replace(
+        candidate,
+        path=path,
+        bend_deg=bend_deg,
+        mean_bend_deg=mean_bend,
+        confidence=confidence(on_ridge, mean_bend, candidate.min_bend_deg),
+        **changes,
+    )
 
 
 class BreakEdgeFinder:
@@ -226,19 +268,42 @@ class BreakEdgeFinder:
         graph = ridge_graph(surface)  # raises for a point cloud
         yield 0.1
         params = self.parameters.resolved(graph.mean_edge_length)
-        bend = graph.vertex_bend
-        areas = vertex_areas(surface.points, surface.triangles)
+        sums = vertex_moments(surface.points, surface.triangles, graph.starts, graph.target)
+        spread, total = cell_spread(surface.points, sums, params.scale, graph.starts, graph.target)
         yield 0.3
-        region, flooded = _regions(graph, surface.valid, bend, areas, params)
-        yield 0.5
-        pieces = _pieces(graph, flooded, bend >= math.radians(params.min_bend_deg), surface)
+        fine_spread, fine_total = ring_spread(sums, graph.starts, graph.target, FINE_RINGS)
+        del sums
+        yield 0.4
+        degree = np.diff(graph.starts)
+        used = surface.valid & (degree > 0)
+        # Creases show in the crease part of the spread, corners (three faces) in the second
+        # eigenvalue; on a noisy scan both bars rise with the typical value of each.
+        second = (total - spread) / 2.0
+        bar = anisotropy_of_bend(params.min_bend_deg)
+        floor = max(bar, params.noise_factor * _median(spread[used]))
+        corner_floor = max(bar, params.noise_factor * _median(second[used]))
+        band = used & ((spread >= floor) | (second >= corner_floor))
+        del second
+        ridge_min_deg = float(bend_of_anisotropy(np.array([floor]))[0])
+        bend_field = np.maximum(spread, fine_spread)
+        areas = vertex_areas(surface.points, surface.triangles)
+        # The flood rises by the bend at scale (where a broad bevel peaks), its steps from cell
+        # to cell smoothed, plus the fine bend (where a sharp crease peaks).
+        heights = blurred(total, graph.starts, graph.target, FINE_RINGS) + fine_total
+        region, flooded = smooth_regions(graph, used, band, heights, areas, params.min_region_area)
+        del heights, fine_total
         yield 0.6
+        # A vertex with more neighbours than faces lies on the mesh's border.
+        faces = np.bincount(surface.triangles.ravel(), minlength=surface.n_points)
+        reach = math.ceil(1.5 * params.scale / graph.mean_edge_length) + 2
+        pieces = ridge_pieces(graph, flooded, band, used & (degree != faces), reach)
+        yield 0.7
         traced = []
         for k, piece in enumerate(pieces):
-            candidate = _trace_piece(surface, piece, params)
+            candidate = self._candidate(graph, piece, bend_field, ridge_min_deg, params)
             if candidate is not None:
                 traced.append(candidate)
-            yield 0.6 + 0.4 * (k + 1) / max(len(pieces), 1)
+            yield 0.7 + 0.3 * (k + 1) / len(pieces)
         traced.sort(key=lambda c: (-c.confidence, -c.length, int(c.path.vertices[0])))
         numbered = tuple(
             replace(c, number=k + 1) for k, c in enumerate(traced[: params.max_candidates])
@@ -249,166 +314,38 @@ class BreakEdgeFinder:
             region=region.astype(np.int32),
             region_kind=np.zeros(n_regions, dtype=np.int8),
             parameters=params,
+            ridge_min_deg=ridge_min_deg,
         )
         yield 1.0
+
+    def _candidate(self, graph, piece, spread, ridge_min_deg, params):
+        """The candidate traced along ``piece``, or None if it is too short."""
+        points = self.surface.points[piece.vertices]
+        extent = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+        if extent < params.min_length / math.pi:  # not even a loop of min_length fits
+            return None
+        traced = trace_piece(self.surface, graph, piece)
+        if traced is None or traced[0].length < params.min_length:
+            return None
+        path, closed = traced
+        blank = BreakEdgeCandidate(
+            number=0,
+            path=path,
+            confidence=0.0,
+            mean_bend_deg=0.0,
+            closed=closed,
+            regions=piece.regions,
+            ridge_min_deg=ridge_min_deg,
+            min_bend_deg=params.min_bend_deg,
+            surface=self.surface,
+        )
+        return rated(blank, path, bend_of_anisotropy(spread[path.vertices]))
 
     def run(self) -> BreakEdgeResult:
         """Run every step; the result."""
         for _ in self.steps():
             pass
         return self.result
-
-
-def _regions(graph, valid, bend, areas, params):
-    """The smooth regions (-1 on the band) and the same labels flooded over the band."""
-    starts, target = graph.starts, graph.target
-    used = valid & (starts[1:] > starts[:-1])
-    smooth = used & (bend < math.radians(params.min_bend_deg))
-    parts = connected_parts(starts, target, smooth)
-    roots, inverse = np.unique(parts[smooth], return_inverse=True)
-    part_area = np.bincount(inverse, areas[smooth], minlength=roots.size)
-    big = part_area >= params.min_region_area
-    # Regions numbered by area, largest first (ties by their least vertex).
-    order = np.lexsort((roots, -part_area))
-    number = np.full(roots.size, -1, dtype=np.int64)
-    kept = order[big[order]]
-    number[kept] = np.arange(kept.size)
-    region = np.full(bend.size, -1, dtype=np.int64)
-    region[smooth] = number[inverse]
-    flooded = flood_labels(starts, target, region, used)
-    return region, flooded
-
-
-@dataclass(frozen=True, eq=False)
-class _Piece:
-    """A stretch of band to trace: its vertices, the regions it parts, its end vertices."""
-
-    vertices: np.ndarray
-    regions: tuple
-    ends: np.ndarray
-
-
-def _local_graph(graph, vertices: np.ndarray, lookup: np.ndarray):
-    """The CSR graph induced on ``vertices`` in local numbering (``lookup`` all -1, restored)."""
-    lookup[vertices] = np.arange(vertices.size)
-    try:
-        counts = graph.starts[vertices + 1] - graph.starts[vertices]
-        sources = np.repeat(np.arange(vertices.size), counts)
-        targets = lookup[graph.target[expand_ranges(graph.starts[vertices], counts)]]
-    finally:
-        lookup[vertices] = -1
-    inside = targets >= 0
-    sources, targets = sources[inside], targets[inside]
-    starts = np.zeros(vertices.size + 1, dtype=np.int64)
-    np.cumsum(np.bincount(sources, minlength=vertices.size), out=starts[1:])
-    return starts, targets
-
-
-def _split(graph, vertices: np.ndarray, lookup: np.ndarray) -> list[np.ndarray]:
-    """``vertices`` split into their connected parts (each sorted)."""
-    starts, targets = _local_graph(graph, vertices, lookup)
-    parts = connected_parts(starts, targets, np.ones(vertices.size, dtype=bool))
-    order = np.argsort(parts, kind="stable")
-    cuts = np.flatnonzero(np.diff(parts[order])) + 1
-    return [vertices[group] for group in np.split(order, cuts)]
-
-
-def _pieces(graph, flooded, ridge, surface) -> list[_Piece]:
-    """The stretches of band between two regions, and the long band stretches inside one."""
-    n = flooded.size
-    starts, target = graph.starts, graph.target
-    sources = np.repeat(np.arange(n, dtype=np.int64), np.diff(starts))
-    a, b = flooded[sources], flooded[target]
-    meet = (a >= 0) & (b >= 0) & (a != b)
-    pair_a, pair_b = np.minimum(a[meet], b[meet]), np.maximum(a[meet], b[meet])
-    n_regions = int(flooded.max()) + 1
-    keys = (pair_a * n_regions + pair_b) * n + sources[meet]
-    keys = np.unique(keys)
-    pairs, vertices = keys // n, keys % n
-    cuts = np.flatnonzero(np.diff(pairs)) + 1
-    lookup = np.full(n, -1, dtype=np.int64)
-    # Vertices where a third region (or the mesh's border) comes in end an edge.
-    border = np.zeros(n, dtype=bool)
-    lowest = np.full(n, n_regions, dtype=np.int64)
-    np.minimum.at(lowest, sources, np.where(b >= 0, b, n_regions))
-    highest = np.full(n, -1, dtype=np.int64)
-    np.maximum.at(highest, sources, b)
-    pieces = []
-    explained = np.zeros(n, dtype=bool)
-    for group_pairs, group in zip(np.split(pairs, cuts), np.split(vertices, cuts), strict=True):
-        if group.size == 0:
-            continue
-        first, second = divmod(int(group_pairs[0]), n_regions)
-        explained[group] = True
-        for part in _split(graph, group, lookup):
-            own = (lowest[part] >= first) & (highest[part] <= second)
-            around = lowest[part], highest[part]
-            third = ~own | ((around[0] != first) & (around[0] != second))
-            third |= (around[1] != first) & (around[1] != second)
-            pieces.append(_Piece(part, (first, second), part[third | border[part]]))
-    # Ridges inside one region: band vertices far from every region pair's meeting line.
-    near = explained.copy()
-    for _ in range(2):
-        near[target[expand_ranges(starts[np.flatnonzero(near)], np.diff(starts)[near])]] = True
-    loose = np.flatnonzero(ridge & ~near & surface.valid)
-    if loose.size:
-        for part in _split(graph, loose, lookup):
-            pieces.append(_Piece(part, (-1, -1), part[:0]))
-    return pieces
-
-
-def _farthest(points: np.ndarray, origin: np.ndarray) -> int:
-    offsets = points - origin
-    return int(np.argmax(np.einsum("ij,ij->i", offsets, offsets)))
-
-
-def _trace_piece(surface, piece: _Piece, params) -> BreakEdgeCandidate | None:
-    """The candidate traced along ``piece``, or None if it is too short."""
-    vertices = piece.vertices
-    points = surface.points[vertices]
-    extent = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
-    if extent < params.min_length / math.pi:  # not even a loop of min_length fits
-        return None
-    ends = piece.ends if piece.ends.size else None
-    closed = ends is None and piece.regions[0] >= 0
-    if closed:
-        start = int(vertices[0])
-        far = int(vertices[_farthest(points, surface.points[start])])
-        centred = points - points.mean(axis=0)
-        _, axes = eigh3(moments(centred))
-        across = np.cross(axes[:, 0], surface.points[far] - surface.points[start])
-        side = (points - (surface.points[start] + surface.points[far]) / 2.0) @ across
-        stops = [start, int(vertices[np.argmax(side)]), far, int(vertices[np.argmin(side)]), start]
-    else:
-        pool = surface.points[ends] if ends is not None else points
-        pool_ids = ends if ends is not None else vertices
-        first = int(pool_ids[_farthest(pool, points.mean(axis=0))])
-        last = int(vertices[_farthest(points, surface.points[first])])
-        if ends is not None:
-            last_end = int(ends[_farthest(pool, surface.points[first])])
-            if np.linalg.norm(
-                surface.points[last_end] - surface.points[first]
-            ) > 0.5 * np.linalg.norm(surface.points[last] - surface.points[first]):
-                last = last_end
-        stops = [first, last]
-    if len(set(stops)) < 2:
-        return None
-    legs = [trace_leg(surface, a, b) for a, b in itertools.pairwise(stops)]
-    path = assemble_path(surface, legs)
-    if path.length < params.min_length:
-        return None
-    bends = path.vertex_bend_deg
-    mean_bend = float(bends.mean())
-    return BreakEdgeCandidate(
-        number=0,
-        path=path,
-        confidence=confidence(path.ridge_fraction, mean_bend, params.min_bend_deg),
-        mean_bend_deg=mean_bend,
-        closed=closed,
-        regions=piece.regions,
-        min_bend_deg=params.min_bend_deg,
-        surface=surface,
-    )
 
 
 def find_break_edges(surface, parameters: BreakEdgeParameters | None = None, **overrides):
@@ -440,22 +377,6 @@ def find_break_edges(surface, parameters: BreakEdgeParameters | None = None, **o
             f"Unknown break-edge parameter {', '.join(unknown)}: use {', '.join(sorted(known))}."
         )
     return BreakEdgeFinder(surface, replace(parameters, **overrides)).run()
-
-
-def _retraced_legs(surface, vertices: np.ndarray, stops: list[int]) -> list[np.ndarray]:
-    """Legs along ``vertices`` between the positions ``stops``, each one exactly what
-    ``trace_leg`` gives between its ends: a leg that does not retrace is split at its middle."""
-    legs = []
-    pending = list(itertools.pairwise(stops))[::-1]
-    while pending:
-        i, j = pending.pop()
-        wanted = vertices[i : j + 1]
-        if j - i <= 1 or np.array_equal(trace_leg(surface, vertices[i], vertices[j]), wanted):
-            legs.append(wanted)
-        else:
-            middle = (i + j) // 2
-            pending += [(middle, j), (i, middle)]
-    return legs
 
 
 def trim(candidate: BreakEdgeCandidate, start_arc: float, end_arc: float) -> BreakEdgeCandidate:
@@ -491,14 +412,11 @@ def trim(candidate: BreakEdgeCandidate, start_arc: float, end_arc: float) -> Bre
     surface = candidate.surface
     inside = [int(w) - first for w in path.waypoints if first < w < last]
     stops = [0, *inside, last - first]
-    legs = _retraced_legs(surface, path.vertices[first : last + 1], stops)
+    legs = retraced_legs(surface, path.vertices[first : last + 1], stops)
     part = assemble_path(surface, legs)
-    mean_bend = float(part.vertex_bend_deg.mean())
-    min_bend = candidate.min_bend_deg
-    return replace(
+    return rated(
         candidate,
-        path=part,
-        mean_bend_deg=mean_bend,
-        confidence=confidence(part.ridge_fraction, mean_bend, min_bend),
+        part,
+        candidate.bend_deg[first : last + 1].copy(),
         closed=bool(part.vertices[0] == part.vertices[-1]),
     )

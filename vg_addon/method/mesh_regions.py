@@ -37,48 +37,59 @@ def connected_parts(starts: np.ndarray, target: np.ndarray, mask: np.ndarray) ->
     -------
     ndarray of int64, shape (n,)
         For each vertex in ``mask`` the smallest vertex index of its part; -1 elsewhere.
+    """
+    members = np.flatnonzero(mask)
+    counts = starts[members + 1] - starts[members]
+    sources = np.repeat(members, counts)
+    neighbours = target[expand_ranges(starts[members], counts)]
+    inside = mask[neighbours]
+    labels = edge_components(mask.size, sources[inside], neighbours[inside])
+    labels[~mask] = -1
+    return labels
 
-    Notes
-    -----
+
+def edge_components(n: int, sources: np.ndarray, targets: np.ndarray) -> np.ndarray:
+    """The connected parts of the graph on ``n`` vertices with the edges ``sources[k]``,
+    ``targets[k]``: for each vertex the smallest vertex index of its part (itself if alone).
+
     Min-label propagation with pointer jumping (each vertex's label is a vertex index, so
     ``label[label]`` jumps ahead along chains of labels): rounds grow like the logarithm of a
     part's diameter on meshes whose vertices are numbered in any spatially coherent order.
     """
-    n = mask.size
-    members = np.flatnonzero(mask)
-    label = np.full(n, -1, dtype=np.int64)
-    label[members] = members
-    # Each member's neighbours inside the mask, once: the edges propagation runs over.
-    counts = starts[members + 1] - starts[members]
-    edges = expand_ranges(starts[members], counts)
-    sources = np.repeat(members, counts)
-    neighbours = target[edges]
-    inside = mask[neighbours]
-    sources, neighbours = sources[inside], neighbours[inside]
+    label = np.arange(n, dtype=np.int64)
+    touched = np.unique(np.concatenate([sources, targets]))
     while True:
-        before = label[members].copy()
+        before = label[touched].copy()
         # Hook: each vertex, and the root its label names, take the least label next to it.
-        offered = label[neighbours]
+        offered = np.minimum(label[sources], label[targets])
         np.minimum.at(label, label[sources], offered)
+        np.minimum.at(label, label[targets], offered)
         np.minimum.at(label, sources, offered)
+        np.minimum.at(label, targets, offered)
         # Jump: follow labels to their root.
         while True:
-            jumped = label[label[members]]
-            if np.array_equal(jumped, label[members]):
+            jumped = label[label[touched]]
+            if np.array_equal(jumped, label[touched]):
                 break
-            label[members] = jumped
-        if np.array_equal(before, label[members]):
-            break
-    out = np.full(n, -1, dtype=np.int64)
-    out[members] = label[members]
-    return out
+            label[touched] = jumped
+        if np.array_equal(before, label[touched]):
+            return label
 
 
-def flood_labels(starts: np.ndarray, target: np.ndarray, labels: np.ndarray, mask: np.ndarray):
+def flood_labels(
+    starts: np.ndarray,
+    target: np.ndarray,
+    labels: np.ndarray,
+    mask: np.ndarray,
+    heights: np.ndarray | None = None,
+    levels: int = 24,
+) -> np.ndarray:
     """Spread ``labels`` (-1 = none) into the unlabelled vertices of ``mask``, ring by ring.
 
     Each round, an unlabelled vertex of ``mask`` with a labelled neighbour takes the least of its
-    neighbours' labels; rounds go on until no such vertex is left.
+    neighbours' labels; rounds go on until no such vertex is left. With ``heights``, the flood
+    rises like water (a watershed): first into the lowest ``1/levels`` of the unlabelled
+    vertices, then the next, so that floods from two sides of a ridge meet on its crest.
 
     Returns
     -------
@@ -89,12 +100,18 @@ def flood_labels(starts: np.ndarray, target: np.ndarray, labels: np.ndarray, mas
     pending = np.flatnonzero(mask & (labels < 0))
     big = np.iinfo(np.int64).max
     keyed = np.where(labels < 0, big, labels)
-    while pending.size:
-        offered = _row_minimum(starts, target, keyed, pending, big)
-        reached = offered < big
-        if not reached.any():
-            break
-        labels[pending[reached]] = offered[reached]
-        keyed[pending[reached]] = offered[reached]
-        pending = pending[~reached]
+    if heights is None or pending.size == 0:
+        ceilings = [np.inf]
+    else:
+        ceilings = [*np.quantile(heights[pending], np.arange(1, levels) / levels), np.inf]
+    for ceiling in ceilings:
+        while pending.size:
+            low = pending if ceiling == np.inf else pending[heights[pending] <= ceiling]
+            offered = _row_minimum(starts, target, keyed, low, big)
+            reached = offered < big
+            if not reached.any():
+                break
+            labels[low[reached]] = offered[reached]
+            keyed[low[reached]] = offered[reached]
+            pending = pending[keyed[pending] == big]
     return labels

@@ -1,0 +1,298 @@
+"""The steps of the break-edge finder between the bend field and the candidates: smooth regions,
+the pieces of ridge between them, and tracing each piece as an :class:`EdgePath`.
+
+See :mod:`.break_edges` for the method as a whole. Everything here is vectorised over vertices;
+the loops run over regions, pieces and the legs of a path.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import GoniometerError
+from .edge_profile import EdgePath, assemble_path, trace_leg
+from .fixed_order import eigh3, moments, row_dot
+from .mesh_regions import connected_parts, flood_labels
+from .ranges import expand_ranges
+
+MIN_OFF_RUN = 3
+"""A traced leg that leaves the crest for this many consecutive vertices gets a via point."""
+
+MAX_VIA_DEPTH = 8
+"""How many times a leg may be split by via points (at most ``2**depth`` legs per stretch)."""
+
+
+def vertex_areas(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """A third of the area of each vertex's triangles (its share of the surface)."""
+    a = points[triangles[:, 1]] - points[triangles[:, 0]]
+    b = points[triangles[:, 2]] - points[triangles[:, 0]]
+    cross = np.cross(a, b)
+    area = np.sqrt(np.einsum("ij,ij->i", cross, cross)) / 6.0
+    return np.bincount(triangles.ravel(), np.repeat(area, 3), minlength=points.shape[0])
+
+
+def smooth_regions(graph, used, band, spread, areas, min_area):
+    """The smooth regions and the same labels flooded over the band up to its crests.
+
+    Parameters
+    ----------
+    graph : RidgeGraph
+    used, band : ndarray of bool, shape (n,)
+        Vertices that take part; those on a ridge.
+    spread : ndarray, shape (n,)
+        The bend field (see :func:`.ridge_field.bend_anisotropy`): the flood rises by it.
+    areas : ndarray, shape (n,)
+        Each vertex's share of the surface.
+    min_area : float
+        Smooth parts smaller than this are no region.
+
+    Returns
+    -------
+    region, flooded : ndarray of int64, shape (n,)
+        Region numbers (largest area first), -1 on the band and in small parts; and every
+        vertex reached from a region labelled with the region whose flood got there first.
+    """
+    starts, target = graph.starts, graph.target
+    smooth = used & ~band
+    parts = connected_parts(starts, target, smooth)
+    roots, inverse = np.unique(parts[smooth], return_inverse=True)
+    part_area = np.bincount(inverse, areas[smooth], minlength=roots.size)
+    big = part_area >= min_area
+    order = np.lexsort((roots, -part_area))  # largest first, ties by their least vertex
+    number = np.full(roots.size, -1, dtype=np.int64)
+    kept = order[big[order]]
+    number[kept] = np.arange(kept.size)
+    region = np.full(used.size, -1, dtype=np.int64)
+    region[smooth] = number[inverse]
+    flooded = flood_labels(starts, target, region, used, heights=spread)
+    return region, flooded
+
+
+@dataclass(frozen=True, eq=False)
+class Piece:
+    """A stretch of ridge to trace.
+
+    Attributes
+    ----------
+    vertices : ndarray of int64
+        The crest: where the floods of the two regions meet (vertices on both sides), or for a
+        ridge inside one region its band vertices.
+    regions : tuple of int
+        The two regions it parts, or (-1, -1) inside one region.
+    ends : ndarray of int64
+        Its vertices where a third region or the mesh's border comes in (none on a loop).
+    """
+
+    vertices: np.ndarray
+    regions: tuple
+    ends: np.ndarray
+
+
+def _local_graph(graph, vertices: np.ndarray, lookup: np.ndarray):
+    """The CSR graph induced on ``vertices`` in local numbering (``lookup`` all -1, restored)."""
+    lookup[vertices] = np.arange(vertices.size)
+    try:
+        counts = graph.starts[vertices + 1] - graph.starts[vertices]
+        sources = np.repeat(np.arange(vertices.size), counts)
+        targets = lookup[graph.target[expand_ranges(graph.starts[vertices], counts)]]
+    finally:
+        lookup[vertices] = -1
+    inside = targets >= 0
+    sources, targets = sources[inside], targets[inside]
+    starts = np.zeros(vertices.size + 1, dtype=np.int64)
+    np.cumsum(np.bincount(sources, minlength=vertices.size), out=starts[1:])
+    return starts, targets
+
+
+def split_parts(graph, vertices: np.ndarray, lookup: np.ndarray) -> list[np.ndarray]:
+    """``vertices`` split into their connected parts (each sorted), largest first."""
+    starts, targets = _local_graph(graph, vertices, lookup)
+    parts = connected_parts(starts, targets, np.ones(vertices.size, dtype=bool))
+    order = np.argsort(parts, kind="stable")
+    cuts = np.flatnonzero(np.diff(parts[order])) + 1
+    groups = [vertices[group] for group in np.split(order, cuts)]
+    return sorted(groups, key=lambda g: (-g.size, int(g[0])))
+
+
+def _rows(graph, vertices: np.ndarray):
+    """(source, neighbour) for every edge leaving ``vertices``."""
+    counts = graph.starts[vertices + 1] - graph.starts[vertices]
+    return np.repeat(vertices, counts), graph.target[expand_ranges(graph.starts[vertices], counts)]
+
+
+def dilate(graph, mask: np.ndarray, rings: int) -> np.ndarray:
+    """``mask`` grown by ``rings`` rings of neighbours."""
+    grown = mask.copy()
+    frontier = np.flatnonzero(mask)
+    for _ in range(rings):
+        _, reached = _rows(graph, frontier)
+        reached = reached[~grown[reached]]
+        grown[reached] = True
+        frontier = np.unique(reached)
+    return grown
+
+
+def ridge_pieces(graph, flooded, band, border, reach: int) -> list[Piece]:
+    """The crests between two regions, split where a third region or the border comes in,
+    and the ridges inside one region (band more than ``reach`` rings from every such crest)."""
+    n = flooded.size
+    lookup = np.full(n, -1, dtype=np.int64)
+    sources = np.repeat(np.arange(n, dtype=np.int64), np.diff(graph.starts))
+    a, b = flooded[sources], flooded[graph.target]
+    meet = (a >= 0) & (b >= 0) & (a != b)
+    n_regions = int(flooded.max()) + 1
+    pair = np.minimum(a[meet], b[meet]) * n_regions + np.maximum(a[meet], b[meet])
+    keys = np.unique(pair * n + sources[meet])
+    pairs, vertices = keys // n, keys % n
+    # A crest vertex that sees three labels (or none, past the mesh's valid part) is an end.
+    crest = np.unique(vertices)
+    own, neighbour = _rows(graph, crest)
+    seen = np.unique(np.concatenate([crest * (n_regions + 1) + flooded[crest] + 1,
+                                     own * (n_regions + 1) + flooded[neighbour] + 1]))  # fmt: skip
+    owner, label = seen // (n_regions + 1), seen % (n_regions + 1) - 1
+    junction = np.zeros(n, dtype=bool)
+    junction[owner[label < 0]] = True
+    counts = np.bincount(owner, minlength=n)
+    junction |= counts >= 3
+    junction |= border
+    pieces = []
+    cuts = np.flatnonzero(np.diff(pairs)) + 1
+    for group_pairs, group in zip(np.split(pairs, cuts), np.split(vertices, cuts), strict=True):
+        if group.size == 0:
+            continue
+        first, second = divmod(int(group_pairs[0]), n_regions)
+        for part in split_parts(graph, group, lookup):
+            pieces.append(Piece(part, (first, second), part[junction[part]]))
+    explained = np.zeros(n, dtype=bool)
+    explained[crest] = True
+    loose = np.flatnonzero(band & ~dilate(graph, explained, reach))
+    if loose.size:
+        for part in split_parts(graph, loose, lookup):
+            pieces.append(Piece(part, (-1, -1), part[:0]))
+    return pieces
+
+
+def _farthest(points: np.ndarray, origin: np.ndarray) -> int:
+    offsets = points - origin
+    return int(np.argmax(np.einsum("ij,ij->i", offsets, offsets)))
+
+
+def piece_stops(points: np.ndarray, piece: Piece) -> tuple[list[int], bool]:
+    """Vertices to trace ``piece`` through (start, ..., end) and whether it is a loop.
+
+    An open piece runs between the two of its ends farthest apart (or, with one end or none,
+    from the vertex farthest from its middle to the vertex farthest from that); a loop runs
+    from its first vertex through the farthest one and back, by the vertices farthest to
+    either side of that chord (in the loop's own plane).
+    """
+    vertices = piece.vertices
+    where = points[vertices]
+    if piece.ends.size == 0 and piece.regions[0] >= 0:
+        start = int(vertices[0])
+        far = int(vertices[_farthest(where, points[start])])
+        _, axes = eigh3(moments(where - where.mean(axis=0)))
+        across = np.cross(axes[:, 0], points[far] - points[start])
+        side = row_dot(where - (points[start] + points[far]) / 2.0, across)
+        left, right = int(vertices[np.argmax(side)]), int(vertices[np.argmin(side)])
+        return [start, left, far, right, start], True
+    ends = piece.ends
+    pool = ends if ends.size >= 2 else vertices
+    first = int(pool[_farthest(points[pool], where.mean(axis=0))])
+    if ends.size == 1:
+        first = int(ends[0])
+    last = int(pool[_farthest(points[pool], points[first])])
+    # Through the crest vertex farthest from both ends: a crest bent like a U is followed
+    # round its bend, not across it.
+    to_first = np.linalg.norm(where - points[first], axis=1)
+    to_last = np.linalg.norm(where - points[last], axis=1)
+    middle = int(vertices[np.argmax(np.minimum(to_first, to_last))])
+    return [first, middle, last], False
+
+
+def follow(surface, graph, start: int, end: int, near: np.ndarray, crest_points, crest_ids):
+    """Legs from ``start`` to ``end`` along the crest: the cheapest ridge path, split by a via
+    point on the crest wherever it strays off ``near`` for :data:`MIN_OFF_RUN` vertices."""
+    legs = []
+    pending = [(start, end, 0)]
+    while pending:
+        a, b, depth = pending.pop()
+        if a == b:
+            continue
+        try:
+            leg = trace_leg(surface, a, b)
+        except GoniometerError:  # the crest between them leaves the corridor: split it
+            if depth >= MAX_VIA_DEPTH:
+                raise
+            to_a = np.linalg.norm(crest_points - surface.points[a], axis=1)
+            to_b = np.linalg.norm(crest_points - surface.points[b], axis=1)
+            via = int(crest_ids[np.argmax(np.minimum(to_a, to_b))])
+            pending += [(via, b, depth + 1), (a, via, depth + 1)]
+            continue
+        off = ~near[leg]
+        run = _longest_run(off)
+        if run is None or run[1] - run[0] < MIN_OFF_RUN or depth >= MAX_VIA_DEPTH:
+            legs.append(leg)
+            continue
+        middle = surface.points[leg[(run[0] + run[1]) // 2]]
+        via = int(crest_ids[_nearest(crest_points, middle)])
+        if via in (a, b):
+            legs.append(leg)
+            continue
+        pending += [(via, b, depth + 1), (a, via, depth + 1)]
+    return legs
+
+
+def _nearest(points: np.ndarray, to: np.ndarray) -> int:
+    offsets = points - to
+    return int(np.argmin(np.einsum("ij,ij->i", offsets, offsets)))
+
+
+def _longest_run(flags: np.ndarray):
+    """(first, end) of the longest run of True in ``flags``, or None."""
+    steps = np.diff(np.concatenate([[0], flags.astype(np.int8), [0]]))
+    begins, ends = np.flatnonzero(steps == 1), np.flatnonzero(steps == -1)
+    if begins.size == 0:
+        return None
+    k = int(np.argmax(ends - begins))
+    return int(begins[k]), int(ends[k])
+
+
+def trace_piece(surface, graph, piece: Piece) -> tuple[EdgePath, bool] | None:
+    """The path along ``piece`` and whether it is a loop (None if it cannot be traced).
+
+    The path may only stray one ring off the piece's crest before a via point pulls it back."""
+    stops, closed = piece_stops(surface.points, piece)
+    if len(set(stops)) < 2:
+        return None
+    crest = np.zeros(surface.n_points, dtype=bool)
+    crest[piece.vertices] = True
+    near = dilate(graph, crest, 1)
+    crest_points = surface.points[piece.vertices]
+    legs = []
+    try:
+        for a, b in itertools.pairwise(stops):
+            legs += follow(surface, graph, a, b, near, crest_points, piece.vertices)
+    except GoniometerError:
+        return None
+    if not legs:
+        return None
+    return assemble_path(surface, legs), closed
+
+
+def retraced_legs(surface, vertices: np.ndarray, stops: list[int]) -> list[np.ndarray]:
+    """Legs along ``vertices`` between the positions ``stops``, each exactly what ``trace_leg``
+    gives between its ends: a leg that does not retrace is split at its middle."""
+    legs = []
+    pending = list(itertools.pairwise(stops))[::-1]
+    while pending:
+        i, j = pending.pop()
+        wanted = vertices[i : j + 1]
+        if j - i <= 1 or np.array_equal(trace_leg(surface, vertices[i], vertices[j]), wanted):
+            legs.append(wanted)
+        else:
+            middle = (i + j) // 2
+            pending += [(middle, j), (i, middle)]
+    return legs

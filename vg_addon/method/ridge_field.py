@@ -1,0 +1,193 @@
+"""How much the surface bends around each vertex, judged over a neighbourhood: the spread of
+the face normals near it.
+
+Around each vertex the area-weighted face normals within a few rings are pooled: their mean
+``m`` and second moment ``T``, whose difference ``C = T - m mᵀ`` is the normals' covariance. Where
+two flat faces with normals ``n1``, ``n2`` meet at a bend ``β`` (180° minus the interior angle)
+and share the neighbourhood in proportions ``w`` and ``1 - w``, ``C`` has the single large
+eigenvalue ``4 w (1 - w) sin²(β / 2)``: ``sin²(β / 2)`` on the crease itself (``w = 1/2``) for any
+bend up to 180°, less off it, nothing on a flat face. Scan noise spreads the normals equally in
+every direction along the surface and adds the same amount to both eigenvalues in the tangent
+plane, so the *anisotropy* ``λ1 - λ2`` keeps only the bend; a gently curved surface (a bone's
+cylinder) spreads its normals by the neighbourhood's size over its radius, which is small.
+
+``λ1 - λ2`` is computed from the invariants of ``C`` (``sqrt(tr² - 4 · minors)``, exact when
+``λ3 = 0`` and close otherwise): additions, products and square roots only, so the field is the
+same on every machine.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .mesh_regions import edge_components
+from .normals import face_normals
+
+_ROWS = 1 << 17  # vertices per block of the neighbourhood sums: the gathered rows stay small
+
+_COLUMNS = 10  # area, area·n (3), area·n nᵀ (6: xx, yy, zz, xy, xz, yz)
+
+
+def rings_for(scale: float, mean_edge_length: float) -> int:
+    """Rings of neighbours pooled for a neighbourhood of radius ``scale`` (1 to 12)."""
+    if mean_edge_length <= 0:
+        return 1
+    return int(min(12, max(1, round(scale / mean_edge_length))))
+
+
+def _moments(weight, nx, ny, nz) -> tuple:
+    """The ten columns: weight, weight·n, weight·n nᵀ (xx, yy, zz, xy, xz, yz)."""
+    first = (weight, weight * nx, weight * ny, weight * nz)
+    return (
+        *first,
+        first[1] * nx,
+        first[2] * ny,
+        first[3] * nz,
+        first[1] * ny,
+        first[1] * nz,
+        first[2] * nz,
+    )
+
+
+def vertex_moments(points, triangles, starts, target, smoothing: int = 1) -> np.ndarray:
+    """Per vertex, its area and the moments of its *smoothed* normal (``(n, 10)``): what
+    :func:`ring_spread` and :func:`box_spread` pool.
+
+    The smoothed normal is the mean face normal within ``smoothing`` rings: a single face's
+    normal carries the scan's noise at full strength, and on a regular grid that noise is
+    spread unevenly between directions (it would read as a crease); averaged over a ring or
+    two it is a few times weaker, while a crease stays a crease.
+    """
+    nx, ny, nz = face_normals(points, triangles)
+    doubled = np.sqrt(nx * nx + ny * ny + nz * nz)
+    corners = triangles.reshape(-1)
+    n = points.shape[0]
+    # Face normals of length twice the area: their sum over a vertex's faces is area-weighted.
+    normals = np.empty((n, 3))
+    for column, values in enumerate((nx, ny, nz)):
+        normals[:, column] = np.bincount(corners, np.repeat(values, 3), minlength=n)
+    area = np.bincount(corners, np.repeat(doubled, 3), minlength=n) / 6.0
+    for _ in range(smoothing):
+        normals = _pool(starts, target, normals)
+    length = np.sqrt(np.einsum("ij,ij->i", normals, normals))
+    normals /= np.where(length > 0, length, 1.0)[:, None]
+    area[length <= 0] = 0.0
+    return np.column_stack(_moments(area, normals[:, 0], normals[:, 1], normals[:, 2]))
+
+
+def _pool(starts: np.ndarray, target: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Each vertex's values plus its neighbours' (one ring of pooling)."""
+    out = values.copy()
+    n = values.shape[0]
+    for first in range(0, n, _ROWS):
+        last = min(n, first + _ROWS)
+        lo, hi = int(starts[first]), int(starts[last])
+        if hi == lo:
+            continue
+        gathered = np.take(values, target[lo:hi], axis=0)
+        rows = starts[first:last] - lo
+        nonempty = starts[first + 1 : last + 1] > starts[first:last]
+        sums = np.add.reduceat(gathered, rows[nonempty], axis=0)
+        out[first:last][nonempty] += sums
+    return out
+
+
+def _spread(sums: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The crease part ``λ1 - λ2`` and the trace of the normals' covariance, from pooled sums."""
+    weight = sums[:, 0]
+    safe = np.where(weight > 0, weight, 1.0)
+    m = sums[:, 1:4] / safe[:, None]
+    t = sums[:, 4:10] / safe[:, None]
+    cxx = t[:, 0] - m[:, 0] * m[:, 0]
+    cyy = t[:, 1] - m[:, 1] * m[:, 1]
+    czz = t[:, 2] - m[:, 2] * m[:, 2]
+    cxy = t[:, 3] - m[:, 0] * m[:, 1]
+    cxz = t[:, 4] - m[:, 0] * m[:, 2]
+    cyz = t[:, 5] - m[:, 1] * m[:, 2]
+    trace = cxx + cyy + czz
+    minors = (cxx * cyy - cxy * cxy) + (cxx * czz - cxz * cxz) + (cyy * czz - cyz * cyz)
+    crease = np.sqrt(np.maximum(trace * trace - 4.0 * minors, 0.0))
+    crease[weight <= 0] = 0.0
+    trace[weight <= 0] = 0.0
+    return crease, np.maximum(trace, 0.0)
+
+
+def ring_spread(sums: np.ndarray, starts, target, rings: int):
+    """The spread of the face normals pooled ``rings`` rings of neighbours around each vertex
+    (a neighbourhood a few edges wide, weighted towards the vertex: it locates crests).
+
+    Parameters
+    ----------
+    sums : ndarray, shape (n, 10)
+        :func:`vertex_moments`.
+    starts, target : ndarray of int64
+        The vertex graph in CSR form (``RidgeGraph.starts`` and ``.target``).
+    rings : int
+        How many times each vertex's sums take in its neighbours'.
+
+    Returns
+    -------
+    crease, total : ndarray, shape (n,)
+        The crease part ``λ1 - λ2`` (``sin²(β/2)`` on a crease of bend ``β``, 0 where flat; see
+        the module's text) and the trace ``λ1 + λ2 + λ3`` (large on creases and corners alike:
+        where three faces meet, ``λ1 ≈ λ2``); in [0, 1], 0 for a vertex with no faces.
+    """
+    for _ in range(rings):
+        sums = _pool(starts, target, sums)
+    return _spread(sums)
+
+
+def cell_spread(points, sums, scale: float, starts, target):
+    """The spread of the normals over a patch about ``1.5 * scale`` wide around each vertex.
+
+    The mesh is cut into *cells*: the connected pieces of the surface inside each cube of a grid
+    of step ``scale / 2`` (the two sides of a thin flake in one cube are two cells, being
+    joined only through other cubes). Each vertex reads its cell's sums pooled with those of
+    the cells next to it along the mesh: a patch of about three cubes across, which the cost
+    does not grow with, and which never reaches through a thin part to its other side. Every
+    vertex of a cell reads the same value.
+
+    Returns ``(crease, total)`` as :func:`ring_spread` does; ``sums`` is :func:`vertex_moments`.
+    """
+    n = points.shape[0]
+    cells = np.floor((points - points.min(axis=0)) / (scale / 2.0)).astype(np.int64)
+    dims = cells.max(axis=0) + 1
+    cube = (cells[:, 0] * dims[1] + cells[:, 1]) * dims[2] + cells[:, 2]
+    sources = np.repeat(np.arange(n, dtype=np.int64), np.diff(starts))
+    inside = cube[sources] == cube[target]
+    cell = edge_components(n, sources[inside], target[inside])
+    _, cell = np.unique(cell, return_inverse=True)
+    count = int(cell.max()) + 1
+    per_cell = np.empty((count, _COLUMNS))
+    for column in range(_COLUMNS):
+        per_cell[:, column] = np.bincount(cell, sums[:, column], minlength=count)
+    a, b = cell[sources[~inside]], cell[target[~inside]]
+    pairs = np.unique(a * count + b)  # each pair of touching cells, both ways
+    pooled = per_cell.copy()
+    first, second = pairs // count, pairs % count
+    for column in range(_COLUMNS):
+        pooled[:, column] += np.bincount(first, per_cell[second, column], minlength=count)
+    crease, total = _spread(pooled)
+    return crease[cell], total[cell]
+
+
+def blurred(values: np.ndarray, starts, target, rings: int) -> np.ndarray:
+    """``values`` averaged over ``rings`` rings of neighbours (each ring a plain mean of a
+    vertex and its neighbours): smooths the steps of a field that is constant per cell."""
+    pair = np.column_stack([values, np.ones(values.size)])
+    for _ in range(rings):
+        pair = _pool(starts, target, pair)
+    return pair[:, 0] / pair[:, 1]
+
+
+def anisotropy_of_bend(bend_deg: float) -> float:
+    """The anisotropy a crease of ``bend_deg`` shows on itself: ``sin²(bend / 2)``."""
+    return math.sin(math.radians(bend_deg) / 2.0) ** 2
+
+
+def bend_of_anisotropy(spread: np.ndarray) -> np.ndarray:
+    """The bend (degrees) a crease with this anisotropy on itself has: ``2 asin(sqrt(a))``."""
+    clipped = np.clip(np.asarray(spread, dtype=np.float64), 0.0, 1.0)
+    return np.degrees(2.0 * np.array([math.asin(math.sqrt(v)) for v in clipped.ravel()]))
