@@ -405,10 +405,8 @@ class VG_OT_find_break_edges(PatchProperties, bpy.types.Operator):
                 "Name the candidates to record: accept='ALL' or numbers like '1 3' (or give "
                 "edges); the panel's button reviews them first."
             )
-        result = BreakEdgeFinder(surface, self.parameters())
-        for _ in result.steps():
-            pass
-        candidates = {c.number: c for c in result.result.candidates}
+        result = BreakEdgeFinder(surface, self.parameters()).run()
+        candidates = {c.number: c for c in result.candidates}
         return [edge_points(candidates[n]) for n in parse_accept(self.accept, candidates)]
 
     def recorded(self, obj, made):

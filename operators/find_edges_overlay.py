@@ -29,6 +29,7 @@ CONFIDENCE_STOPS = (
     (1.0, (0.15, 0.9, 0.25)),
 )
 REJECTED_COLOR = (0.08, 0.08, 0.08, 0.9)  # dark: seen on the grey mesh, not in the way
+REJECTED_TEXT = (0.7, 0.7, 0.7, 1.0)
 HALO_COLOR = (1.0, 1.0, 1.0, 1.0)  # under the selected candidate
 TRIM_COLOR = (0.2, 0.75, 1.0, 1.0)  # the first trim click
 WIDTH = {"pending": 3.0, "accepted": 5.0, "rejected": 2.0}
@@ -168,7 +169,8 @@ class FindEdgesOverlay(ViewOverlay):
             else:
                 continue  # not in view
             placed.append((xy.x, xy.y))
-            shown = HALO_COLOR if index == self._selected else colour
+            shown = colour if colour != REJECTED_COLOR else REJECTED_TEXT
+            shown = HALO_COLOR if index == self._selected else shown
             blf.color(font, *shown[:3], 1.0)
             blf.position(font, xy.x + 8 * scale, xy.y + 6 * scale, 0.0)
             blf.draw(font, f"[{text}]" if index == self._selected else text)

@@ -3,7 +3,8 @@
 One GUI Blender per Debian suite (trixie: Blender 4.3, unstable: 5.2) on the synthetic bone
 fragment of ``scene.py`` (its rims are the break edges the finder finds), the tests in file
 order on that one window: Esc at the review records nothing; a candidate accepted with a click
-and A, another rejected with a click and X, Enter: one Edge Profile with its stations; Ctrl+Z
+and A, another rejected with a click and X, a third trimmed with T and two clicks (left
+undecided), Enter: one Edge Profile with its stations; Ctrl+Z
 removes all of it in one step. The harness reports the running review (phase, candidates on
 screen, decisions). ``VG_GUI_PICTURES=DIR`` keeps the screenshots; ``VG_GUI_DOC_PICTURE=PATH``
 writes the review's picture, one candidate accepted and one rejected
@@ -57,17 +58,10 @@ def start_review(gui, places) -> dict:
 
 def clear_spot(found, index) -> tuple[float, float]:
     """A screen point on candidate ``index`` as far as can be from every other candidate."""
-    others = [
-        xy for k, c in enumerate(found["candidates"]) if k != index for xy in c["screen"] if xy
-    ]
-    best, gap = None, -1.0
-    for xy in found["candidates"][index]["screen"]:
-        if xy is None:
-            continue
-        d = min((np.hypot(xy[0] - o[0], xy[1] - o[1]) for o in others), default=1e9)
-        if d > gap:
-            best, gap = xy, d
-    assert best is not None and gap > 25, f"candidate {index + 1} is not clear of the others"
+    spots = [xy for xy in found["candidates"][index]["screen"] if xy]
+    assert spots, f"candidate {index + 1} is not in view"
+    best = max(spots, key=lambda xy: clear_of(found, index, xy))
+    assert clear_of(found, index, best) > 25, f"candidate {index + 1} is not clear of the others"
     return tuple(best)
 
 
@@ -79,6 +73,37 @@ def decide(gui, found, index: int, key: str, decision: str) -> dict:
     return review(
         gui.wait_for(lambda s: review(s)["candidates"][index]["decision"] == decision, 10, key)
     )
+
+
+def trim_third(gui, found) -> dict:
+    """T on candidate 3 and two clicks on it a third of the way along apart: it is replaced by
+    the part between them, still undecided (so nothing of it is recorded)."""
+    before = found["candidates"][2]
+    clear = [k for k, xy in enumerate(before["screen"]) if xy and clear_of(found, 2, xy) > 25]
+    ends = [clear[0], next((k for k in clear if k - clear[0] >= 8), None)]
+    assert ends[1] is not None, "candidate 3 is not clear to trim"
+    gui.click(tuple(before["screen"][ends[0]]))
+    assert review(gui.settle())["selected"] == 2
+    gui.key("t")
+    gui.click(tuple(before["screen"][ends[1]]))  # either order
+    gui.click(tuple(before["screen"][ends[0]]))
+    after = review(
+        gui.wait_for(
+            lambda s: review(s)["candidates"][2]["length"] < before["length"], 20, "the trim"
+        )
+    )
+    trimmed = after["candidates"][2]
+    assert trimmed["decision"] == "pending" and trimmed["number"] == 3
+    # The screen points are evenly spaced path vertices: the part kept is about their share.
+    share = (ends[1] - ends[0]) / len(before["screen"])
+    assert abs(trimmed["length"] / before["length"] - share) < 0.08
+    return after
+
+
+def clear_of(found, index, xy) -> float:
+    """How far (pixels) the screen point ``xy`` is from every candidate but ``index``."""
+    others = [o for k, c in enumerate(found["candidates"]) if k != index for o in c["screen"] if o]
+    return min((float(np.hypot(xy[0] - o[0], xy[1] - o[1])) for o in others), default=1e9)
 
 
 def keep_picture(path: Path) -> None:
@@ -173,6 +198,7 @@ def test_accept_one_reject_one_and_enter_records_one_edge_profile(gui, places):
     assert [c["decision"] for c in found["candidates"]] == (
         ["rejected", "accepted"] + ["pending"] * (n - 2)
     )
+    found = trim_third(gui, found) if n >= 3 else found
     gui.settle(3)
     picture = review_picture(gui, found, "find_edges_review")
     target = os.environ.get("VG_GUI_DOC_PICTURE")
