@@ -158,7 +158,7 @@ def measure_all(surface, found, settings, names=None) -> list:
         try:
             measured.append((points, surface.measure_along(points, *settings)))
         except GoniometerError as error:
-            failures.append(f"{name}: {str(error).splitlines()[0]}")
+            failures.append(f"{name}: {error}")
     if failures:
         raise GoniometerError(
             f"{len(failures)} of {len(found)} edges cannot be measured; nothing was recorded.\n"
