@@ -183,11 +183,12 @@ def _checked_angle(normal_plus, normal_minus) -> float:
     return angle
 
 
-def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray]:
+def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray, list]:
     """Steps 9-13 of Algorithm 1: the WithinSS split of ``projection`` and a plane per side.
 
-    Returns the measured fields, and the step from the "−" side's centroid to the "+" side's
-    (their own vertices).
+    Returns the measured fields, the step from the "−" side's centroid to the "+" side's (their
+    own vertices), and each side's plane as (normal, centroid, fit error), ``None`` for a side
+    that borrowed a row (the refinement's first round starts from these).
     """
     threshold, _ = withinss_split(projection, min_size=MIN_SIDE_VERTICES)
     labels = projection >= threshold
@@ -207,7 +208,11 @@ def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray]:
         "n_minus": int((~labels).sum()),
         "n_shared": shared_plus + shared_minus,
     }
-    return fields, mean_plus - mean_minus
+    planes = [
+        None if shared_plus else (normal_plus, mean_plus, error_plus),
+        None if shared_minus else (normal_minus, mean_minus, error_minus),
+    ]
+    return fields, mean_plus - mean_minus, planes
 
 
 def _planes_form_ridge(fields, step) -> bool:
@@ -266,7 +271,7 @@ def measure_patch(
     joined = np.concatenate((points, normals), axis=1)
     weak = abs(correlation) < WEAK_CORRELATION
     if not (oriented and weak and lam > 0):
-        fields, step = _split_and_fit(points, joined, projection(orientation))
+        fields, step, planes = _split_and_fit(points, joined, projection(orientation))
         other_angle = None
     else:
         # The sign is weakly determined: measure with both and keep the better plane fit.
@@ -278,9 +283,9 @@ def measure_patch(
                 refusal = error
         if not readings:
             raise refusal
-        orientation, fields, step = min(readings, key=lambda reading: reading[1]["fit_error"])
+        orientation, fields, step, planes = min(readings, key=lambda r: r[1]["fit_error"])
         other_angle = next(
-            (r["angle"] for sign, r, _ in readings if sign != orientation), fields["angle"]
+            (r["angle"] for sign, r, *_ in readings if sign != orientation), fields["angle"]
         )
     if weak or _planes_form_ridge(fields, step) != (correlation >= 0):
         convexity = "unclear"
@@ -298,7 +303,7 @@ def measure_patch(
         orientation_difference=0.0 if other_angle is None else abs(other_angle - fields["angle"]),
     )
     if rule == "refined":
-        _refine(points, normals, center, radius, fields)
+        _refine(points, normals, center, radius, fields, planes)
     return fields
 
 
@@ -328,8 +333,9 @@ def _check_shared_row(points, labels, spacing) -> None:
         )
 
 
-def _refine(points, normals, center, radius, fields) -> None:
-    """Replace Algorithm 1's planes by :func:`refine_sides`' where it applies (in place)."""
+def _refine(points, normals, center, radius, fields, planes) -> None:
+    """Replace Algorithm 1's planes by :func:`refine_sides`' where it applies (in place);
+    ``planes``: Algorithm 1's, as :func:`_split_and_fit` returns them."""
     if fields["n_shared"]:
         _check_shared_row(points, fields["labels"], mean_edge_length(radius, points.shape[0]))
     refined = refine_sides(
@@ -340,6 +346,7 @@ def _refine(points, normals, center, radius, fields) -> None:
         radius,
         mean_edge_length(radius, points.shape[0]),
         fields["fit_error"],
+        planes,
     )
     if refined is None:
         return

@@ -19,8 +19,12 @@ The result replaces Algorithm 1's only where it explains the patch much better a
 the user measured: the summed plane-fit error falls by :data:`MIN_IMPROVEMENT` or more, both
 faces are shown to be planes (:data:`CURVED_GAIN`), the crease passes near the centre
 (:data:`CREASE_REACH`), and what is left out is a strip along the crease, not a face
-(:data:`MAX_LEFT_OUT`, :data:`MAX_LEFT_OUT_OF_PATCH`). A curved or rough wall keeps Algorithm
-1's planes bit for bit; so do creases on a row of vertices, where nothing moves. Everything runs
+(:data:`MAX_LEFT_OUT`, :data:`MAX_LEFT_OUT_OF_PATCH`; beyond them only where all of it lies
+nearer the crease than what is kept and the kept band shows no bend, :data:`STRICT_GAIN`). A
+curved or rough wall keeps Algorithm 1's planes bit for bit; so do creases on a row of vertices,
+where nothing moves. Where the strip is shown but what is left of a face is too few rows of
+vertices to carry its plane, Algorithm 1's reading is known to be off and the measurement is
+refused (:class:`~vg_addon.errors.GoniometerError`, saying why). Everything runs
 in a fixed order (:mod:`.fixed_order`), so the same inputs give the same bits on every machine.
 The reasons and the measurements are in docs/METHOD.md.
 """
@@ -31,6 +35,7 @@ import math
 
 import numpy as np
 
+from ..errors import GoniometerError
 from .fixed_order import dot3, eigh3, gram, moments, norm3, row_dot, rows_dot, solve, total
 
 NEAR_SPACINGS = 3.0
@@ -63,6 +68,11 @@ residual of its plane is curved. There the plane is a secant, the vertices next 
 pull it towards the tangent at the crease, and leaving any out would move the reading for a
 reason that is not the mesh's: the refinement is for faces that are planes."""
 
+STRICT_GAIN = 1.1
+"""The quadratic's largest gain where more than the shares above is left out
+(:data:`MAX_LEFT_OUT`, :data:`MAX_LEFT_OUT_OF_PATCH`): a plane with noise gains ``n / (n - 6)``
+from the quadratic's six terms; the far band of the half annulus's curved wall gains 1.3."""
+
 CREASE_REACH = 0.5
 """The refined planes must meet within this fraction of the radius of the centre. On a scan a
 patch can hold three faces; leaving one out may leave two others that fit planes well but meet
@@ -77,16 +87,25 @@ MAX_ROUNDS = 20
 """Rounds of re-assignment; the sides settle within 2 to 4."""
 
 MAX_LEFT_OUT = 0.5
-"""The most of a side that may be left out: the robust plane rests on the half of the side
+"""The most of a side that may be left out, unless what is left out lies nearer the crease than
+everything kept (:func:`_beside_the_crease`): the robust plane rests on the half of the side
 nearest it, so beyond half what is left out could be the face and what is kept a chance band
-(a plane cuts a curved wall in two strips); the side is then no plane with a strip at the
-crease, and Algorithm 1's planes are kept."""
+(a plane cuts a curved wall in two strips)."""
 
 MAX_LEFT_OUT_OF_PATCH = 0.2
 """The most of the whole patch that may be left out at a right or obtuse crease (at an acute
 one, ``1 / sin(angle)`` times this, at most :data:`MAX_LEFT_OUT`: the strip that cuts the corner
-reaches that much farther into each face). A strip a few spacings wide along the crease is a
-small part of a patch; on a scan, more left out is another face in the patch, not a strip."""
+reaches that much farther into each face), unless what is left out lies nearer the crease than
+everything kept. A strip a few spacings wide along the crease is a small part of a patch; on a
+scan, more left out is another face in the patch, not a strip. A mesh stretched across the
+crease holds few rows per face, and its strip is a large share of them."""
+
+MAX_STRAY = 0.02
+"""The share of a side that a scan's noise may put beyond the outlier limit (a few in a thousand
+beyond :data:`OUTLIER_SPREADS` for Gaussian noise, more on rougher scans): a side that left out no
+more than this is not asked where they lie, and a strip beside the crease may have this many
+beyond it. A face of its own, or the far strip of a curved wall that a plane cuts in two, is
+more."""
 
 LTS_STEPS = 2
 """Refits of a face's plane to the half of its vertices nearest the previous fit."""
@@ -189,6 +208,16 @@ def _residuals(basis, height, fitted_on):
     return np.abs(height - fitted)
 
 
+def _median(values) -> float:
+    """``np.median`` of a 1-D array without NaNs, bit for bit, without its wrapper's overhead:
+    the middle value, or the mean of the two middle values (their sum halved)."""
+    half = values.size // 2
+    if values.size % 2:
+        return float(np.partition(values, half)[half])
+    lower, upper = np.partition(values, (half - 1, half))[half - 1 : half + 1]
+    return float((lower + upper) / 2)
+
+
 def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
     """Vertices of ``side`` that lie off the face's plane, fitted robustly to ``fitted_on``.
 
@@ -205,38 +234,74 @@ def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
     u, w, height = _face_coordinates(points[members], plane, frame, radius)
     basis = np.stack([np.ones_like(u), u, w])
     # Start from the half farthest from the crease, where the face is least likely disturbed.
-    subset = fit_here & (u >= float(np.median(u[fit_here])))
+    subset = fit_here & (u >= _median(u[fit_here]))
     for _ in range(LTS_STEPS):
         residual = _residuals(basis, height, subset)
         if residual is None:
             return off
-        subset = fit_here & (residual <= float(np.median(residual[fit_here])))
+        middle = _median(residual[fit_here])
+        subset = fit_here & (residual <= middle)
         if subset.sum() < MIN_FAR_VERTICES:
             break
-    spread = max(1.4826 * float(np.median(residual[fit_here])), NOISE_FLOOR * spacing)
+    spread = max(1.4826 * middle, NOISE_FLOOR * spacing)
     off[members] = residual > OUTLIER_SPREADS * spread
     return off
 
 
-def _planar(points, side, plane, frame, spacing, radius) -> bool:
-    """Whether a side's kept vertices are shown to lie on its plane: they reach far enough across
-    the crease (:data:`MIN_CURVATURE_SPREAD`) for a bend to show, and a quadratic surface fits
-    them no markedly better than the plane (:data:`CURVED_GAIN`)."""
+def _planar(points, side, plane, frame, spacing, radius, gain=None) -> bool | None:
+    """Whether a side's kept vertices are shown to lie on its plane: ``True`` where they reach far
+    enough across the crease (:data:`MIN_CURVATURE_SPREAD`) for a bend to show and a quadratic
+    surface fits them no markedly better than the plane (:data:`CURVED_GAIN`); ``False`` where the
+    quadratic fits markedly better (a curved face); ``None`` where they are too few rows, or too
+    narrow a band, to tell. ``gain``: the quadratic's largest allowed gain, if not
+    :data:`CURVED_GAIN`."""
     u, w, height = _face_coordinates(points[side], plane, frame, radius)
     if float(u.max() - u.min()) * radius < MIN_CURVATURE_SPREAD * spacing:
-        return False
+        return None
     basis = np.stack([np.ones_like(u), u, w, u * w, w * w, u * u])
     residual = _residuals(basis, height, np.ones(u.size, dtype=bool))
     if residual is None:
-        return False
+        return None  # two rows of vertices, or fewer: every smooth surface through them fits
     floor = (NOISE_FLOOR * spacing) ** 2
     return (
         total(height * height) / height.size
-        <= CURVED_GAIN * (total(residual * residual) / height.size) + floor
+        <= (gain or CURVED_GAIN) * (total(residual * residual) / height.size) + floor
     )
 
 
-def refine_sides(points, normals, labels, center, radius, spacing, split_error):
+def _beside_the_crease(to_line, side, used) -> bool:
+    """Whether what a side left out lies nearer the crease than what it kept: at most
+    :data:`MAX_STRAY` of the side is left out beyond the kept vertex that many from the nearest
+    (a scan's noise outliers); a strip that cuts the corner lies there whole, a face of its own
+    or the far strip of a curved wall does not."""
+    kept = to_line[side & used]
+    if kept.size == 0:
+        return False
+    allowed = int(MAX_STRAY * int(side.sum()))
+    nearest = float(np.partition(kept, min(allowed, kept.size - 1))[min(allowed, kept.size - 1)])
+    return int((side & ~used & (to_line > nearest)).sum()) <= allowed
+
+
+def _refuse_a_lost_face(points, plus, used, planes, frame, split_error) -> None:
+    """Refuse where handing over and leaving out the vertices off a face left it one row of
+    vertices, if what it left out is a strip along the crease and the other face's plane explains
+    its side :data:`MIN_IMPROVEMENT` times better than Algorithm 1's planes did (else, return:
+    the refinement does not apply)."""
+    whole = [plane for plane in planes if plane is not None]
+    if len(whole) != 1 or split_error < MIN_IMPROVEMENT * whole[0][2]:
+        return
+    to_line = _distance_to_line(points, frame[0], frame[1])
+    lost = plus if planes[0] is None else ~plus
+    if not (lost & ~used).any() or _beside_the_crease(to_line, lost, used):
+        raise GoniometerError(
+            "The vertices next to the crease lie on neither face (the mesh's triangles cut the "
+            "corner), and without them one face keeps a single row of vertices in the patch, so "
+            "its plane is not determined: use a larger radius (or the 'oriented' rule to "
+            "replicate a reading taken with it)."
+        )
+
+
+def refine_sides(points, normals, labels, center, radius, spacing, split_error, planes=None):
     """Refine Algorithm 1's split (see the module's description).
 
     Parameters
@@ -251,6 +316,10 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
         The patch radius and its mean edge length.
     split_error : float
         Algorithm 1's summed plane-fit error.
+    planes : list, optional
+        Algorithm 1's two planes as (unit normal oriented by the side's mean normal, centroid,
+        fit error), or ``None`` for a side whose plane is not its own vertices' (a borrowed row):
+        the first round starts from them instead of fitting them again.
 
     Returns
     -------
@@ -258,15 +327,26 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
         The refined fields (``labels``, ``used``, the two planes' normals and fit errors), or
         ``None`` where the refinement does not apply: nothing moved, a side ran out of vertices or
         no longer spans a plane, or one of the conditions in the module's description fails.
+
+    Raises
+    ------
+    GoniometerError
+        Where a strip that cuts the corner is found but a face keeps too few rows of vertices
+        without it to carry its plane (Algorithm 1's reading would be off, by an unknown amount).
     """
     if split_error <= (NOISE_FLOOR * spacing) ** 2:
         return None  # Algorithm 1's planes already fit to rounding error
     plus = labels
     used = np.ones(points.shape[0], dtype=bool)
-    planes = None
+    given, frame = planes or [None, None], None
     for round_number in range(MAX_ROUNDS):
-        planes = [_side_plane(points, normals, side) for side in (plus & used, ~plus & used)]
+        planes = [
+            _side_plane(points, normals, side) if round_number or plane is None else plane
+            for side, plane in zip((plus & used, ~plus & used), given, strict=True)
+        ]
         if planes[0] is None or planes[1] is None:
+            if frame is not None:
+                _refuse_a_lost_face(points, plus, used, planes, frame, split_error)
             return None
         if round_number == 1 and split_error < EARLY_IMPROVEMENT * (planes[0][2] + planes[1][2]):
             return None  # the first round found no corner-cutting strip: a scan's noise
@@ -299,6 +379,7 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
     else:
         planes = [_side_plane(points, normals, side) for side in (plus & used, ~plus & used)]
         if planes[0] is None or planes[1] is None:
+            _refuse_a_lost_face(points, plus, used, planes, frame, split_error)
             return None
         found = _half_plane_distances(points, center, planes)
         if found is None:
@@ -310,23 +391,40 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error):
     if split_error < MIN_IMPROVEMENT * refined_error:
         return None
     on_line, direction, into_faces = frame
+    if _distance_to_line(center[None, :], on_line, direction)[0] > CREASE_REACH * radius:
+        return None  # the planes of two other faces: the crease is not where the user measured
+    to_line = _distance_to_line(points, on_line, direction)
     # An acute corner's strip reaches 1 / sin(angle) times as far into each face.
     opening = math.sqrt(max(0.0, 1.0 - dot3(planes[0][0], planes[1][0]) ** 2))
     share = MAX_LEFT_OUT_OF_PATCH / max(opening, MAX_LEFT_OUT_OF_PATCH / MAX_LEFT_OUT)
-    if (~used).sum() > share * used.size:
-        return None
-    to_line = _distance_to_line(points, on_line, direction)
-    if _distance_to_line(center[None, :], on_line, direction)[0] > CREASE_REACH * radius:
-        return None  # the planes of two other faces: the crease is not where the user measured
+    small = (~used).sum() <= share * used.size
+    planar, sides = [], []
     for side, plane, into_face in zip((plus, ~plus), planes, into_faces, strict=True):
-        frame = (on_line, direction, into_face)
         left_out, kept = side & ~used, side & used
-        if left_out.sum() > MAX_LEFT_OUT * side.sum():
-            return None
-        if left_out.any() and np.median(to_line[left_out]) > np.median(to_line[kept]):
+        beside = _beside_the_crease(to_line, side, used)
+        stray = left_out.sum() > MAX_STRAY * side.sum() and not beside
+        if stray and _median(to_line[left_out]) > _median(to_line[kept]):
             return None  # what was left out is no strip along the crease (a face of its own)
-        if not _planar(points, kept, plane, frame, spacing, radius):
-            return None  # a curved face: its plane is a secant, and stays Algorithm 1's
+        small = small and left_out.sum() <= MAX_LEFT_OUT * side.sum()
+        if not (small or beside):
+            return None
+        sides.append((kept, plane, (on_line, direction, into_face)))
+    # Beyond the shares, the kept band must show no bend at all: a curved wall's far band, which
+    # a plane fits but for its curvature, gains from a quadratic what a plane with noise cannot.
+    gain = None if small else STRICT_GAIN
+    for kept, plane, frame in sides:
+        planar.append(_planar(points, kept, plane, frame, spacing, radius, gain))
+    if False in planar:
+        return None  # a curved face: its plane is a secant, and stays Algorithm 1's
+    if None in planar:
+        if not small:
+            return None  # a wide strip and a face too narrow to show it is a plane: a curved wall
+        raise GoniometerError(
+            "The vertices next to the crease lie on neither face (the mesh's triangles cut the "
+            "corner), and without them a face keeps too few rows of vertices in the patch to show "
+            "it is a plane, so the angle is not determined: use a larger radius (or the "
+            "'oriented' rule to replicate a reading taken with it)."
+        )
     return {
         "labels": plus,
         "used": used,
