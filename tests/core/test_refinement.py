@@ -10,6 +10,7 @@ import pytest
 
 from vg_addon import GoniometerError, Surface
 from vg_addon.method.algorithm import DEFAULT_RULE, RULES
+from vg_addon.method.refinement import _median
 from vg_addon.reference_shapes import marched_wedge, stretched_wedge
 from vg_addon.synthetic_meshes import bevelled_wedge, bone_fragment, wedge
 
@@ -173,3 +174,24 @@ def test_a_face_of_too_few_rows_beside_a_strip_is_refused(angle, spacing):
     assert abs(surface.measure(center, 0.2, rule="oriented").angle - angle) > 1.0
     with pytest.raises(GoniometerError, match="too few rows of vertices"):
         surface.measure(center, 0.2)
+
+
+def test_a_face_left_one_row_beside_a_strip_is_refused():
+    """At 175° on grid 0.0106 one face holds three rows in the patch, two of them in the strip
+    that cuts the corner: without them it is one row, and no plane. Algorithm 1 read +2.45° with a
+    stability figure of ± 0.1°; the refined rule says why it cannot read it."""
+    points, triangles = stretched_wedge(175.0, 0.0106)
+    center = points[np.argmin(np.linalg.norm(points, axis=1))]
+    surface = Surface(points, triangles)
+    assert abs(surface.measure(center, 0.2, rule="oriented").angle - 175.0) > 2.0
+    with pytest.raises(GoniometerError, match="single row of vertices in the patch"):
+        surface.measure(center, 0.2)
+
+
+@pytest.mark.parametrize("size", [1, 2, 3, 10, 11, 999, 1000])
+def test_the_fast_median_is_numpys_bit_for_bit(size):
+    """The refinement's median skips np.median's wrapper; oracle: np.median itself."""
+    rng = np.random.default_rng(size)
+    for scale in (1e-12, 1.0, 1e9):
+        values = rng.normal(size=size) * scale
+        assert _median(values) == float(np.median(values))
