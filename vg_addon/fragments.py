@@ -5,9 +5,8 @@ of every vertex and which faces are fracture surfaces:
 
 * :func:`bone_shaft`: the demo's long-bone shaft (:func:`~vg_addon.synthetic_meshes.bone_fragment`),
   a hollow tube with a transverse and an oblique fracture face: four rims, all closed loops.
-* :func:`bevelled_cube`: a cube marched from its implicit function, two of its top edges rounded
-  by a fillet (a worn or bevelled edge, whose true edge is the fillet's middle line), the other
-  ten sharp but bevelled by the marching as a scan's are.
+* :func:`bevelled_cube`: a cube, two of its top edges rounded by a fillet (a worn or bevelled
+  edge, whose true edge is the fillet's middle line), the other ten sharp.
 * :func:`flake`: a flake-like solid: a convex dorsal cap on a flat ventral (fracture) face with a
   knife edge of 45° all round, and a striking platform cut across one end; meshed with its
   vertices on the edges.
@@ -22,7 +21,6 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .marching_tetrahedra import march
 from .method.normals import vertex_normals
 from .synthetic_meshes import REGION_OBLIQUE, REGION_TRANSVERSE
 from .synthetic_meshes import bone_fragment as _bone_fragment
@@ -116,22 +114,33 @@ def bone_shaft(spacing: float = 1.0, **options) -> Fragment:
     )
 
 
-def _cube_terms(p: np.ndarray, half: float, fillet: float) -> np.ndarray:
-    """Signed distances (positive outside) of the cube's faces: +x, -x, +y, -y, +z, -z, and the
-    two fillets rounding the edges where +z meets +x and -x."""
-    terms = [p[:, 0] - half, -half - p[:, 0], p[:, 1] - half, -half - p[:, 1]]
-    terms += [p[:, 2] - half, -half - p[:, 2]]
-    for sign in (1.0, -1.0):
-        a = sign * p[:, 0] - half + fillet
-        b = p[:, 2] - half + fillet
-        inside = (a > 0) & (b > 0)
-        terms.append(np.where(inside, np.hypot(a, b) - fillet, -np.inf))
-    return np.stack(terms, axis=1)
+def _cube_profile(a: float, r: float, spacing: float):
+    """The cube's cross-section in the (x, z) plane, walked once round (not closed), with
+    each point's face (+x 0, -x 1, +z 4, -z 5, fillets 6 and 7) and corners on the points."""
+
+    def line(p, q, face):
+        count = max(1, math.ceil(math.dist(p, q) / spacing))
+        t = np.arange(count)[:, None] / count
+        return np.asarray(p) + t * (np.asarray(q) - np.asarray(p)), np.full(count, face)
+
+    def arc(centre, start, face):
+        count = max(2, math.ceil(r * math.pi / 2 / spacing))
+        theta = start + np.arange(count) / count * math.pi / 2
+        return np.column_stack(
+            [centre[0] + r * np.cos(theta), centre[1] + r * np.sin(theta)]
+        ), np.full(count, face)
+
+    pieces = [
+        line((-a, -a), (a, -a), 5), line((a, -a), (a, a - r), 0), arc((a - r, a - r), 0.0, 6),
+        line((a - r, a), (-(a - r), a), 4), arc((-(a - r), a - r), math.pi / 2, 7),
+        line((-a, a - r), (-a, -a), 1),
+    ]  # fmt: skip
+    return np.vstack([p for p, _ in pieces]), np.concatenate([f for _, f in pieces])
 
 
-def bevelled_cube(size: float = 20.0, fillet: float = 1.5, spacing: float = 0.5) -> Fragment:
+def bevelled_cube(size: float = 20.0, fillet: float = 1.5, spacing: float = 0.4) -> Fragment:
     """A cube of side ``size`` whose two top edges along y are rounded by a fillet of radius
-    ``fillet``; marched with grid step ``spacing``.
+    ``fillet``: a prism of its cross-section, vertices about ``spacing`` apart, on the edges.
 
     The true edge of a rounded edge is the fillet's middle line; where the rounded edges meet
     the side faces ±y, those faces' edges follow the fillet's arc. Faces: 0..5 the planes +x,
@@ -139,11 +148,24 @@ def bevelled_cube(size: float = 20.0, fillet: float = 1.5, spacing: float = 0.5)
     fracture face); the fragment tests edges, not the kinds of regions.
     """
     a, r = size / 2.0, fillet
-    shift = 0.3183 * spacing
-    lower = np.full(3, -a - 2 * spacing + shift)
-    upper = np.full(3, a + 2 * spacing)
-    points, triangles = march(lambda p: _cube_terms(p, a, r).max(axis=1), lower, upper, spacing)
-    faces = np.argmin(np.abs(_cube_terms(points, a, r)), axis=1).astype(np.int64)
+    profile, labels = _cube_profile(a, r, spacing)
+    closed = np.vstack([profile, profile[:1]])  # rows repeat their first point (welded)
+    ys = np.linspace(-a, a, max(2, math.ceil(size / spacing)) + 1)
+    sides = [np.column_stack([closed[:, 0], np.full(len(closed), y), closed[:, 1]]) for y in ys]
+    parts = [(*_strips(sides, lambda c: c * [1.0, 0.0, 1.0]), 4)]
+    scales = np.linspace(0.0, 1.0, max(2, math.ceil(a / spacing)) + 1)
+    for y, face in ((a, 2), (-a, 3)):
+        rows = [np.array([[0.0, y, 0.0]])]
+        rows += [np.column_stack([f * closed[:, 0], np.full(len(closed), y), f * closed[:, 1]])
+                 for f in scales[1:]]  # fmt: skip
+        outward = np.array([0.0, 1.0 if y > 0 else -1.0, 0.0])
+        parts.append((*_strips(rows, lambda c, o=outward: np.broadcast_to(o, c.shape)), face))
+    points, triangles, faces = _weld(parts)
+    # The side vertices take their face from the profile (the caps' own rows came later).
+    on_side = np.abs(np.abs(points[:, 1]) - a) > 1e-9
+    offsets = points[:, None, [0, 2]] - profile[None, :, :]
+    nearest = np.argmin(np.einsum("ijk,ijk->ij", offsets, offsets), axis=1)
+    faces = np.where(on_side, labels[nearest], faces)
     mid = a - r + r / math.sqrt(2.0)
     inner = a - r  # where the flat top ends and each fillet begins
     edges = [

@@ -39,6 +39,7 @@ from .ridge_field import (
     blurred,
     cell_spread,
     ring_spread,
+    spread_of,
     vertex_moments,
 )
 
@@ -47,6 +48,13 @@ SCALE_EDGES = 5.0
 
 MIN_LENGTH_SCALES = 5.0
 """Default ``min_length``: this many times ``scale``."""
+
+FRACTURE_MAX_SPREAD = 0.05
+"""A region whose normals spread less than this (the trace of their covariance, about their
+mean squared angle from the mean normal: 0.05 is some 13°) is near plane: a fracture face."""
+
+ORIGINAL_MIN_SPREAD = 0.1
+"""A region whose normals spread more than this (some 18°) is curved: original surface."""
 
 FINE_RINGS = 2
 """Rings of neighbours of the fine bend field, whose crests the edges are traced along."""
@@ -237,6 +245,30 @@ def rated(candidate: BreakEdgeCandidate, path: EdgePath, bend_deg: np.ndarray, *
     )
 
 
+def region_kinds(region: np.ndarray, sums: np.ndarray, n_regions: int) -> np.ndarray:
+    """What each region probably is: 2 fracture surface, 1 original surface, 0 unknown.
+
+    A heuristic for shaft fragments and flakes: a fracture face is near plane (its normals
+    spread less than :data:`FRACTURE_MAX_SPREAD`), the original outer and inner surfaces of a
+    bone and the dorsal face of a flake are curved (more than :data:`ORIGINAL_MIN_SPREAD`), and
+    the largest region is original surface. Spiral fractures and flat cortex defeat it: the
+    kinds are a hint for the analyst, not a measurement.
+    """
+    kinds = np.zeros(n_regions, dtype=np.int8)
+    if n_regions == 0:
+        return kinds
+    inside = region >= 0
+    pooled = np.stack(
+        [np.bincount(region[inside], sums[inside, k], minlength=n_regions) for k in range(10)],
+        axis=1,
+    )
+    _, spread = spread_of(pooled)
+    kinds[spread < FRACTURE_MAX_SPREAD] = 2
+    kinds[spread > ORIGINAL_MIN_SPREAD] = 1
+    kinds[0] = 1  # regions are numbered by area, largest first
+    return kinds
+
+
 class BreakEdgeFinder:
     """Find break edges step by step (a modal operator steps it on a timer).
 
@@ -272,7 +304,6 @@ class BreakEdgeFinder:
         spread, total = cell_spread(surface.points, sums, params.scale, graph.starts, graph.target)
         yield 0.3
         fine_spread, fine_total = ring_spread(sums, graph.starts, graph.target, FINE_RINGS)
-        del sums
         yield 0.4
         degree = np.diff(graph.starts)
         used = surface.valid & (degree > 0)
@@ -289,7 +320,7 @@ class BreakEdgeFinder:
         areas = vertex_areas(surface.points, surface.triangles)
         # The flood rises by the bend at scale (where a broad bevel peaks), its steps from cell
         # to cell smoothed, plus the fine bend (where a sharp crease peaks).
-        heights = blurred(total, graph.starts, graph.target, FINE_RINGS) + fine_total
+        heights = blurred(total, graph.starts, graph.target, 2 * FINE_RINGS) + fine_total
         region, flooded = smooth_regions(graph, used, band, heights, areas, params.min_region_area)
         del heights, fine_total
         yield 0.6
@@ -312,7 +343,7 @@ class BreakEdgeFinder:
         self.result = BreakEdgeResult(
             candidates=numbered,
             region=region.astype(np.int32),
-            region_kind=np.zeros(n_regions, dtype=np.int8),
+            region_kind=region_kinds(region, sums, n_regions),
             parameters=params,
             ridge_min_deg=ridge_min_deg,
         )

@@ -269,7 +269,7 @@ def trace_piece(surface, graph, piece: Piece) -> tuple[EdgePath, bool] | None:
         return None
     crest = np.zeros(surface.n_points, dtype=bool)
     crest[piece.vertices] = True
-    near = dilate(graph, crest, 1)
+    near = crest
     crest_points = surface.points[piece.vertices]
     legs = []
     try:

@@ -53,7 +53,7 @@ def _moments(weight, nx, ny, nz) -> tuple:
 
 def vertex_moments(points, triangles, starts, target, smoothing: int = 1) -> np.ndarray:
     """Per vertex, its area and the moments of its *smoothed* normal (``(n, 10)``): what
-    :func:`ring_spread` and :func:`box_spread` pool.
+    :func:`ring_spread` and :func:`cell_spread` pool.
 
     The smoothed normal is the mean face normal within ``smoothing`` rings: a single face's
     normal carries the scan's noise at full strength, and on a regular grid that noise is
@@ -94,8 +94,8 @@ def _pool(starts: np.ndarray, target: np.ndarray, values: np.ndarray) -> np.ndar
     return out
 
 
-def _spread(sums: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The crease part ``λ1 - λ2`` and the trace of the normals' covariance, from pooled sums."""
+def spread_of(sums: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Of pooled :func:`vertex_moments` sums: the crease part ``λ1 - λ2`` and the trace of the normals' covariance, from pooled sums."""
     weight = sums[:, 0]
     safe = np.where(weight > 0, weight, 1.0)
     m = sums[:, 1:4] / safe[:, None]
@@ -136,7 +136,7 @@ def ring_spread(sums: np.ndarray, starts, target, rings: int):
     """
     for _ in range(rings):
         sums = _pool(starts, target, sums)
-    return _spread(sums)
+    return spread_of(sums)
 
 
 def cell_spread(points, sums, scale: float, starts, target):
@@ -169,7 +169,7 @@ def cell_spread(points, sums, scale: float, starts, target):
     first, second = pairs // count, pairs % count
     for column in range(_COLUMNS):
         pooled[:, column] += np.bincount(first, per_cell[second, column], minlength=count)
-    crease, total = _spread(pooled)
+    crease, total = spread_of(pooled)
     return crease[cell], total[cell]
 
 
