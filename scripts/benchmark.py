@@ -45,7 +45,13 @@ def radius_for(surface: Surface, center, target: int) -> float:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--vertices", type=int, default=1_000_000, help="size of the big mesh")
+    parser.add_argument(
+        "--case", choices=("all", "find_edges"), default="all", help="run only this case"
+    )
     args = parser.parse_args(argv)
+    if args.case == "find_edges":
+        find_edges_figures(args.vertices)
+        return
 
     print(
         f"machine: {platform.machine()}, {platform.processor() or 'cpu'}, "
@@ -95,6 +101,42 @@ def main(argv=None) -> None:
     core_figures(int(np.sqrt(args.vertices)))
     blas_path_comparison(int(np.sqrt(args.vertices)))
     refinement_comparison(int(np.sqrt(args.vertices)))
+    find_edges_figures(args.vertices)
+
+
+def find_edges_figures(vertices: int) -> None:
+    """Find Break Edges on a scan-sized bone shaft (mm, rough surface): the time from the call to
+    the candidates (the ridge graph built inside it, as on a first click), each step's share,
+    and the peak memory the finder allocates (tracemalloc, in a second run)."""
+    import tracemalloc
+
+    from vg_addon.method.break_edges import BreakEdgeFinder
+    from vg_addon.synthetic_meshes import bone_fragment
+
+    spacing = 0.1 * np.sqrt(988_000 / vertices)  # 0.1 mm gives 988,000 vertices
+    bone = bone_fragment(spacing=spacing, roughness=0.02)
+    print(f"\nfind break edges: bone shaft, {len(bone.points):,} vertices, edges {spacing:.3g} mm")
+    for run in ("time", "memory"):
+        surface = Surface(bone.points, bone.triangles)
+        finder = BreakEdgeFinder(surface)
+        if run == "memory":
+            tracemalloc.start()
+        start = last = time.perf_counter()
+        shares = []
+        for progress in finder.steps():
+            now = time.perf_counter()
+            shares.append((progress, now - last))
+            last = now
+        total = time.perf_counter() - start
+        if run == "time":
+            steps = ", ".join(f"to {p:.2f}: {t:.2f} s" for p, t in shares if t >= 0.05)
+            print(
+                f"call to candidates: {total:8.2f} s ({len(finder.result.candidates)} found; {steps})"
+            )
+        else:
+            _, peak = tracemalloc.get_traced_memory()
+            tracemalloc.stop()
+            print(f"peak memory allocated by the finder: {peak / 2**20:8.0f} MiB")
 
 
 def refinement_comparison(side: int, rounds: int = 5) -> None:

@@ -64,6 +64,17 @@ times ``|a-b|`` (plus a few edge lengths): room for a half-circle, not for a loo
 _graphs: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
+def stable_order(keys: np.ndarray) -> np.ndarray:
+    """``np.argsort(keys, kind="stable")`` for non-negative int64 keys, faster: where each key
+    and its position fit in one int64 together, an unstable sort of ``key * size + position``
+    (all distinct, so the order is the same) is several times quicker than the stable sort."""
+    size = keys.size
+    if size == 0 or int(keys.max()) >= (2**62) // max(size, 1):
+        return np.argsort(keys, kind="stable")
+    combined = keys * np.int64(size) + np.arange(size, dtype=np.int64)
+    return np.argsort(combined)
+
+
 class RidgeGraph:
     """The directed mesh edges of a surface in CSR form with their ridge costs.
 
@@ -95,7 +106,7 @@ class RidgeGraph:
         keep = valid[first] & valid[second] & (first != second)
         if not keep.all():
             keys, face = keys[keep], face[keep]
-        order = np.argsort(keys, kind="stable")
+        order = stable_order(keys)
         keys, face = keys[order], face[order]
         is_first = np.ones(keys.size, dtype=bool)
         is_first[1:] = keys[1:] != keys[:-1]
@@ -122,7 +133,7 @@ class RidgeGraph:
         lengths = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
         costs = lengths * (FLOOR + np.exp(-bend / BEND_SCALE))
         source = np.concatenate([u, v])
-        order = np.argsort(source, kind="stable")
+        order = stable_order(source)
         edge = np.concatenate([np.arange(u.size), np.arange(u.size)])[order]
         self.target = np.concatenate([v, u])[order]
         self.costs = costs[edge]

@@ -57,7 +57,10 @@ def edge_components(n: int, sources: np.ndarray, targets: np.ndarray) -> np.ndar
     part's diameter on meshes whose vertices are numbered in any spatially coherent order.
     """
     label = np.arange(n, dtype=np.int64)
-    touched = np.unique(np.concatenate([sources, targets]))
+    touched = np.zeros(n, dtype=bool)
+    touched[sources] = True
+    touched[targets] = True
+    touched = np.flatnonzero(touched)
     while True:
         before = label[touched].copy()
         # Hook: each vertex, and the root its label names, take the least label next to it.
