@@ -124,3 +124,40 @@ def test_bad_input_is_refused():
         find_break_edges(surface, bend=3)
     with pytest.raises(GoniometerError):
         BreakEdgeFinder(surface, BreakEdgeParameters(max_candidates=0))
+
+
+def test_the_reference_lens_rim_is_found_as_one_loop(shared_data):
+    """The intersecting spheres' rim is the circle x = 1 of radius √0.5 about (1, 1, 1)."""
+    from vg_addon.formats.meshio import read_mesh
+    from vg_addon.reference_shapes import SPHERE_CENTRES
+
+    mesh = read_mesh(shared_data / "IntersectingSpheres.ply")
+    surface = Surface(mesh.points, mesh.triangles)
+    result = surface.find_break_edges()
+    assert len(result.candidates) == 1
+    rim = result.candidates[0]
+    assert rim.closed
+    centre = (np.array(SPHERE_CENTRES[0]) + SPHERE_CENTRES[1]) / 2
+    offset = rim.path.points - centre
+    radial = np.hypot(offset[:, 1], offset[:, 2])
+    h = rim.path.mean_edge_length
+    assert np.abs(offset[:, 0]).max() <= 2 * h
+    assert np.abs(radial - np.sqrt(0.5)).max() <= 2 * h
+    assert rim.length == pytest.approx(2 * np.pi * np.sqrt(0.5), rel=0.1)
+
+
+def test_candidates_on_the_real_scan_retrace_and_follow_ridges(shared_data):
+    from vg_addon.formats.meshio import read_mesh
+
+    mesh = read_mesh(shared_data / "sample_mesh.ply")
+    surface = Surface(mesh.points, mesh.triangles)
+    result = surface.find_break_edges()
+    assert result.candidates
+    for candidate in result.candidates:
+        points = candidate.waypoint_points
+        again = surface.trace_edge(points[0], points[-1], via=points[1:-1])
+        assert np.array_equal(again.vertices, candidate.path.vertices)
+        assert candidate.length >= result.parameters.min_length
+        assert 0.0 <= candidate.confidence <= 1.0
+        # Most of the path bends at least the bar it was found with (judged at the scale).
+        assert (candidate.bend_deg >= result.ridge_min_deg).mean() >= 0.8
