@@ -30,9 +30,9 @@ from .edge_pieces import (
     ridge_pieces,
     smooth_regions,
     trace_piece,
-    vertex_areas,
 )
 from .edge_profile import EdgePath, assemble_path, ridge_graph
+from .mesh_regions import flood_labels
 from .ridge_field import (
     anisotropy_of_bend,
     bend_of_anisotropy,
@@ -303,8 +303,6 @@ class BreakEdgeFinder:
         sums = vertex_moments(surface.points, surface.triangles, graph.starts, graph.target)
         spread, total = cell_spread(surface.points, sums, params.scale, graph.starts, graph.target)
         yield 0.3
-        fine_spread, fine_total = ring_spread(sums, graph.starts, graph.target, FINE_RINGS)
-        yield 0.4
         degree = np.diff(graph.starts)
         used = surface.valid & (degree > 0)
         # Creases show in the crease part of the spread, corners (three faces) in the second
@@ -316,13 +314,17 @@ class BreakEdgeFinder:
         band = used & ((spread >= floor) | (second >= corner_floor))
         del second
         ridge_min_deg = float(bend_of_anisotropy(np.array([floor]))[0])
+        region = smooth_regions(graph, used, band, sums[:, 0], params.min_region_area)
+        yield 0.45
+        # The fine field only where the flood goes (the band and the parts too small to be
+        # regions). The flood rises by the bend at scale (where a broad bevel peaks), its steps
+        # from cell to cell smoothed, plus the fine bend (where a sharp crease peaks).
+        rows = np.flatnonzero(used & (region < 0))
+        fine_spread, fine_total = ring_spread(sums, graph.starts, graph.target, FINE_RINGS, rows)
+        heights = blurred(total, graph.starts, graph.target, 2 * FINE_RINGS, rows) + fine_total
+        flooded = flood_labels(graph.starts, graph.target, region, used, heights=heights)
         bend_field = np.maximum(spread, fine_spread)
-        areas = vertex_areas(surface.points, surface.triangles)
-        # The flood rises by the bend at scale (where a broad bevel peaks), its steps from cell
-        # to cell smoothed, plus the fine bend (where a sharp crease peaks).
-        heights = blurred(total, graph.starts, graph.target, 2 * FINE_RINGS) + fine_total
-        region, flooded = smooth_regions(graph, used, band, heights, areas, params.min_region_area)
-        del heights, fine_total
+        del heights, fine_total, fine_spread
         yield 0.6
         # A vertex with more neighbours than faces lies on the mesh's border.
         faces = np.bincount(surface.triangles.ravel(), minlength=surface.n_points)

@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import GoniometerError
 from .edge_profile import EdgePath, assemble_path, trace_leg
 from .fixed_order import eigh3, moments, row_dot
-from .mesh_regions import connected_parts, flood_labels
+from .mesh_regions import connected_parts, dilate
 from .ranges import expand_ranges
 
 MIN_OFF_RUN = 3
@@ -25,25 +25,14 @@ MAX_VIA_DEPTH = 8
 """How many times a leg may be split by via points (at most ``2**depth`` legs per stretch)."""
 
 
-def vertex_areas(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """A third of the area of each vertex's triangles (its share of the surface)."""
-    a = points[triangles[:, 1]] - points[triangles[:, 0]]
-    b = points[triangles[:, 2]] - points[triangles[:, 0]]
-    cross = np.cross(a, b)
-    area = np.sqrt(np.einsum("ij,ij->i", cross, cross)) / 6.0
-    return np.bincount(triangles.ravel(), np.repeat(area, 3), minlength=points.shape[0])
-
-
-def smooth_regions(graph, used, band, spread, areas, min_area):
-    """The smooth regions and the same labels flooded over the band up to its crests.
+def smooth_regions(graph, used, band, areas, min_area) -> np.ndarray:
+    """The smooth regions: the connected parts of the vertices off the band.
 
     Parameters
     ----------
     graph : RidgeGraph
     used, band : ndarray of bool, shape (n,)
         Vertices that take part; those on a ridge.
-    spread : ndarray, shape (n,)
-        The bend field (see :func:`.ridge_field.bend_anisotropy`): the flood rises by it.
     areas : ndarray, shape (n,)
         Each vertex's share of the surface.
     min_area : float
@@ -51,13 +40,11 @@ def smooth_regions(graph, used, band, spread, areas, min_area):
 
     Returns
     -------
-    region, flooded : ndarray of int64, shape (n,)
-        Region numbers (largest area first), -1 on the band and in small parts; and every
-        vertex reached from a region labelled with the region whose flood got there first.
+    ndarray of int64, shape (n,)
+        Region numbers (largest area first), -1 on the band and in small parts.
     """
-    starts, target = graph.starts, graph.target
     smooth = used & ~band
-    parts = connected_parts(starts, target, smooth)
+    parts = connected_parts(graph.starts, graph.target, smooth)
     roots, inverse = np.unique(parts[smooth], return_inverse=True)
     part_area = np.bincount(inverse, areas[smooth], minlength=roots.size)
     big = part_area >= min_area
@@ -67,8 +54,7 @@ def smooth_regions(graph, used, band, spread, areas, min_area):
     number[kept] = np.arange(kept.size)
     region = np.full(used.size, -1, dtype=np.int64)
     region[smooth] = number[inverse]
-    flooded = flood_labels(starts, target, region, used, heights=spread)
-    return region, flooded
+    return region
 
 
 @dataclass(frozen=True, eq=False)
@@ -123,18 +109,6 @@ def _rows(graph, vertices: np.ndarray):
     return np.repeat(vertices, counts), graph.target[expand_ranges(graph.starts[vertices], counts)]
 
 
-def dilate(graph, mask: np.ndarray, rings: int) -> np.ndarray:
-    """``mask`` grown by ``rings`` rings of neighbours."""
-    grown = mask.copy()
-    frontier = np.flatnonzero(mask)
-    for _ in range(rings):
-        _, reached = _rows(graph, frontier)
-        reached = reached[~grown[reached]]
-        grown[reached] = True
-        frontier = np.unique(reached)
-    return grown
-
-
 def ridge_pieces(graph, flooded, band, border, reach: int) -> list[Piece]:
     """The crests between two regions, split where a third region or the border comes in,
     and the ridges inside one region (band more than ``reach`` rings from every such crest)."""
@@ -168,7 +142,7 @@ def ridge_pieces(graph, flooded, band, border, reach: int) -> list[Piece]:
             pieces.append(Piece(part, (first, second), part[junction[part]]))
     explained = np.zeros(n, dtype=bool)
     explained[crest] = True
-    loose = np.flatnonzero(band & ~dilate(graph, explained, reach))
+    loose = np.flatnonzero(band & ~dilate(graph.starts, graph.target, explained, reach))
     if loose.size:
         for part in split_parts(graph, loose, lookup):
             pieces.append(Piece(part, (-1, -1), part[:0]))

@@ -118,3 +118,16 @@ def flood_labels(
             keyed[low[reached]] = offered[reached]
             pending = pending[keyed[pending] == big]
     return labels
+
+
+def dilate(starts: np.ndarray, target: np.ndarray, mask: np.ndarray, rings: int) -> np.ndarray:
+    """``mask`` grown by ``rings`` rings of neighbours."""
+    grown = mask.copy()
+    frontier = np.flatnonzero(mask)
+    for _ in range(rings):
+        counts = starts[frontier + 1] - starts[frontier]
+        reached = target[expand_ranges(starts[frontier], counts)]
+        reached = reached[~grown[reached]]
+        grown[reached] = True
+        frontier = np.unique(reached)
+    return grown

@@ -22,8 +22,9 @@ import math
 
 import numpy as np
 
-from .mesh_regions import edge_components
+from .mesh_regions import dilate, edge_components
 from .normals import face_normals
+from .ranges import expand_ranges
 
 _ROWS = 1 << 17  # vertices per block of the neighbourhood sums: the gathered rows stay small
 
@@ -52,8 +53,8 @@ def _moments(weight, nx, ny, nz) -> tuple:
 
 
 def vertex_moments(points, triangles, starts, target, smoothing: int = 1) -> np.ndarray:
-    """Per vertex, its area and the moments of its *smoothed* normal (``(n, 10)``): what
-    :func:`ring_spread` and :func:`cell_spread` pool.
+    """Per vertex, its area (a third of its faces') and the moments of its *smoothed* normal
+    (``(n, 10)``): what :func:`ring_spread` and :func:`cell_spread` pool.
 
     The smoothed normal is the mean face normal within ``smoothing`` rings: a single face's
     normal carries the scan's noise at full strength, and on a regular grid that noise is
@@ -114,9 +115,34 @@ def spread_of(sums: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return crease, np.maximum(trace, 0.0)
 
 
-def ring_spread(sums: np.ndarray, starts, target, rings: int):
-    """The spread of the face normals pooled ``rings`` rings of neighbours around each vertex
-    (a neighbourhood a few edges wide, weighted towards the vertex: it locates crests).
+def pooled_at(starts, target, values: np.ndarray, rings: int, rows: np.ndarray) -> np.ndarray:
+    """``values`` pooled ``rings`` rings of neighbours deep (each ring: a vertex's values plus
+    its neighbours'), worked out only where needed for the vertices ``rows``; the result is
+    full-size and zero elsewhere."""
+    wanted = np.zeros(values.shape[0], dtype=bool)
+    wanted[rows] = True
+    levels = [wanted]
+    for _ in range(rings - 1):
+        levels.append(dilate(starts, target, levels[-1], 1))
+    current = values
+    for level in reversed(levels):
+        at = np.flatnonzero(level)
+        counts = starts[at + 1] - starts[at]
+        out = np.zeros_like(values)
+        out[at] = current[at]
+        nonempty = counts > 0
+        gathered = np.take(current, target[expand_ranges(starts[at], counts)], axis=0)
+        firsts = (np.cumsum(counts) - counts)[nonempty]
+        if firsts.size:
+            out[at[nonempty]] += np.add.reduceat(gathered, firsts, axis=0)
+        current = out
+    return current
+
+
+def ring_spread(sums: np.ndarray, starts, target, rings: int, rows: np.ndarray):
+    """The spread of the normals pooled ``rings`` rings of neighbours around each of the
+    vertices ``rows`` (a neighbourhood a few edges wide, weighted towards the vertex: it
+    locates crests); full-size arrays, zero elsewhere.
 
     Parameters
     ----------
@@ -125,7 +151,8 @@ def ring_spread(sums: np.ndarray, starts, target, rings: int):
     starts, target : ndarray of int64
         The vertex graph in CSR form (``RidgeGraph.starts`` and ``.target``).
     rings : int
-        How many times each vertex's sums take in its neighbours'.
+    rows : ndarray of int64
+        The vertices wanted.
 
     Returns
     -------
@@ -134,9 +161,7 @@ def ring_spread(sums: np.ndarray, starts, target, rings: int):
         the module's text) and the trace ``λ1 + λ2 + λ3`` (large on creases and corners alike:
         where three faces meet, ``λ1 ≈ λ2``); in [0, 1], 0 for a vertex with no faces.
     """
-    for _ in range(rings):
-        sums = _pool(starts, target, sums)
-    return spread_of(sums)
+    return spread_of(pooled_at(starts, target, sums, rings, rows))
 
 
 def cell_spread(points, sums, scale: float, starts, target):
@@ -173,13 +198,12 @@ def cell_spread(points, sums, scale: float, starts, target):
     return crease[cell], total[cell]
 
 
-def blurred(values: np.ndarray, starts, target, rings: int) -> np.ndarray:
-    """``values`` averaged over ``rings`` rings of neighbours (each ring a plain mean of a
-    vertex and its neighbours): smooths the steps of a field that is constant per cell."""
-    pair = np.column_stack([values, np.ones(values.size)])
-    for _ in range(rings):
-        pair = _pool(starts, target, pair)
-    return pair[:, 0] / pair[:, 1]
+def blurred(values: np.ndarray, starts, target, rings: int, rows: np.ndarray) -> np.ndarray:
+    """``values`` averaged over ``rings`` rings of neighbours at the vertices ``rows`` (each
+    ring a plain mean of a vertex and its neighbours; zero elsewhere): smooths the steps of a
+    field that is constant per cell."""
+    pair = pooled_at(starts, target, np.column_stack([values, np.ones(values.size)]), rings, rows)
+    return np.divide(pair[:, 0], pair[:, 1], out=np.zeros(values.size), where=pair[:, 1] > 0)
 
 
 def anisotropy_of_bend(bend_deg: float) -> float:
