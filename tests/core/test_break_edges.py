@@ -161,3 +161,41 @@ def test_candidates_on_the_real_scan_retrace_and_follow_ridges(shared_data):
         assert 0.0 <= candidate.confidence <= 1.0
         # Most of the path bends at least the bar it was found with (judged at the scale).
         assert (candidate.bend_deg >= result.ridge_min_deg).mean() >= 0.8
+
+
+def test_connected_parts_and_partial_pooling_match_plain_walks():
+    """Oracles: a breadth-first search for the parts, whole-mesh pooling for the partial one."""
+    from collections import deque
+
+    from vg_addon.method.edge_profile import ridge_graph
+    from vg_addon.method.mesh_regions import connected_parts
+    from vg_addon.method.ridge_field import pooled_at
+
+    fragment = bone_fragment(spacing=2.0)
+    surface = Surface(fragment.points, fragment.triangles)
+    graph = ridge_graph(surface)
+    mask = fragment.region != REGION_RIM  # the rims cut the shaft into four faces
+    labels = connected_parts(graph.starts, graph.target, mask)
+    expected = np.full(mask.size, -1)
+    for seed in np.flatnonzero(mask):
+        if expected[seed] >= 0:
+            continue
+        queue, expected[seed] = deque([seed]), seed  # seeds in order: the least vertex
+        while queue:
+            v = queue.popleft()
+            for w in graph.target[graph.starts[v] : graph.starts[v + 1]]:
+                if mask[w] and expected[w] < 0:
+                    expected[w] = seed
+                    queue.append(w)
+    assert np.array_equal(labels, expected) and np.unique(labels[mask]).size == 4
+    values = np.random.default_rng(0).random((surface.n_points, 2))
+    whole = values.copy()
+    for _ in range(3):
+        whole = whole + np.array(
+            [whole[graph.target[graph.starts[v] : graph.starts[v + 1]]].sum(axis=0)
+             for v in range(surface.n_points)]
+        )  # fmt: skip
+    rows = np.flatnonzero(fragment.region == REGION_RIM)
+    partial = pooled_at(graph.starts, graph.target, values, 3, rows)
+    assert np.allclose(partial[rows], whole[rows], rtol=1e-12)
+    assert not partial[np.setdiff1d(np.arange(surface.n_points), rows)].any()

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import GoniometerError
 from .edge_profile import EdgePath, assemble_path, trace_leg
-from .fixed_order import eigh3, moments, row_dot
+from .fixed_order import eigh3, moments, row_dot, rows_dot
 from .mesh_regions import connected_parts, dilate
 from .ranges import expand_ranges
 
@@ -149,9 +149,14 @@ def ridge_pieces(graph, flooded, band, border, reach: int) -> list[Piece]:
     return pieces
 
 
+def _squared(offsets: np.ndarray) -> np.ndarray:
+    """Squared lengths of rows, summed in a fixed order (the same bits on every machine)."""
+    return rows_dot(offsets, offsets)
+
+
 def _farthest(points: np.ndarray, origin: np.ndarray) -> int:
     offsets = points - origin
-    return int(np.argmax(np.einsum("ij,ij->i", offsets, offsets)))
+    return int(np.argmax(rows_dot(offsets, offsets)))
 
 
 def piece_stops(points: np.ndarray, piece: Piece) -> tuple[list[int], bool]:
@@ -180,8 +185,8 @@ def piece_stops(points: np.ndarray, piece: Piece) -> tuple[list[int], bool]:
     last = int(pool[_farthest(points[pool], points[first])])
     # Through the crest vertex farthest from both ends: a crest bent like a U is followed
     # round its bend, not across it.
-    to_first = np.linalg.norm(where - points[first], axis=1)
-    to_last = np.linalg.norm(where - points[last], axis=1)
+    to_first = _squared(where - points[first])
+    to_last = _squared(where - points[last])
     middle = int(vertices[np.argmax(np.minimum(to_first, to_last))])
     return [first, middle, last], False
 
@@ -200,8 +205,8 @@ def follow(surface, graph, start: int, end: int, near: np.ndarray, crest_points,
         except GoniometerError:  # the crest between them leaves the corridor: split it
             if depth >= MAX_VIA_DEPTH:
                 raise
-            to_a = np.linalg.norm(crest_points - surface.points[a], axis=1)
-            to_b = np.linalg.norm(crest_points - surface.points[b], axis=1)
+            to_a = _squared(crest_points - surface.points[a])
+            to_b = _squared(crest_points - surface.points[b])
             via = int(crest_ids[np.argmax(np.minimum(to_a, to_b))])
             pending += [(via, b, depth + 1), (a, via, depth + 1)]
             continue
@@ -221,7 +226,7 @@ def follow(surface, graph, start: int, end: int, near: np.ndarray, crest_points,
 
 def _nearest(points: np.ndarray, to: np.ndarray) -> int:
     offsets = points - to
-    return int(np.argmin(np.einsum("ij,ij->i", offsets, offsets)))
+    return int(np.argmin(rows_dot(offsets, offsets)))
 
 
 def _longest_run(flags: np.ndarray):

@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from .fixed_order import rows_dot
 from .mesh_regions import dilate, edge_components
 from .normals import face_normals
 from .ranges import expand_ranges
@@ -72,7 +73,7 @@ def vertex_moments(points, triangles, starts, target, smoothing: int = 1) -> np.
     area = np.bincount(corners, np.repeat(doubled, 3), minlength=n) / 6.0
     for _ in range(smoothing):
         normals = _pool(starts, target, normals)
-    length = np.sqrt(np.einsum("ij,ij->i", normals, normals))
+    length = np.sqrt(rows_dot(normals, normals))
     normals /= np.where(length > 0, length, 1.0)[:, None]
     area[length <= 0] = 0.0
     return np.column_stack(_moments(area, normals[:, 0], normals[:, 1], normals[:, 2]))
