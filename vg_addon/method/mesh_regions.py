@@ -42,8 +42,8 @@ def connected_parts(starts: np.ndarray, target: np.ndarray, mask: np.ndarray) ->
     counts = starts[members + 1] - starts[members]
     sources = np.repeat(members, counts)
     neighbours = target[expand_ranges(starts[members], counts)]
-    inside = mask[neighbours]
-    labels = edge_components(mask.size, sources[inside], neighbours[inside])
+    once = mask[neighbours] & (sources < neighbours)  # each edge once: hooking takes both ends
+    labels = edge_components(mask.size, sources[once], neighbours[once])
     labels[~mask] = -1
     return labels
 

@@ -183,7 +183,8 @@ def cell_spread(points, sums, scale: float, starts, target):
     cube = (cells[:, 0] * dims[1] + cells[:, 1]) * dims[2] + cells[:, 2]
     sources = np.repeat(np.arange(n, dtype=np.int64), np.diff(starts))
     inside = cube[sources] == cube[target]
-    cell = edge_components(n, sources[inside], target[inside])
+    once = inside & (sources < target)  # each edge once: the hooking takes both ends
+    cell = edge_components(n, sources[once], target[once])
     _, cell = np.unique(cell, return_inverse=True)
     count = int(cell.max()) + 1
     per_cell = np.empty((count, _COLUMNS))
