@@ -126,6 +126,28 @@ def test_bad_input_is_refused():
         BreakEdgeFinder(surface, BreakEdgeParameters(max_candidates=0))
 
 
+def test_a_scale_or_length_beyond_the_mesh_is_refused_and_one_within_it_returns():
+    """A scale of 1e12 once froze the finder; the oracle for the bound is the bounding box."""
+    fragment = bone_fragment(spacing=2.0)
+    surface = Surface(fragment.points, fragment.triangles)
+    extent = surface.points.max(axis=0) - surface.points.min(axis=0)
+    diagonal = float(np.sqrt(np.sum(extent**2)))
+    for name in ("scale", "min_length"):
+        for value in (1e12, 1.01 * diagonal):
+            with pytest.raises(GoniometerError, match=f"{name}.*larger than the whole mesh"):
+                find_break_edges(surface, **{name: value})
+        for value in (float("nan"), float("inf"), -1.0, 0.0):
+            with pytest.raises(GoniometerError, match=name):
+                find_break_edges(surface, **{name: value})
+    # As large as allowed: one patch covers the mesh; it returns, with no candidate longer
+    # than the mesh can hold.
+    result = find_break_edges(surface, scale=0.99 * diagonal)
+    assert result.parameters.scale == pytest.approx(0.99 * diagonal)
+    assert result.region.shape == (surface.n_points,)
+    result = find_break_edges(surface, min_length=0.99 * diagonal)
+    assert all(c.length >= 0.99 * diagonal for c in result.candidates)
+
+
 def test_the_reference_lens_rim_is_found_as_one_loop(shared_data):
     """The intersecting spheres' rim is the circle x = 1 of radius √0.5 about (1, 1, 1)."""
     from vg_addon.formats.meshio import read_mesh
@@ -199,3 +221,19 @@ def test_connected_parts_and_partial_pooling_match_plain_walks():
     partial = pooled_at(graph.starts, graph.target, values, 3, rows)
     assert np.allclose(partial[rows], whole[rows], rtol=1e-12)
     assert not partial[np.setdiff1d(np.arange(surface.n_points), rows)].any()
+
+
+def test_dilate_by_more_rings_than_the_mesh_has_fills_the_seeds_part_and_returns():
+    """Oracle: every vertex reachable from the seed (its connected part, by a plain walk)."""
+    from vg_addon.method.edge_profile import ridge_graph
+    from vg_addon.method.mesh_regions import connected_parts, dilate
+
+    fragment = bone_fragment(spacing=2.0)
+    surface = Surface(fragment.points, fragment.triangles)
+    graph = ridge_graph(surface)
+    seed = np.zeros(surface.n_points, dtype=bool)
+    seed[0] = True
+    everywhere = np.ones(surface.n_points, dtype=bool)
+    part = connected_parts(graph.starts, graph.target, everywhere)
+    grown = dilate(graph.starts, graph.target, seed, 10**12)
+    assert np.array_equal(grown, part == part[0])

@@ -98,8 +98,16 @@ class BreakEdgeParameters:
     noise_factor: float = 4.0
     max_candidates: int = 200
 
-    def check(self) -> BreakEdgeParameters:
-        """The parameters, or a :class:`GoniometerError` naming the first bad one."""
+    def check(self, diagonal: float | None = None) -> BreakEdgeParameters:
+        """The parameters, or a :class:`GoniometerError` naming the first bad one.
+
+        Parameters
+        ----------
+        diagonal : float, optional
+            The mesh's bounding-box diagonal: ``scale`` and ``min_length`` may not exceed it
+            (a neighbourhood or an edge longer than the whole mesh means a slip of the units,
+            and would only cost time).
+        """
         if not (_is_number(self.noise_factor) and 0 <= self.noise_factor < math.inf):
             raise GoniometerError(f"noise_factor must be a number ≥ 0; got {self.noise_factor!r}.")
         for name in ("scale", "min_length", "min_region_area"):
@@ -109,6 +117,15 @@ class BreakEdgeParameters:
                     f"The break-edge parameter {name} must be a positive number (or None for the "
                     f"default); got {value!r}."
                 )
+        if diagonal is not None:
+            for name in ("scale", "min_length"):
+                value = getattr(self, name)
+                if value is not None and value > diagonal:
+                    raise GoniometerError(
+                        f"The break-edge parameter {name} ({value:g}) is larger than the whole "
+                        f"mesh (its bounding box is {diagonal:g} across); choose a smaller one "
+                        "or None for the default."
+                    )
         bend = self.min_bend_deg
         if not (_is_number(bend) and 0 < bend < 180):
             raise GoniometerError(
@@ -288,7 +305,9 @@ class BreakEdgeFinder:
         if not isinstance(parameters, BreakEdgeParameters):
             raise GoniometerError("The parameters must be a BreakEdgeParameters.")
         self.surface = surface
-        self.parameters = parameters.check()
+        points = surface.points
+        diagonal = math.hypot(*(points.max(axis=0) - points.min(axis=0))) if len(points) else None
+        self.parameters = parameters.check(diagonal)
         self.result: BreakEdgeResult | None = None
 
     def steps(self) -> Iterator[float]:

@@ -125,6 +125,8 @@ def dilate(starts: np.ndarray, target: np.ndarray, mask: np.ndarray, rings: int)
     grown = mask.copy()
     frontier = np.flatnonzero(mask)
     for _ in range(rings):
+        if frontier.size == 0:  # nothing left to grow into: more rings change nothing
+            break
         counts = starts[frontier + 1] - starts[frontier]
         reached = target[expand_ranges(starts[frontier], counts)]
         reached = reached[~grown[reached]]
