@@ -5,7 +5,8 @@ it in fresh processes under other BLAS kernels (``OPENBLAS_CORETYPE``), thread c
 (``OPENBLAS_NUM_THREADS``) and with NumPy's run-time SIMD paths switched off
 (``NPY_DISABLE_CPU_FEATURES``), and requires the same document bit for bit each time. The cases
 cover Algorithm 1 under both rules (meshes and point clouds, convex, concave, inward, noisy), the
-stability figure and its parts, a radius sweep, and an edge profile with its summary.
+stability figure and its parts, a radius sweep, an edge profile with its summary, and the break
+edges found on a rough bone fragment (waypoint vertices, confidences, bends).
 """
 
 from __future__ import annotations
@@ -96,6 +97,22 @@ def probe() -> dict:
     bone_surface = Surface(bone.points, bone.triangles)
     for k, site in enumerate(bone.sites[:4]):
         out[f"bone site {k}"] = _measure(bone_surface, site.point, 3.0, stability=k % 2 == 0)
+    # Break edges: their waypoints become an Edge Profile's stored Points.
+    found = bone_surface.find_break_edges()
+    out["break edges"] = {
+        "ridge_min_deg": float(found.ridge_min_deg).hex(),
+        "regions": np.unique(found.region, return_counts=True)[1].tolist(),
+        "candidates": [
+            {
+                "waypoints": c.path.vertices[c.path.waypoints].tolist(),
+                "n_vertices": int(c.path.vertices.size),
+                "closed": c.closed,
+                "confidence": float(c.confidence).hex(),
+                "mean_bend_deg": float(c.mean_bend_deg).hex(),
+            }
+            for c in found.candidates
+        ],
+    }
     sweep = radius_sweep(surface, [0.0, 0.0, 0.0], 0.1, 0.4, 7)
     out["sweep"] = [
         measurement_record(point.measurement) if point.measurement else point.error

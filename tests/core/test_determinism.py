@@ -26,7 +26,8 @@ PROBE = HERE / "determinism_probe.py"
 PINS = HERE / "data" / "determinism_pins.json"
 
 # Each OpenBLAS kernel with the CPU flags it needs; one this CPU lacks would crash the process.
-KERNELS = {"Prescott": {"sse3"}, "Sandybridge": {"avx"}, "Haswell": {"avx2", "fma"}}
+# (/proc/cpuinfo names SSE3 "pni".)
+KERNELS = {"Prescott": {"pni"}, "Sandybridge": {"avx"}, "Haswell": {"avx2", "fma"}}
 
 # The BLAS control: products shaped like the ones the measuring path used to hand to BLAS (a
 # weight matrix times per-vertex features, a patch's 3×3 moments); their last bits depend on the

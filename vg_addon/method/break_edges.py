@@ -373,7 +373,7 @@ class BreakEdgeFinder:
     def _candidate(self, graph, piece, spread, ridge_min_deg, params):
         """The candidate traced along ``piece``, or None if it is too short."""
         points = self.surface.points[piece.vertices]
-        extent = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+        extent = math.hypot(*(points.max(axis=0) - points.min(axis=0)))  # fixed order, no BLAS
         if extent < params.min_length / math.pi:  # not even a loop of min_length fits
             return None
         traced = trace_piece(self.surface, graph, piece)
