@@ -32,7 +32,10 @@ def edge_specs(args, sources) -> list[dict]:
         An unreadable edges CSV, a row without Points, Spacing or Radius, or naming no mesh
         given; a spacing that would make more than ``edge_profile.MAX_STATIONS`` stations.
     """
-    specs = [args_spec(args, [spec["start"], *spec["via"], spec["end"]]) for spec in args.edge]
+    specs = [
+        args_spec(args, [spec["start"], *spec["via"], spec["end"]], given=f"--edge {number}")
+        for number, spec in enumerate(args.edge, start=1)
+    ]
     for number, spec in enumerate(specs, start=1):
         try:
             check_spacing(spec)
@@ -72,6 +75,7 @@ def edge_specs(args, sources) -> list[dict]:
             # Files of earlier versions hold world-space points (a mesh file's object is
             # untransformed: the same numbers).
             "space": "world" if row.coordinates == csvio.WORLD_COORDINATES else "mesh",
+            "given": f"{Path(args.edges_csv).name} row {number}",
         }
         add_checked(specs, problems, spec, f"row {number}")
     if problems:
@@ -82,9 +86,10 @@ def edge_specs(args, sources) -> list[dict]:
     return specs
 
 
-def args_spec(args, points, *, mesh_name: str = "", note: str = "") -> dict:
+def args_spec(args, points, *, mesh_name: str = "", note: str = "", given: str = "") -> dict:
     """An edge through ``points`` measured with the command line's spacing, radius, λ and patch
-    mode, on the mesh ``mesh_name`` ("" for every mesh); ``note`` is stored as its User Data."""
+    mode, on the mesh ``mesh_name`` ("" for every mesh); ``note`` is stored as its User Data,
+    ``given`` names where the points came from (points far from the mesh are refused)."""
     return {
         "points": points,
         "spacing": args.spacing,
@@ -93,6 +98,7 @@ def args_spec(args, points, *, mesh_name: str = "", note: str = "") -> dict:
         "patch": args.patch,
         "mesh_name": mesh_name,
         "note": note,
+        "given": given,
     }
 
 
@@ -158,7 +164,7 @@ def picked_point_specs(args, sources) -> list[dict]:
         except GoniometerError as error:
             problems.append(str(error))
             continue
-        spec = args_spec(args, points.tolist(), mesh_name=name, note=path.name)
+        spec = args_spec(args, points.tolist(), mesh_name=name, note=path.name, given=path.name)
         add_checked(specs, problems, spec, path.name)
     if problems:
         raise UsageError(
@@ -252,6 +258,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
                 spec["patch"],
                 space=spec.get("space", "mesh"),
                 surface=surface,
+                given=spec.get("given", ""),
             )
             # Recorded without repainting: the colours are painted once, after every edge.
             edge = edges.record_profile(obj, profile, geometry, clicks, note=spec.get("note", ""))

@@ -16,6 +16,7 @@ from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, profile_plot, record_codec
 from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.edge_profile import summarize
+from ..vg_addon.method.given_points import check_given_points
 from . import measuring, records
 from .mesh_data import (
     check_measurable,
@@ -48,6 +49,7 @@ def measure_edge(
     depsgraph=None,
     space="mesh",
     surface=None,
+    given="",
 ):
     """Trace and measure the edge through ``points`` on ``obj`` without recording anything:
     ``(EdgeProfile, Geometry, points)``, the last the points in mesh coordinates.
@@ -57,7 +59,9 @@ def measure_edge(
     ``measuring.measure_on_object``'s radius. ``surface``: the ``Surface`` to measure on instead
     of the object's cached one (the batch's float64 file coordinates, with the same vertices).
     A spacing that would make more than ``edge_profile.MAX_STATIONS`` stations is refused
-    before anything is allocated for them.
+    before anything is allocated for them. ``given``: where points read from a file came from
+    (a file or edge name); if set, points far from the mesh are refused naming it
+    (``edge_profile.check_given_points``) instead of snapping to the nearest vertex.
     """
     check_measurable(obj)
     points = np.asarray(points, dtype=np.float64)
@@ -73,6 +77,8 @@ def measure_edge(
         points = mesh_points(points, geometry.matrix)
     if surface is None:
         surface = surface_for(obj, geometry)
+    if given:
+        check_given_points(surface, points, radius, given)
     profile = surface.measure_along(points, spacing, radius, lam, patch)
     return profile, geometry, points
 

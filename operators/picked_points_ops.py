@@ -19,6 +19,7 @@ from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import picked_points
+from ..vg_addon.method.given_points import check_given_points
 from .common import poll_measurable, typed_value
 from .csv_ops import _path
 from .find_edges import measure_all, record_all
@@ -46,12 +47,29 @@ def picked_edges(paths, names, *, ignore_mesh_names=False) -> list:
             found.append((path, picked_points.edge_points(picked)))
         except GoniometerError as error:
             failures.append(str(error))
+    refuse_listed(failures, len(paths), "cannot be used; nothing was imported.")
+    return found
+
+
+def check_files_near(surface, found, radius) -> None:
+    """Refuse the files of ``found`` (``(path, points)``) with points far from ``surface``
+    (picked on another copy of the mesh, or in other units), every such file named at once."""
+    failures = []
+    for path, points in found:
+        try:
+            check_given_points(surface, points, radius, f"'{Path(path).name}'")
+        except GoniometerError as error:
+            failures.append(str(error))
+    refuse_listed(failures, len(found), "lie off the mesh; nothing was recorded.")
+
+
+def refuse_listed(failures, total, what) -> None:
+    """Raise one GoniometerError listing ``failures`` (of ``total`` files), if any."""
     if failures:
         raise GoniometerError(
-            f"{len(failures)} of {len(paths)} picked-points files cannot be used; nothing was "
-            "imported.\n" + bounded_list(failures, lines=True)
+            f"{len(failures)} of {total} picked-points files {what}\n"
+            + bounded_list(failures, lines=True)
         )
-    return found
 
 
 class VG_OT_import_picked_points(bpy.types.Operator, ImportHelper):
@@ -101,6 +119,7 @@ class VG_OT_import_picked_points(bpy.types.Operator, ImportHelper):
             )
             geometry = evaluated_geometry(obj, context.evaluated_depsgraph_get())
             surface = surface_for(obj, geometry)
+            check_files_near(surface, found, radius)
             measured = measure_all(
                 surface,
                 [points for _, points in found],

@@ -7,6 +7,7 @@ The .pp files are written here as MeshLab writes them (text), the oracle is the 
 
 from __future__ import annotations
 
+import numpy as np
 from bpy_helpers import batch
 
 from vg_addon import Surface
@@ -100,3 +101,34 @@ def test_bad_pp_files_stop_the_run_before_anything_is_measured(tmp_path):
     result = ok(batch(mesh, "--edges", stray, "--spacing", 0.5, "--radius", 0.3, "--out", out), 2)
     assert "flake.pp: no mesh given is named by it" in result.stderr
     assert not out.exists()
+
+
+def test_a_pp_file_picked_on_a_shifted_copy_is_refused_naming_it(tmp_path):
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+    mesh = tmp_path / "ramp.ply"
+    meshio.write_ply(mesh, shape.points, shape.triangles)
+    # Crease vertices (the wedge's top): 1.5 above each, no vertex is nearer than 1.5.
+    crease = shape.points[(np.abs(shape.points[:, 1]) < 1e-12) & (shape.points[:, 2] == 0.0)]
+    ends = [crease[np.argmin(np.abs(crease[:, 0] - x))] for x in (-1.5, 1.5)]
+    write_pp(tmp_path / "ramp_good.pp", [p.tolist() for p in ends])
+    write_pp(tmp_path / "ramp_shifted.pp", [(p + np.array([0.0, 0.0, 1.5])).tolist() for p in ends])
+    out = tmp_path / "out.csv"
+    result = batch(mesh, "--edges", tmp_path, "--spacing", 0.5, "--radius", 0.3, "--out", out)
+    assert result.returncode == 1, result.stdout + result.stderr
+    rows = csvio.read_measurements_csv(out)
+    failed = [row for row in rows if row.error]
+    assert len(failed) == 1, [row.error for row in rows]
+    assert "ramp_shifted.pp: point 1 (" in failed[0].error
+    assert failed[0].error.count(" is 1.5 from the mesh") == 2
+    edges = csvio.read_edges_csv(out.with_name("out_edges.csv"))
+    assert [e.user_data for e in edges] == ["ramp_good.pp"]  # the good file is still measured
+
+    # The same points typed as --edge and --via: the via point is the one refused.
+    typed = tmp_path / "typed.csv"
+    up = (ends[0] + ends[1]) / 2 + np.array([0.0, 0.0, 1.5])
+    result = batch(mesh, "--edge", *ends[0], *ends[1], "--via", *up, "--spacing", 0.5,
+                   "--radius", 0.3, "--out", typed)  # fmt: skip
+    assert result.returncode == 1, result.stdout + result.stderr
+    (row,) = csvio.read_measurements_csv(typed)
+    assert "--edge 1: point 2 (" in row.error and " is 1.5 from the mesh" in row.error
+    assert "point 1 " not in row.error and "point 3 " not in row.error

@@ -198,3 +198,24 @@ def test_picked_points_make_edges_named_files_only_all_or_nothing(vg, tmp_path):
         "FINISHED"
     }
     assert len(obj.vg.edges) == 3
+
+
+def test_picked_points_off_the_mesh_are_refused_naming_the_file(vg, tmp_path):
+    obj = fragment_object()
+    surface = core_surface(obj)
+    path = find_break_edges(surface).candidates[0].path
+    k = path.vertices.size
+    # Picked on a copy of the mesh moved 30 along x, beside this one (it spans x from
+    # -12 to 12); the oracle distance is the brute-force nearest vertex's.
+    shifted = path.points[[3, k // 2]] + np.array([30.0, 0.0, 0.0])
+    nearest = np.linalg.norm(surface.points[None] - shifted[:, None], axis=2).min(axis=1)
+    good = write_pp(tmp_path / "Fragment_good.pp", path.points[[3, k // 2]])
+    off = write_pp(tmp_path / "Fragment_shifted.pp", shifted)
+    with pytest.raises(RuntimeError, match="1 of 2 picked-points files lie off the mesh") as error:
+        bpy.ops.vg.import_picked_points(
+            directory=str(tmp_path), files=[{"name": good.name}, {"name": off.name}]
+        )
+    assert "'Fragment_shifted.pp': point 1 (" in str(error.value)
+    assert f"is {nearest[0]:.6g} from the mesh" in str(error.value)
+    assert f"is {nearest[1]:.6g} from the mesh" in str(error.value)
+    assert len(obj.vg.edges) == len(obj.vg.measurements) == 0

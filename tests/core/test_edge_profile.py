@@ -12,6 +12,7 @@ import pytest
 
 from vg_addon import GoniometerError, Surface
 from vg_addon.formats.meshio import read_mesh
+from vg_addon.method.given_points import check_given_points
 from vg_addon.synthetic_meshes import lens, varying_wedge, wedge
 
 
@@ -278,3 +279,25 @@ def test_profile_does_not_depend_on_vertex_order(ramp):
     assert a.angles.tolist() == b.angles.tolist()
     assert np.array_equal(a.path.points, b.path.points)
     assert a.pooled_angle == b.pooled_angle
+
+
+def test_given_points_off_the_mesh_are_refused_with_their_distance(ramp):
+    shape, surface = ramp
+    h = mean_edge_length(shape.points, shape.triangles)
+    crease = shape.points[(np.abs(shape.points[:, 1]) < 1e-12) & (shape.points[:, 2] == 0.0)]
+    start = crease[np.argmin(np.abs(crease[:, 0] + 3.0))]
+    end = crease[np.argmin(np.abs(crease[:, 0] - 3.0))]
+    # On the mesh: accepted (a vertex, and a point half a mean edge length off the crease).
+    check_given_points(surface, [start, end + np.array([0.0, 0.5 * h, 0.0])], 0.3, "ok.pp")
+    # Picked on a copy 1.5 above: the crease is the wedge's top, so each point is exactly 1.5
+    # from its own vertex and nearer no other.
+    up = np.array([0.0, 0.0, 1.5])
+    shifted = [start + up, end + up]
+    with pytest.raises(GoniometerError) as error:
+        check_given_points(surface, shifted, 0.3, "shifted.pp")
+    message = str(error.value)
+    assert message.startswith("shifted.pp: point 1 (")
+    assert message.count(" is 1.5 from the mesh") == 2
+    assert f"farther than {max(0.3, 3 * h):.6g}" in message
+    # The limit is the radius when that is larger: 1.5 away is accepted with a radius of 2.
+    check_given_points(surface, shifted, 2.0, "wide.pp")

@@ -1,0 +1,45 @@
+"""Points given in a file or typed, checked to lie on the mesh before an edge is traced."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import GoniometerError
+from .algorithm import as_radius
+from .edge_profile import ridge_graph
+
+
+def check_given_points(surface, points, radius: float, where: str) -> None:
+    """Refuse points given in a file or typed (not clicked on the surface) that lie farther than
+    ``max(radius, 3 × mean edge length)`` from every vertex: a point picked on another copy of
+    the mesh, or in other units, would otherwise snap to some vertex and be measured.
+
+    Parameters
+    ----------
+    points : array_like, shape (k, 3)
+        The edge's start, via points and end, in the surface's coordinates.
+    radius : float
+        The measuring radius of the edge's stations.
+    where : str
+        Names the file or edge in the message.
+
+    Raises
+    ------
+    GoniometerError
+        Naming every point too far, its distance and the limit.
+    """
+    limit = max(as_radius(radius), 3.0 * ridge_graph(surface).mean_edge_length)
+    far = []
+    for number, point in enumerate(np.asarray(points, dtype=np.float64), 1):
+        _, distance = surface.index.nearest(point, limit)
+        if not distance <= limit:
+            _, distance = surface.index.nearest(point, math.inf)
+            x, y, z = point
+            far.append(f"point {number} ({x:g}, {y:g}, {z:g}) is {distance:.6g} from the mesh")
+    if far:
+        raise GoniometerError(
+            f"{where}: {'; '.join(far)}, farther than {limit:.6g} (the radius or three mean edge "
+            "lengths): check that the points were picked on this mesh, in its units and frame."
+        )
