@@ -148,6 +148,20 @@ def test_a_file_belongs_to_the_mesh_its_name_starts_with():
     assert pp.mesh_for_file("other.pp", names) is None
 
 
+def test_a_file_name_matches_its_mesh_whatever_the_case_unless_that_is_ambiguous():
+    names = ["Bone", "bone_12", "FLAKE"]
+    assert pp.mesh_for_file("bone.pp", names) == "Bone"
+    assert pp.mesh_for_file("BONE_12_Break3.PP", names) == "bone_12"
+    assert pp.mesh_for_file("Bone_1.pp", names) == "Bone"
+    assert pp.mesh_for_file("flake_a.pp", names) == "FLAKE"
+    assert pp.mesh_for_file("flakes.pp", names) is None
+    # Two meshes differing only in case: the one spelt like the file, else neither.
+    twins = ["Scan", "scan"]
+    assert pp.mesh_for_file("scan_a.pp", twins) == "scan"
+    assert pp.mesh_for_file("Scan.pp", twins) == "Scan"
+    assert pp.mesh_for_file("SCAN.pp", twins) is None
+
+
 def test_a_folder_lists_its_pp_files_by_name(tmp_path):
     for name in ("b.pp", "a.PP", "c.txt"):
         (tmp_path / name).write_text("<PickedPoints/>", encoding="utf-8")

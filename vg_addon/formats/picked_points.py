@@ -267,7 +267,10 @@ def edge_points(picked: PickedPoints) -> np.ndarray:
 def mesh_for_file(path: str | os.PathLike, mesh_names) -> str | None:
     """The mesh a picked-points file belongs to, by its file name: ``NAME.pp`` or
     ``NAME_anything.pp`` belongs to the mesh ``NAME``; where several names fit (meshes ``bone``
-    and ``bone_12`` for ``bone_12_a.pp``) the longest wins. None when no name fits.
+    and ``bone_12`` for ``bone_12_a.pp``) the longest wins. Case does not matter (``Bone_12.PP``
+    belongs to ``bone_12``) unless two names of that length differ only in case: then the one
+    spelt like the file wins, and if neither is, the file names no mesh (None, as when no name
+    fits).
 
     Parameters
     ----------
@@ -279,8 +282,20 @@ def mesh_for_file(path: str | os.PathLike, mesh_names) -> str | None:
     stem = Path(path).name
     if stem.lower().endswith(SUFFIX):
         stem = stem[: -len(SUFFIX)]
-    fits = [name for name in mesh_names if name and (stem == name or stem.startswith(name + "_"))]
-    return max(fits, key=len) if fits else None
+    folded = stem.casefold()
+    fits = {
+        name
+        for name in mesh_names
+        if name and (folded == name.casefold() or folded.startswith(name.casefold() + "_"))
+    }
+    if not fits:
+        return None
+    longest = max(map(len, fits))
+    best = [name for name in fits if len(name) == longest]
+    if len(best) == 1:
+        return best[0]
+    exact = [name for name in best if stem == name or stem.startswith(name + "_")]
+    return exact[0] if len(exact) == 1 else None
 
 
 def files_in(folder: str | os.PathLike) -> list[Path]:
