@@ -18,13 +18,14 @@ from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.edge_profile import check_station_count
 from .cli import UsageError
 from .find_edges import found_edge_specs
-from .stdio import say
 
 
-def edge_specs(args, sources) -> list[dict]:
+def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
     """The edges of a run: ``--edge`` (with ``--via``, on every mesh) and the rows of
     ``--edges CSV`` (each on the mesh its Mesh Name names), as dicts of ``points``, ``spacing``,
-    ``radius``, ``lam``, ``patch`` and ``mesh_name`` ("" for every mesh).
+    ``radius``, ``lam``, ``patch`` and ``mesh_name`` ("" for every mesh). A line naming the
+    ``.pp`` files of an ``--edges`` folder that name no mesh given is appended to
+    ``passed_over`` (for the run's summary).
 
     Raises
     ------
@@ -44,7 +45,7 @@ def edge_specs(args, sources) -> list[dict]:
     if not args.edges_csv:
         return specs
     if is_picked_points(args.edges_csv):
-        return specs + picked_point_specs(args, sources)
+        return specs + picked_point_specs(args, sources, passed_over)
     try:
         rows = csvio.read_edges_csv(Path(args.edges_csv))
     except OSError as error:
@@ -118,13 +119,13 @@ def is_picked_points(path: str) -> bool:
     return Path(path).is_dir() or Path(path).suffix.lower() == picked_points.SUFFIX
 
 
-def picked_point_specs(args, sources) -> list[dict]:
+def picked_point_specs(args, sources, passed_over: list | None = None) -> list[dict]:
     """The edges of ``--edges`` given as a ``.pp`` file or a folder of them: each file's active
     points in order (start, via points, end), measured with ``--spacing``, ``--radius``,
     ``--lambda`` and ``--patch`` on the mesh its file name names (``NAME.pp`` or
     ``NAME_*.pp`` for the mesh ``NAME``; any single mesh with ``--ignore-mesh-names``). In a
-    folder, files that name no mesh given are passed over (said in one line); a file named
-    directly must name one.
+    folder, files that name no mesh given are passed over (one line appended to
+    ``passed_over`` names them); a file named directly must name one.
 
     Raises
     ------
@@ -147,12 +148,12 @@ def picked_point_specs(args, sources) -> list[dict]:
         raise UsageError(f"--edges {given}: the folder has no {picked_points.SUFFIX} files.")
     single = args.ignore_mesh_names and len(sources) == 1
     names = [source.name for source in sources]
-    specs, problems, passed_over = [], [], []
+    specs, problems, unmatched = [], [], []
     for path in paths:
         name = sources[0].name if single else picked_points.mesh_for_file(path, names)
         if name is None:
             if folder:
-                passed_over.append(path.name)
+                unmatched.append(path.name)
             else:
                 problems.append(
                     f"{path.name}: no mesh given is named by it (NAME.pp or NAME_*.pp belongs "
@@ -171,10 +172,10 @@ def picked_point_specs(args, sources) -> list[dict]:
             f"--edges {given}: {len(problems)} picked-points file(s) cannot be measured:\n"
             + bounded_list(problems, lines=True)
         )
-    if passed_over and not args.quiet:
-        say(
-            f"--edges {given}: {len(passed_over)} file(s) name no mesh given and are passed "
-            f"over: {bounded_list(passed_over)}"
+    if unmatched and passed_over is not None:
+        passed_over.append(
+            f"--edges {given}: {len(unmatched)} file(s) name no mesh given and are passed "
+            f"over: {bounded_list(unmatched)}"
         )
     return specs
 
@@ -236,14 +237,20 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         One summary per measured edge.
     plots : list of (what, path, png bytes function)
         Each profile's plot, to draw beside the output CSV once the rows are written.
+    found : int
+        How many edges ``--find-edges`` found on the mesh (-1: not looked for, or the finder
+        could not run, which is an error row).
     """
     station_rows, edge_rows, plots = [], [], []
+    found = -1
     name = source.name
     painted = None  # the geometry the edges were measured on, once one is recorded
     specs = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
     if options.get("find_edges"):
         try:
-            specs += found_edge_specs(surface, options, name)
+            found_specs = found_edge_specs(surface, options, name)
+            found = len(found_specs)
+            specs += found_specs
         except GoniometerError as error:
             station_rows.append(not_found_row(options, name, str(error), units))
     for spec in specs:
@@ -291,4 +298,4 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         plots.append(("profile plot", path, data))
     if painted is not None:
         measuring.repaint(obj, geometry=painted)
-    return station_rows, edge_rows, plots
+    return station_rows, edge_rows, plots, found

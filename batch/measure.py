@@ -47,6 +47,7 @@ class MeshResult:
     winding: str = ""  # see vg_addon.method.winding.WINDINGS
     sweep_rows: list = dataclasses.field(default_factory=list)  # [(task index, [cells])]
     sweep_plots: int = 0
+    found_edges: int = -1  # edges --find-edges found (-1: not looked for)
 
     def to_json(self) -> dict:
         out = dataclasses.asdict(self)
@@ -205,7 +206,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
 
     profile_plots = []
     if options.get("edges") or options.get("find_edges"):
-        result.station_rows, result.edge_rows, profile_plots = measure_edges(
+        result.station_rows, result.edge_rows, profile_plots, result.found_edges = measure_edges(
             obj, source, options, units, stem, surface, precision
         )
 

@@ -15,6 +15,7 @@ import bpy
 
 from ..bridge import records
 from ..vg_addon import GoniometerError
+from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, files
 from ..vg_addon.method.result import stability_text, stability_warning
 from ..vg_addon.method.winding import winding_message
@@ -46,6 +47,7 @@ class Run:
         self.edges_by_mesh: dict[int, tuple[list, list]] = {}
         self.results: list[MeshResult] = []
         self.bad_files: list[str] = []
+        self.passed_over: list[str] = []  # lines naming .pp files that name no mesh given
         self.lock = threading.Lock()
         self.started = time.perf_counter()
         self.last_progress = 0.0
@@ -277,6 +279,16 @@ class Run:
             self.say(f"wrote {csvio.edges_path_for(self.args.out)}")
         for message in self.bad_files:
             self.say(f"  unreadable mesh: {message}")
+        for line in self.passed_over:
+            self.say(line)
+        nothing = [
+            self.sources[m].name for m in sorted(r.mesh for r in self.results if r.found_edges == 0)
+        ]
+        if nothing:
+            self.say(
+                f"--find-edges found no break edge on {len(nothing)} mesh(es), which have no "
+                f"edge rows: {bounded_list(nothing)}"
+            )
         where = "standard output" if self.args.out == files.STDOUT else self.args.out
         self.say(f"wrote the CSV to {where}")
         return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
@@ -351,7 +363,8 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             tasks = bp.shard(tasks, k, n)
     except GoniometerError as error:
         raise UsageError(str(error)) from None
-    edges = edge_specs(args, sources)
+    passed_over = []
+    edges = edge_specs(args, sources, passed_over)
     groups = {mesh: ts for mesh, ts in bp.by_mesh(tasks).items() if mesh >= 0}
     if edges or args.find_edges:  # every mesh with edges is measured, with or without points
         groups = {
@@ -387,6 +400,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     if args.sweep:
         sweep_paths(args.out)[1].mkdir(parents=True, exist_ok=True)
     run = Run(args, sources, tasks, len(groups))
+    run.passed_over = passed_over
     for note in renamed:
         run.say(f"note: {note}")
     if args.shard and not args.quiet:

@@ -23,6 +23,7 @@ from bpy_helpers import batch, colours, exact, expected_colours
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
+from vg_addon.marching_tetrahedra import march
 from vg_addon.method.break_edges import find_break_edges
 from vg_addon.synthetic_meshes import bone_fragment
 
@@ -192,6 +193,27 @@ def test_a_min_length_longer_than_every_edge_finds_none(tmp_path):
     )
     assert csvio.read_measurements_csv(out) == []
     assert csvio.read_edges_csv(csvio.edges_path_for(out)) == []
+
+
+def test_quiet_still_names_the_meshes_where_no_edge_was_found(tmp_path):
+    # A smooth ball has no break edge (the finder finds none on it: the oracle is the core's
+    # answer on the same mesh); the bone has some.
+    points, triangles = march(
+        lambda p: np.linalg.norm(p, axis=1) - 10.0, [-11.3] * 3, [11.6] * 3, 0.8
+    )
+    assert len(Surface(points, triangles).find_break_edges().candidates) == 0
+    balls = [tmp_path / "ball.ply", tmp_path / "Ball2.ply"]
+    for ball in balls:
+        meshio.write_ply(ball, points, triangles)
+    bone = write_bone(tmp_path / "bone.ply")
+    out = tmp_path / "out.csv"
+    # Measured in two processes, so the count crosses from the workers too.
+    result = ok(batch(*balls, bone, "--find-edges", "--spacing", SPACING, "--radius", RADIUS,
+                      "--quiet", "--jobs", 2, "--out", out))  # fmt: skip
+    assert "found 0 break edge(s)" not in result.stderr  # the per-mesh line is quiet
+    line = "--find-edges found no break edge on 2 mesh(es), which have no edge rows: ball, Ball2"
+    assert line in result.stderr
+    assert {e.mesh_name for e in csvio.read_edges_csv(csvio.edges_path_for(out))} == {"bone"}
 
 
 def test_a_point_cloud_is_one_failed_row_saying_why(tmp_path):

@@ -110,18 +110,24 @@ def test_a_pp_file_picked_on_a_shifted_copy_is_refused_naming_it(tmp_path):
     # Crease vertices (the wedge's top): 1.5 above each, no vertex is nearer than 1.5.
     crease = shape.points[(np.abs(shape.points[:, 1]) < 1e-12) & (shape.points[:, 2] == 0.0)]
     ends = [crease[np.argmin(np.abs(crease[:, 0] - x))] for x in (-1.5, 1.5)]
-    write_pp(tmp_path / "ramp_good.pp", [p.tolist() for p in ends])
+    # Named in another case than the mesh: still its file.
+    write_pp(tmp_path / "Ramp_Good.PP", [p.tolist() for p in ends])
+    write_pp(tmp_path / "other.pp", [p.tolist() for p in ends])  # names no mesh given
     write_pp(tmp_path / "ramp_shifted.pp", [(p + np.array([0.0, 0.0, 1.5])).tolist() for p in ends])
     out = tmp_path / "out.csv"
-    result = batch(mesh, "--edges", tmp_path, "--spacing", 0.5, "--radius", 0.3, "--out", out)
+    result = batch(mesh, "--edges", tmp_path, "--spacing", 0.5, "--radius", 0.3, "--out", out,
+                   "--quiet")  # fmt: skip
     assert result.returncode == 1, result.stdout + result.stderr
+    # --quiet still says which files were passed over and which edge failed.
+    assert "1 file(s) name no mesh given and are passed over: other.pp" in result.stderr
+    assert "failed: edge 2 on 'ramp': edge not measured: ramp_shifted.pp" in result.stderr
     rows = csvio.read_measurements_csv(out)
     failed = [row for row in rows if row.error]
     assert len(failed) == 1, [row.error for row in rows]
     assert "ramp_shifted.pp: point 1 (" in failed[0].error
     assert failed[0].error.count(" is 1.5 from the mesh") == 2
     edges = csvio.read_edges_csv(out.with_name("out_edges.csv"))
-    assert [e.user_data for e in edges] == ["ramp_good.pp"]  # the good file is still measured
+    assert [e.user_data for e in edges] == ["Ramp_Good.PP"]  # the good file is still measured
 
     # The same points typed as --edge and --via: the via point is the one refused.
     typed = tmp_path / "typed.csv"
