@@ -23,16 +23,24 @@ import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from edge_truth import mean_edge_length, score  # noqa: E402
+from edge_truth import found_on, mean_edge_length, score  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from vg_addon import Surface  # noqa: E402
 from vg_addon.formats.meshio import read_mesh  # noqa: E402
-from vg_addon.fragments import bevelled_cube, bone_shaft, flake, with_noise  # noqa: E402
+from vg_addon.fragments import (  # noqa: E402
+    bevelled_cube,
+    bone_shaft,
+    flake,
+    marched_bevelled_cube,
+    marched_flake,
+    with_noise,
+)
 
 OUT = ROOT / "docs" / "images"
 DATA = ROOT.parent / "shared" / "data"
 MAX_DRAWN = 60_000  # triangles drawn per view (a random sample of a bigger mesh)
+MARCH_STEP = 0.4  # the marched fragments' grid step: how far marching cuts a corner, at most
 KIND_COLOURS = {0: (0.80, 0.80, 0.62), 1: (0.55, 0.70, 0.88), 2: (0.93, 0.62, 0.45)}
 
 
@@ -116,6 +124,23 @@ def synthetic() -> None:
             )
 
 
+def harder() -> None:
+    """The limits table: noise of 0.3 mean edge lengths, and fragments meshed by marching
+    tetrahedra (edges between vertices), scored at one mean edge and at the marching step."""
+    print("| fragment | vertices | tolerance (mm) | found (mm) | recall | false | bar |")
+    print("|---|---|---|---|---|---|---|")
+    cases = [(make, 0.3, None) for make in (lambda: bone_shaft(0.3), bevelled_cube, flake)]
+    cases += [(make, noise, tolerance) for make in (marched_bevelled_cube, marched_flake)
+              for noise in (0.0, 0.1) for tolerance in (None, MARCH_STEP)]  # fmt: skip
+    for make, noise, tolerance in cases:
+        fragment, surface, _, f = found_on(make, noise, tolerance)
+        passed = f["recall"] >= 0.95 and f["false"] <= 0.05
+        print(
+            f"| {fragment.name} | {surface.n_points:,} | {f['tolerance']:.3f} | {f['found_length']:.0f} | "
+            f"{100 * f['recall']:.1f}% | {100 * f['false']:.1f}% | {'pass' if passed else 'FAIL'} |"
+        )
+
+
 def real() -> None:
     for file in ("sample_mesh.ply", "HalfAnnulus.ply", "IntersectingSpheres.ply"):
         if not (DATA / file).exists():
@@ -146,4 +171,5 @@ def real() -> None:
 
 if __name__ == "__main__":
     synthetic()
+    harder()
     real()

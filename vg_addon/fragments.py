@@ -11,7 +11,9 @@ of every vertex and which faces are fracture surfaces:
   knife edge of 45° all round, and a striking platform cut across one end; meshed with its
   vertices on the edges.
 
-:func:`with_noise` adds scanner-like noise to any of them. Lengths are millimetres.
+:func:`with_noise` adds scanner-like noise to any of them; :func:`marched_bevelled_cube` and
+:func:`marched_flake` mesh the cube and the flake afresh by marching tetrahedra, so that no vertex
+lies on an edge. Lengths are millimetres.
 """
 
 from __future__ import annotations
@@ -21,11 +23,20 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .marching_tetrahedra import march
 from .method.normals import vertex_normals
 from .synthetic_meshes import REGION_OBLIQUE, REGION_TRANSVERSE
 from .synthetic_meshes import bone_fragment as _bone_fragment
 
-__all__ = ["Fragment", "bevelled_cube", "bone_shaft", "flake", "with_noise"]
+__all__ = [
+    "Fragment",
+    "bevelled_cube",
+    "bone_shaft",
+    "flake",
+    "marched_bevelled_cube",
+    "marched_flake",
+    "with_noise",
+]
 
 _SAMPLES_PER_MM = 20  # true edges are sampled this densely (every 0.05 mm)
 
@@ -334,3 +345,69 @@ def with_noise(fragment: Fragment, sigma: float, seed: int = 0) -> Fragment:
     rng = np.random.default_rng(seed)
     moved = fragment.points + sigma * rng.standard_normal(len(fragment.points))[:, None] * normals
     return replace(fragment, points=moved, name=f"{fragment.name}, noise {sigma:g} mm")
+
+
+def _marched(truth: Fragment, function, face_of, spacing: float) -> Fragment:
+    """``truth``'s solid (``function``: negative inside) meshed afresh by marching tetrahedra,
+    as a scanner's reconstruction meshes it: its edges run between vertices and the triangles
+    across them cut the corner. The true edges and fracture faces stay ``truth``'s."""
+    low, high = truth.points.min(axis=0), truth.points.max(axis=0)
+    shift = np.array([0.3183, 0.2719, 0.1414]) * spacing  # no grid point on a face or an edge
+    points, triangles = march(function, low - 2 * spacing + shift, high + 2 * spacing, spacing)
+    return Fragment(
+        name=f"{truth.name}, marched",
+        points=points,
+        triangles=triangles,
+        edges=truth.edges,
+        faces=face_of(points),
+        fracture=truth.fracture,
+    )
+
+
+def marched_bevelled_cube(
+    size: float = 20.0, fillet: float = 1.5, spacing: float = 0.4
+) -> Fragment:
+    """:func:`bevelled_cube` meshed by marching tetrahedra of step ``spacing``: no vertex on
+    its edges (see :func:`_marched`)."""
+    a, r = size / 2.0, fillet
+    inner = a - r
+
+    def terms(p):
+        """Signed distances to the faces 0..7 (the fillets' only over their quarter)."""
+        x, y, z = p[:, 0], p[:, 1], p[:, 2]
+        corner = (np.abs(x) > inner) & (z > inner)
+        round_ = np.hypot(np.abs(x) - inner, z - inner) - r
+        fillets = [np.where(corner & (s * x > 0), round_, np.inf) for s in (1.0, -1.0)]
+        return np.stack([x - a, -x - a, y - a, -y - a, z - a, -z - a, *fillets], axis=1)
+
+    def function(p):
+        flat = terms(p)[:, :6].max(axis=1)
+        corner = (np.abs(p[:, 0]) > inner) & (p[:, 2] > inner)
+        round_ = np.hypot(np.abs(p[:, 0]) - inner, p[:, 2] - inner) - r
+        return np.where(corner, np.maximum(round_, np.abs(p[:, 1]) - a), flat)
+
+    def face_of(p):
+        return np.argmin(np.abs(terms(p)), axis=1).astype(np.int64)
+
+    return _marched(bevelled_cube(size, fillet, spacing), function, face_of, spacing)
+
+
+def marched_flake(
+    radius: float = 20.0, platform: float = 14.0, spacing: float = 0.4, edge_deg=FLAKE_EDGE_DEG
+) -> Fragment:
+    """:func:`flake` meshed by marching tetrahedra of step ``spacing``: no vertex on its edges
+    (see :func:`_marched`)."""
+    sphere = radius / math.sin(math.radians(edge_deg))
+    centre = np.array([0.0, 0.0, -math.sqrt(sphere**2 - radius**2)])
+
+    def terms(p):
+        """Signed distances to the dorsal cap, the ventral face and the platform (faces 0..2)."""
+        offset = p - centre
+        cap = np.sqrt(np.sum(offset * offset, axis=1)) - sphere
+        return np.stack([cap, -p[:, 2], p[:, 0] - platform], axis=1)
+
+    def face_of(p):
+        return np.argmin(np.abs(terms(p)), axis=1).astype(np.int64)
+
+    truth = flake(radius, platform, spacing, edge_deg)
+    return _marched(truth, lambda p: terms(p).max(axis=1), face_of, spacing)

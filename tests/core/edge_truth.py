@@ -72,3 +72,22 @@ def score(fragment, paths, tolerance: float | None = None) -> dict:
             sum(np.linalg.norm(np.diff(e, axis=0), axis=1).sum() for e in fragment.edges)
         ),
     }
+
+
+def found_on(make, noise: float = 0.0, tolerance: float | None = None):
+    """Run the finder (default parameters) on the fragment ``make()`` makes, with noise of
+    ``noise`` mean edge lengths (seed 1) if any, and score it.
+
+    Returns ``(fragment, surface, result, figures)``; ``figures`` as :func:`score` gives them.
+    """
+    from vg_addon import Surface
+    from vg_addon.fragments import with_noise
+
+    fragment = make()
+    if noise:
+        h = mean_edge_length(fragment.points, fragment.triangles)
+        fragment = with_noise(fragment, noise * h, seed=1)
+    surface = Surface(fragment.points, fragment.triangles)
+    result = surface.find_break_edges()
+    figures = score(fragment, [c.path.points for c in result.candidates], tolerance)
+    return fragment, surface, result, figures
