@@ -173,3 +173,20 @@ def test_without_matplotlib_the_numpy_drawings_are_used(tmp_path):
         "refused": 1,  # the smallest radius: the NumPy drawing marks it too
         "matplotlib_imported": False,
     }
+
+
+# Sizes where width / dpi × dpi falls just short of a whole pixel (251 / 100 × 100 = 250.99…)
+# among others: the image Blender copies pixels into must have exactly the size asked for.
+SIZES = [(480, 251), (160, 113), (167, 230), *((160 + 13 * k, 100 + 7 * k) for k in range(40))]
+
+
+def test_matplotlib_images_are_exactly_the_size_asked_for():
+    pytest.importorskip("matplotlib", reason="requirements/report.txt")
+    for width, height in SIZES:
+        image = profile_plot.render_profile(ARC, ANGLES, width=width, height=height)
+        assert image.shape == (height, width, 4)
+    for width, height in SIZES[::6]:
+        for dpi in (100, 120, 72):
+            figure = mpl_plots.profile_figure(ARC, ANGLES, width=width, height=height, dpi=dpi)
+            data = mpl_plots.png(figure)
+            assert struct.unpack(">II", data[16:24]) == (width, height), dpi

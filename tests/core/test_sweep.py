@@ -145,3 +145,17 @@ def test_matplotlib_plot_has_both_panels_labels_and_the_refused_radii(surface, t
     path = tmp_path / "sweep.png"
     sweep_plot.write_sweep_png(path, points, units="mm", title="Wedge, site 1")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_matplotlib_sweep_images_are_exactly_the_size_asked_for(surface):
+    pytest.importorskip("matplotlib", reason="requirements/report.txt")
+    from vg_addon.formats import mpl_plots
+
+    series = sweep_plot.sweep_series(radius_sweep(surface, [0.01, 0.0, 0.0], 0.02, 0.6, 5))
+    # 251 / 100 × 100 falls just short of a whole pixel.
+    for width, height in ((480, 251), (640, 413), (801, 559), (800, 560), (517, 339)):
+        for dpi in (100, 120):
+            figure = mpl_plots.sweep_figure(*series, width=width, height=height, dpi=dpi)
+            assert mpl_plots.rgba(figure).shape == (height, width, 4)
+            data = mpl_plots.png(figure)
+            assert struct.unpack(">II", data[16:24]) == (width, height)

@@ -49,8 +49,11 @@ def _figure(width: int, height: int, dpi: float):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    # Agg truncates figsize × dpi to whole pixels, and width / dpi × dpi can fall just short
+    # (251 / 100 × 100 = 250.99…): half a pixel more makes the truncation land on the size asked.
+    size = ((width + 0.5) / dpi, (height + 0.5) / dpi)
     with matplotlib.rc_context(STYLE):
-        figure = Figure(figsize=(width / dpi, height / dpi), dpi=dpi, layout="constrained")
+        figure = Figure(figsize=size, dpi=dpi, layout="constrained")
         FigureCanvasAgg(figure)
     return figure
 
