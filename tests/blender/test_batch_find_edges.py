@@ -185,12 +185,20 @@ def test_find_edges_with_jobs_writes_the_serial_runs_rows(tmp_path):
 
 def test_a_min_length_longer_than_every_edge_finds_none(tmp_path):
     mesh = write_bone(tmp_path / "bone.ply")
+    shape = bone_fragment(spacing=0.8)
+    # Longer than every edge the core finds, shorter than the mesh's diagonal (a min length
+    # beyond the diagonal is refused as a mistake, not answered with nothing).
+    longest = max(
+        c.length for c in find_break_edges(Surface(shape.points, shape.triangles)).candidates
+    )
+    diagonal = float(np.linalg.norm(shape.points.max(axis=0) - shape.points.min(axis=0)))
+    assert longest < diagonal
+    min_length = f"{(longest + diagonal) / 2:.6g}"
     out = tmp_path / "out.csv"
     result = ok(batch(mesh, "--find-edges", "--spacing", SPACING, "--radius", RADIUS,
-                      "--min-length", 1000, "--out", out))  # fmt: skip
-    assert (
-        "bone: found 0 break edge(s)" in result.stderr and "length at least 1000" in result.stderr
-    )
+                      "--min-length", min_length, "--out", out))  # fmt: skip
+    assert "bone: found 0 break edge(s)" in result.stderr
+    assert f"length at least {float(min_length):.4g}" in result.stderr
     assert csvio.read_measurements_csv(out) == []
     assert csvio.read_edges_csv(csvio.edges_path_for(out)) == []
 
