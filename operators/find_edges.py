@@ -320,7 +320,8 @@ class FindEdgesSession(ViewSession):
 
 
 def _optional(value: float) -> float | None:
-    return None if value <= 0.0 else typed_value(value)
+    """0 means "derived from the mesh"; a negative value goes on to be refused, not replaced."""
+    return None if value == 0.0 else typed_value(value)
 
 
 class VG_OT_find_break_edges(PatchProperties, bpy.types.Operator):

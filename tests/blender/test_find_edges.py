@@ -99,6 +99,9 @@ def test_named_candidates_only_and_unknown_numbers_refused_with_nothing_recorded
         bpy.ops.vg.find_break_edges(accept="first")
     with pytest.raises(RuntimeError, match="Name the candidates to record"):
         bpy.ops.vg.find_break_edges()
+    for name in ("scale", "min_length"):  # refused as given, never replaced by the default
+        with pytest.raises(RuntimeError, match=f"parameter {name} must be a positive number"):
+            bpy.ops.vg.find_break_edges(accept="ALL", **{name: -1.0})
     assert len(obj.vg.edges) == len(obj.vg.measurements) == 0
     assert bpy.ops.vg.find_break_edges(accept="2") == {"FINISHED"}
     assert len(obj.vg.edges) == 1
