@@ -265,11 +265,11 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         unit = unit_symbol(obj, context.scene)
         column.prop(settings, "edge_spacing", text=f"Spacing ({unit})")
         column.prop(settings, "radius", text=f"Radius ({unit})")
+        layout.operator("vg.measure_edge", text="Edge Profile", icon="CURVE_PATH")
+        wrapped_label(layout, context, "Click start, via points, end; Enter measures", "INFO")
         row = layout.split(factor=0.7, align=True)
         row.operator("vg.find_break_edges", text="Find Break Edges", icon="VIEWZOOM")
         row.operator("vg.import_picked_points", text=".pp", icon="IMPORT")
-        layout.operator("vg.measure_edge", text="Edge Profile", icon="CURVE_PATH")
-        wrapped_label(layout, context, "Click start, via points, end; Enter measures", "INFO")
         if not len(obj.vg.edges):
             return
         row = layout.row()
