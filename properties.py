@@ -26,10 +26,11 @@ from mathutils import Vector
 
 from .vg_addon import palette, units
 from .vg_addon.formats.record_codec import exact_numbers
+from .vg_addon.method.break_edges import BreakEdgeParameters
 from .vg_addon.method.result import (
     UNDETERMINED_REFUSED,
     UNSTABLE_DEGREES,
-    stability_text,
+    stored_stability_text,
     stored_stability_warning,
 )
 
@@ -98,12 +99,7 @@ def _text_value(key, default=""):
 
 
 def _stability_text(self):
-    parts = exact_numbers(self).get("stability")
-    if not parts:
-        return "not computed"
-    return stability_text(
-        parts["spread"], int(parts.get("runs") or 0), int(parts.get("refused") or 0)
-    )
+    return stored_stability_text(exact_numbers(self).get("stability"))
 
 
 def _stability_warning(self):
@@ -227,14 +223,16 @@ class VG_Measurement(PropertyGroup):
     stability_text: StringProperty(
         name="Stability",
         description="The largest change of the angle with the centre moved two edge lengths, "
-        "the radius ±10%, λ from 1 to 3, and the vertices resampled",
+        "the radius ±10%, λ from 1 to 3, and the vertices resampled, plus how far it moves "
+        "with the vertices next to the crease left out",
         get=_stability_text,
     )
     stability_warning: StringProperty(
         name="Stability warning",
         description=f"Why the reading is flagged: its stability figure is more than "
         f"{UNSTABLE_DEGREES:g}° (unstable), or more than {UNDETERMINED_REFUSED:.0%} of its "
-        "perturbed runs were refused (undetermined); empty for a reading that is not flagged",
+        "perturbed runs were refused or a face kept too few vertices away from the crease "
+        "(undetermined); empty for a reading that is not flagged",
         get=_stability_warning,
     )
     stability_center: FloatProperty(name="Centre moved (°)", get=_stability_part("center"))
@@ -242,6 +240,7 @@ class VG_Measurement(PropertyGroup):
     stability_lam: FloatProperty(name="λ 1 to 3 (°)", get=_stability_part("lam"))
     stability_bootstrap: FloatProperty(name="Bootstrap 95% (°)", get=_stability_part("bootstrap"))
     stability_orientation: FloatProperty(name="Other sign (°)", get=_stability_part("orientation"))
+    stability_crease: FloatProperty(name="Crease left out (°)", get=_stability_part("crease"))
     color_plus: FloatVectorProperty(
         name="Colour +", size=3, subtype="COLOR_GAMMA", get=_side_colour(0)
     )
@@ -414,6 +413,31 @@ class VG_SceneSettings(PropertyGroup):
         min=0.0,
         soft_min=1e-4,
         precision=4,
+    )
+    find_scale: FloatProperty(
+        name="Scale",
+        description="Find Break Edges: the neighbourhood a bend is judged at, in the mesh's own "
+        "units; 0: derived from the mesh",
+        default=0.0,
+        min=0.0,
+        precision=4,
+    )
+    find_min_length: FloatProperty(
+        name="Min Length",
+        description="Find Break Edges: shorter candidates are dropped, in the mesh's own units; "
+        "0: derived from the mesh",
+        default=0.0,
+        min=0.0,
+        precision=4,
+    )
+    find_min_bend: FloatProperty(
+        name="Min Bend",
+        description="Find Break Edges: a ridge bends at least this much (180° minus its angle), "
+        "in degrees",
+        default=BreakEdgeParameters().min_bend_deg,
+        min=0.0,
+        max=180.0,
+        soft_max=90.0,
     )
     sweep_stop: FloatProperty(
         name="To",

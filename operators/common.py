@@ -100,6 +100,14 @@ EDGE_SETTINGS = {
 }
 
 
+#: The panel settings Find Break Edges takes by default for its detector's parameters.
+FIND_SETTINGS = {
+    "scale": "find_scale",
+    "min_length": "find_min_length",
+    "min_bend": "find_min_bend",
+}
+
+
 def clear_texts(area, workspace) -> None:
     """Remove a modal session's header text (``area``) and status-bar hints (``workspace``);
     either may be None or already gone."""

@@ -5,7 +5,7 @@ Invoked from the Edge Profiles panel it runs a modal session: the detector
 (``BreakEdgeFinder``) is stepped on a timer with a progress bar (Esc stops it, nothing
 changed); then every candidate is drawn over the mesh, numbered and coloured by confidence
 (``find_edges_overlay``), and the analyst clicks one to select it, accepts it (A), rejects it
-(X) or trims it (T, then two clicks on it); Enter measures every accepted candidate with the
+(X) or trims it (T, then two clicks on it, and on a loop a third on the part kept); Enter measures every accepted candidate with the
 panel's Spacing, Radius, λ and Patch and records each as an Edge Profile, all in one undo step.
 Esc during the review records nothing. The interaction is
 :class:`~vg_addon.workflow.find_edges_state.FindEdgesMachine` (pure, tested without a screen).
@@ -38,6 +38,7 @@ from ..vg_addon.workflow.find_edges_state import (
 )
 from .common import (
     EDGE_SETTINGS,
+    FIND_SETTINGS,
     PatchProperties,
     defaults_from_panel,
     length_property,
@@ -268,17 +269,17 @@ class FindEdgesSession(ViewSession):
     def refresh(self, context) -> None:
         """Hand the candidates to the overlay; update header and status bar."""
         machine = self.machine
-        trim_point = None
+        trim_points = None
         if machine.trim_arcs and machine.selected is not None:
             path = machine.candidates[machine.selected].path
-            at = int(np.searchsorted(path.arc_lengths, machine.trim_arcs[0]))
-            trim_point = path.points[min(at, len(path.points) - 1)]
+            at = np.searchsorted(path.arc_lengths, machine.trim_arcs)
+            trim_points = path.points[np.minimum(at, len(path.points) - 1)]
         self.overlay.update(
             machine.candidates,
             [str(d) for d in machine.decisions],
             machine.selected,
             np.array(self.obj.matrix_world, dtype=np.float64),
-            trim_point,
+            trim_points,
         )
         if self._area is not None:
             self._area.header_text_set(self.header_text(context.scene))
@@ -305,8 +306,11 @@ class FindEdgesSession(ViewSession):
                 f"bend {c.mean_bend_deg:.0f}°"
             )
         if machine.phase is FindPhase.TRIMMING:
-            ends = "first" if not machine.trim_arcs else "second"
-            parts.append(f"Trim: click the {ends} end of the part to keep · Esc back")
+            if len(machine.trim_arcs) < 2:
+                ends = "first" if not machine.trim_arcs else "second"
+                parts.append(f"Trim: click the {ends} end of the part to keep · Esc back")
+            else:
+                parts.append("Trim: click the part of the loop to keep · Esc back")
         else:
             parts.append(KEYS)
         if machine.message:
@@ -346,14 +350,18 @@ class VG_OT_find_break_edges(PatchProperties, bpy.types.Operator):
         "Spacing", "Arc length between stations, in mesh units; default: the panel's"
     )
     scale: length_property(
-        "Scale", "The neighbourhood a bend is judged at, in mesh units; 0: derived from the mesh"
+        "Scale",
+        "The neighbourhood a bend is judged at, in mesh units; 0: derived from the mesh; "
+        "default: the panel's",
     )
     min_length: length_property(
-        "Min Length", "Shorter candidates are dropped, in mesh units; 0: derived from the mesh"
+        "Min Length",
+        "Shorter candidates are dropped, in mesh units; 0: derived from the mesh; default: the "
+        "panel's",
     )
     min_bend: FloatProperty(
         name="Min Bend (°)",
-        description="A ridge bends at least this much (180° minus its angle)",
+        description="A ridge bends at least this much (180° minus its angle); default: the panel's",
         default=BreakEdgeParameters().min_bend_deg,
         soft_min=0.0,
         soft_max=90.0,
@@ -381,11 +389,7 @@ class VG_OT_find_break_edges(PatchProperties, bpy.types.Operator):
         )
 
     def execute(self, context):
-        defaults_from_panel(
-            self,
-            context,
-            EDGE_SETTINGS,
-        )
+        defaults_from_panel(self, context, {**EDGE_SETTINGS, **FIND_SETTINGS})
         obj = context.active_object
         try:
             check_measurable(obj)
@@ -429,6 +433,7 @@ class VG_OT_find_break_edges(PatchProperties, bpy.types.Operator):
         if context.area is None or context.area.type != "VIEW_3D":
             self.report({"WARNING"}, "Break edges are reviewed in the 3D viewport.")
             return {"CANCELLED"}
+        defaults_from_panel(self, context, FIND_SETTINGS)
         obj = context.active_object
         try:
             check_measurable(obj)

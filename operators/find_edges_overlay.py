@@ -81,7 +81,7 @@ class FindEdgesOverlay(ViewOverlay):
         self._text_handle = None
         self._items: list | None = None
         self._selected: int | None = None
-        self._trim_point: np.ndarray | None = None
+        self._trim_points: np.ndarray | None = None
         self._batches = None
 
     def start(self) -> None:
@@ -100,13 +100,13 @@ class FindEdgesOverlay(ViewOverlay):
         super().stop()
 
     def _drop(self) -> None:
-        self._items = self._batches = self._trim_point = None
+        self._items = self._batches = self._trim_points = None
         self._selected = None
 
-    def update(self, candidates, decisions, selected, matrix, trim_point=None) -> None:
+    def update(self, candidates, decisions, selected, matrix, trim_points=None) -> None:
         """New data: the candidates (each with ``number``, ``confidence`` and a ``path`` in mesh
         coordinates), their decisions (``"pending"``, ``"accepted"``, ``"rejected"``), the
-        selected index (or None) and the first trim click (mesh coordinates, or None), drawn
+        selected index (or None) and the trim clicks so far (mesh coordinates, or None), drawn
         where the object's ``matrix`` (``matrix_world``) places them."""
         matrix = np.asarray(matrix, dtype=np.float64)
         items = []
@@ -121,10 +121,10 @@ class FindEdgesOverlay(ViewOverlay):
             )
         self._items = items
         self._selected = selected
-        self._trim_point = (
+        self._trim_points = (
             None
-            if trim_point is None
-            else world_points(np.reshape(trim_point, (1, 3)), matrix).astype(np.float32)
+            if trim_points is None
+            else world_points(np.reshape(trim_points, (-1, 3)), matrix).astype(np.float32)
         )
         self._batches = None
 
@@ -138,8 +138,8 @@ class FindEdgesOverlay(ViewOverlay):
             if index == self._selected:
                 batches.append(("LINES", batch, HALO_COLOR, width + HALO_EXTRA))
             batches.append(("LINES", batch, colour, width))
-        if self._trim_point is not None:
-            batch = batch_for_shader(points, "POINTS", {"pos": self._trim_point})
+        if self._trim_points is not None:
+            batch = batch_for_shader(points, "POINTS", {"pos": self._trim_points})
             batches.append(("POINTS", batch, TRIM_COLOR, POINT_SIZE))
         return batches
 

@@ -191,6 +191,7 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
         ("± λ", "lam"),
         ("± bootstrap", "bootstrap"),
         ("± orientation", "orientation"),
+        ("± crease", "crease"),
     ):
         if key in stability:
             rows.append((label, exact_text(stability[key]) + "°"))
@@ -245,8 +246,8 @@ def _text_fitted(layout, context, label, value) -> None:
 
 
 class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
-    """Whole edges: spacing, Find Break Edges and the .pp import, the Edge Profile button, the
-    list, and the selected one's plot."""
+    """Whole edges: spacing, Find Break Edges (with its settings, folded) and the .pp import, the
+    Edge Profile button, the list, and the selected one's plot."""
 
     bl_label = "Edge Profiles"
     bl_parent_id = "VIEW3D_PT_vg_measure"
@@ -270,6 +271,16 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         row = layout.split(factor=0.7, align=True)
         row.operator("vg.find_break_edges", text="Find Break Edges", icon="VIEWZOOM")
         row.operator("vg.import_picked_points", text=".pp", icon="IMPORT")
+        header, body = layout.panel("VG_find_edges_settings", default_closed=True)
+        header.label(text="Finder Settings")
+        if body is not None:
+            column = body.column(align=True)
+            column.use_property_split = True
+            column.use_property_decorate = False
+            column.prop(settings, "find_scale", text=f"Scale ({unit})")
+            column.prop(settings, "find_min_length", text=f"Min Length ({unit})")
+            column.prop(settings, "find_min_bend", text="Min Bend (°)")
+            wrapped_label(body, context, "0: derived from the mesh", "INFO")
         if not len(obj.vg.edges):
             return
         row = layout.row()

@@ -107,6 +107,36 @@ def test_named_candidates_only_and_unknown_numbers_refused_with_nothing_recorded
     assert len(obj.vg.edges) == 1
 
 
+def test_the_panels_finder_settings_drive_it_and_are_saved_in_the_blend(vg, tmp_path):
+    obj = fragment_object()
+    surface = core_surface(obj)
+    lengths = sorted(c.length for c in find_break_edges(surface).candidates)
+    assert len(lengths) >= 2
+    # Between the two shortest: the core, given it, drops the shortest candidate.
+    min_length = (lengths[0] + lengths[1]) / 2
+    kept = find_break_edges(surface, min_length=min_length).candidates
+    assert 1 <= len(kept) < len(lengths)
+    settings = bpy.context.scene.vg_settings
+    settings.find_min_length, settings.find_min_bend = min_length, 35.0
+    path, name = tmp_path / "settings.blend", obj.name
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.read_homefile(use_empty=True)
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    settings = bpy.context.scene.vg_settings
+    assert (settings.find_scale, settings.find_min_bend) == (0.0, 35.0)
+    assert settings.find_min_length == pytest.approx(min_length, rel=1e-6)  # a float32 property
+    obj = bpy.data.objects[name]
+    bpy.context.view_layer.objects.active = obj
+    expected = find_break_edges(
+        core_surface(obj), min_length=settings.find_min_length, min_bend_deg=35.0
+    ).candidates
+    assert bpy.ops.vg.find_break_edges(accept="ALL") == {"FINISHED"}
+    assert len(obj.vg.edges) == len(expected) < len(lengths)
+    # What the caller gives wins over the panel.
+    with pytest.raises(RuntimeError, match="parameter min_length must be a positive number"):
+        bpy.ops.vg.find_break_edges(accept="ALL", min_length=-1.0)
+
+
 def test_a_review_records_its_accepted_and_trimmed_edges_in_one_undo_step(vg):
     """The review on the bridge's own surface: accept candidate 1, reject 2, trim and accept 3;
     what it stores in ``edges`` records exactly the machine's profiles, and one undo removes

@@ -4,6 +4,8 @@ Oracles: the generators' own labels of which vertices lie on a rim (the exact ge
 ``trace_edge`` for replication (a candidate's waypoints retrace its path).
 """
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -91,8 +93,30 @@ def test_trim_keeps_a_part_that_retraces(bone):
     points = part.waypoint_points
     again = surface.trace_edge(points[0], points[-1], via=points[1:-1])
     assert np.array_equal(again.vertices, part.path.vertices)
+
+
+def test_trim_of_a_loop_may_keep_the_part_through_its_start(bone):
+    _, surface, result = bone
+    loop = next(c for c in result.candidates if c.closed)
+    arc = loop.path.arc_lengths
+    start_arc, end_arc = 0.7 * loop.length, 0.2 * loop.length
+    first = int(np.argmin(np.abs(arc - start_arc)))
+    last = int(np.argmin(np.abs(arc - end_arc)))
+    through = trim(loop, start_arc, end_arc)
+    expected = np.concatenate([loop.path.vertices[first:], loop.path.vertices[1 : last + 1]])
+    assert np.array_equal(through.path.vertices, expected)
+    assert not through.closed and through.bend_deg.shape == expected.shape
+    assert through.length == pytest.approx(loop.length - arc[first] + arc[last])
+    # The two parts two cuts make are the whole loop.
+    between = trim(loop, end_arc, start_arc)
+    assert through.length + between.length == pytest.approx(loop.length)
+    points = through.waypoint_points
+    again = surface.trace_edge(points[0], points[-1], via=points[1:-1])
+    assert np.array_equal(again.vertices, through.path.vertices)
+    # An open candidate has no part through its start: the ends must come in order.
+    opened = replace(loop, closed=False)
     with pytest.raises(GoniometerError, match="before the end"):
-        trim(candidate, 30.0, 10.0)
+        trim(opened, start_arc, end_arc)
 
 
 def test_steps_report_progress_and_leave_the_result(bone):

@@ -176,6 +176,28 @@ def test_two_clicks_trim_the_selected_candidate_to_the_part_between(surface):
     assert np.array_equal(machine.profiles[0][1].path.vertices, part.vertices)
 
 
+@pytest.mark.parametrize("inside", [True, False], ids=["between", "through_the_start"])
+def test_on_a_loop_a_third_click_picks_the_part_kept(surface, inside):
+    machine = found(surface)
+    index = next(k for k, c in enumerate(machine.candidates) if c.closed)
+    machine.select(index)
+    loop = machine.candidates[index].path
+    n = loop.vertices.size
+    a, b = n // 4, (3 * n) // 5
+    machine.start_trim()
+    drawn = pixels(machine, side_view(surface))
+    assert machine.pick(drawn, drawn[index][a]) and machine.pick(drawn, drawn[index][b])
+    assert machine.phase is FindPhase.TRIMMING and machine.message.startswith("Click the part")
+    assert machine.pick(drawn, drawn[index][(a + b) // 2 if inside else n // 10])
+    assert machine.phase is FindPhase.REVIEW and machine.message == ""
+    part = machine.candidates[index].path
+    if inside:
+        expected = loop.vertices[a : b + 1]
+    else:
+        expected = np.concatenate([loop.vertices[b:], loop.vertices[1 : a + 1]])
+    assert np.array_equal(part.vertices, expected)
+
+
 def test_a_click_off_the_trimmed_candidate_and_esc_leave_it_whole(surface):
     machine = found(surface)
     drawn = pixels(machine, side_view(surface))

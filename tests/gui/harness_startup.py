@@ -158,6 +158,7 @@ def _find_edges(window, area):
                     "number": candidate.number,
                     "confidence": candidate.confidence,
                     "length": candidate.length,
+                    "closed": candidate.closed,
                     "decision": str(decision),
                     "screen": screen,
                 }

@@ -76,8 +76,9 @@ def decide(gui, found, index: int, key: str, decision: str) -> dict:
 
 
 def trim_third(gui, found) -> dict:
-    """T on candidate 3 and two clicks on it a third of the way along apart: it is replaced by
-    the part between them, still undecided (so nothing of it is recorded)."""
+    """T on candidate 3 and two clicks on it a third of the way along apart (on a loop, a third
+    click between them picks that part): it is replaced by the part between them, still
+    undecided (so nothing of it is recorded)."""
     before = found["candidates"][2]
     clear = [k for k, xy in enumerate(before["screen"]) if xy and clear_of(found, 2, xy) > 25]
     ends = [clear[0], next((k for k in clear if k - clear[0] >= 8), None)]
@@ -87,6 +88,15 @@ def trim_third(gui, found) -> dict:
     gui.key("t")
     gui.click(tuple(before["screen"][ends[1]]))  # either order
     gui.click(tuple(before["screen"][ends[0]]))
+    if before["closed"]:
+        trimming = gui.settle()["find_edges"]
+        assert (trimming["phase"], trimming["message"]) == (
+            "TRIMMING",
+            "Click the part of the loop to keep.",
+        )
+        between = next((k for k in clear if ends[0] < k < ends[1]), None)
+        assert between is not None, "no clear point on candidate 3 between the trim's ends"
+        gui.click(tuple(before["screen"][between]))
     after = review(
         gui.wait_for(
             lambda s: review(s)["candidates"][2]["length"] < before["length"], 20, "the trim"

@@ -434,14 +434,16 @@ def find_break_edges(surface, parameters: BreakEdgeParameters | None = None, **o
 def trim(candidate: BreakEdgeCandidate, start_arc: float, end_arc: float) -> BreakEdgeCandidate:
     """The part of ``candidate`` between arc lengths ``start_arc`` and ``end_arc``.
 
-    Each end snaps to the path vertex nearest its arc length. The part keeps the candidate's
-    waypoints that fall inside it, plus via points where the part would not otherwise retrace
-    identically through ``trace_edge``. Its confidence and mean bend are those of the part.
+    Each end snaps to the path vertex nearest its arc length. On a loop (``candidate.closed``) a
+    ``start_arc`` beyond ``end_arc`` keeps the part that runs on from ``start_arc`` through the
+    loop's start to ``end_arc``. The part keeps the candidate's waypoints that fall inside it,
+    plus via points where the part would not otherwise retrace identically through
+    ``trace_edge``. Its confidence and mean bend are those of the part.
 
     Raises
     ------
     GoniometerError
-        Arc lengths out of order or leaving less than one mesh edge.
+        Arc lengths out of order on an open candidate, or leaving less than one mesh edge.
     """
     path = candidate.path
     arc = path.arc_lengths
@@ -449,26 +451,37 @@ def trim(candidate: BreakEdgeCandidate, start_arc: float, end_arc: float) -> Bre
         start_arc, end_arc = float(start_arc), float(end_arc)
     except (TypeError, ValueError):
         raise GoniometerError("The trim's arc lengths must be numbers.") from None
-    if not (math.isfinite(start_arc) and math.isfinite(end_arc) and start_arc < end_arc):
+    wraps = candidate.closed and start_arc > end_arc
+    if not (math.isfinite(start_arc) and math.isfinite(end_arc) and (start_arc < end_arc or wraps)):
         raise GoniometerError(
             f"Trim from arc length {start_arc:g} to {end_arc:g}: the start must come before the "
             f"end, both within 0 to {path.length:.6g}."
         )
     first = int(np.argmin(np.abs(arc - start_arc)))
     last = int(np.argmin(np.abs(arc - end_arc)))
-    if last <= first:
+    end = arc.size - 1
+    if wraps:
+        # The loop's start and end are one vertex: a part that reaches either does not wrap.
+        if first == end:
+            first, wraps = 0, False
+        elif last == 0:
+            last, wraps = end, False
+    if wraps:
+        vertices = np.concatenate([path.vertices[first:], path.vertices[1 : last + 1]])
+        bend_deg = np.concatenate([candidate.bend_deg[first:], candidate.bend_deg[1 : last + 1]])
+        inside = [int(w) - first for w in path.waypoints if first < w < end]
+        inside += [end - first] + [end - first + int(w) for w in path.waypoints if 0 < w < last]
+    elif last <= first:
         raise GoniometerError(
             f"Trimming from {start_arc:g} to {end_arc:g} leaves less than one mesh edge of this "
             "candidate: keep a longer part."
         )
+    else:
+        vertices = path.vertices[first : last + 1]
+        bend_deg = candidate.bend_deg[first : last + 1].copy()
+        inside = [int(w) - first for w in path.waypoints if first < w < last]
     surface = candidate.surface
-    inside = [int(w) - first for w in path.waypoints if first < w < last]
-    stops = [0, *inside, last - first]
-    legs = retraced_legs(surface, path.vertices[first : last + 1], stops)
+    stops = [0, *inside, vertices.size - 1]
+    legs = retraced_legs(surface, vertices, stops)
     part = assemble_path(surface, legs)
-    return rated(
-        candidate,
-        part,
-        candidate.bend_deg[first : last + 1].copy(),
-        closed=bool(part.vertices[0] == part.vertices[-1]),
-    )
+    return rated(candidate, part, bend_deg, closed=bool(part.vertices[0] == part.vertices[-1]))

@@ -3,7 +3,8 @@
 The detector (``method.break_edges.BreakEdgeFinder``) is stepped until it has its candidates
 (each step a chunk of work, so a modal operator can show progress and stop at once); then the
 analyst reviews them: select one (a click near it, or the next in turn), accept it, reject it,
-or trim it to the part between two clicks on it. Finishing measures every accepted candidate
+or trim it to the part between two clicks on it (on a loop, a third click picks the part).
+Finishing measures every accepted candidate
 with the Edge Profile settings, one per step, all or nothing: a candidate whose stations
 cannot be measured sends the review back with a message naming it. Cancelling at any point
 leaves nothing. The Blender operator only projects, translates events, draws and records the
@@ -108,7 +109,8 @@ class FindEdgesMachine:
     selected : int or None
         Index into :attr:`candidates` of the selected one.
     trim_arcs : list of float
-        The arc lengths clicked so far while trimming (0 or 1 of them).
+        The arc lengths clicked so far while trimming: the two ends of the part kept, then, on a
+        loop, a point on the part kept.
     profiles : list of (ndarray, EdgeProfile)
         Set when :attr:`phase` is ``DONE``: each accepted candidate's points (as
         :func:`edge_points`) and its measured profile, in candidate order.
@@ -272,7 +274,8 @@ class FindEdgesMachine:
 
     # -- trimming ---------------------------------------------------------------------------
     def start_trim(self) -> bool:
-        """Start trimming the selected candidate: the next two clicks on it mark the part kept."""
+        """Start trimming the selected candidate: the next two clicks on it mark the ends of the
+        part kept (on a loop, a third click on the part to keep says which of the two it is)."""
         if not self.reviewing:
             return False
         if self.selected is None:
@@ -290,13 +293,19 @@ class FindEdgesMachine:
             return False
         candidate = self.candidates[self.selected]
         self.trim_arcs.append(float(candidate.path.arc_lengths[index]))
-        if len(self.trim_arcs) < 2:
-            self.message = ""
+        ends = 3 if candidate.closed else 2
+        if len(self.trim_arcs) < ends:
+            self.message = "Click the part of the loop to keep." if len(self.trim_arcs) == 2 else ""
             return True
-        low, high = sorted(self.trim_arcs)
+        low, high = sorted(self.trim_arcs[:2])
+        chosen = self.trim_arcs[2] if candidate.closed else low
         self.trim_arcs = []
         self.phase = FindPhase.REVIEW
-        return self.trim_to(low, high)
+        # Two clicks cut a loop in two: the third says which part is kept (it may run on through
+        # the loop's start).
+        if low <= chosen <= high:
+            return self.trim_to(low, high)
+        return self.trim_to(high, low)
 
     def trim_to(self, start_arc: float, end_arc: float) -> bool:
         """Trim the selected candidate to the arc lengths ``start_arc`` to ``end_arc`` along
