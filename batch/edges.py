@@ -267,20 +267,31 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
                 surface=surface,
                 given=spec.get("given", ""),
             )
-            # Recorded without repainting: the colours are painted once, after every edge.
-            edge = edges.record_profile(obj, profile, geometry, clicks, note=spec.get("note", ""))
+            # Recorded without repainting: the colours are painted once, after every edge. The
+            # plot kept in the object is drawn only for a .blend that is saved (--save-blend);
+            # the run writes its own plot file below.
+            edge = edges.record_profile(
+                obj,
+                profile,
+                geometry,
+                clicks,
+                note=spec.get("note", ""),
+                plot=bool(options.get("save_blend")),
+            )
             painted = geometry
         except GoniometerError as error:
             obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
             station_rows.append(failed_edge_row(number, spec, name, str(error), units))
             continue
+        # The edge's stations are the items it just appended: read those, not every stored one.
+        measurements = obj.vg.measurements
+        stations = range(len(measurements) - edge.n_stations, len(measurements))
         station_rows.extend(
             dataclasses.replace(
-                records.to_row(obj, item, stale=False, units=units, precision=precision),
+                records.to_row(obj, measurements[i], stale=False, units=units, precision=precision),
                 mesh_name=name,
             )
-            for item in obj.vg.measurements
-            if item.edge_number == edge.number
+            for i in stations
         )
         edge_rows.append(
             dataclasses.replace(records.edge_row(obj, edge, units=units), mesh_name=name)

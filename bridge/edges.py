@@ -31,7 +31,12 @@ PLOT_SIZE = (480, 240)
 
 def free_break(obj) -> int:
     """The object's current break number if no measurement uses it yet, else the next unused."""
-    used = {item.break_number for item in obj.vg.measurements}
+    # Read at once (foreach_get): a batch recording hundreds of edges would otherwise read every
+    # stored measurement's break again for each new edge.
+    measurements = obj.vg.measurements
+    breaks = np.zeros(len(measurements), dtype=np.int32)
+    measurements.foreach_get("break_number", breaks)
+    used = set(breaks.tolist())
     number = obj.vg.break_number
     while number in used:
         number += 1
@@ -134,7 +139,7 @@ def measure_edge_on_object(
     return edge
 
 
-def record_profile(obj, profile, geometry, clicks, *, note=""):
+def record_profile(obj, profile, geometry, clicks, *, note="", plot=True):
     """Record a measured ``profile`` on ``obj``: every station as a measurement of one new
     break, and the edge's record with its summary and plot; the colours are not repainted
     (``measuring.repaint`` once after several edges).
@@ -150,6 +155,9 @@ def record_profile(obj, profile, geometry, clicks, *, note=""):
         The start, via points and end the profile was traced through, in mesh coordinates.
     note : str
         Free text stored with the edge and each station.
+    plot : bool
+        Also draw the edge's plot as a packed image (:func:`make_plot`); a batch run whose
+        object is never saved skips it (it writes its own plot files).
 
     Returns
     -------
@@ -172,7 +180,8 @@ def record_profile(obj, profile, geometry, clicks, *, note=""):
         obj, profile, clicks, geometry.fingerprint, break_number=break_number, note=note
     )
     obj.vg.break_number = break_number + 1  # the next measurement starts a new break
-    edge.plot = make_plot(obj, edge).name
+    if plot:
+        edge.plot = make_plot(obj, edge).name
     return edge
 
 

@@ -1,9 +1,16 @@
 """The measurement map's edge lines: each edge profile's traced path drawn as a thin magenta tube.
 
 A map of a fragment whose edges were profiled (clicked, imported from a CSV or ``.pp`` file, or
-found by ``--find-edges``) shows where each edge runs; the stations' numbered labels stay as
-they are. The tubes are curve objects of the map's throwaway scene, made here and removed with
-it.
+found by ``--find-edges``) shows where each edge runs. The tubes are curve objects of the map's
+throwaway scene, made here and removed with it.
+
+An edge's stations are numbered in order along its line, a few millimetres apart, so most views
+have room for only some of their labels. Of a label no chosen view draws, the map makes a
+close-up (or a view of its own) only for the first and last station of each edge
+(:func:`inner_stations` names the others): at most two extra views per edge. The numbers
+between them follow along the magenta line, and each station's angle is in the CSV and the
+edge's profile plot. One close-up per crowded station made the map of a bone with four found
+edges 36 views long (30 close-ups, two minutes of rendering at 1M vertices).
 """
 
 from __future__ import annotations
@@ -31,6 +38,21 @@ def edge_paths(obj) -> list[tuple[np.ndarray, bool]]:
         if points.ndim == 2 and points.shape[0] >= 2 and points.shape[1] == 3:
             paths.append((points, numbers.get("space") == record_codec.MESH))
     return paths
+
+
+def inner_stations(obj) -> set[int]:
+    """The numbers of ``obj``'s edge stations that are neither the first nor the last (by arc
+    length) of their edge's current stations: those the map labels only where a view has room."""
+    by_edge: dict[int, list[tuple[float, int]]] = {}
+    for item in obj.vg.measurements:
+        if item.edge_number > 0 and not item.stale:
+            arc = float(record_codec.exact_numbers(item).get("arc_length", 0.0))
+            by_edge.setdefault(item.edge_number, []).append((arc, item.number))
+    inner = set()
+    for stations in by_edge.values():
+        stations.sort()
+        inner.update(number for _arc, number in stations[1:-1])
+    return inner
 
 
 def add_edge_lines(scene, obj, material, size: float, keep) -> int:

@@ -16,8 +16,11 @@ Every measurement appears in at least one view: the views are planned before any
 rendered, and a measurement that none of the chosen views shows gets a view of its own, looking
 onto its surface along its mean normal (or tilted from it, or from the other side, until a ray
 reaches its centre). One that no direction sees (inside a closed cavity) is listed on a last
-picture, "not shown", which the contact sheet includes. The labels are set in DejaVu Sans Mono,
-which Blender ships: its "1" has a flag and a foot, so "11" never reads "II".
+picture, "not shown", which the contact sheet includes. The stations of an edge profile between
+its first and last are the exception: they are labelled where a view has room, and get no view
+of their own (``map_edges.inner_stations``; their numbers run in order along the edge's line).
+The labels are set in DejaVu Sans Mono, which Blender ships: its "1" has a flag and a foot, so
+"11" never reads "II".
 Each edge profile's traced path is drawn as a thin magenta line (``map_edges``). Everything made
 for the render is removed afterwards, whatever happens.
 """
@@ -38,7 +41,7 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, looks_at, place_labels, view_up
 from .colors import new_sides_material
 from .label_data import labels_of
-from .map_edges import LINE_COLOUR, add_edge_lines
+from .map_edges import LINE_COLOUR, add_edge_lines, inner_stations
 from .mesh_data import read_positions, world_points
 
 MAP_VIEWS = ("SIX", "FLAKE")
@@ -104,6 +107,9 @@ class MapJob:
         self.depsgraph = bpy.context.evaluated_depsgraph_get()
         self.views = list(view_list(obj, views, self.depsgraph))
         self.labels = labels_of(obj)
+        inner = inner_stations(obj)
+        # Labels that get no view of their own when no chosen view draws them (see map_edges).
+        self._inner = {i for i, label in enumerate(self.labels) if label.number in inner}
         self.placements: list[list] = []  # per view: (label index, side) of each label drawn
         self.not_shown: list = []  # labels no view can show (listed on the last picture)
         self.written: list[Path] = []
@@ -297,7 +303,9 @@ class MapJob:
         self._zooms: dict[int, tuple] = {}
         drawn = {index for placed in self.placements for index, _side in placed}
         for index, label in enumerate(self.labels):
-            if index not in drawn and not self._add_view_for(index, label, drawn):
+            if index in drawn or index in self._inner:
+                continue  # an inner station of an edge gets no view of its own (map_edges)
+            if not self._add_view_for(index, label, drawn):
                 self.not_shown.append(label)
         if self.not_shown:
             self.views.append((NOT_SHOWN, None, None))

@@ -334,3 +334,37 @@ def test_labels_crowded_out_of_the_six_views_get_close_ups(vg, tmp_path):
     # A close-up per label left out at most (labels go left or right of their centre, so a row
     # of centres 0.06 apart still fits about two to a picture: here 9 close-ups).
     assert all("close-up" in n for n in names[6:]) and 6 < len(names) <= 6 + 12 - len(six), names
+
+
+def test_an_edges_inner_stations_get_no_close_ups(vg, tmp_path):
+    """An edge profile's stations crowd along its line: the map makes extra views only for the
+    first and last station of each edge (the others are labelled where the six views have room),
+    while the same readings taken as single measurements each get one when crowded out. The
+    oracle for the ends is the stations' stored arc lengths."""
+    obj = wedge_object(100.0, "Edge", n=40)
+    vg.bridge.edges.measure_edge_on_object(obj, [(-0.6, 0.0, 0.0), (0.6, 0.0, 0.0)], 0.06, 0.2)
+    stations = sorted((exact(item)["arc_length"], item.number) for item in obj.vg.measurements)
+    assert len(stations) >= 15
+    ends = {stations[0][1], stations[-1][1]}
+    job = vg.bridge.measurement_map.MapJob(obj, tmp_path, size=(320, 240), samples=1)
+    try:
+        extra = [name for name, _look, _up in job.views[6:]]
+        drawn = {job.labels[i].number for placed in job.placements for i, _side in placed}
+        crowded = len(stations) - len(
+            {job.labels[i].number for placed in job.placements[:6] for i, _side in placed}
+        )
+    finally:
+        job.close()
+    assert crowded > 2  # the test's point: the six views leave more than the ends out
+    assert all(int(name.rsplit(" ", 1)[1]) in ends for name in extra), extra
+    assert ends <= drawn and not job.not_shown
+
+    single = wedge_object(100.0, "Single", n=40)
+    for _arc, number in stations:
+        item = next(i for i in obj.vg.measurements if i.number == number)
+        vg.bridge.measuring.measure_on_object(single, exact(item)["center"], 0.2)
+    plain = vg.bridge.measurement_map.MapJob(single, tmp_path / "plain", size=(320, 240), samples=1)
+    try:
+        assert len(plain.views) > len(job.views)  # each crowded reading gets a close-up
+    finally:
+        plain.close()

@@ -62,6 +62,7 @@ CORRIDOR_STRETCH = 2.0
 times ``|a-b|`` (plus a few edge lengths): room for a half-circle, not for a loop."""
 
 _graphs: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_extents: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def stable_order(keys: np.ndarray) -> np.ndarray:
@@ -323,6 +324,15 @@ def _flat_spans(on_ridge: np.ndarray, arc: np.ndarray) -> tuple:
     )
 
 
+def surface_extent(surface) -> float:
+    """The largest side of the surface's bounding box, computed once per surface (a pass over
+    every vertex: per click it cost more than the snap itself on a 1M-vertex scan)."""
+    extent = _extents.get(surface)
+    if extent is None:
+        extent = _extents[surface] = float(np.ptp(surface.points, axis=0).max())
+    return extent
+
+
 def snap_click(surface, click, number: int = 1) -> int:
     """The vertex a click on the edge snaps to (the nearest one, however far).
 
@@ -330,7 +340,7 @@ def snap_click(surface, click, number: int = 1) -> int:
     """
     click = as_center(click)
     graph = ridge_graph(surface)
-    reach = max(float(np.ptp(surface.points, axis=0).max()), graph.mean_edge_length, 1e-300)
+    reach = max(surface_extent(surface), graph.mean_edge_length, 1e-300)
     vertex, _ = surface.index.nearest(click, reach)
     if vertex < 0:
         raise GoniometerError(

@@ -1,0 +1,61 @@
+"""A batch run's edges as the saved .blend keeps them: every edge with its stations (the items
+the edge appended, in order) and its plot, drawn from its own numbers, also when edges follow
+measurements recorded before them; a run that saves no .blend still writes each edge's plot
+file.
+
+Oracles: the core's ``Surface.measure_along`` for the stations, and the extension's plot
+drawing (``profile_plot.render_profile``) of the edge's stored numbers for the plot's pixels.
+"""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+from bpy_helpers import batch, exact
+
+from vg_addon import Surface
+from vg_addon.formats import meshio, profile_plot
+from vg_addon.synthetic_meshes import wedge
+
+EDGES = ([-0.8, 0.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.8, 0.0, 0.0], [-0.6, 0, 0, 0.6, 0, 0])
+
+
+def run(tmp_path, *extra):
+    shape = wedge(90.0, n=30, irregular=True, seed=2)
+    mesh = meshio.write_ply(tmp_path / "w.ply", shape.points, shape.triangles)
+    edges = [arg for points in EDGES for arg in ("--edge", *points)]
+    result = batch(mesh, "--at", 0.3, 0, 0, *edges, "--spacing", 0.1, "--radius", 0.2,
+                   "--out", tmp_path / "out.csv", *extra)  # fmt: skip
+    assert result.returncode == 0, result.stdout + result.stderr
+    return mesh
+
+
+def test_saved_edges_keep_their_stations_and_plots(vg, tmp_path):
+    mesh = run(tmp_path, "--save-blend", tmp_path / "saved.blend")
+    bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "saved.blend"))
+    obj = bpy.data.objects["w"]
+    data = meshio.read_mesh(mesh)
+    surface = Surface(data.points, data.triangles)
+    assert [e.number for e in obj.vg.edges] == [1, 2, 3]
+    for edge, points in zip(obj.vg.edges, EDGES, strict=True):
+        profile = surface.measure_along(np.reshape(points, (2, 3)), 0.1, 0.2)
+        items = [item for item in obj.vg.measurements if item.edge_number == edge.number]
+        assert [exact(item)["angle"] for item in items] == profile.angles.tolist()
+        numbers = exact(edge)
+        image = bpy.data.images[edge.plot]
+        assert image.packed_file is not None and tuple(image.size) == (480, 240)
+        pixels = np.empty(480 * 240 * 4, dtype=np.float32)
+        image.pixels.foreach_get(pixels)
+        drawn = profile_plot.render_profile(
+            numbers["arc_lengths"], numbers["angles"], width=480, height=240, units="BU",
+            title=f"{obj.name}, edge {edge.number}", pooled=numbers["pooled_angle"],
+        )  # fmt: skip
+        want = (drawn[::-1].astype(np.float32) / 255.0).ravel()
+        assert np.abs(pixels - want).max() < 1.0 / 255.0
+
+
+def test_a_run_not_saved_still_writes_every_edges_plot_file(vg, tmp_path):
+    run(tmp_path)  # the plot kept in Blender is skipped; the run's own files are not
+    assert sorted(p.name for p in tmp_path.glob("out_w_edge*.png")) == [
+        f"out_w_edge{n}.png" for n in (1, 2, 3)
+    ]
