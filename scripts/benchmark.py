@@ -5,7 +5,8 @@ Python that has NumPy. Prints: spatial-index build for a 1M-vertex mesh, patch q
 measurement time for 1k/10k/100k-vertex patches, measurements per second on the 1M-vertex mesh,
 and WithinSS on 100k values; then the core's figures for a click on a 1M-vertex scan-like ridge
 (Surface build with int64 and int32 triangles, winding, first and later geodesic measurement,
-Euclidean measurement of a 2,000-vertex patch).
+Euclidean measurement of a 2,000-vertex patch); Find Break Edges on a 1M-vertex bone shaft, and
+the batch profiling every edge it finds (``--case find_edges`` runs only these two).
 """
 
 from __future__ import annotations
@@ -51,6 +52,7 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     if args.case == "find_edges":
         find_edges_figures(args.vertices)
+        batch_find_edges_figures(args.vertices)
         return
 
     print(
@@ -102,6 +104,7 @@ def main(argv=None) -> None:
     blas_path_comparison(int(np.sqrt(args.vertices)))
     refinement_comparison(int(np.sqrt(args.vertices)))
     find_edges_figures(args.vertices)
+    batch_find_edges_figures(args.vertices)
 
 
 def find_edges_figures(vertices: int) -> None:
@@ -141,6 +144,52 @@ def find_edges_figures(vertices: int) -> None:
             _, peak = tracemalloc.get_traced_memory()
             tracemalloc.stop()
             print(f"peak memory allocated by the finder: {peak / 2**20:8.0f} MiB")
+
+
+def batch_find_edges_figures(vertices: int, spacing: float = 2.0, radius: float = 2.5) -> None:
+    """The batch end to end on the same bone shaft, written as a PLY file: ``vg_batch.py BONE
+    --find-edges --spacing 2 --radius 2.5`` (every edge found profiled, its rows, edges CSV and
+    plots written), its wall and CPU time, its peak memory (the process's largest resident
+    set) and the batch's own lines on the finder and the import. Needs a Python with bpy."""
+    import importlib.util
+    import os
+    import re
+    import subprocess
+    import tempfile
+
+    from vg_addon.formats import meshio
+    from vg_addon.synthetic_meshes import bone_fragment
+
+    if importlib.util.find_spec("bpy") is None:
+        print("\n(no batch figures: this Python has no bpy; run with .venv/bin/python)")
+        return
+    bone = bone_fragment(spacing=0.1 * np.sqrt(988_000 / vertices), roughness=0.02)
+    script = Path(__file__).resolve().parents[1] / "vg_batch.py"
+    with tempfile.TemporaryDirectory(prefix="vg-bench-batch-") as folder:
+        mesh = Path(folder) / "bone.ply"
+        meshio.write_ply(mesh, bone.points, bone.triangles)
+        command = [sys.executable, str(script), str(mesh), "--find-edges", "--spacing",
+                   f"{spacing:g}", "--radius", f"{radius:g}", "--out", str(Path(folder) / "o.csv")]  # fmt: skip
+        log_path = Path(folder) / "log.txt"
+        with open(log_path, "w") as log_file:
+            start = time.perf_counter()
+            process = subprocess.Popen(command, stdout=log_file, stderr=subprocess.STDOUT)
+            # wait4: this child's own resource use (its peak memory, not the benchmark's).
+            _, status, usage = os.wait4(process.pid, 0)
+            wall = time.perf_counter() - start
+        log = log_path.read_text(errors="replace")
+    if os.waitstatus_to_exitcode(status) != 0:
+        print(f"\nbatch --find-edges failed (exit {os.waitstatus_to_exitcode(status)}):\n{log}")
+        return
+    lines = [line for line in log.splitlines() if re.search(r"found \d+ break|mesh import", line)]
+    print(
+        f"\nbatch --find-edges --spacing {spacing:g} --radius {radius:g}, "
+        f"{len(bone.points):,} vertices: {wall:6.2f} s wall, "
+        f"{usage.ru_utime + usage.ru_stime:6.2f} s CPU, peak memory "
+        f"{usage.ru_maxrss / 1024:6.0f} MiB (largest resident set)"
+    )
+    for line in lines:
+        print(f"  {line.removeprefix('vg_batch: ')}")
 
 
 def refinement_comparison(side: int, rounds: int = 5) -> None:
