@@ -92,7 +92,7 @@ class Run:
             where = f"row {task.source_row}" if task.source_row else f"point {task.number}"
             self.say(
                 f"  flagged: {where} on {row.mesh_name!r}: {row.angle:.2f}° "
-                f"{stability_text(row.stability, row.stability_runs or 0, row.stability_refused or 0)}"
+                f"{stability_text(row.stability, *_counts(row))}"
                 f": {warning}"
             )
         if len(flagged) > 10:
@@ -294,6 +294,15 @@ class Run:
         return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
 
 
+def _counts(row) -> tuple[int, int, int]:
+    """A row's stability runs, refused runs and refused crease bands (0 where empty)."""
+    return (
+        row.stability_runs or 0,
+        row.stability_refused or 0,
+        row.stability_crease_refused or 0,
+    )
+
+
 def flagged_rows(rows: dict) -> list:
     """``(index, row, warning)`` of the measured rows whose stability figure flags them (see
     ``vg_addon.method.result.stability_warning``), in row order."""
@@ -301,9 +310,7 @@ def flagged_rows(rows: dict) -> list:
     for index, row in sorted(rows.items()):
         if row.error or row.stability is None:
             continue
-        warning = stability_warning(
-            row.stability, row.stability_runs or 0, row.stability_refused or 0
-        )
+        warning = stability_warning(row.stability, *_counts(row))
         if warning:
             flagged.append((index, row, warning))
     return flagged

@@ -53,7 +53,8 @@ def stability_flag(item) -> str:
     if not item.stability_warning:
         return ""
     parts = exact_numbers(item).get("stability") or {}
-    if stability_undetermined(int(parts.get("runs") or 0), int(parts.get("refused") or 0)):
+    counts = (int(parts.get(key) or 0) for key in ("runs", "refused", "crease_refused"))
+    if stability_undetermined(*counts):
         return "±?"  # the figure itself may be far too small: no number that looks steady
     return f"±{float(parts.get('spread', 0.0)):.0f}°"
 

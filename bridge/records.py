@@ -402,6 +402,8 @@ def measurement_row(
         stability_orientation=stability.get("orientation"),
         stability_runs=stability.get("runs"),
         stability_refused=stability.get("refused"),
+        stability_crease=stability.get("crease"),
+        stability_crease_refused=stability.get("crease_refused"),
         error="",
     )
 

@@ -51,6 +51,8 @@ OUR_EXTRA_COLUMNS = [
     "Stability Orientation",
     "Stability Runs",
     "Stability Refused",
+    "Stability Crease",
+    "Stability Crease Refused",
     "error",
 ]
 
@@ -99,6 +101,8 @@ def good_row(**changes) -> MeasurementRow:
         stability_orientation=0.0,
         stability_runs=21,
         stability_refused=1,
+        stability_crease=0.1,
+        stability_crease_refused=0,
         error="",
     )
     values.update(changes)

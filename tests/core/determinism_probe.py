@@ -50,6 +50,7 @@ def measurement_record(m) -> dict:
         s = m.stability
         entry["stability"] = _hex([s.spread, s.center, s.radius, s.lam, s.bootstrap])
         entry["stability_runs"] = [s.n_runs, s.n_failed]
+        entry["stability_crease"] = [float(s.crease).hex(), s.crease_refused]
     return entry
 
 

@@ -88,8 +88,8 @@ def test_parts_and_figure():
     surface = noisy_wedge(70, 0.004, seed=9)
     s = surface.measure([0.0, 0.0, 0.0], 0.45, stability=True).stability
     parts = (s.center, s.radius, s.lam, s.bootstrap, s.orientation)
-    assert s.spread == max(parts)
-    assert all(part >= 0 for part in parts)
+    assert s.spread == max(parts) + s.crease  # the crease part is a bias, added to the spread
+    assert all(part >= 0 for part in (*parts, s.crease)) and s.crease_refused == 0
     assert s.n_runs >= 2 + 5 + 3 and 0 <= s.n_failed <= s.n_runs
     assert s.text().startswith("± ") and s.text().endswith("°")
 

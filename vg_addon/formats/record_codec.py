@@ -45,6 +45,8 @@ def _stability(stability) -> dict:
         "orientation": float(stability.orientation),
         "runs": int(stability.n_runs),
         "refused": int(stability.n_failed),
+        "crease": float(stability.crease),
+        "crease_refused": int(stability.crease_refused),
     }
 
 

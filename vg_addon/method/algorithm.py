@@ -363,6 +363,7 @@ def _refine(points, normals, center, radius, fields, planes) -> None:
         n_plus=int(labels.sum()),
         n_minus=int((~labels).sum()),
         n_left_out=int((~used).sum()),
+        left_out=~used,
     )
 
 
@@ -494,6 +495,10 @@ def goniometer(
     labels = np.empty_like(fields["labels"])
     labels[order] = fields["labels"]
     fields["labels"] = labels
+    if fields.get("left_out") is not None:
+        left_out = np.empty_like(fields["left_out"])
+        left_out[order] = fields["left_out"]
+        fields["left_out"] = left_out
     return Measurement(
         **fields,
         indices=None,

@@ -36,53 +36,78 @@ UNDETERMINED_REFUSED = 0.1
 undetermined: the refused runs add nothing to it, so it may be far too small."""
 
 
-def stability_text(spread: float, runs: int = 0, refused: int = 0) -> str:
+def stability_text(spread: float, runs: int = 0, refused: int = 0, crease_refused: int = 0) -> str:
     """The stability figure as shown: ``"± 0.4°"`` (two decimals below 0.1°), or ``"± ?"`` when
     it is undetermined (see :func:`stability_undetermined`): a spread of the few runs that were
     not refused says nothing, and printed as a number it would vouch for the reading."""
-    if stability_undetermined(runs, refused):
+    if stability_undetermined(runs, refused, crease_refused):
         return "± ?"
     return f"± {spread:.2f}°" if spread < 0.1 else f"± {spread:.1f}°"
 
 
-def stability_undetermined(runs: int, refused: int) -> bool:
-    """Whether more than :data:`UNDETERMINED_REFUSED` of a figure's ``runs`` were ``refused``:
+def stability_undetermined(runs: int, refused: int, crease_refused: int = 0) -> bool:
+    """Whether more than :data:`UNDETERMINED_REFUSED` of a figure's ``runs`` were ``refused``,
+    or a band left out along the crease left a face without a plane (``crease_refused`` > 0):
     the figure is then undetermined (it may be far too small)."""
-    return runs > 0 and refused > UNDETERMINED_REFUSED * runs
+    return (runs > 0 and refused > UNDETERMINED_REFUSED * runs) or crease_refused > 0
 
 
-def stability_warning(spread: float, runs: int = 0, refused: int = 0) -> str:
+def stability_warning(
+    spread: float, runs: int = 0, refused: int = 0, crease_refused: int = 0
+) -> str:
     """Why a reading with this stability figure should not be trusted as it stands, or ``""``.
 
     The one rule every place that shows a reading uses (the list, the Selected Measurement
     panel, the operator's report, the batch's summary): unstable when the figure (``spread``,
     degrees) is more than :data:`UNSTABLE_DEGREES`; undetermined when more than
-    :data:`UNDETERMINED_REFUSED` of its ``runs`` perturbed measurements were ``refused``.
+    :data:`UNDETERMINED_REFUSED` of its ``runs`` perturbed measurements were ``refused``, or
+    when leaving out the vertices next to the crease left a face too few vertices to fit its
+    plane (``crease_refused`` bands).
     """
     reasons = []
     if spread > UNSTABLE_DEGREES:
         reasons.append(
             f"Unstable: the angle moves by up to {spread:.1f}° when the centre, radius or λ "
-            f"change slightly or the vertices are resampled (more than {UNSTABLE_DEGREES:g}°)."
+            "change slightly, the vertices are resampled or those next to the crease are left "
+            f"out (more than {UNSTABLE_DEGREES:g}°)."
         )
-    if stability_undetermined(runs, refused):
+    if runs > 0 and refused > UNDETERMINED_REFUSED * runs:
         reasons.append(
             f"Undetermined: {refused} of {runs} perturbed measurements were refused (more than "
             f"{UNDETERMINED_REFUSED:.0%}), so the ± figure may be far too small."
+        )
+    if crease_refused > 0:
+        reasons.append(
+            "Undetermined: without the vertices next to the crease a face keeps too few "
+            "vertices off it to fit its plane, so how far they tilt the reading is not known "
+            "and the ± figure may be far too small."
         )
     if not reasons:
         return ""
     return " ".join(reasons) + " Measure again on the edge, or with a larger radius."
 
 
+def _stored_counts(parts: dict) -> tuple[int, int, int]:
+    """``runs``, ``refused`` and ``crease_refused`` of a stored stability record (0 where absent:
+    records made before the crease part)."""
+    return tuple(int(parts.get(key) or 0) for key in ("runs", "refused", "crease_refused"))
+
+
+def stored_stability_text(parts: dict | None) -> str:
+    """:func:`stability_text` of a stored stability record (the JSON dict with ``spread``,
+    ``runs``, ``refused`` and ``crease_refused``); ``"not computed"`` for none."""
+    if not parts:
+        return "not computed"
+    return stability_text(float(parts["spread"]), *_stored_counts(parts))
+
+
 def stored_stability_warning(parts: dict | None) -> str:
     """:func:`stability_warning` of a stored stability record (the JSON dict with ``spread``,
-    ``runs`` and ``refused``, as a measurement record and the CSV keep it); ``""`` for none."""
+    ``runs``, ``refused`` and ``crease_refused``, as a measurement record and the CSV keep it);
+    ``""`` for none."""
     if not parts:
         return ""
-    return stability_warning(
-        float(parts.get("spread", 0.0)), int(parts.get("runs") or 0), int(parts.get("refused") or 0)
-    )
+    return stability_warning(float(parts.get("spread", 0.0)), *_stored_counts(parts))
 
 
 @dataclass(frozen=True)
@@ -90,13 +115,14 @@ class Stability:
     """How much a measurement's angle depends on where and how it was taken.
 
     Each part is the largest change of the angle, in degrees, under one kind of perturbation of
-    the measurement (the changes that make two drag measurements of one edge differ); ``spread``,
-    the figure shown as "± 0.4°", is the largest part.
+    the measurement (the changes that make two drag measurements of one edge differ, and the
+    vertices next to the crease left out); ``spread``, the figure shown as "± 0.4°", is the
+    largest of the first five parts plus :attr:`crease`.
 
     Attributes
     ----------
     spread : float
-        The largest of the parts below.
+        The largest of the parts below but :attr:`crease`, plus :attr:`crease`.
     center : float
         The centre moved to each vertex within two mean edge lengths of it.
     radius : float
@@ -114,6 +140,15 @@ class Stability:
     n_failed : int
         Of those, how many were refused (too few vertices, no edge, ...); they add nothing to
         the parts, so a large count means the figure is optimistic.
+    crease : float
+        The largest change of the angle when the vertices within one or two mesh spacings, or a
+        quarter or half of the radius, of the line where the planes meet are left out and the
+        planes fitted again (:mod:`~vg_addon.method.crease_band`): the tilt the vertices next to
+        the crease give both planes, which every perturbed run above shares. Added to the
+        largest of the other parts, not compared with them: it is a bias, they are spreads.
+    crease_refused : int
+        Bands whose refit was refused (a side kept too few vertices, or a line): the figure is
+        then undetermined.
     """
 
     spread: float
@@ -124,16 +159,18 @@ class Stability:
     orientation: float
     n_runs: int
     n_failed: int
+    crease: float = 0.0
+    crease_refused: int = 0
 
     def text(self) -> str:
         """The figure as shown: ``"± 0.4°"`` (two decimals below 0.1°), ``"± ?"`` when undetermined."""
-        return stability_text(self.spread, self.n_runs, self.n_failed)
+        return stability_text(self.spread, self.n_runs, self.n_failed, self.crease_refused)
 
     @property
     def warning(self) -> str:
         """Why the reading is flagged (unstable, or the figure undetermined), or ``""``: see
         :func:`stability_warning`."""
-        return stability_warning(self.spread, self.n_runs, self.n_failed)
+        return stability_warning(self.spread, self.n_runs, self.n_failed, self.crease_refused)
 
 
 @dataclass(frozen=True, eq=False)
@@ -205,6 +242,8 @@ class Measurement:
     n_left_out : int
         Under the refined rule: vertices next to the crease that lie on neither face and were
         left out of the plane fits (they keep their side in ``labels``). Usually 0.
+    left_out : ndarray of bool, shape (k,) or None
+        Which of them, aligned with ``labels`` (``None`` where none was left out).
     """
 
     angle: float
@@ -238,6 +277,7 @@ class Measurement:
     stability: Stability | None = None
     split_angle: float | None = None
     n_left_out: int = 0
+    left_out: np.ndarray | None = None
 
     @property
     def angle_meaning(self) -> str:

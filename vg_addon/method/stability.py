@@ -1,5 +1,6 @@
 """The stability figure: how much a measurement's angle moves under the changes of centre, radius
-and λ that make two drag measurements of one edge differ, and under a bootstrap of its vertices.
+and λ that make two drag measurements of one edge differ, and under a bootstrap of its vertices,
+plus how far it moves when the vertices next to the crease are left out (:mod:`.crease_band`).
 
 All perturbed measurements run at once on one pool of vertices (the ball that holds every
 perturbed patch; for the bootstrap, the patch itself): Algorithm 1 batched over the rows of a
@@ -14,6 +15,7 @@ import numpy as np
 
 from ..errors import GoniometerError
 from .algorithm import FLAT_TOLERANCE_DEG, MIN_SIDE_VERTICES
+from .crease_band import crease_change
 from .fixed_order import (
     acos_degrees_array,
     combine,
@@ -481,11 +483,16 @@ def estimate_stability(surface, m: Measurement) -> Stability:
     low, high = np.percentile(resampled[kept], [2.5, 97.5]) if kept.any() else (0.0, 0.0)
     parts["bootstrap"] = float(high - low) / 2.0
     parts["orientation"] = m.orientation_difference
+    # The runs above all keep the vertices next to the crease, and so share the tilt they give
+    # the planes: that bias is measured apart and added to the spread, not compared with it.
+    crease, crease_refused = crease_change(surface, m)
     return Stability(
-        spread=max(parts.values()),
+        spread=max(parts.values()) + crease,
         **parts,
         n_runs=int(center_ids.size + kept.size),
         n_failed=int((~measured).sum() + (~kept).sum()),
+        crease=crease,
+        crease_refused=crease_refused,
     )
 
 

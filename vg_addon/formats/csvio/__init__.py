@@ -31,6 +31,7 @@ from .edges import (
     write_edges_csv,
 )
 from .measurements import (
+    CREASE_COLUMNS,
     EXPORT_COLUMNS,
     LATER_COLUMNS,
     MESHLAB_COLUMNS,
@@ -75,6 +76,7 @@ from .text import (
 
 __all__ = [
     "COORDINATE_SPACES",
+    "CREASE_COLUMNS",
     "EDGE_COLUMNS",
     "EXPORT_COLUMNS",
     "LATER_COLUMNS",

@@ -97,6 +97,8 @@ SCHEMA = (
     ("stability_orientation", "float", ("Stability Orientation",)),
     ("stability_runs", "int", ("Stability Runs",)),
     ("stability_refused", "int", ("Stability Refused",)),
+    ("stability_crease", "float", ("Stability Crease",)),
+    ("stability_crease_refused", "int", ("Stability Crease Refused",)),
     ("error", "text", ("error",)),
 )
 
@@ -118,12 +120,25 @@ RULE_COLUMNS = (
 )
 
 
+#: Columns added with the stability figure's crease part (issue 19). Exports written before lack
+#: them; their figures read as they were (no crease part, none refused).
+CREASE_COLUMNS = ("Stability Crease", "Stability Crease Refused")
+
+
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
 EXPORT_COLUMNS = tuple(column for _, _, columns in SCHEMA for column in columns)
 
 
 #: Columns added after the first exports: a file without them still reads (their cells empty).
-LATER_COLUMNS = ("Precision", *RULE_COLUMNS, "Edge #", "Arc Length", "Spacing", "Coordinates")
+LATER_COLUMNS = (
+    "Precision",
+    *RULE_COLUMNS,
+    "Edge #",
+    "Arc Length",
+    "Spacing",
+    "Coordinates",
+    *CREASE_COLUMNS,
+)
 
 
 @dataclass
@@ -198,6 +213,11 @@ class MeasurementRow:
         1 to 3, the bootstrap's 95% half-width, and the other sign's reading where unclear.
     stability_runs, stability_refused : int or None
         Perturbed measurements tried, and how many of them were refused.
+    stability_crease : float or None
+        The crease part: the largest change of the angle with the vertices next to the crease
+        left out (included in ``stability``, added to the largest of the other parts).
+    stability_crease_refused : int or None
+        Bands along the crease whose refit was refused; more than 0 makes the figure undetermined.
     error : str
         Empty for a good row; why it failed otherwise.
     """
@@ -245,6 +265,8 @@ class MeasurementRow:
     stability_orientation: float | None = None
     stability_runs: int | None = None
     stability_refused: int | None = None
+    stability_crease: float | None = None
+    stability_crease_refused: int | None = None
     error: str = ""
 
 

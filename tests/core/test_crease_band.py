@@ -1,0 +1,108 @@
+"""The stability figure's crease part: a reading off by the strip of vertices that cuts the corner
+gets a figure at least as large as its error, or is undetermined with the reason. Oracle: the
+exact angle each wedge was built with."""
+
+import math
+
+import numpy as np
+import pytest
+
+from vg_addon import GoniometerError, Surface
+from vg_addon.method.crease_band import crease_change
+from vg_addon.method.result import stored_stability_text, stored_stability_warning
+from vg_addon.reference_shapes import stretched_wedge
+from vg_addon.synthetic_meshes import wedge
+
+
+def nearest_the_crease(points):
+    return points[np.argmin(np.linalg.norm(points, axis=1))]
+
+
+def covered(surface, center, exact, rule="refined"):
+    """The reading, its figure, and whether the figure covers its error (or is undetermined);
+    None where the measurement is refused."""
+    try:
+        m = surface.measure(center, 0.2, rule=rule, stability=True)
+    except GoniometerError:
+        return None
+    figure = m.stability
+    undetermined = figure.text() == "± ?"
+    return m, undetermined or abs(m.angle - exact) <= figure.spread
+
+
+@pytest.mark.parametrize("angle", [30, 90, 150])
+def test_nothing_moves_on_a_crease_through_a_row_of_vertices(angle):
+    """Every vertex on its face: leaving any out moves nothing, and the figure is as before."""
+    mesh = wedge(angle, n=50, irregular=True, seed=angle)
+    surface = Surface(mesh.points, mesh.triangles)
+    m = surface.measure([0.02, 0.01, 0.0], 0.5, stability=True)
+    s = m.stability
+    assert s.crease < 1e-9 and s.crease_refused == 0
+    assert s.spread == pytest.approx(max(s.center, s.radius, s.lam, s.bootstrap, s.orientation))
+    assert abs(m.angle - angle) < 1e-6
+
+
+@pytest.mark.parametrize("spacing", [0.009, 0.013])
+@pytest.mark.parametrize("angle", [60, 120, 150, 165])
+def test_algorithm_1_readings_off_by_the_strip_are_covered(angle, spacing):
+    """The oriented rule keeps the strip that cuts the corner (0.1° to 2° off on these grids,
+    which the figure was not tuned on); its perturbed runs all share that tilt, the crease part
+    does not."""
+    points, triangles = stretched_wedge(angle, spacing)
+    surface = Surface(points, triangles)
+    m, ok = covered(surface, nearest_the_crease(points), angle, rule="oriented")
+    assert ok, (m.angle - angle, m.stability)
+    assert m.stability.crease > 0.5 * abs(m.angle - angle)  # the part that covers it
+
+
+# The readings issue 19 named (METHOD.md "What it does not fix"), and the same wedges with other
+# seeds: each is right, refused, or shows a figure at least as large as its error.
+NAMED = [(172, 0.0106, 0.0), (170, 0.0106, 0.01), (175, 0.0106, 0.01), (165, 0.02, 0.01)]
+
+
+@pytest.mark.parametrize(("angle", "spacing", "jitter"), NAMED)
+@pytest.mark.parametrize("seed", [7, 8])
+def test_near_flat_creases_on_coarse_grids_are_covered_or_undetermined(
+    angle, spacing, jitter, seed
+):
+    points, triangles = stretched_wedge(angle, spacing)
+    rng = np.random.default_rng(seed)
+    noisy = points + rng.normal(scale=jitter * spacing, size=points.shape)
+    result = covered(Surface(noisy, triangles), nearest_the_crease(points), angle)
+    if result is not None:
+        m, ok = result
+        assert ok, (m.angle - angle, m.stability)
+
+
+def test_a_face_left_without_vertices_beyond_the_band_makes_the_figure_undetermined():
+    """A near-flat valley on a coarse grid: each side is two rows, which always fit a plane
+    exactly, so the figure's other parts are 0; without the row beside the crease a side is one
+    row, and the figure says it cannot tell."""
+    angle = 174.0
+    flat, triangles = stretched_wedge(90.0, 0.0125)
+    points = flat.copy()
+    points[:, 1] *= math.tan(math.radians(angle) / 2.0)
+    surface = Surface(points, triangles[:, ::-1])
+    m = surface.measure(nearest_the_crease(points), 0.2, stability=True)
+    s = m.stability
+    assert s.crease_refused > 0 and s.text() == "± ?"
+    assert "without the vertices next to the crease a face keeps too few" in s.warning
+    # The stored record (the list, the panel, the CSV) says the same.
+    stored = {"spread": s.spread, "runs": s.n_runs, "refused": s.n_failed}
+    assert stored_stability_text(stored) != "± ?"  # a record made before the crease part
+    stored["crease_refused"] = s.crease_refused
+    assert stored_stability_text(stored) == "± ?"
+    assert stored_stability_warning(stored) == s.warning
+
+
+def test_the_crease_part_is_reproducible_and_added_to_the_spread():
+    points, triangles = stretched_wedge(150.0, 0.011)
+    rng = np.random.default_rng(3)
+    surface = Surface(points + rng.normal(scale=1e-4, size=points.shape), triangles)
+    m = surface.measure(nearest_the_crease(points), 0.2, rule="oriented", stability=True)
+    s = m.stability
+    others = max(s.center, s.radius, s.lam, s.bootstrap, s.orientation)
+    assert s.spread == others + s.crease and s.crease > 0
+    assert crease_change(surface, m) == (s.crease, s.crease_refused)
+    again = surface.measure(nearest_the_crease(points), 0.2, rule="oriented", stability=True)
+    assert again.stability == s

@@ -1,0 +1,123 @@
+"""The stability figure's crease part: how far the reading moves when the vertices next to the
+crease are left out of the plane fits.
+
+Every perturbed run of the figure (centre, radius, λ, bootstrap) keeps the vertices next to the
+crease, so where the mesh's triangles cut the corner all of them share the tilt those vertices
+give the planes: their spread stays small while the reading is off. Leaving out a band along the
+line where the two planes meet and fitting each side's plane again to what is left measures that
+tilt: on faces that are planes, with every vertex on its face, nothing moves; where the vertices
+next to the crease lie off the faces, the reading moves towards the faces' own angle. Each band
+is two plane fits on the patch, in a fixed order (:mod:`.fixed_order`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .algorithm import MIN_SIDE_VERTICES
+from .fixed_order import acos_degrees, dot3, eigh3, moments, norm3, row_dot, rows_dot, solve
+from .refinement import mean_edge_length
+
+BAND_SPACINGS = (1.0, 2.0)
+"""Bands of this many mesh spacings either side of the crease line: the vertices of the
+triangles that cut the corner, and of the ring beside them."""
+
+BAND_RADII = (0.25, 0.5)
+"""Bands of this share of the radius either side of the crease line: on a mesh whose rows lie
+far apart across the crease (a near-flat edge on a coarse or stretched mesh) the strip off the
+faces is wider than two mesh spacings, and only the far part of each face is on it."""
+
+MIN_REACH = 1.0
+"""What is left of a side must reach this many mesh spacings across the crease (from its vertex
+nearest the crease line to its farthest): else it is one row of vertices, which any plane through
+it fits, noise or none."""
+
+_RANK_TOLERANCE = 1e-10  # as Algorithm 1's test for a side on a line
+
+
+def _plane_normal(points, normals) -> np.ndarray | None:
+    """The PCA plane's unit normal, oriented by the side's mean normal; ``None`` where the side
+    has too few vertices or they lie on a line."""
+    count = points.shape[0]
+    if count < MIN_SIDE_VERTICES:
+        return None
+    centroid = np.add.reduce(points, axis=0) / count
+    values, vectors = eigh3(moments(points - centroid) / count)
+    if not values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny):
+        return None
+    normal = vectors[:, 0]
+    return -normal if dot3(normal, np.add.reduce(normals, axis=0)) < 0 else normal
+
+
+def _distance_to_crease(points, sides, normal_plus, normal_minus) -> np.ndarray | None:
+    """Each point's distance to the line where the two planes meet (each plane through its
+    side's centroid); ``None`` where the planes do not meet in a line."""
+    direction = np.cross(normal_plus, normal_minus)
+    length = norm3(direction)
+    if length <= 1e-12:
+        return None
+    direction = direction / length
+    offsets = [
+        dot3(normal, np.add.reduce(points[side], axis=0) / int(side.sum()))
+        for normal, side in zip((normal_plus, normal_minus), sides, strict=True)
+    ]
+    # The line's point nearest the centre (the origin of ``points``).
+    on_line = solve(np.array([normal_plus, normal_minus, direction]), [*offsets, 0.0])
+    if on_line is None:
+        return None
+    relative = points - np.array(on_line)
+    along = row_dot(relative, direction)
+    return np.sqrt(np.maximum(rows_dot(relative, relative) - along * along, 0.0))
+
+
+def _reaches(to_line, spacing) -> bool:
+    """Whether a side's vertices (their distances to the crease line) reach across it by
+    :data:`MIN_REACH` mesh spacings."""
+    return to_line.size > 0 and float(to_line.max() - to_line.min()) >= MIN_REACH * spacing
+
+
+def crease_change(surface, m) -> tuple[float, int]:
+    """The crease part of a measurement's stability figure.
+
+    Parameters
+    ----------
+    surface, m : Surface, Measurement
+        A measurement taken by ``surface.measure`` (it holds the patch's ``indices``).
+
+    Returns
+    -------
+    change : float
+        The largest change of the angle, in degrees, when the vertices within each band of
+        :data:`BAND_SPACINGS` mesh spacings and :data:`BAND_RADII` radii of the crease line are
+        left out and each side's plane is fitted again to the rest. Also where the planes fit
+        their vertices exactly: two rows of vertices always fit a plane, on the face or not.
+    refused : int
+        How many bands left a side too few vertices, a line, or a band narrower than
+        :data:`MIN_REACH` to fit its plane: then how far the vertices next to the crease tilt the
+        reading is not known.
+    """
+    spacing = mean_edge_length(m.radius, m.n_vertices)
+    points = surface.points[m.indices] - m.center
+    normals = surface.normals[m.indices]
+    used = np.ones(m.n_vertices, dtype=bool) if m.left_out is None else ~m.left_out
+    sides = (m.labels & used, ~m.labels & used)
+    widths = [k * spacing for k in BAND_SPACINGS] + [k * m.radius for k in BAND_RADII]
+    to_line = _distance_to_crease(points, sides, m.normal_plus, m.normal_minus)
+    if to_line is None:
+        return 0.0, len(widths)
+    change, refused = 0.0, 0
+    for width in widths:
+        kept = [side & (to_line > width) for side in sides]
+        fitted = [
+            _plane_normal(points[side], normals[side]) if _reaches(to_line[side], spacing) else None
+            for side in kept
+        ]
+        if fitted[0] is None or fitted[1] is None:
+            refused += 1
+            continue
+        angle = 180.0 - acos_degrees(dot3(fitted[0], fitted[1]))
+        change = max(change, abs(angle - m.angle))
+    return change, refused
+
+
+__all__ = ["BAND_RADII", "BAND_SPACINGS", "MIN_REACH", "crease_change"]
