@@ -60,6 +60,8 @@ class Run:
         self.stream = files.output_target(args.out) == "stream"
         self.failed_outputs: list[str] = []  # .blend or pictures that could not be written
         self.write_error = ""  # why the last write of the CSV failed ("" if it did not)
+        # Each row's CSV line, formatted once: every rewrite of the growing CSV reuses them.
+        self.csv_lines: dict = {}
         for task in tasks:
             if task.mesh < 0:
                 self.rows[task.index] = error_row(task, task.mesh_name, task.error, self.units)
@@ -203,7 +205,7 @@ class Run:
         out = self.args.out if out is None else out
         start = time.perf_counter()
         rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
-        csvio.write_measurements_csv(out, rows)
+        csvio.write_measurements_csv(out, rows, lines=self.csv_lines)
         if any(getattr(self.args, name, None) for name in ("edge", "edges_csv", "find_edges")):
             csvio.write_edges_csv(csvio.edges_path_for(out), self.edge_rows)
         self.last_write = time.perf_counter()

@@ -359,7 +359,7 @@ def writable_row(row):
     return dataclasses.replace(row, **changes)
 
 
-def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
+def format_measurements_csv(rows: Iterable[MeasurementRow], *, lines: dict | None = None) -> str:
     """The text of an export: the :data:`EXPORT_COLUMNS` header and one line per row.
 
     Floats are written with ``repr`` (so they read back bit-identical), integers as integers,
@@ -367,18 +367,32 @@ def format_measurements_csv(rows: Iterable[MeasurementRow]) -> str:
     ``= + - @``, a tab, a carriage return or an apostrophe gets a leading apostrophe, so no
     spreadsheet runs it as a formula (the readers remove it again).
 
+    ``lines``: a dict kept between calls by a writer that rewrites a growing file (the batch):
+    it remembers each row's line (rows are matched by identity, and kept in it; a row is not
+    changed once written), so each call formats only the rows it has not seen.
+
     Raises
     ------
     GoniometerError
         A value that cannot be written: a non-finite or non-numeric float, a fractional count,
         a vector without three numbers.
     """
-    lines = [csv_line(EXPORT_COLUMNS)]
-    lines.extend(csv_line(row_cells(index, row, SCHEMA)) for index, row in enumerate(rows))
-    return "".join(lines)
+    text = [csv_line(EXPORT_COLUMNS)]
+    for index, row in enumerate(rows):
+        known = None if lines is None else lines.get(id(row))
+        if known is not None and known[0] is row:
+            text.append(known[1])
+            continue
+        line = csv_line(row_cells(index, row, SCHEMA))
+        if lines is not None:
+            lines[id(row)] = (row, line)  # the row kept: its id is not reused while here
+        text.append(line)
+    return "".join(text)
 
 
-def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
+def write_measurements_csv(
+    path, rows: Iterable[MeasurementRow], *, lines: dict | None = None
+) -> None:
     """Write an export to ``path`` (UTF-8, comma-delimited, ``\\n`` line ends).
 
     The whole text is formatted first (see :func:`format_measurements_csv`). A regular file is
@@ -398,7 +412,7 @@ def write_measurements_csv(path, rows: Iterable[MeasurementRow]) -> None:
     OSError
         Other file-system errors (disk full, no permission to create the file, ...).
     """
-    data = format_measurements_csv(rows).encode("utf-8")
+    data = format_measurements_csv(rows, lines=lines).encode("utf-8")
     replace_atomically(path, data)
 
 
