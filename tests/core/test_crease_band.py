@@ -106,3 +106,23 @@ def test_the_crease_part_is_reproducible_and_added_to_the_spread():
     assert crease_change(surface, m) == (s.crease, s.crease_refused)
     again = surface.measure(nearest_the_crease(points), 0.2, rule="oriented", stability=True)
     assert again.stability == s
+
+
+def test_the_crease_columns_round_trip_and_older_exports_still_read():
+    from csv_rows import cells, good_row
+
+    from vg_addon.formats import csvio
+    from vg_addon.method.result import stability_text
+
+    row = good_row(stability=2.5, stability_crease=1.25, stability_crease_refused=2)
+    (back,) = csvio.read_measurements_csv(csvio.format_measurements_csv([row]))
+    assert (back.stability_crease, back.stability_crease_refused) == (1.25, 2)
+    counts = (back.stability_runs, back.stability_refused, back.stability_crease_refused)
+    assert stability_text(back.stability, *counts) == "± ?"
+    # An export written before the crease part: its figure reads as it was written.
+    written = cells(csvio.format_measurements_csv([good_row()]))
+    keep = [i for i, c in enumerate(written[0]) if c not in csvio.CREASE_COLUMNS]
+    text = "\n".join(",".join(f'"{line[i]}"' for i in keep) for line in written) + "\n"
+    (old,) = csvio.read_measurements_csv(text)
+    assert old.stability_crease is None and old.stability_crease_refused is None
+    assert old.stability == good_row().stability
