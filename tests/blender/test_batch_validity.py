@@ -114,7 +114,6 @@ def test_the_summary_flags_unstable_readings_in_the_words_of_the_list(tmp_path):
     assert rows[0].stability < 5.0 < rows[1].stability
     flagged = [line for line in run.stderr.splitlines() if "flagged:" in line]
     assert "1 flagged reading(s)" in run.stderr and len(flagged) == 1, run.stderr
-    assert (
-        f"{rows[1].angle:.2f}° ± {rows[1].stability:.1f}°: Unstable: the angle moves"
-        in (flagged[0])
-    )
+    # Off the crease the patch holds barely a row of one face: unstable, and undetermined too.
+    assert f"{rows[1].angle:.2f}° ± ?: Unstable: the angle moves" in flagged[0]
+    assert "Undetermined: without the vertices next to the crease" in flagged[0]
