@@ -266,7 +266,8 @@ class MapJob:
     def _layout(self, look, up, focus=None, zoom=None) -> list:
         """The labels a view looking along ``look`` draws: ``(label index, side)`` of each one
         whose centre it sees, on the picture, and that has room there; ``focus`` (a label
-        index) first, then the selected measurement, then the newest."""
+        index) first, then the selected measurement, then all but the inner stations of edges,
+        then the newest."""
         right, up, back, centre, _front, scale = self._frame(look, up, zoom)
         width, height = self.size
         pixel = scale / width
@@ -282,8 +283,13 @@ class MapJob:
         if not shown:
             return []
         total = len(shown)
+        # Focus, then the selected measurement, then any but an edge's inner stations (which
+        # get no view of their own), then the newest.
         priority = [
-            (2 * total if i == focus else total if self.labels[i].active else 0) + rank
+            4 * total * (i == focus)
+            + 2 * total * self.labels[i].active
+            + total * (i not in self._inner)
+            + rank
             for rank, i in enumerate(shown)
         ]
         widths = [GLYPH_EM * len(self.labels[i].text) * text_px for i in shown]
