@@ -16,7 +16,7 @@ import numpy as np
 
 from .algorithm import MIN_SIDE_VERTICES
 from .fixed_order import acos_degrees, dot3, eigh3, moments, norm3, row_dot, rows_dot, solve
-from .refinement import NOISE_FLOOR, mean_edge_length
+from .refinement import mean_edge_length
 
 BAND_SPACINGS = (1.0, 2.0)
 """Bands of this many mesh spacings either side of the crease line: the vertices of the
@@ -89,10 +89,9 @@ def crease_change(surface, m) -> tuple[float, int]:
     change : float
         The largest change of the angle, in degrees, when the vertices within each band of
         :data:`BAND_SPACINGS` mesh spacings and :data:`BAND_RADII` radii of the crease line are
-        left out and each side's plane is fitted again to the rest. Where the planes fit their
-        vertices exactly, only the narrowest band is tried: it cannot move the reading, but two
-        rows of vertices always fit a plane exactly, on the face or not, and without the row
-        beside the crease such a side is one row.
+        left out and each side's plane is fitted again to the rest (no band wider than the
+        widest of :data:`BAND_RADII`). Also where the planes fit their vertices exactly: two rows
+        of vertices always fit a plane, on the face or not.
     refused : int
         How many bands left a side too few vertices, a line, or a band narrower than
         :data:`MIN_REACH` to fit its plane: then how far the vertices next to the crease tilt the
@@ -103,11 +102,9 @@ def crease_change(surface, m) -> tuple[float, int]:
     normals = surface.normals[m.indices]
     used = np.ones(m.n_vertices, dtype=bool) if m.left_out is None else ~m.left_out
     sides = (m.labels & used, ~m.labels & used)
-    widths = [k * spacing for k in BAND_SPACINGS] + [k * m.radius for k in BAND_RADII]
-    if m.fit_error <= (NOISE_FLOOR * spacing) ** 2:
-        # Every vertex lies on its side's plane: any part of a side that spans a plane spans that
-        # one, so the narrowest band tells all (it only asks whether what is left is a plane).
-        widths = widths[:1]
+    # On a patch of few vertices two spacings can be more than half the radius: no band is wider.
+    widest = max(BAND_RADII) * m.radius
+    widths = [min(k * spacing, widest) for k in BAND_SPACINGS] + [k * m.radius for k in BAND_RADII]
     to_line = _distance_to_crease(points, sides, m.normal_plus, m.normal_minus)
     if to_line is None:
         return 0.0, len(widths)
