@@ -12,6 +12,7 @@ the batch profiling every edge it finds (``--case find_edges`` runs only these t
 from __future__ import annotations
 
 import argparse
+import importlib
 import platform
 import sys
 import time
@@ -109,8 +110,10 @@ def main(argv=None) -> None:
 
 def find_edges_figures(vertices: int) -> None:
     """Find Break Edges on a scan-sized bone shaft (mm, rough surface): the time from the call to
-    the candidates (the ridge graph built inside it, as on a first click), each step's share,
-    and the peak memory the finder allocates (tracemalloc, in a second run)."""
+    the candidates (the ridge graph built inside it, as on a first click), the number of steps
+    and the longest (what Esc waits for in Blender), the peak memory the finder allocates
+    (tracemalloc, in a second run), and the finder before and after it was sped up, side by
+    side."""
     import tracemalloc
 
     from vg_addon.method.break_edges import BreakEdgeFinder
@@ -132,9 +135,10 @@ def find_edges_figures(vertices: int) -> None:
             last = now
         total = time.perf_counter() - start
         if run == "time":
-            steps = ", ".join(f"to {p:.2f}: {t:.2f} s" for p, t in shares if t >= 0.05)
+            longest = max(shares, key=lambda share: share[1])
             print(
-                f"call to candidates: {total:8.2f} s ({len(finder.result.candidates)} found; {steps})"
+                f"call to candidates: {total:8.2f} s ({len(finder.result.candidates)} found) in "
+                f"{len(shares)} steps, the longest {longest[1]:.2f} s (to {longest[0]:.2f})"
             )
             start = time.perf_counter()
             BreakEdgeFinder(surface).run()  # the ridge graph is kept with the surface
@@ -144,6 +148,47 @@ def find_edges_figures(vertices: int) -> None:
             _, peak = tracemalloc.get_traced_memory()
             tracemalloc.stop()
             print(f"peak memory allocated by the finder: {peak / 2**20:8.0f} MiB")
+    find_edges_before_after(bone)
+
+
+FIND_EDGES_BEFORE = "ec2841d"
+"""The last commit before the finder's ridge graph was built from packed sorts and its long
+phases were split into steps."""
+
+
+def find_edges_before_after(bone, rounds: int = 2) -> None:
+    """The finder of :data:`FIND_EDGES_BEFORE` and today's on the same bone, interleaved round by
+    round (best of ``rounds``): wall and CPU time from the call to the candidates, the steps
+    and the longest step."""
+    from vg_addon.method.break_edges import BreakEdgeFinder
+
+    loaded = _core_at(FIND_EDGES_BEFORE, "vg_addon_find_before")
+    if loaded is None:
+        return
+    before = importlib.import_module("vg_addon_find_before.method.break_edges").BreakEdgeFinder
+    cores = {"today": (Surface, BreakEdgeFinder), FIND_EDGES_BEFORE: (loaded.Surface, before)}
+    best = {}
+    for _ in range(rounds):
+        for name, (surface_type, finder_type) in cores.items():
+            finder = finder_type(surface_type(bone.points, bone.triangles))
+            wall, cpu = time.perf_counter(), time.process_time()
+            last, longest, count = wall, 0.0, 0
+            for _ in finder.steps():
+                now = time.perf_counter()
+                longest, last, count = max(longest, now - last), now, count + 1
+            figures = (time.perf_counter() - wall, time.process_time() - cpu, longest, count)
+            best[name] = tuple(map(min, zip(best.get(name, figures), figures, strict=True)))
+    print(f"find break edges before ({FIND_EDGES_BEFORE}) and today, best of {rounds}:")
+    for name, (wall, cpu, longest, count) in best.items():
+        print(
+            f"  {name:8s} call to candidates {wall:6.2f} s wall, {cpu:6.2f} s CPU; "
+            f"{count:4d} steps, the longest {longest:5.2f} s"
+        )
+    (new_wall, new_cpu, new_longest, _), (old_wall, old_cpu, old_longest, _) = best.values()
+    print(
+        f"  ratios today/before: wall {new_wall / old_wall:5.2f}, CPU {new_cpu / old_cpu:5.2f}, "
+        f"longest step {new_longest / old_longest:5.2f}"
+    )
 
 
 def batch_find_edges_figures(vertices: int, spacing: float = 2.0, radius: float = 2.5) -> None:
@@ -274,29 +319,35 @@ BLAS_COMMIT = "97179f7"
 
 
 def _blas_core():
-    """The core as it was at :data:`BLAS_COMMIT`, imported under another name from ``git archive``
-    (None, with the reason printed, where git or that commit is not available)."""
-    import importlib
+    """The core as it was at :data:`BLAS_COMMIT` (None, with the reason printed, where git or
+    that commit is not available), and its stability module."""
+    core = _core_at(BLAS_COMMIT, "vg_addon_blas")
+    if core is None:
+        return None
+    return core, importlib.import_module("vg_addon_blas.method.stability")
+
+
+def _core_at(commit: str, alias: str):
+    """The core as it was at ``commit``, imported as ``alias`` from ``git archive`` (None, with
+    the reason printed, where git or that commit is not available)."""
     import subprocess
     import tempfile
 
     root = Path(__file__).resolve().parents[1]
-    folder = Path(tempfile.mkdtemp(prefix="vg-blas-core-"))
+    folder = Path(tempfile.mkdtemp(prefix=f"{alias}-"))
     try:
         archive = subprocess.run(
-            ["git", "-C", str(root), "archive", BLAS_COMMIT, "vg_addon"],
+            ["git", "-C", str(root), "archive", commit, "vg_addon"],
             capture_output=True,
             check=True,
         ).stdout
         subprocess.run(["tar", "-x", "-C", str(folder)], input=archive, check=True)
     except (OSError, subprocess.CalledProcessError) as error:
-        print(f"(no BLAS-path comparison: git archive {BLAS_COMMIT} failed: {error})")
+        print(f"(no comparison with {commit}: git archive failed: {error})")
         return None
-    (folder / "vg_addon").rename(folder / "vg_addon_blas")
+    (folder / "vg_addon").rename(folder / alias)
     sys.path.insert(0, str(folder))
-    return importlib.import_module("vg_addon_blas"), importlib.import_module(
-        "vg_addon_blas.method.stability"
-    )
+    return importlib.import_module(alias)
 
 
 def blas_path_comparison(side: int, rounds: int = 5) -> None:

@@ -31,7 +31,8 @@ from .edge_pieces import (
     smooth_regions,
     trace_piece,
 )
-from .edge_profile import EdgePath, assemble_path, ridge_graph
+from .edge_profile import EdgePath, assemble_path, has_ridge_graph, ridge_graph
+from .mesh_edges import MeshEdges
 from .mesh_regions import flood_labels
 from .ridge_field import (
     anisotropy_of_bend,
@@ -42,6 +43,7 @@ from .ridge_field import (
     spread_of,
     vertex_moments,
 )
+from .stepping import STEP
 
 SCALE_EDGES = 5.0
 """Default ``scale``: this many mean edge lengths."""
@@ -286,6 +288,19 @@ def region_kinds(region: np.ndarray, sums: np.ndarray, n_regions: int) -> np.nda
     return kinds
 
 
+def _phase(work, low: float, high: float):
+    """Run the stepwise ``work`` (see :mod:`.stepping`), yielding a progress that climbs from
+    ``low`` towards ``high`` with each of its steps; its result."""
+    progress = low
+    while True:
+        try:
+            next(work)
+        except StopIteration as done:
+            return done.value
+        progress += (high - progress) / 8.0
+        yield progress
+
+
 class BreakEdgeFinder:
     """Find break edges step by step (a modal operator steps it on a timer).
 
@@ -294,6 +309,10 @@ class BreakEdgeFinder:
     surface : Surface
         A triangle mesh.
     parameters : BreakEdgeParameters, optional
+    step : int, optional
+        Faces, vertices or edges worked through per step of the long phases (default
+        :data:`~.stepping.STEP`): smaller steps let a caller stop sooner, at some cost in time.
+        The result does not depend on it.
 
     Attributes
     ----------
@@ -301,9 +320,14 @@ class BreakEdgeFinder:
         Set once :meth:`steps` is exhausted.
     """
 
-    def __init__(self, surface, parameters: BreakEdgeParameters = BreakEdgeParameters()):
+    def __init__(
+        self, surface, parameters: BreakEdgeParameters = BreakEdgeParameters(), *, step: int = STEP
+    ):
         if not isinstance(parameters, BreakEdgeParameters):
             raise GoniometerError("The parameters must be a BreakEdgeParameters.")
+        if isinstance(step, bool) or not isinstance(step, (int, np.integer)) or step < 1:
+            raise GoniometerError(f"The finder's step must be a whole number ≥ 1; got {step!r}.")
+        self.step = int(step)
         self.surface = surface
         points = surface.points
         diagonal = math.hypot(*(points.max(axis=0) - points.min(axis=0))) if len(points) else None
@@ -313,14 +337,29 @@ class BreakEdgeFinder:
     def steps(self) -> Iterator[float]:
         """Do the work in chunks, yielding the progress (0 to 1) after each.
 
-        Stopping early leaves nothing changed: the surface is only read.
+        A chunk is a block of ``step`` faces, vertices or edges, a round of a
+        walk over the mesh, or one candidate traced, so a chunk takes a fraction of a second
+        even on a million vertices and more chunks come with a larger mesh; the result does
+        not depend on how the work is chunked. Stopping early leaves nothing changed: the
+        surface is only read (its ridge graph, once complete, is kept with it).
         """
         surface = self.surface
-        graph = ridge_graph(surface)  # raises for a point cloud
+        edges = None
+        if surface.triangles is not None and not has_ridge_graph(surface):
+            work = MeshEdges.stepwise(surface.points, surface.triangles, surface.valid, self.step)
+            edges = yield from _phase(work, 0.0, 0.1)
+        graph = ridge_graph(surface, edges)  # raises for a point cloud
+        del edges
         yield 0.1
         params = self.parameters.resolved(graph.mean_edge_length)
-        sums = vertex_moments(surface.points, surface.triangles, graph.starts, graph.target)
-        spread, total = cell_spread(surface.points, sums, params.scale, graph.starts, graph.target)
+        work = vertex_moments(
+            surface.points, surface.triangles, graph.starts, graph.target, block=self.step
+        )
+        sums = yield from _phase(work, 0.1, 0.2)
+        work = cell_spread(
+            surface.points, sums, params.scale, graph.starts, graph.target, block=self.step
+        )
+        spread, total = yield from _phase(work, 0.2, 0.3)
         yield 0.3
         degree = np.diff(graph.starts)
         used = surface.valid & (degree > 0)
@@ -333,13 +372,18 @@ class BreakEdgeFinder:
         band = used & ((spread >= floor) | (second >= corner_floor))
         del second
         ridge_min_deg = float(bend_of_anisotropy(np.array([floor]))[0])
-        region = smooth_regions(graph, used, band, sums[:, 0], params.min_region_area)
+        yield 0.32
+        work = smooth_regions(
+            graph, used, band, sums[:, 0], params.min_region_area, block=self.step
+        )
+        region = yield from _phase(work, 0.32, 0.45)
         yield 0.45
         # The fine field only where the flood goes (the band and the parts too small to be
         # regions). The flood rises by the bend at scale (where a broad bevel peaks), its steps
         # from cell to cell smoothed, plus the fine bend (where a sharp crease peaks).
         rows = np.flatnonzero(used & (region < 0))
         fine_spread, fine_total = ring_spread(sums, graph.starts, graph.target, FINE_RINGS, rows)
+        yield 0.5
         heights = blurred(total, graph.starts, graph.target, 2 * FINE_RINGS, rows) + fine_total
         flooded = flood_labels(graph.starts, graph.target, region, used, heights=heights)
         bend_field = np.maximum(spread, fine_spread)
@@ -355,7 +399,7 @@ class BreakEdgeFinder:
             candidate = self._candidate(graph, piece, bend_field, ridge_min_deg, params)
             if candidate is not None:
                 traced.append(candidate)
-            yield 0.7 + 0.3 * (k + 1) / len(pieces)
+            yield 0.7 + 0.25 * (k + 1) / len(pieces)
         traced.sort(key=lambda c: (-c.confidence, -c.length, int(c.path.vertices[0])))
         numbered = tuple(
             replace(c, number=k + 1) for k, c in enumerate(traced[: params.max_candidates])

@@ -15,8 +15,9 @@ import numpy as np
 from ..errors import GoniometerError
 from .edge_profile import EdgePath, assemble_path, trace_leg
 from .fixed_order import eigh3, moments, row_dot, rows_dot
-from .mesh_regions import connected_parts, dilate
+from .mesh_regions import connected_part_steps, connected_parts, dilate, sorted_unique
 from .ranges import expand_ranges
+from .stepping import STEP
 
 MIN_OFF_RUN = 3
 """A traced leg that leaves the crest for this many consecutive vertices gets a via point."""
@@ -25,7 +26,7 @@ MAX_VIA_DEPTH = 8
 """How many times a leg may be split by via points (at most ``2**depth`` legs per stretch)."""
 
 
-def smooth_regions(graph, used, band, areas, min_area) -> np.ndarray:
+def smooth_regions(graph, used, band, areas, min_area, block: int = STEP):
     """The smooth regions: the connected parts of the vertices off the band.
 
     Parameters
@@ -37,15 +38,21 @@ def smooth_regions(graph, used, band, areas, min_area) -> np.ndarray:
         Each vertex's share of the surface.
     min_area : float
         Smooth parts smaller than this are no region.
+    block : int, optional
+        Vertices per step.
 
     Returns
     -------
     ndarray of int64, shape (n,)
-        Region numbers (largest area first), -1 on the band and in small parts.
+        Region numbers (largest area first), -1 on the band and in small parts. Stepwise (see
+        :mod:`.stepping`): a generator that yields between chunks of work and returns them.
     """
     smooth = used & ~band
-    parts = connected_parts(graph.starts, graph.target, smooth)
-    roots, inverse = np.unique(parts[smooth], return_inverse=True)
+    parts = yield from connected_part_steps(graph.starts, graph.target, smooth, block)
+    # Each part is labelled by its least vertex, its root: parts numbered in the roots' order.
+    is_root = smooth & (parts == np.arange(smooth.size))
+    roots = np.flatnonzero(is_root)
+    inverse = (np.cumsum(is_root) - 1)[parts[smooth]]
     part_area = np.bincount(inverse, areas[smooth], minlength=roots.size)
     big = part_area >= min_area
     order = np.lexsort((roots, -part_area))  # largest first, ties by their least vertex
@@ -114,12 +121,12 @@ def ridge_pieces(graph, flooded, band, border, reach: int) -> list[Piece]:
     and the ridges inside one region (band more than ``reach`` rings from every such crest)."""
     n = flooded.size
     lookup = np.full(n, -1, dtype=np.int64)
-    sources = np.repeat(np.arange(n, dtype=np.int64), np.diff(graph.starts))
-    a, b = flooded[sources], flooded[graph.target]
+    a, b = np.repeat(flooded, np.diff(graph.starts)), flooded[graph.target]
     meet = (a >= 0) & (b >= 0) & (a != b)
+    sources = np.searchsorted(graph.starts, np.flatnonzero(meet), side="right") - 1
     n_regions = int(flooded.max()) + 1
     pair = np.minimum(a[meet], b[meet]) * n_regions + np.maximum(a[meet], b[meet])
-    keys = np.unique(pair * n + sources[meet])
+    keys = sorted_unique(pair * n + sources)
     pairs, vertices = keys // n, keys % n
     # A crest vertex that sees three labels (or none, past the mesh's valid part) is an end.
     crest = np.unique(vertices)

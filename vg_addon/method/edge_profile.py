@@ -36,7 +36,7 @@ from ..errors import GoniometerError, bounded_list
 from .algorithm import as_center, as_radius
 from .break_figures import break_figures, fragment_axis
 from .fixed_order import acos_degrees, dot3, eigh3, in_frame, moments, norm3
-from .normals import face_normals
+from .mesh_edges import MeshEdges
 from .ranges import expand_ranges
 from .result import Measurement
 
@@ -66,17 +66,6 @@ _extents: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _searches: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def stable_order(keys: np.ndarray) -> np.ndarray:
-    """``np.argsort(keys, kind="stable")`` for non-negative int64 keys, faster: where each key
-    and its position fit in one int64 together, an unstable sort of ``key * size + position``
-    (all distinct, so the order is the same) is several times quicker than the stable sort."""
-    size = keys.size
-    if size == 0 or int(keys.max()) >= (2**62) // max(size, 1):
-        return np.argsort(keys, kind="stable")
-    combined = keys * np.int64(size) + np.arange(size, dtype=np.int64)
-    return np.argsort(combined)
-
-
 class RidgeGraph:
     """The directed mesh edges of a surface in CSR form with their ridge costs.
 
@@ -99,59 +88,27 @@ class RidgeGraph:
     mean_edge_length : float
     """
 
-    def __init__(self, points: np.ndarray, triangles: np.ndarray, valid: np.ndarray):
-        n = points.shape[0]
-        first = triangles.ravel()
-        second = triangles[:, [1, 2, 0]].ravel()
-        keys = np.minimum(first, second) * np.int64(n) + np.maximum(first, second)
-        face = np.repeat(np.arange(triangles.shape[0], dtype=np.int64), 3)
-        keep = valid[first] & valid[second] & (first != second)
-        if not keep.all():
-            keys, face = keys[keep], face[keep]
-        order = stable_order(keys)
-        keys, face = keys[order], face[order]
-        is_first = np.ones(keys.size, dtype=bool)
-        is_first[1:] = keys[1:] != keys[:-1]
-        runs = np.flatnonzero(is_first)
-        counts = np.diff(np.append(runs, keys.size))
-        unique_keys = keys[runs]
-
-        normals = np.column_stack(face_normals(points, triangles))
-        norm = np.linalg.norm(normals, axis=1)
-        normals = np.divide(
-            normals, norm[:, None], out=np.zeros_like(normals), where=norm[:, None] > 0
-        )
+    def __init__(self, points: np.ndarray, triangles: np.ndarray, valid: np.ndarray, edges=None):
+        if edges is None:
+            edges = MeshEdges(points, triangles, valid)
         # An edge shared by two faces bends by the angle between their normals; boundary edges
         # (one face) and the extra faces of a non-manifold edge do not count.
-        shared = counts >= 2
-        bend = np.zeros(unique_keys.size)
-        f1 = face[runs[shared]]
-        f2 = face[runs[shared] + 1]
-        cosine = np.einsum("ij,ij->i", normals[f1], normals[f2])
-        bend[shared] = np.arccos(np.clip(cosine, -1.0, 1.0))
-
-        u, v = unique_keys // n, unique_keys % n
-        offsets = points[u] - points[v]
-        lengths = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
-        costs = lengths * (FLOOR + np.exp(-bend / BEND_SCALE))
-        source = np.concatenate([u, v])
-        order = stable_order(source)
-        edge = np.concatenate([np.arange(u.size), np.arange(u.size)])[order]
-        self.target = np.concatenate([v, u])[order]
-        self.costs = costs[edge]
-        self.starts = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(np.bincount(source, minlength=n), out=self.starts[1:])
-        self.vertex_bend = np.zeros(n)
-        np.maximum.at(self.vertex_bend, u, bend)
-        np.maximum.at(self.vertex_bend, v, bend)
+        bend, lengths = edges.bends, edges.lengths
+        self.starts, self.target = edges.starts, edges.target
+        self.costs = edges.both_ways(lengths * (FLOOR + np.exp(-bend / BEND_SCALE)))
+        self.vertex_bend = edges.vertex_maximum(bend)
         used = self.starts[1:] > self.starts[:-1]
         noise = float(np.median(self.vertex_bend[used])) if used.any() else 0.0
         self.ridge_min = max(np.radians(RIDGE_MIN_DEG), NOISE_FACTOR * noise)
         self.mean_edge_length = float(lengths.mean()) if lengths.size else 0.0
 
 
-def ridge_graph(surface) -> RidgeGraph:
-    """The :class:`RidgeGraph` of ``surface``, built on first use and kept with it."""
+def ridge_graph(surface, edges=None) -> RidgeGraph:
+    """The :class:`RidgeGraph` of ``surface``, built on first use and kept with it.
+
+    ``edges``: the surface's :class:`~.mesh_edges.MeshEdges`, where the caller has built them
+    already (the break-edge finder does, in steps); otherwise they are built here.
+    """
     graph = _graphs.get(surface)
     if graph is None:
         if surface.triangles is None:
@@ -159,11 +116,14 @@ def ridge_graph(surface) -> RidgeGraph:
                 "Tracing a break edge follows mesh edges, and this surface is a point cloud with "
                 "no faces: give the triangles, or measure the edge point by point."
             )
-        # int64: the edge keys below are products of two vertex indices.
-        triangles = surface.triangles.astype(np.int64, copy=False)
-        graph = RidgeGraph(surface.points, triangles, surface.valid)
+        graph = RidgeGraph(surface.points, surface.triangles, surface.valid, edges)
         _graphs[surface] = graph
     return graph
+
+
+def has_ridge_graph(surface) -> bool:
+    """Whether the :class:`RidgeGraph` of ``surface`` is built already."""
+    return surface in _graphs
 
 
 @dataclass(frozen=True, eq=False)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from .ranges import expand_ranges
+from .stepping import STEP, finish
 
 
 def _row_minimum(starts, target, values: np.ndarray, rows: np.ndarray, empty) -> np.ndarray:
@@ -38,12 +39,24 @@ def connected_parts(starts: np.ndarray, target: np.ndarray, mask: np.ndarray) ->
     ndarray of int64, shape (n,)
         For each vertex in ``mask`` the smallest vertex index of its part; -1 elsewhere.
     """
-    members = np.flatnonzero(mask)
-    counts = starts[members + 1] - starts[members]
-    sources = np.repeat(members, counts)
-    neighbours = target[expand_ranges(starts[members], counts)]
-    once = mask[neighbours] & (sources < neighbours)  # each edge once: hooking takes both ends
-    labels = edge_components(mask.size, sources[once], neighbours[once])
+    return finish(connected_part_steps(starts, target, mask))
+
+
+def connected_part_steps(starts, target, mask: np.ndarray, block: int = STEP):
+    """:func:`connected_parts` in steps (see :mod:`.stepping`): yields after each block of
+    ``block`` vertices and each round."""
+    ends = []
+    for first in range(0, mask.size, block):
+        members = np.flatnonzero(mask[first : first + block]) + first
+        counts = starts[members + 1] - starts[members]
+        sources = np.repeat(members, counts)
+        neighbours = target[expand_ranges(starts[members], counts)]
+        once = mask[neighbours] & (sources < neighbours)  # each edge once: hooking takes both
+        ends.append((sources[once], neighbours[once]))
+        yield
+    sources, neighbours = (np.concatenate(column) for column in zip(*ends, strict=True))
+    del ends
+    labels = yield from edge_component_steps(mask.size, sources, neighbours)
     labels[~mask] = -1
     return labels
 
@@ -56,6 +69,12 @@ def edge_components(n: int, sources: np.ndarray, targets: np.ndarray) -> np.ndar
     ``label[label]`` jumps ahead along chains of labels): rounds grow like the logarithm of a
     part's diameter on meshes whose vertices are numbered in any spatially coherent order.
     """
+    return finish(edge_component_steps(n, sources, targets))
+
+
+def edge_component_steps(n: int, sources: np.ndarray, targets: np.ndarray):
+    """:func:`edge_components` in steps (see :mod:`.stepping`): yields after each hooking and
+    each jumping, returns the labels."""
     label = np.arange(n, dtype=np.int64)
     touched = np.zeros(n, dtype=bool)
     touched[sources] = True
@@ -69,12 +88,18 @@ def edge_components(n: int, sources: np.ndarray, targets: np.ndarray) -> np.ndar
         np.minimum.at(label, label[targets], offered)
         np.minimum.at(label, sources, offered)
         np.minimum.at(label, targets, offered)
-        # Jump: follow labels to their root.
-        while True:
-            jumped = label[label[touched]]
-            if np.array_equal(jumped, label[touched]):
-                break
-            label[touched] = jumped
+        del offered
+        yield
+        # Jump: follow labels to their root. A vertex whose label names a root keeps it (roots
+        # do not move while jumping), so only the others are looked at again.
+        active = touched
+        while active.size:
+            current = label[active]
+            jumped = label[current]
+            moved = jumped != current
+            active = active[moved]
+            label[active] = jumped[moved]
+        yield
         if np.array_equal(before, label[touched]):
             return label
 
@@ -120,6 +145,15 @@ def flood_labels(
     return labels
 
 
+def sorted_unique(values: np.ndarray) -> np.ndarray:
+    """``np.unique(values)`` of an integer array by one sort (NumPy 2's hashing ``np.unique`` is
+    several times slower on millions of distinct values)."""
+    values = np.sort(values)
+    if values.size > 1:
+        values = values[np.concatenate(([True], values[1:] != values[:-1]))]
+    return values
+
+
 def dilate(starts: np.ndarray, target: np.ndarray, mask: np.ndarray, rings: int) -> np.ndarray:
     """``mask`` grown by ``rings`` rings of neighbours."""
     grown = mask.copy()
@@ -131,5 +165,5 @@ def dilate(starts: np.ndarray, target: np.ndarray, mask: np.ndarray, rings: int)
         reached = target[expand_ranges(starts[frontier], counts)]
         reached = reached[~grown[reached]]
         grown[reached] = True
-        frontier = np.unique(reached)
+        frontier = sorted_unique(reached)
     return grown

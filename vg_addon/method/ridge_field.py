@@ -23,11 +23,10 @@ import math
 import numpy as np
 
 from .fixed_order import rows_dot
-from .mesh_regions import dilate, edge_components
+from .mesh_regions import dilate, edge_component_steps, sorted_unique
 from .normals import face_normals
 from .ranges import expand_ranges
-
-_ROWS = 1 << 17  # vertices per block of the neighbourhood sums: the gathered rows stay small
+from .stepping import STEP
 
 _COLUMNS = 10  # area, area·n (3), area·n nᵀ (6: xx, yy, zz, xy, xz, yz)
 
@@ -53,7 +52,7 @@ def _moments(weight, nx, ny, nz) -> tuple:
     )
 
 
-def vertex_moments(points, triangles, starts, target, smoothing: int = 1) -> np.ndarray:
+def vertex_moments(points, triangles, starts, target, smoothing: int = 1, block: int = STEP):
     """Per vertex, its area (a third of its faces') and the moments of its *smoothed* normal
     (``(n, 10)``): what :func:`ring_spread` and :func:`cell_spread` pool.
 
@@ -61,30 +60,47 @@ def vertex_moments(points, triangles, starts, target, smoothing: int = 1) -> np.
     normal carries the scan's noise at full strength, and on a regular grid that noise is
     spread unevenly between directions (it would read as a crease); averaged over a ring or
     two it is a few times weaker, while a crease stays a crease.
+
+    Stepwise (see :mod:`.stepping`): yields between blocks of ``block`` faces or vertices and
+    returns the moments; the numbers do not depend on ``block``.
     """
-    nx, ny, nz = face_normals(points, triangles)
+    m, n = triangles.shape[0], points.shape[0]
+    nx, ny, nz = (np.empty(m) for _ in range(3))
+    for first in range(0, m, block):
+        rows = slice(first, first + block)
+        nx[rows], ny[rows], nz[rows] = face_normals(points, triangles[rows])
+        yield
     doubled = np.sqrt(nx * nx + ny * ny + nz * nz)
     corners = triangles.reshape(-1)
-    n = points.shape[0]
     # Face normals of length twice the area: their sum over a vertex's faces is area-weighted.
     normals = np.empty((n, 3))
     for column, values in enumerate((nx, ny, nz)):
         normals[:, column] = np.bincount(corners, np.repeat(values, 3), minlength=n)
+        yield
     area = np.bincount(corners, np.repeat(doubled, 3), minlength=n) / 6.0
+    del nx, ny, nz, doubled
+    yield
     for _ in range(smoothing):
-        normals = _pool(starts, target, normals)
-    length = np.sqrt(rows_dot(normals, normals))
-    normals /= np.where(length > 0, length, 1.0)[:, None]
-    area[length <= 0] = 0.0
-    return np.column_stack(_moments(area, normals[:, 0], normals[:, 1], normals[:, 2]))
+        normals = yield from _pool(starts, target, normals, block)
+    out = np.empty((n, _COLUMNS))
+    for first in range(0, n, block):
+        rows = slice(first, first + block)
+        part = normals[rows]
+        length = np.sqrt(rows_dot(part, part))
+        part /= np.where(length > 0, length, 1.0)[:, None]
+        weight = area[rows]
+        weight[length <= 0] = 0.0
+        out[rows] = np.column_stack(_moments(weight, part[:, 0], part[:, 1], part[:, 2]))
+        yield
+    return out
 
 
-def _pool(starts: np.ndarray, target: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Each vertex's values plus its neighbours' (one ring of pooling)."""
+def _pool(starts: np.ndarray, target: np.ndarray, values: np.ndarray, block: int):
+    """Each vertex's values plus its neighbours' (one ring of pooling), stepwise."""
     out = values.copy()
     n = values.shape[0]
-    for first in range(0, n, _ROWS):
-        last = min(n, first + _ROWS)
+    for first in range(0, n, block):
+        last = min(n, first + block)
         lo, hi = int(starts[first]), int(starts[last])
         if hi == lo:
             continue
@@ -93,6 +109,7 @@ def _pool(starts: np.ndarray, target: np.ndarray, values: np.ndarray) -> np.ndar
         nonempty = starts[first + 1 : last + 1] > starts[first:last]
         sums = np.add.reduceat(gathered, rows[nonempty], axis=0)
         out[first:last][nonempty] += sums
+        yield
     return out
 
 
@@ -162,10 +179,13 @@ def ring_spread(sums: np.ndarray, starts, target, rings: int, rows: np.ndarray):
         the module's text) and the trace ``λ1 + λ2 + λ3`` (large on creases and corners alike:
         where three faces meet, ``λ1 ≈ λ2``); in [0, 1], 0 for a vertex with no faces.
     """
-    return spread_of(pooled_at(starts, target, sums, rings, rows))
+    pooled = pooled_at(starts, target, sums, rings, rows)[rows]
+    crease, total = np.zeros(sums.shape[0]), np.zeros(sums.shape[0])
+    crease[rows], total[rows] = spread_of(pooled)  # row by row: the same as on every vertex
+    return crease, total
 
 
-def cell_spread(points, sums, scale: float, starts, target):
+def cell_spread(points, sums, scale: float, starts, target, block: int = STEP):
     """The spread of the normals over a patch about ``1.5 * scale`` wide around each vertex.
 
     The mesh is cut into *cells*: the connected pieces of the surface inside each cube of a grid
@@ -175,23 +195,52 @@ def cell_spread(points, sums, scale: float, starts, target):
     does not grow with, and which never reaches through a thin part to its other side. Every
     vertex of a cell reads the same value.
 
-    Returns ``(crease, total)`` as :func:`ring_spread` does; ``sums`` is :func:`vertex_moments`.
+    Stepwise (see :mod:`.stepping`): yields between chunks of work (blocks of ``block``
+    vertices, rounds) and returns ``(crease, total)`` as :func:`ring_spread` does; ``sums`` is
+    :func:`vertex_moments`.
     """
     n = points.shape[0]
     cells = np.floor((points - points.min(axis=0)) / (scale / 2.0)).astype(np.int64)
     dims = cells.max(axis=0) + 1
     cube = (cells[:, 0] * dims[1] + cells[:, 1]) * dims[2] + cells[:, 2]
-    sources = np.repeat(np.arange(n, dtype=np.int64), np.diff(starts))
-    inside = cube[sources] == cube[target]
-    once = inside & (sources < target)  # each edge once: the hooking takes both ends
-    cell = edge_components(n, sources[once], target[once])
-    _, cell = np.unique(cell, return_inverse=True)
+    del cells
+    degree = np.diff(starts)
+    inside = np.empty(target.size, dtype=bool)  # both ends in one cube
+    ends = []
+    for first in range(0, n, block):
+        last = min(n, first + block)
+        lo, hi = int(starts[first]), int(starts[last])
+        sources = np.repeat(np.arange(first, last, dtype=np.int64), degree[first:last])
+        targets = target[lo:hi]
+        inside[lo:hi] = cube[sources] == cube[targets]
+        once = inside[lo:hi] & (sources < targets)  # each edge once: the hooking takes both
+        ends.append((sources[once], targets[once]))
+        yield
+    del cube
+    sources, targets = (np.concatenate(column) for column in zip(*ends, strict=True))
+    del ends
+    root = yield from edge_component_steps(n, sources, targets)
+    del sources, targets
+    # Cells numbered in the order of their least vertex (each part's label, the root).
+    number = np.cumsum(root == np.arange(n)) - 1
+    cell = number[root]
+    del root, number
     count = int(cell.max()) + 1
     per_cell = np.empty((count, _COLUMNS))
     for column in range(_COLUMNS):
         per_cell[:, column] = np.bincount(cell, sums[:, column], minlength=count)
-    a, b = cell[sources[~inside]], cell[target[~inside]]
-    pairs = np.unique(a * count + b)  # each pair of touching cells, both ways
+    yield
+    pairs = []
+    for first in range(0, n, block):
+        last = min(n, first + block)
+        lo, hi = int(starts[first]), int(starts[last])
+        across = ~inside[lo:hi]
+        near = cell[target[lo:hi][across]]
+        pairs.append(np.repeat(cell[first:last], degree[first:last])[across] * count + near)
+        yield
+    del inside
+    pairs = sorted_unique(np.concatenate(pairs))  # each pair of touching cells, both ways
+    yield
     pooled = per_cell.copy()
     first, second = pairs // count, pairs % count
     for column in range(_COLUMNS):
