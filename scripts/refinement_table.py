@@ -6,6 +6,8 @@ Run: .venv/bin/python scripts/refinement_table.py (a few minutes; the reference 
 ../shared/data, and are skipped without it). With ``--variants``: how many of the stretched
 wedges on four grids, upright, wound as valleys, turned at random and jittered off their faces,
 each rule reads right (within 0.1°; 175°: 0.5°), wrong or refuses (the table's "Variants").
+With ``--unseen``: the same count on stretched wedges of other grids, angles, jitters, seeds and
+a turn that the rule was not tuned on, turned and wound as valleys.
 """
 
 from __future__ import annotations
@@ -126,9 +128,9 @@ def variants():
                 yield f"stretched, jittered {jitter:.0%}", angle, noisy, triangles, center
 
 
-def variant_rows():
+def variant_rows(cases=None):
     counts = {}
-    for group, angle, points, triangles, center in variants():
+    for group, angle, points, triangles, center in cases or variants():
         surface = Surface(points, triangles)
         for rule in ("oriented", "refined"):
             cell = reading(surface, center, 0.2, rule, angle)
@@ -141,8 +143,30 @@ def variant_rows():
         print(f"| {group} | {rule} | {row['right']} | {row['wrong']} | {row['refused']} |")
 
 
+def unseen():
+    """Yield (group, exact angle, points, triangles, centre): stretched wedges on grids, angles,
+    jitters and seeds that the variants do not use, turned by another rotation, as valleys."""
+    turn = _turn(11)
+    for spacing in (0.008, 0.0125, 0.017):
+        flat, triangles = stretched_wedge(90.0, spacing)
+        for angle in (10, 30, 60, 100, 140, 155, 168, 174):
+            points = flat.copy()
+            points[:, 1] *= math.tan(math.radians(angle) / 2.0)
+            center = points[np.argmin(np.linalg.norm(points, axis=1))]
+            for jitter in (0.0, 0.02, 0.05):
+                seed = 1000 + angle + int(spacing * 1e4) + int(jitter * 100)
+                noise = np.random.default_rng(seed).normal(
+                    scale=jitter * spacing, size=points.shape
+                )
+                moved = points + noise if jitter else points
+                group = f"unseen, jittered {jitter:.0%}"
+                yield group, angle, moved @ turn.T, triangles[:, ::-1], center @ turn.T
+
+
 if __name__ == "__main__":
-    if "--variants" in sys.argv:
+    if "--unseen" in sys.argv:
+        variant_rows(unseen())
+    elif "--variants" in sys.argv:
         variant_rows()
     else:
         crease_rows()

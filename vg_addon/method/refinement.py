@@ -25,7 +25,13 @@ curved or rough wall keeps Algorithm 1's planes bit for bit; so do creases on a 
 where nothing moves. Where the strip is shown, the planes without it fit the patch
 :data:`DECISIVE_IMPROVEMENT` times better, but what is left of a face is too few rows of
 vertices to carry its plane, Algorithm 1's reading is known to be off and the measurement is
-refused (:class:`~vg_addon.errors.GoniometerError`, saying why). Everything runs
+refused (:class:`~vg_addon.errors.GoniometerError`, saying why).
+
+Where a scan's noise hides the strip's single vertices, so that these steps keep Algorithm 1's
+planes or end in planes that do not fit 1000-fold better (:data:`DECISIVE_IMPROVEMENT`), a second
+stage finds the strip by where its vertices lie on average, band by band outwards from the crease
+(:data:`STRIP_SPREADS`), leaves it out whole and fits the planes again; its planes are used where
+both faces are then shown to be planes and meet near the centre. Everything runs
 in a fixed order (:mod:`.fixed_order`), so the same inputs give the same bits on every machine.
 The reasons and the measurements are in docs/METHOD.md.
 """
@@ -121,6 +127,21 @@ LTS_STEPS = 2
 MIN_FAR_VERTICES = 12
 """A side needs this many vertices away from the other face for its robust plane; with fewer,
 none of its vertices is left out."""
+
+STRIP_SPREADS = 3.0
+"""A band of vertices at one distance from the crease (one mesh spacing wide) belongs to the strip
+that cuts the corner where its mean height over the face, towards the other face, exceeds this
+many standard errors of a mean of its size (the robust spread of the face's outer half over the
+square root of its count). A scan's noise averages out over a band; the strip's vertices all lie
+on the same side of both faces, so they stand out however noisy the scan."""
+
+MIN_BAND_VERTICES = 3
+"""Bands holding fewer vertices than this are passed over when the strip is measured."""
+
+FIRST_BAND = 2.0
+"""Before the strip is measured, the vertices within this many mesh spacings of Algorithm 1's
+crease line are left out once and the planes fitted again: Algorithm 1's planes are tilted by the
+strip, and so is their line, beside which the strip's bands would be measured."""
 
 _RANK_TOLERANCE = 1e-10
 
@@ -309,41 +330,23 @@ def _refuse_a_lost_face(points, plus, used, planes, frame, split_error) -> None:
         )
 
 
-def refine_sides(points, normals, labels, center, radius, spacing, split_error, planes=None):
-    """Refine Algorithm 1's split (see the module's description).
+def _fields(plus, used, planes) -> dict:
+    """The refined fields :func:`refine_sides` returns, from the sides and their two planes."""
+    return {
+        "labels": plus,
+        "used": used,
+        "normal_plus": planes[0][0],
+        "normal_minus": planes[1][0],
+        "fit_error_plus": planes[0][2],
+        "fit_error_minus": planes[1][2],
+        "fit_error": planes[0][2] + planes[1][2],
+    }
 
-    Parameters
-    ----------
-    points, normals : ndarray, shape (k, 3)
-        The patch, in canonical order.
-    labels : ndarray of bool, shape (k,)
-        Algorithm 1's sides (``True``: "+").
-    center : ndarray, shape (3,)
-        The centre of the patch.
-    radius, spacing : float
-        The patch radius and its mean edge length.
-    split_error : float
-        Algorithm 1's summed plane-fit error.
-    planes : list, optional
-        Algorithm 1's two planes as (unit normal oriented by the side's mean normal, centroid,
-        fit error), or ``None`` for a side whose plane is not its own vertices' (a borrowed row):
-        the first round starts from them instead of fitting them again.
 
-    Returns
-    -------
-    dict or None
-        The refined fields (``labels``, ``used``, the two planes' normals and fit errors), or
-        ``None`` where the refinement does not apply: nothing moved, a side ran out of vertices or
-        no longer spans a plane, or one of the conditions in the module's description fails.
-
-    Raises
-    ------
-    GoniometerError
-        Where a strip that cuts the corner is found but a face keeps too few rows of vertices
-        without it to carry its plane (Algorithm 1's reading would be off, by an unknown amount).
+def _refine_by_outliers(points, normals, labels, center, radius, spacing, split_error, planes):
+    """The first stage of :func:`refine_sides`: the vertices off each face's robust plane are
+    left out, with the gates of the module's description. Same parameters and results.
     """
-    if split_error <= (NOISE_FLOOR * spacing) ** 2:
-        return None  # Algorithm 1's planes already fit to rounding error
     plus = labels
     used = np.ones(points.shape[0], dtype=bool)
     given, frame = planes or [None, None], None
@@ -435,15 +438,149 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error, 
             "it is a plane, so the angle is not determined: use a larger radius (or the "
             "'oriented' rule to replicate a reading taken with it)."
         )
-    return {
-        "labels": plus,
-        "used": used,
-        "normal_plus": planes[0][0],
-        "normal_minus": planes[1][0],
-        "fit_error_plus": planes[0][2],
-        "fit_error_minus": planes[1][2],
-        "fit_error": refined_error,
-    }
+    return _fields(plus, used, planes)
+
+
+def _strip_width(points, side, kept, plane, toward_other, to_line, spacing) -> float:
+    """How far from the crease the strip that cuts the corner reaches on one side: the outer edge
+    of the last of the bands (one spacing wide, from the crease outwards) whose vertices lie, on
+    average, significantly towards the other face (:data:`STRIP_SPREADS`); 0 where none does."""
+    normal, centroid, _ = plane
+    if dot3(normal, toward_other) < 0:
+        normal = -normal
+    height = row_dot(points[side] - centroid, normal)
+    distance = to_line[side]
+    outer = kept[side] & (distance >= _median(distance[kept[side]]))
+    if not outer.any():
+        return 0.0
+    spread = 1.4826 * _median(np.abs(height[outer] - _median(height[outer])))
+    spread = max(spread, NOISE_FLOOR * spacing)
+    bands = (distance / spacing).astype(np.int64)
+    counts = np.bincount(bands)
+    sums = np.bincount(bands, weights=height)
+    width = 0.0
+    for band in np.flatnonzero(counts >= MIN_BAND_VERTICES).tolist():
+        count = int(counts[band])
+        if float(sums[band]) / count <= STRIP_SPREADS * spread / math.sqrt(count):
+            break
+        width = (band + 1) * spacing
+    return width
+
+
+def _refine_by_strip(points, normals, labels, center, radius, spacing, planes):
+    """The second stage of :func:`refine_sides`, where the first leaves Algorithm 1's planes: the
+    strip that cuts the corner is measured by where the vertices lie on average, band by band
+    outwards from the crease (:func:`_strip_width`), not by which single vertices stand out from
+    a scan's noise; it is left out whole, the vertices beyond it go to the face they are nearer,
+    and the planes are fitted again, until nothing changes. Used only where both faces are then
+    shown to be planes (:func:`_planar`) and meet near the centre; ``None`` otherwise."""
+    plus = labels
+    planes = [
+        plane if plane is not None else _side_plane(points, normals, side)
+        for plane, side in zip(planes or [None, None], (plus, ~plus), strict=True)
+    ]
+    kept = np.ones(points.shape[0], dtype=bool)
+    widths = [0.0, 0.0]
+    if planes[0] is not None and planes[1] is not None and FIRST_BAND > 0:
+        found = _half_plane_distances(points, center, planes)
+        if found is None:
+            return None
+        (to_plus, to_minus), frame = found
+        plus = to_plus < to_minus
+        kept = _distance_to_line(points, frame[0], frame[1]) >= FIRST_BAND * spacing
+        if min(int((plus & kept).sum()), int((~plus & kept).sum())) < MIN_FAR_VERTICES:
+            return None
+        planes = [_side_plane(points, normals, side) for side in (plus & kept, ~plus & kept)]
+    for round_number in range(MAX_ROUNDS):
+        if planes[0] is None or planes[1] is None:
+            return None
+        found = _half_plane_distances(points, center, planes)
+        if found is None:
+            return None
+        (to_plus, to_minus), frame = found
+        on_line, direction, into_faces = frame
+        to_line = _distance_to_line(points, on_line, direction)
+        new_plus = to_plus < to_minus
+        new_kept = np.ones(points.shape[0], dtype=bool)
+        sides = (new_plus, ~new_plus)
+        for k, side in enumerate(sides):
+            widths[k] = _strip_width(
+                points, side, kept, planes[k], into_faces[1 - k], to_line, spacing
+            )
+            new_kept[side] = to_line[side] >= widths[k]
+        if round_number == 0 and max(widths) == 0.0:
+            return None  # no strip beside the planes fitted without the first band
+        if np.array_equal(new_plus, plus) and np.array_equal(new_kept, kept):
+            break
+        plus, kept = new_plus, new_kept
+        if min(int((plus & kept).sum()), int((~plus & kept).sum())) < MIN_FAR_VERTICES:
+            return None
+        planes = [_side_plane(points, normals, side) for side in (plus & kept, ~plus & kept)]
+    else:
+        return None
+    if max(widths) == 0.0:
+        return None  # no strip: Algorithm 1's planes stand
+    if _distance_to_line(center[None, :], on_line, direction)[0] > CREASE_REACH * radius:
+        return None
+    for k, side in enumerate((plus, ~plus)):
+        face_frame = (on_line, direction, into_faces[k])
+        if _planar(points, side & kept, planes[k], face_frame, spacing, radius) is not True:
+            return None  # a curved face, or one too narrow to show it is a plane
+    return _fields(plus, kept, planes)
+
+
+def refine_sides(points, normals, labels, center, radius, spacing, split_error, planes=None):
+    """Refine Algorithm 1's split (see the module's description).
+
+    Parameters
+    ----------
+    points, normals : ndarray, shape (k, 3)
+        The patch, in canonical order.
+    labels : ndarray of bool, shape (k,)
+        Algorithm 1's sides (``True``: "+").
+    center : ndarray, shape (3,)
+        The centre of the patch.
+    radius, spacing : float
+        The patch radius and its mean edge length.
+    split_error : float
+        Algorithm 1's summed plane-fit error.
+    planes : list, optional
+        Algorithm 1's two planes as (unit normal oriented by the side's mean normal, centroid,
+        fit error), or ``None`` for a side whose plane is not its own vertices' (a borrowed row):
+        the first round starts from them instead of fitting them again.
+
+    Returns
+    -------
+    dict or None
+        The refined fields (``labels``, ``used``, the two planes' normals and fit errors), or
+        ``None`` where the refinement does not apply: nothing moved, a side ran out of vertices or
+        no longer spans a plane, or one of the conditions in the module's description fails.
+
+    Raises
+    ------
+    GoniometerError
+        Where a strip that cuts the corner is found but a face keeps too few rows of vertices
+        without it to carry its plane (Algorithm 1's reading would be off, by an unknown amount).
+    """
+    if split_error <= (NOISE_FLOOR * spacing) ** 2:
+        return None  # Algorithm 1's planes already fit to rounding error
+    refusal = None
+    try:
+        refined = _refine_by_outliers(
+            points, normals, labels, center, radius, spacing, split_error, planes
+        )
+    except GoniometerError as error:
+        refined, refusal = None, error
+    if refined is not None and split_error >= DECISIVE_IMPROVEMENT * refined["fit_error"]:
+        return refined  # exact faces without the vertices off them: nothing is left to find
+    by_strip = _refine_by_strip(points, normals, labels, center, radius, spacing, planes)
+    if by_strip is not None and (
+        refined is None or by_strip["used"].sum() <= refined["used"].sum()
+    ):
+        return by_strip  # a band at least as large as the vertices the first stage found off
+    if refusal is not None:
+        raise refusal
+    return refined
 
 
 __all__ = ["MIN_IMPROVEMENT", "NEAR_SPACINGS", "mean_edge_length", "refine_sides"]
