@@ -149,11 +149,6 @@ def find_edges_figures(vertices: int) -> None:
             print(f"peak memory allocated by the finder: {peak / 2**20:8.0f} MiB")
 
 
-SPEED_BASE = "ec2841d"
-"""The last commit before the refined rule's cost was cut (issue 19, item 5): its core is the
-"before" of :func:`refinement_comparison`."""
-
-
 def refinement_comparison(side: int, rounds: int = 5) -> None:
     """The refined rule (the default) against the oriented rule, and both against the core at
     :data:`SPEED_BASE`, side by side in one run, interleaved round by round (best of ``rounds``
@@ -279,6 +274,10 @@ def core_figures(side: int, repeats: int = 3) -> None:
 
 BLAS_COMMIT = "97179f7"
 """The last commit whose measuring path used BLAS and LAPACK (matrix products, ``eigh``)."""
+
+SPEED_BASE = "ec2841d"
+"""The last commit before the refined rule's cost was cut (issue 19, item 5): its core is the
+"before" of :func:`refinement_comparison`."""
 
 
 def _core_at(commit: str, name: str):
