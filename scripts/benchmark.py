@@ -48,9 +48,15 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--vertices", type=int, default=1_000_000, help="size of the big mesh")
     parser.add_argument(
-        "--case", choices=("all", "find_edges"), default="all", help="run only this case"
+        "--case",
+        choices=("all", "find_edges", "refinement"),
+        default="all",
+        help="run only this case",
     )
     args = parser.parse_args(argv)
+    if args.case == "refinement":
+        refinement_comparison(int(np.sqrt(args.vertices)))
+        return
     if args.case == "find_edges":
         find_edges_figures(args.vertices)
         batch_find_edges_figures(args.vertices)
@@ -238,9 +244,11 @@ def batch_find_edges_figures(vertices: int, spacing: float = 2.0, radius: float 
 
 
 def refinement_comparison(side: int, rounds: int = 5) -> None:
-    """The refined rule (the default) against the oriented rule, side by side in one run: a
-    2,000-vertex measurement where the refinement has nothing to do (an exact ridge), where it
-    runs and declines (a noisy ridge, as on a scan), and where it applies (a marched crease)."""
+    """The refined rule (the default) against the oriented rule, and both against the core at
+    :data:`SPEED_BASE`, side by side in one run, interleaved round by round (best of ``rounds``
+    rounds of 30 calls): a 2,000-vertex measurement where the refinement has nothing to do (an
+    exact ridge), where it runs and declines (a noisy ridge, as on a scan), and where it applies
+    (a marched crease). The readings are checked to be the same bits before and after."""
     from benchmark_drag import ridge_mesh
 
     from vg_addon.reference_shapes import marched_wedge
@@ -252,33 +260,77 @@ def refinement_comparison(side: int, rounds: int = 5) -> None:
     marched, marched_triangles, _, direction = marched_wedge(90.0, 0.0075, turn_seed=3)
     along = np.abs(marched @ direction)
     off = np.linalg.norm(marched - np.outer(marched @ direction, direction), axis=1)
+    old_core = _core_at(SPEED_BASE, "vg_addon_speed_base")
     cases = [
-        ("exact ridge", Surface(points, triangles), points),
-        ("noisy ridge", Surface(noisy, triangles), noisy),
-        ("marched crease", Surface(marched, marched_triangles), marched),
+        ("exact ridge", points, triangles),
+        ("noisy ridge", noisy, triangles),
+        ("marched crease", marched, marched_triangles),
     ]
-    print("\nrefined (default) against oriented rule, 2,000-vertex patches, best of rounds:")
-    for name, surface, where in cases:
+    print(
+        "\nrefined (default) against oriented rule, 2,000-vertex patches, best of rounds"
+        + (f"; before: the core at {SPEED_BASE}" if old_core else "")
+        + ":"
+    )
+    for name, where, faces in cases:
+        cores = {"now": Surface(where, faces)}
+        if old_core is not None:
+            cores["before"] = old_core.Surface(where, faces)
         if name == "marched crease":
             center = where[np.argmin(np.where(along < 0.05, off, np.inf))]
         else:
             center = where[
                 np.argmin(np.abs(where[:, 1]) + np.abs(where[:, 2]) + np.abs(where[:, 0]))
             ]
-        radius = radius_for(surface, center, 2_000)
-        times = {}
-        for rule in ("oriented", "refined"):
-            times[rule] = best_of(
-                lambda r=rule, s=surface, c=center, rad=radius: s.measure(c, rad, rule=r),
-                30 * rounds,
-            )
-        m = surface.measure(center, radius)
+        radius = radius_for(cores["now"], center, 2_000)
+        times = dict.fromkeys(((when, rule) for when in cores for rule in RULES_TIMED), np.inf)
+        for _ in range(rounds):
+            for when, rule in list(times):
+                seconds = best_of(
+                    lambda s=cores[when], r=rule, c=center, rad=radius: s.measure(c, rad, rule=r),
+                    30,
+                )
+                times[when, rule] = min(times[when, rule], seconds)
+        m = cores["now"].measure(center, radius)
         applied = "applied" if m.split_angle is not None else "kept Algorithm 1's"
+        now = times["now", "refined"]
         print(
-            f"  {name:15s} ({surface.n_points:>9,} vertices): oriented {times['oriented'] * 1e3:6.2f} ms, "
-            f"refined {times['refined'] * 1e3:6.2f} ms, ratio {times['refined'] / times['oriented']:5.2f} "
-            f"({applied})"
+            f"  {name:15s} ({len(where):>9,} vertices, refinement {applied}): now oriented "
+            f"{times['now', 'oriented'] * 1e3:5.2f} ms, refined {now * 1e3:5.2f} ms "
+            f"(ratio {now / times['now', 'oriented']:4.2f})"
         )
+        if "before" in cores:
+            before = cores["before"].measure(center, radius)
+            same = _same_reading(m, before)
+            old_oriented, old_refined = times["before", "oriented"], times["before", "refined"]
+            print(
+                f"  {'':15s} before: oriented {old_oriented * 1e3:5.2f} ms, refined "
+                f"{old_refined * 1e3:5.2f} ms; now/before: oriented "
+                f"{times['now', 'oriented'] / old_oriented:4.2f}, refined {now / old_refined:4.2f}; "
+                f"refined now / oriented before {now / old_oriented:4.2f}; "
+                f"same bits: {'yes' if same else 'NO'}"
+            )
+
+
+RULES_TIMED = ("oriented", "refined")
+
+
+def _same_reading(new, old) -> bool:
+    """Whether two measurements hold the same bits in every field both have."""
+    from dataclasses import fields
+
+    for field in fields(old):
+        a, b = getattr(new, field.name, None), getattr(old, field.name)
+        if isinstance(b, np.ndarray):
+            if not (
+                isinstance(a, np.ndarray) and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+            ):
+                return False
+        elif isinstance(b, float):
+            if not (isinstance(a, float) and a.hex() == b.hex()):
+                return False
+        elif not hasattr(b, "__dataclass_fields__") and a != b:
+            return False
+    return True
 
 
 def core_figures(side: int, repeats: int = 3) -> None:
@@ -317,6 +369,9 @@ def core_figures(side: int, repeats: int = 3) -> None:
 BLAS_COMMIT = "97179f7"
 """The last commit whose measuring path used BLAS and LAPACK (matrix products, ``eigh``)."""
 
+SPEED_BASE = "ec2841d"
+"""The last commit before the refined rule's cost was cut (issue 19, item 5): its core is the
+"before" of :func:`refinement_comparison`."""
 
 def _blas_core():
     """The core as it was at :data:`BLAS_COMMIT` (None, with the reason printed, where git or

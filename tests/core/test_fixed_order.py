@@ -9,10 +9,16 @@ import pytest
 from vg_addon.method.fixed_order import (
     acos_degrees,
     acos_degrees_array,
+    column_moments,
+    columns_dot,
     eigh3,
     eigh3_batched,
     exact_weighted_sums,
+    gram,
     moments,
+    offset_columns,
+    row_dot,
+    solve,
     solve3,
     split_exactly,
 )
@@ -111,3 +117,52 @@ def test_acos_degrees_clips_and_matches_the_scalar_and_array_forms(cosine):
     expected = float(np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0))))
     assert acos_degrees(cosine) == pytest.approx(expected, abs=1e-12)
     assert acos_degrees_array(np.array([cosine]))[0] == acos_degrees(cosine)
+
+
+# Sizes around NumPy's pairwise-summation blocks (8 and 128 values) and its buffer (8,192).
+SUM_SIZES = (1, 2, 7, 8, 9, 127, 128, 129, 1000, 2001, 8191, 8192, 8193, 70001)
+
+
+@pytest.mark.parametrize("size", SUM_SIZES)
+def test_batched_sums_are_each_row_summed_alone(size):
+    """``gram`` and ``column_moments`` sum all their rows of products in one call; each entry must
+    be the bits of that row's own one-dimensional sum (what they summed before, one call each), or
+    every stored number built on them would move."""
+    rng = np.random.default_rng(size)
+    columns = rng.normal(size=(3, size)) * np.array([[1.0], [1e-4], [1e5]])
+    values = rng.normal(size=size)
+    matrix, rhs = gram(columns, values)
+    for i in range(3):
+        assert rhs[i] == np.add.reduce(columns[i] * values)
+        for j in range(3):
+            assert matrix[i, j] == np.add.reduce(columns[i] * columns[j])
+    entries = column_moments(columns)
+    pairs = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+    assert entries == [float(np.add.reduce(columns[i] * columns[j])) for i, j in pairs]
+    assert np.array_equal(
+        moments(np.ascontiguousarray(columns.T)).ravel()[[0, 1, 2, 4, 5, 8]], entries
+    )
+
+
+def test_columns_dot_gives_row_dots_bits():
+    rng = np.random.default_rng(8)
+    rows = rng.normal(size=(3001, 3)) * 1e3
+    origin, vector = rng.normal(size=3), rng.normal(size=3)
+    columns = offset_columns(rows, origin)
+    for k in range(3):
+        assert columns[k].tobytes() == (rows - origin)[:, k].tobytes()
+    assert columns_dot(columns, vector).tobytes() == row_dot(rows - origin, vector).tobytes()
+
+
+def test_solve_agrees_with_lapack_and_pivots():
+    """Gaussian elimination with partial pivoting on Python floats agrees with LAPACK's solver;
+    a singular matrix gives None; a system that needs a row swap is solved exactly."""
+    rng = np.random.default_rng(9)
+    for _ in range(200):
+        matrix = rng.normal(size=(6, 6))
+        rhs = rng.normal(size=6)
+        got = solve(matrix, rhs)
+        exact = np.linalg.solve(matrix, rhs)  # LAPACK, an independent solver
+        assert np.allclose(got, exact, rtol=1e-9, atol=1e-12)
+    assert solve(np.ones((3, 3)), np.ones(3)) is None
+    assert solve([[0.0, 2.0], [1.0, 0.0]], [4.0, 3.0]) == [3.0, 2.0]  # a row swap, exact

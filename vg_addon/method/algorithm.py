@@ -7,7 +7,17 @@ import math
 import numpy as np
 
 from ..errors import GoniometerError
-from .fixed_order import acos_degrees, dot3, eigh3, moments, norm3, row_dot, total
+from .fixed_order import (
+    acos_degrees,
+    column_moments,
+    dot3,
+    eigh3,
+    eigh3_entries,
+    moments,
+    norm3,
+    row_dot,
+    total,
+)
 from .refinement import NOISE_FLOOR, mean_edge_length, refine_sides
 from .result import Measurement
 from .withinss import withinss_split
@@ -67,9 +77,13 @@ def canonical_order(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
     return np.lexsort(keys)
 
 
-def _smallest_eigenvector(matrix: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-    """Smallest eigenvalue, its unit eigenvector (sign fixed) and all eigenvalues of a 3x3 SPD matrix."""
-    values, vectors = eigh3(matrix)
+def _smallest_eigenvector(matrix) -> tuple[float, np.ndarray, np.ndarray]:
+    """Smallest eigenvalue, its unit eigenvector (sign fixed) and all eigenvalues of a 3x3 SPD
+    matrix, given as an array or as its six entries ``xx, xy, xz, yy, yz, zz``."""
+    if isinstance(matrix, list):
+        values, vectors = eigh3_entries(*matrix)
+    else:
+        values, vectors = eigh3(matrix)
     vector = vectors[:, 0]
     if vector[np.argmax(np.abs(vector))] < 0:  # a sign that does not depend on the solver
         vector = -vector
@@ -85,9 +99,14 @@ def _column_means(array: np.ndarray) -> np.ndarray:
 def _plane(points: np.ndarray, mean: np.ndarray | None = None) -> tuple[np.ndarray, float, bool]:
     """PCA plane fit: unit normal, mean squared distance to the plane, and whether the points
     span a plane at all (``False``: they lie on a line). ``mean``: the points' mean, if known."""
-    centred = points - (_column_means(points) if mean is None else mean)
-    covariance = moments(centred) / points.shape[0]
-    error, normal, values = _smallest_eigenvector(covariance)
+    count = points.shape[0]
+    mean = _column_means(points) if mean is None else mean
+    # The centred coordinates column by column (the same differences, contiguous for products).
+    centred = np.empty((3, count))
+    np.subtract(points.T, mean[:, None], out=centred)
+    error, normal, values = _smallest_eigenvector(
+        [value / count for value in column_moments(centred)]
+    )
     spans = bool(values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny))
     return normal, max(error, 0.0), spans
 
@@ -117,7 +136,7 @@ def _fit_side(points, joined, mask, side: str) -> tuple[np.ndarray, float, int, 
     vertices (a coarse mesh across a near-flat edge) has no plane of its own; the row of the
     other side nearest it (the vertices on the edge, which lie on both faces) completes it.
     """
-    rows = joined[mask]
+    rows = np.compress(mask, joined, axis=0)  # joined[mask], without fancy indexing's overhead
     means = _column_means(rows)
     own, centroid = rows[:, :3], means[:3]
     normal, error, spans = _plane(own, centroid)
@@ -161,8 +180,8 @@ def check_rule(rule) -> str:
 
 def _correlation(a: np.ndarray, b: np.ndarray) -> float:
     """Pearson correlation of two vectors; 0 when either is constant."""
-    a = a - a.mean()
-    b = b - b.mean()
+    a = a - np.add.reduce(a) / a.size  # a.mean(): the same sum and division, without its wrapper
+    b = b - np.add.reduce(b) / b.size
     scale = math.sqrt(total(a * a) * total(b * b))
     return total(a * b) / scale if scale > 0 else 0.0
 
@@ -192,6 +211,7 @@ def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray, list]:
     """
     threshold, _ = withinss_split(projection, min_size=MIN_SIDE_VERTICES)
     labels = projection >= threshold
+    n_plus = int(np.count_nonzero(labels))
     normal_plus, error_plus, shared_plus, mean_plus = _fit_side(points, joined, labels, "+")
     normal_minus, error_minus, shared_minus, mean_minus = _fit_side(points, joined, ~labels, "-")
     angle = _checked_angle(normal_plus, normal_minus)
@@ -204,8 +224,8 @@ def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray, list]:
         "normal_minus": normal_minus,
         "threshold": threshold,
         "labels": labels,
-        "n_plus": int(labels.sum()),
-        "n_minus": int((~labels).sum()),
+        "n_plus": n_plus,
+        "n_minus": labels.size - n_plus,
         "n_shared": shared_plus + shared_minus,
     }
     planes = [

@@ -32,6 +32,32 @@ def rows_dot(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     return first[:, 0] * second[:, 0] + first[:, 1] * second[:, 1] + first[:, 2] * second[:, 2]
 
 
+def offset_columns(rows: np.ndarray, origin) -> np.ndarray:
+    """``(rows - origin).T`` for an ``(n, 3)`` array, as a contiguous ``(3, n)`` array: the same
+    differences, laid out for :func:`columns_dot`'s and :func:`columns_dots`' contiguous
+    products."""
+    columns = np.empty((3, rows.shape[0]))
+    np.subtract(rows.T, np.asarray(origin, dtype=np.float64)[:, None], out=columns)
+    return columns
+
+
+def columns_dot(columns, vector) -> np.ndarray:
+    """:func:`row_dot` of the rows whose three columns are ``columns``: ``x·v0 + y·v1 + z·v2``
+    in that order, so the same bits."""
+    v0, v1, v2 = (float(value) for value in vector)
+    x, y, z = columns
+    return x * v0 + y * v1 + z * v2
+
+
+def columns_dots(columns: np.ndarray, vectors) -> np.ndarray:
+    """:func:`columns_dot` with each of ``m`` vectors at once, shape ``(m, n)``: every product in
+    one call and the same sums, ``x·v0 + y·v1 + z·v2`` in that order, so the same bits."""
+    products = np.asarray(vectors, dtype=np.float64)[:, :, None] * columns[None]
+    dots = np.add(products[:, 0], products[:, 1])
+    dots += products[:, 2]
+    return dots
+
+
 def in_frame(rows: np.ndarray, frame: np.ndarray) -> np.ndarray:
     """``rows @ frame.T``: each ``(n, 3)`` row's coordinates along the three rows of ``frame``."""
     return np.stack([row_dot(rows, axis) for axis in frame], axis=1)
@@ -58,15 +84,27 @@ def moments(rows: np.ndarray) -> np.ndarray:
 
     Each of the six distinct entries is NumPy's pairwise sum of a contiguous row of products.
     """
-    columns = rows.T.copy()
-    products = np.empty((6, rows.shape[0]))
-    for k, (i, j) in enumerate(_UPPER):
-        np.multiply(columns[i], columns[j], out=products[k])
-    sums = np.add.reduce(products, axis=1)
-    out = np.empty((3, 3))
-    for k, (i, j) in enumerate(_UPPER):
-        out[i, j] = out[j, i] = sums[k]
-    return out
+    return _symmetric(column_moments(rows.T.copy()))
+
+
+def column_moments(columns: np.ndarray) -> list[float]:
+    """The six distinct entries of :func:`moments` (``xx, xy, xz, yy, yz, zz``) of the points
+    whose coordinates are the three contiguous rows of ``columns``, shape ``(3, n)``: the same
+    sums, for callers that hold their points column by column."""
+    x, y, z = columns
+    products = np.empty((6, columns.shape[1]))
+    np.multiply(x, x, out=products[0])
+    np.multiply(x, y, out=products[1])
+    np.multiply(x, z, out=products[2])
+    np.multiply(y, y, out=products[3])
+    np.multiply(y, z, out=products[4])
+    np.multiply(z, z, out=products[5])
+    return np.add.reduce(products, axis=1).tolist()
+
+
+def _symmetric(entries) -> np.ndarray:
+    xx, xy, xz, yy, yz, zz = entries
+    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
 
 
 _UPPER = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
@@ -76,42 +114,55 @@ def gram(columns: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarra
     """The normal equations of a least-squares fit, ``(A.T @ A, A.T @ values)``.
 
     ``columns`` has shape ``(m, k)``: ``m`` basis functions at ``k`` points, so ``A`` is its
-    transpose. Every entry is NumPy's pairwise sum of one contiguous row of products.
+    transpose. Every entry is NumPy's pairwise sum of one contiguous row of products (all rows
+    summed by one call, which sums each row as it would alone).
     """
     m = columns.shape[0]
-    matrix = np.empty((m, m))
+    pairs = [(i, j) for i in range(m) for j in range(i, m)]
+    products = np.empty((len(pairs) + m, columns.shape[1]))
+    for k, (i, j) in enumerate(pairs):
+        np.multiply(columns[i], columns[j], out=products[k])
     for i in range(m):
-        for j in range(i, m):
-            matrix[i, j] = matrix[j, i] = np.add.reduce(columns[i] * columns[j])
-    return matrix, np.array([np.add.reduce(columns[i] * values) for i in range(m)])
+        np.multiply(columns[i], values, out=products[len(pairs) + i])
+    sums = np.add.reduce(products, axis=1).tolist()
+    matrix = [[0.0] * m for _ in range(m)]
+    for k, (i, j) in enumerate(pairs):
+        matrix[i][j] = matrix[j][i] = sums[k]
+    return np.array(matrix), np.array(sums[len(pairs) :])
 
 
 def solve(matrix, rhs) -> list[float] | None:
     """Solve the small linear system ``matrix @ x = rhs`` by Gaussian elimination with partial
     pivoting on Python floats; None when singular (a pivot below 1e-13 of the largest entry)."""
-    a = [list(row) for row in np.asarray(matrix, dtype=np.float64).tolist()]
+    a = np.asarray(matrix, dtype=np.float64).tolist()
     b = [float(value) for value in rhs]
     n = len(b)
-    largest = max(abs(value) for row in a for value in row)
+    largest = max(max(map(abs, row)) for row in a)
     if not math.isfinite(largest) or largest == 0.0:
         return None
     for column in range(n):
-        pivot = max(range(column, n), key=lambda row: abs(a[row][column]))
-        if abs(a[pivot][column]) <= 1e-13 * largest:
+        pivot, size = column, abs(a[column][column])
+        for row in range(column + 1, n):  # the first of the largest, as max() picks
+            if abs(a[row][column]) > size:
+                pivot, size = row, abs(a[row][column])
+        if size <= 1e-13 * largest:
             return None
         a[column], a[pivot] = a[pivot], a[column]
         b[column], b[pivot] = b[pivot], b[column]
+        top, head = a[column], a[column][column]
         for row in range(column + 1, n):
-            factor = a[row][column] / a[column][column]
+            current = a[row]
+            factor = current[column] / head
             for k in range(column, n):
-                a[row][k] -= factor * a[column][k]
+                current[k] -= factor * top[k]
             b[row] -= factor * b[column]
     x = [0.0] * n
     for row in range(n - 1, -1, -1):
         value = b[row]
+        current = a[row]
         for k in range(row + 1, n):
-            value -= a[row][k] * x[k]
-        x[row] = value / a[row][row]
+            value -= current[k] * x[k]
+        x[row] = value / current[row]
     return x
 
 
@@ -158,16 +209,6 @@ def acos_degrees_array(cosines: np.ndarray) -> np.ndarray:
     return np.degrees(np.array([math.acos(c) for c in clipped], dtype=np.float64))
 
 
-def _rotation(app: float, aqq: float, apq: float) -> tuple[float, float, float]:
-    """The Jacobi rotation ``(t, c, s)`` that zeroes ``apq`` (Numerical Recipes' form). Where
-    ``theta²`` overflows, ``t`` is 0: ``apq`` is then below 1e-150 of ``aqq − app`` and is
-    dropped."""
-    theta = (aqq - app) / (apq + apq)
-    t = math.copysign(1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0)), theta)
-    c = 1.0 / math.sqrt(t * t + 1.0)
-    return t, c, t * c
-
-
 def eigh3(matrix) -> tuple[np.ndarray, np.ndarray]:
     """Eigenvalues (ascending) and unit eigenvectors (columns) of a symmetric 3×3 matrix.
 
@@ -187,58 +228,81 @@ def eigh3(matrix) -> tuple[np.ndarray, np.ndarray]:
         ``vectors[:, k]`` belongs to ``values[k]``.
     """
     (a0, a01, a02), (_, a1, a12), (_, _, a2) = np.asarray(matrix, dtype=np.float64).tolist()
+    return eigh3_entries(a0, a01, a02, a1, a12, a2)
+
+
+def eigh3_entries(a0, a01, a02, a1, a12, a2) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`eigh3` of the symmetric matrix with diagonal ``a0, a1, a2`` and off-diagonal
+    entries ``a01, a02, a12`` (Python floats).
+
+    Each rotation, written out in place (the same operations in the same order as a call per
+    step, without the calls): ``theta = (a_qq − a_pp) / 2 a_pq``,
+    ``t = sign(theta) / (|theta| + √(theta² + 1))``, ``c = 1 / √(t² + 1)``, ``s = t c`` (Numerical
+    Recipes' form; where ``theta²`` overflows, ``t`` is 0: ``a_pq`` is then below 1e-150 of
+    ``a_qq − a_pp`` and is dropped). After the first sweep an ``a_pq`` below the last bit of both
+    diagonal entries is zeroed, not rotated.
+    """
+    copysign, sqrt = math.copysign, math.sqrt
     # Columns of the eigenvector matrix, rotated along with the matrix.
-    v0, v1, v2 = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
+    x0, y0, z0, x1, y1, z1, x2, y2, z2 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
     for sweep in range(_MAX_SWEEPS):
         if a01 == 0.0 and a02 == 0.0 and a12 == 0.0:
             break
         first = sweep == 0
         if a01 != 0.0:  # p, q, r = 0, 1, 2
-            if not first and _negligible(a0, a1, a01):
+            g = 100.0 * abs(a01)
+            if not first and abs(a0) + g == abs(a0) and abs(a1) + g == abs(a1):
                 a01 = 0.0
             else:
-                t, c, s = _rotation(a0, a1, a01)
+                theta = (a1 - a0) / (a01 + a01)
+                t = copysign(1.0 / (abs(theta) + sqrt(theta * theta + 1.0)), theta)
+                c = 1.0 / sqrt(t * t + 1.0)
+                s = t * c
                 shift = t * a01
                 a0, a1, a01 = a0 - shift, a1 + shift, 0.0
                 a02, a12 = c * a02 - s * a12, s * a02 + c * a12
-                v0, v1 = _rotate(v0, v1, c, s)
+                x0, y0, z0, x1, y1, z1 = (
+                    c * x0 - s * x1, c * y0 - s * y1, c * z0 - s * z1,
+                    s * x0 + c * x1, s * y0 + c * y1, s * z0 + c * z1,
+                )  # fmt: skip
         if a02 != 0.0:  # p, q, r = 0, 2, 1
-            if not first and _negligible(a0, a2, a02):
+            g = 100.0 * abs(a02)
+            if not first and abs(a0) + g == abs(a0) and abs(a2) + g == abs(a2):
                 a02 = 0.0
             else:
-                t, c, s = _rotation(a0, a2, a02)
+                theta = (a2 - a0) / (a02 + a02)
+                t = copysign(1.0 / (abs(theta) + sqrt(theta * theta + 1.0)), theta)
+                c = 1.0 / sqrt(t * t + 1.0)
+                s = t * c
                 shift = t * a02
                 a0, a2, a02 = a0 - shift, a2 + shift, 0.0
                 a01, a12 = c * a01 - s * a12, s * a01 + c * a12
-                v0, v2 = _rotate(v0, v2, c, s)
+                x0, y0, z0, x2, y2, z2 = (
+                    c * x0 - s * x2, c * y0 - s * y2, c * z0 - s * z2,
+                    s * x0 + c * x2, s * y0 + c * y2, s * z0 + c * z2,
+                )  # fmt: skip
         if a12 != 0.0:  # p, q, r = 1, 2, 0
-            if not first and _negligible(a1, a2, a12):
+            g = 100.0 * abs(a12)
+            if not first and abs(a1) + g == abs(a1) and abs(a2) + g == abs(a2):
                 a12 = 0.0
             else:
-                t, c, s = _rotation(a1, a2, a12)
+                theta = (a2 - a1) / (a12 + a12)
+                t = copysign(1.0 / (abs(theta) + sqrt(theta * theta + 1.0)), theta)
+                c = 1.0 / sqrt(t * t + 1.0)
+                s = t * c
                 shift = t * a12
                 a1, a2, a12 = a1 - shift, a2 + shift, 0.0
                 a01, a02 = c * a01 - s * a02, s * a01 + c * a02
-                v1, v2 = _rotate(v1, v2, c, s)
-    diagonal, columns = (a0, a1, a2), (v0, v1, v2)
+                x1, y1, z1, x2, y2, z2 = (
+                    c * x1 - s * x2, c * y1 - s * y2, c * z1 - s * z2,
+                    s * x1 + c * x2, s * y1 + c * y2, s * z1 + c * z2,
+                )  # fmt: skip
+    diagonal = (a0, a1, a2)
+    columns = ((x0, y0, z0), (x1, y1, z1), (x2, y2, z2))
     order = sorted(range(3), key=diagonal.__getitem__)
     values = np.array([diagonal[k] for k in order])
     vectors = np.array([columns[k] for k in order]).T
     return values, vectors
-
-
-def _negligible(app: float, aqq: float, apq: float) -> bool:
-    """Whether ``apq`` is below the last bit of both diagonal entries (zeroed, not rotated)."""
-    g = 100.0 * abs(apq)
-    return abs(app) + g == abs(app) and abs(aqq) + g == abs(aqq)
-
-
-def _rotate(vp, vq, c: float, s: float) -> tuple:
-    """Columns ``p`` and ``q`` of the eigenvector matrix after a rotation."""
-    return (
-        (c * vp[0] - s * vq[0], c * vp[1] - s * vq[1], c * vp[2] - s * vq[2]),
-        (s * vp[0] + c * vq[0], s * vp[1] + c * vq[1], s * vp[2] + c * vq[2]),
-    )
 
 
 def eigh3_batched(matrices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

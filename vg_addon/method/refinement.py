@@ -43,7 +43,19 @@ import math
 import numpy as np
 
 from ..errors import GoniometerError
-from .fixed_order import dot3, eigh3, gram, moments, norm3, row_dot, rows_dot, solve, total
+from .fixed_order import (
+    column_moments,
+    columns_dot,
+    columns_dots,
+    dot3,
+    eigh3_entries,
+    gram,
+    norm3,
+    offset_columns,
+    row_dot,
+    solve,
+    total,
+)
 
 NEAR_SPACINGS = 3.0
 """How close to the other side's half-plane, in mesh spacings, a vertex may be handed over or
@@ -157,22 +169,28 @@ def mean_edge_length(radius: float, n_vertices: int) -> float:
 
 def _distance_to_line(points, on_line, direction) -> np.ndarray:
     """Each point's distance to the line through ``on_line`` along the unit ``direction``."""
-    relative = points - on_line
-    along = row_dot(relative, direction)
-    return np.sqrt(np.maximum(rows_dot(relative, relative) - along * along, 0.0))
+    relative = offset_columns(points, on_line)
+    along = columns_dot(relative, direction)
+    squares = relative * relative
+    return np.sqrt(np.maximum(squares[0] + squares[1] + squares[2] - along * along, 0.0))
 
 
 def _side_plane(points, normals, mask):
     """PCA plane of the masked points: unit normal (oriented by the side's mean normal), centroid
     and mean squared distance; ``None`` when the points do not span a plane."""
-    own = points[mask]
-    count = own.shape[0]
-    centroid = np.add.reduce(own, axis=0) / count
-    values, vectors = eigh3(moments(own - centroid) / count)
+    # One gather and one sum (row after row, each column on its own) for points and normals.
+    rows = np.compress(mask, np.concatenate((points, normals), axis=1), axis=0)
+    count = rows.shape[0]
+    sums = np.add.reduce(rows, axis=0)
+    centroid = sums[:3] / count
+    centred = np.empty((3, count))
+    np.subtract(rows[:, :3].T, centroid[:, None], out=centred)
+    xx, xy, xz, yy, yz, zz = (value / count for value in column_moments(centred))
+    values, vectors = eigh3_entries(xx, xy, xz, yy, yz, zz)
     if not values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny):
         return None
     normal = vectors[:, 0]
-    if dot3(normal, np.add.reduce(normals[mask], axis=0)) < 0:
+    if dot3(normal, sums[3:]) < 0:
         normal = -normal
     return normal, centroid, max(float(values[0]), 0.0)
 
@@ -198,18 +216,25 @@ def _half_plane_distances(points, center, planes):
     if on_line is None:
         return None
     on_line = np.array(on_line)
-    relative = points - on_line
-    along = row_dot(relative, direction)
-    across = relative - along[:, None] * direction
-    distance_to_line = np.sqrt(rows_dot(across, across))
-    distances, outward = [], []
+    relative = offset_columns(points, on_line)
+    along = columns_dot(relative, direction)
+    across = relative - direction[:, None] * along
+    squares = across * across
+    distance_to_line = np.sqrt(squares[0] + squares[1] + squares[2])
+    outward = []
     for normal, centroid in ((normal_plus, centroid_plus), (normal_minus, centroid_minus)):
         into_face = _cross(direction, normal)
         if dot3(into_face, centroid - on_line) < 0:
             into_face = -into_face
-        on_face = row_dot(across, into_face) >= 0
-        distances.append(np.where(on_face, np.abs(row_dot(across, normal)), distance_to_line))
         outward.append(into_face)
+    # Per face: how far into it (its side of the crease line) and the height over its plane.
+    into_plus, height_plus, into_minus, height_minus = columns_dots(
+        across, [outward[0], normal_plus, outward[1], normal_minus]
+    )
+    distances = [
+        np.where(into_plus >= 0, np.abs(height_plus), distance_to_line),
+        np.where(into_minus >= 0, np.abs(height_minus), distance_to_line),
+    ]
     return distances, (on_line, direction, outward)
 
 
@@ -218,23 +243,21 @@ def _face_coordinates(points, plane, frame, radius):
     in radii, from the crease line), and its height over the face's plane."""
     normal, centroid, _ = plane
     on_line, direction, into_face = frame
-    relative = points - on_line
-    u = row_dot(relative, into_face) / radius
-    w = row_dot(relative, direction) / radius
+    u, w = columns_dots(offset_columns(points, on_line), [into_face, direction]) / radius
     return u, w, row_dot(points - centroid, normal)
 
 
 def _residuals(basis, height, fitted_on):
     """``|height − fit|`` for the least-squares fit of ``height`` by the rows of ``basis`` over the
     points ``fitted_on``; ``None`` when the fit is singular."""
-    matrix, rhs = gram(np.ascontiguousarray(basis[:, fitted_on]), height[fitted_on])
+    matrix, rhs = gram(np.compress(fitted_on, basis, axis=1), np.compress(fitted_on, height))
     coefficients = solve(matrix, rhs)
     if coefficients is None:
         return None
     fitted = basis[0] * coefficients[0]
     for k in range(1, basis.shape[0]):
-        fitted = fitted + basis[k] * coefficients[k]
-    return np.abs(height - fitted)
+        fitted += basis[k] * coefficients[k]
+    return np.abs(height - fitted, out=fitted)
 
 
 def _median(values) -> float:
@@ -243,8 +266,8 @@ def _median(values) -> float:
     half = values.size // 2
     if values.size % 2:
         return float(np.partition(values, half)[half])
-    lower, upper = np.partition(values, (half - 1, half))[half - 1 : half + 1]
-    return float((lower + upper) / 2)
+    middle = np.partition(values, (half - 1, half))
+    return (float(middle[half - 1]) + float(middle[half])) / 2  # the same IEEE sum and halving
 
 
 def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
@@ -256,21 +279,21 @@ def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
     vertices on the face.
     """
     off = np.zeros(points.shape[0], dtype=bool)
-    if fitted_on.sum() < MIN_FAR_VERTICES:
+    if np.count_nonzero(fitted_on) < MIN_FAR_VERTICES:
         return off
     members = np.flatnonzero(side)
     fit_here = fitted_on[members]
-    u, w, height = _face_coordinates(points[members], plane, frame, radius)
+    u, w, height = _face_coordinates(np.take(points, members, axis=0), plane, frame, radius)
     basis = np.stack([np.ones_like(u), u, w])
     # Start from the half farthest from the crease, where the face is least likely disturbed.
-    subset = fit_here & (u >= _median(u[fit_here]))
+    subset = fit_here & (u >= _median(np.compress(fit_here, u)))
     for _ in range(LTS_STEPS):
         residual = _residuals(basis, height, subset)
         if residual is None:
             return off
-        middle = _median(residual[fit_here])
+        middle = _median(np.compress(fit_here, residual))
         subset = fit_here & (residual <= middle)
-        if subset.sum() < MIN_FAR_VERTICES:
+        if np.count_nonzero(subset) < MIN_FAR_VERTICES:
             break
     spread = max(1.4826 * middle, NOISE_FLOOR * spacing)
     off[members] = residual > OUTLIER_SPREADS * spread
