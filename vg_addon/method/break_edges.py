@@ -7,9 +7,9 @@ The method, in four steps (docs/EDGE_DETECTION.md shows it at work):
 2. **Smooth regions.** Vertices bending less than ``min_bend_deg`` are smooth; their connected
    parts larger than ``min_region_area`` are the regions (fracture faces, the original outer and
    inner surfaces); the thin band of ridge vertices between them is left out (``region`` -1).
-   Where the fine bend field (two rings) calls part of the band flat, that part joins the one
-   region it touches, or becomes a region of its own where it touches none: a face narrower
-   than the band the scale leaves (see :mod:`.narrow_faces`).
+   Where the fine bend field (two rings) calls a part of the band flat and it touches no
+   region, it becomes a region of its own: a face narrower than the band the scale leaves (see
+   :mod:`.narrow_faces`).
 3. **Edges between regions.** The band is flooded from both sides; where two regions' floods
    meet lies the break edge between them, open (ending where a third region or the mesh's border
    comes in) or closed (a loop). Ridges that fade into a single region are found as long pieces of
@@ -404,8 +404,8 @@ class BreakEdgeFinder:
         yield 1.0
 
     def _narrow_faces(self, graph, sums, region, rows, fine_spread, fine_total, bar, params):
-        """``region`` with the band's flat parts (by the fine field) joined to the region each
-        touches, or made regions where they touch none (see :mod:`.narrow_faces`)."""
+        """``region`` with the band's flat parts (by the fine field) that touch no region made
+        regions of their own (see :mod:`.narrow_faces`)."""
         inside = np.flatnonzero(region >= 0)
         sample = inside[:: max(1, inside.size // NOISE_SAMPLES)]
         if sample.size:

@@ -5,11 +5,10 @@ counts as ridge while any part of its patch reaches over a crease: the band roun
 about ``2 × scale`` wide, and a face narrower than that between two creases (the 5 mm wall of a
 bone shaft meshed at 0.8 mm, the platform of a small flake) is band from rim to rim. The fine
 field (two rings) sees the same face as flat a few edges in from each rim. Each connected part
-of band vertices that the fine field calls flat then
-
-* joins the one region it touches (the flat margin of a region beside its crease), or
-* becomes a region of its own if it touches none and is large enough (a swallowed face), or
-* stays band if it touches two or more (it bridges a gap in a crease: joining would merge them).
+of band vertices that the fine field calls flat and that touches no region becomes a region of
+its own if it is large enough (a swallowed face). A flat part touching a region is left in the
+band: it is that region's margin beside its crease, or a rounded edge, and joining it would move
+where the floods of two regions meet (off the middle of a rounded edge on a noisy scan).
 
 Everything is vectorised over vertices; see :mod:`.break_edges` for the method as a whole.
 """
@@ -31,9 +30,9 @@ def flat_band(fine_spread, fine_second, rows, floor: float, corner_floor: float)
 
 
 def recovered_regions(graph, region, flat, areas, min_new_area: float) -> np.ndarray:
-    """``region`` with the flat parts of the band joined to the one region each touches, or made
-    regions of their own (at least ``min_new_area``) where they touch none; renumbered by area,
-    largest first (ties by their least vertex), -1 left on the band.
+    """``region`` with each flat part of the band that touches no region made a region of its
+    own if at least ``min_new_area``; renumbered by area, largest first (ties by their least
+    vertex), -1 left on the band.
 
     Parameters
     ----------
@@ -45,7 +44,7 @@ def recovered_regions(graph, region, flat, areas, min_new_area: float) -> np.nda
     areas : ndarray, shape (n,)
         Each vertex's share of the surface.
     min_new_area : float
-        A flat part touching no region must be this large to become one.
+        A flat part must be this large to become a region.
     """
     flat = flat & (region < 0)
     out = region.astype(np.int64, copy=True)
@@ -57,19 +56,13 @@ def recovered_regions(graph, region, flat, areas, min_new_area: float) -> np.nda
     counts = graph.starts[members + 1] - graph.starts[members]
     neighbour = graph.target[expand_ranges(graph.starts[members], counts)]
     touching = np.repeat(part_of, counts)
-    beside = out[neighbour]
-    known = beside >= 0
-    n_regions = int(out.max()) + 1
-    pairs = np.unique(touching[known] * n_regions + beside[known])
-    pair_part, pair_region = pairs // max(n_regions, 1), pairs % max(n_regions, 1)
-    touches = np.bincount(pair_part, minlength=roots.size)
-    joins = np.full(roots.size, -1, dtype=np.int64)
-    single = touches[pair_part] == 1
-    joins[pair_part[single]] = pair_region[single]
+    touches = np.zeros(roots.size, dtype=bool)
+    touches[touching[out[neighbour] >= 0]] = True
     part_area = np.bincount(part_of, areas[members], minlength=roots.size)
-    alone = np.flatnonzero((touches == 0) & (part_area >= min_new_area))
-    joins[alone] = n_regions + np.arange(alone.size)
-    out[members] = joins[part_of]
+    alone = np.flatnonzero(~touches & (part_area >= min_new_area))
+    number = np.full(roots.size, -1, dtype=np.int64)
+    number[alone] = int(out.max()) + 1 + np.arange(alone.size)
+    out[members] = number[part_of]
     return _by_area(out, areas)
 
 
