@@ -261,3 +261,18 @@ def test_dilate_by_more_rings_than_the_mesh_has_fills_the_seeds_part_and_returns
     part = connected_parts(graph.starts, graph.target, everywhere)
     grown = dilate(graph.starts, graph.target, seed, 10**12)
     assert np.array_equal(grown, part == part[0])
+
+
+def test_a_scale_below_the_mesh_spacing_is_refused_and_one_just_above_it_runs():
+    """The bound's oracle: the mesh's mean edge length, measured here from its edges."""
+    fragment = bone_fragment(spacing=2.0)
+    surface = Surface(fragment.points, fragment.triangles)
+    edges = np.vstack([surface.triangles[:, [0, 1]], surface.triangles[:, [1, 2]],
+                       surface.triangles[:, [2, 0]]])  # fmt: skip
+    edges = np.unique(np.sort(edges, axis=1), axis=0)
+    h = float(np.linalg.norm(np.diff(surface.points[edges], axis=1)[:, 0], axis=1).mean())
+    for value in (1e-9, 0.5 * h, 0.95 * h):
+        with pytest.raises(GoniometerError, match=r"scale.*smaller than the mesh's mean edge"):
+            find_break_edges(surface, scale=value)
+    result = find_break_edges(surface, scale=1.5 * h)
+    assert result.parameters.scale == pytest.approx(1.5 * h)

@@ -131,3 +131,20 @@ def test_stations_read_what_a_hand_placed_measurement_reads(shaft, label):
     assert np.linalg.norm(centres[nearest] - site.point) <= 0.6
     by_hand = surface.measure(site.point, 2.0)
     assert abs(profile.stations[nearest].angle - by_hand.angle) <= 0.5
+
+
+@pytest.mark.parametrize(
+    ("spacing", "roughness"),
+    [(0.5, 0.0), (0.6, 0.0), (0.6, 0.05), (0.7, 0.0), (0.7, 0.05), (0.8, 0.0)],
+)
+def test_the_demo_bone_at_coarse_spacings_has_all_four_rims(spacing, roughness):
+    """The README demo's shaft at 0.5 to 0.8 mm: its transverse face is 5 mm wide, narrower than
+    the band the default scale (five edges, up to 4 mm) leaves round its two rims; the fine field
+    recovers it as a region, so all four rims are found (the fragment's exact rims the oracle)."""
+    fragment = bone_shaft(spacing, roughness=roughness, seed=1)
+    surface = Surface(fragment.points, fragment.triangles)
+    result = surface.find_break_edges()
+    figures = score(fragment, [c.path.points for c in result.candidates])
+    assert figures["recall"] >= 0.95, figures
+    assert figures["false"] <= 0.05, figures
+    assert len(result.candidates) == 4 and all(c.closed for c in result.candidates)

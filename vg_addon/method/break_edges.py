@@ -7,6 +7,9 @@ The method, in four steps (docs/EDGE_DETECTION.md shows it at work):
 2. **Smooth regions.** Vertices bending less than ``min_bend_deg`` are smooth; their connected
    parts larger than ``min_region_area`` are the regions (fracture faces, the original outer and
    inner surfaces); the thin band of ridge vertices between them is left out (``region`` -1).
+   Where the fine bend field (two rings) calls a part of the band flat and it touches no
+   region, it becomes a region of its own: a face narrower than the band the scale leaves (see
+   :mod:`.narrow_faces`).
 3. **Edges between regions.** The band is flooded from both sides; where two regions' floods
    meet lies the break edge between them, open (ending where a third region or the mesh's border
    comes in) or closed (a loop). Ridges that fade into a single region are found as long pieces of
@@ -34,6 +37,7 @@ from .edge_pieces import (
 from .edge_profile import EdgePath, assemble_path, has_ridge_graph, ridge_graph
 from .mesh_edges import MeshEdges
 from .mesh_regions import flood_labels
+from .narrow_faces import flat_band, recovered_regions
 from .ridge_field import (
     anisotropy_of_bend,
     bend_of_anisotropy,
@@ -61,6 +65,21 @@ ORIGINAL_MIN_SPREAD = 0.1
 FINE_RINGS = 2
 """Rings of neighbours of the fine bend field, whose crests the edges are traced along."""
 
+NOISE_SAMPLES = 20_000
+"""The fine field's typical bend on a noisy scan is judged on about this many region vertices."""
+
+FLAT_SHARE = 0.5
+"""A band vertex is flat by the fine field below this share of the ridge bar: only clearly flat
+vertices join a region (half the bar keeps a noisy scan's crest in the band)."""
+
+MIN_SCALE_EDGES = 1.0
+"""A ``scale`` below this many mean edge lengths is refused: its neighbourhood would hold no
+neighbours, so every vertex would read flat."""
+
+NEW_FACE_RINGS = 4.0
+"""A face the coarse field swallowed becomes a region if at least as large as a disc of this
+many mean edge lengths in radius."""
+
 MIN_REGION_SCALES = 2.0
 """Default ``min_region_area``: a disc of this many times ``scale`` in radius."""
 
@@ -75,7 +94,7 @@ class BreakEdgeParameters:
         The size of the neighbourhood a bend is judged over, and the unit of the other derived
         lengths. None: :data:`SCALE_EDGES` mean edge lengths (0.3 mm on a scan with 0.1 mm edges).
         Larger values see past scan noise and find rounded edges, smaller ones separate close
-        edges.
+        edges. A scale below :data:`MIN_SCALE_EDGES` mean edge lengths is refused.
     min_bend_deg : float
         A ridge bends at least this much (degrees, 180° minus the interior angle). Default 30°:
         break edges of bone and stone are rarely blunter than 150°.
@@ -139,8 +158,20 @@ class BreakEdgeParameters:
         return self
 
     def resolved(self, mean_edge_length: float) -> BreakEdgeParameters:
-        """These parameters with every ``None`` replaced by its default for this mesh."""
+        """These parameters with every ``None`` replaced by its default for this mesh.
+
+        Raises
+        ------
+        GoniometerError
+            ``scale`` below :data:`MIN_SCALE_EDGES` times ``mean_edge_length``.
+        """
         scale = self.scale if self.scale is not None else SCALE_EDGES * mean_edge_length
+        if scale < MIN_SCALE_EDGES * mean_edge_length:
+            raise GoniometerError(
+                f"The break-edge parameter scale ({scale:g}) is smaller than the mesh's mean edge "
+                f"length ({mean_edge_length:g}): a neighbourhood that small holds no neighbours to "
+                "judge a bend by; choose a larger one or None for the default."
+            )
         min_length = self.min_length if self.min_length is not None else MIN_LENGTH_SCALES * scale
         area = self.min_region_area
         if area is None:
@@ -384,6 +415,8 @@ class BreakEdgeFinder:
         rows = np.flatnonzero(used & (region < 0))
         fine_spread, fine_total = ring_spread(sums, graph.starts, graph.target, FINE_RINGS, rows)
         yield 0.5
+        region = self._narrow_faces(graph, sums, region, rows, fine_spread, fine_total, bar, params)
+        rows = np.flatnonzero(used & (region < 0))
         heights = blurred(total, graph.starts, graph.target, 2 * FINE_RINGS, rows) + fine_total
         flooded = flood_labels(graph.starts, graph.target, region, used, heights=heights)
         bend_field = np.maximum(spread, fine_spread)
@@ -413,6 +446,25 @@ class BreakEdgeFinder:
             ridge_min_deg=ridge_min_deg,
         )
         yield 1.0
+
+    def _narrow_faces(self, graph, sums, region, rows, fine_spread, fine_total, bar, params):
+        """``region`` with the band's flat parts (by the fine field) that touch no region made
+        regions of their own (see :mod:`.narrow_faces`)."""
+        inside = np.flatnonzero(region >= 0)
+        sample = inside[:: max(1, inside.size // NOISE_SAMPLES)]
+        if sample.size:
+            s_spread, s_total = ring_spread(sums, graph.starts, graph.target, FINE_RINGS, sample)
+            # Noise spreads the normals in every direction (the second eigenvalue), a bone's
+            # curvature in one (the crease part): only the noise should raise the bar.
+            second = (s_total[sample] - s_spread[sample]) / 2.0
+            floor = max(bar, params.noise_factor * _median(second))
+        else:
+            floor = bar
+        bar_flat = FLAT_SHARE * floor
+        flat = flat_band(fine_spread, (fine_total - fine_spread) / 2.0, rows, bar_flat, bar_flat)
+        h = graph.mean_edge_length
+        min_area = math.pi * (NEW_FACE_RINGS * h) ** 2
+        return recovered_regions(graph, region, flat, sums[:, 0], min_area)
 
     def _candidate(self, graph, piece, spread, ridge_min_deg, params):
         """The candidate traced along ``piece``, or None if it is too short."""
