@@ -373,6 +373,7 @@ SPEED_BASE = "ec2841d"
 """The last commit before the refined rule's cost was cut (issue 19, item 5): its core is the
 "before" of :func:`refinement_comparison`."""
 
+
 def _blas_core():
     """The core as it was at :data:`BLAS_COMMIT` (None, with the reason printed, where git or
     that commit is not available), and its stability module."""
