@@ -547,7 +547,10 @@ def _refine_by_strip(points, normals, labels, center, radius, spacing, planes):
         return None
     for k, side in enumerate((plus, ~plus)):
         face_frame = (on_line, direction, into_faces[k])
-        if _planar(points, side & kept, planes[k], face_frame, spacing, radius) is not True:
+        if (
+            _planar(points, side & kept, planes[k], face_frame, spacing, radius, STRICT_GAIN)
+            is not True
+        ):
             return None  # a curved face, or one too narrow to show it is a plane
     return _fields(plus, kept, planes)
 
