@@ -235,10 +235,10 @@ def test_edge_profiles_list_shows_each_edge_and_picks_by_click(gui, places):
     edges = gui.settle()["objects"][OBJ]["edges"]
     assert len(edges) == len(EDGES)
     assert all(abs(edge["mean"] - WEDGE_ANGLE) < 1e-6 for edge in edges)
-    # The list is below the button and its hint line: where hovering copies its index
-    # property. Clicking down it selects each edge in turn, top to bottom.
+    # The list is below the button, its hint line, Find Break Edges and its folded settings:
+    # where hovering copies its index property. Clicking down it selects each edge in turn.
     below = int(button[1])
-    span = gui.list_span("active_edge_index", range(below + 16, below + 170, 4))
+    span = gui.list_span("active_edge_index", range(below + 16, below + 240, 4))
     shot = sidebar_shot(gui, "edge_list", below - 100, 420)
     assert span, f"no edge list is drawn ({shot})"
     left, _top, width, _height = gui.state()["regions"]["UI"]
