@@ -249,3 +249,21 @@ def test_a_strip_hidden_in_noise_is_found_by_where_its_vertices_lie_on_average(
     for faces in (triangles, triangles[:, ::-1]):
         m = Surface(points, faces).measure(center, 0.2)
         assert abs(m.angle - angle) < 0.1 and m.n_left_out > 0, (m.angle, oriented.angle)
+
+
+def test_strip_bands_far_from_the_line_make_no_bin_per_spacing_up_to_it():
+    # Near-parallel planes put their line far from the patch: the bands are binned by what they
+    # hold, not by every spacing up to the line (a bincount that long would not fit in memory).
+    from vg_addon.method.refinement import _strip_width
+
+    rng = np.random.default_rng(5)
+    count = 400
+    points = np.column_stack(
+        [rng.uniform(-1, 1, count), rng.uniform(-1, 1, count), np.zeros(count)]
+    )
+    side = np.ones(count, dtype=bool)
+    plane = (np.array([0.0, 0.0, 1.0]), np.zeros(3), 0.0)
+    to_line = 1e15 + np.abs(points[:, 0])  # spacings 0.1: 1e16 bins before
+    width = _strip_width(points, side, side, plane, np.array([0.0, 0.0, 1.0]), to_line, 0.1)
+    assert width == 0.0  # a flat side: no band lies towards the other face
+    assert _strip_width(points, side, ~side, plane, plane[0], to_line, 0.1) == 0.0

@@ -471,6 +471,8 @@ def _strip_width(points, side, kept, plane, toward_other, to_line, spacing) -> f
     normal, centroid, _ = plane
     if dot3(normal, toward_other) < 0:
         normal = -normal
+    if not kept[side].any():
+        return 0.0
     height = row_dot(points[side] - centroid, normal)
     distance = to_line[side]
     outer = kept[side] & (distance >= _median(distance[kept[side]]))
@@ -478,13 +480,16 @@ def _strip_width(points, side, kept, plane, toward_other, to_line, spacing) -> f
         return 0.0
     spread = 1.4826 * _median(np.abs(height[outer] - _median(height[outer])))
     spread = max(spread, NOISE_FLOOR * spacing)
-    bands = (distance / spacing).astype(np.int64)
-    counts = np.bincount(bands)
-    sums = np.bincount(bands, weights=height)
+    # Only the bands that hold vertices: a line far from the patch (planes near parallel) would
+    # otherwise make a bin for every spacing up to it. The sums run in the same order.
+    bands, slot, counts = np.unique(
+        (distance / spacing).astype(np.int64), return_inverse=True, return_counts=True
+    )
+    sums = np.bincount(slot.ravel(), weights=height)
     width = 0.0
-    for band in np.flatnonzero(counts >= MIN_BAND_VERTICES).tolist():
-        count = int(counts[band])
-        if float(sums[band]) / count <= STRIP_SPREADS * spread / math.sqrt(count):
+    for index in np.flatnonzero(counts >= MIN_BAND_VERTICES).tolist():
+        band, count = int(bands[index]), int(counts[index])
+        if float(sums[index]) / count <= STRIP_SPREADS * spread / math.sqrt(count):
             break
         width = (band + 1) * spacing
     return width
@@ -590,13 +595,11 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error, 
     """
     if split_error <= (NOISE_FLOOR * spacing) ** 2:
         return None  # Algorithm 1's planes already fit to rounding error
-    refusal = None
-    try:
-        refined = _refine_by_outliers(
-            points, normals, labels, center, radius, spacing, split_error, planes
-        )
-    except GoniometerError as error:
-        refined, refusal = None, error
+    # A refusal of the first stage stands: it showed a strip that leaves a face too little to
+    # carry its plane, and a narrower band found by the second would read that face's plane off.
+    refined = _refine_by_outliers(
+        points, normals, labels, center, radius, spacing, split_error, planes
+    )
     if refined is not None and split_error >= DECISIVE_IMPROVEMENT * refined["fit_error"]:
         return refined  # exact faces without the vertices off them: nothing is left to find
     by_strip = _refine_by_strip(points, normals, labels, center, radius, spacing, planes)
@@ -604,8 +607,6 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error, 
         refined is None or by_strip["used"].sum() <= refined["used"].sum()
     ):
         return by_strip  # a band at least as large as the vertices the first stage found off
-    if refusal is not None:
-        raise refusal
     return refined
 
 
