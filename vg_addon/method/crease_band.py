@@ -12,10 +12,22 @@ is two plane fits on the patch, in a fixed order (:mod:`.fixed_order`).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .algorithm import MIN_SIDE_VERTICES
-from .fixed_order import acos_degrees, dot3, eigh3, moments, norm3, row_dot, rows_dot, solve
+from .fixed_order import (
+    acos_degrees,
+    dot3,
+    eigh3,
+    moments,
+    norm3,
+    row_dot,
+    rows_dot,
+    solve,
+    total,
+)
 from .refinement import mean_edge_length
 
 BAND_SPACINGS = (1.0, 2.0)
@@ -33,6 +45,32 @@ nearest the crease line to its farthest): else it is one row of vertices, which 
 it fits, noise or none."""
 
 _RANK_TOLERANCE = 1e-10  # as Algorithm 1's test for a side on a line
+
+
+def _acute_reach(normal_plus, normal_minus) -> float:
+    """How many times farther from the crease line than a mesh spacing a vertex of one face lies
+    within a mesh spacing of the other face: ``1 / sin(angle)`` at an acute crease (a vertex at
+    distance ``d`` from the line is ``d sin(angle)`` from the other face), 1 at a right or obtuse
+    one (the other face's nearest point is then the crease line itself). A cell of the mesh that
+    holds both faces is that far from the line, and its vertices can lie on either face or on
+    neither; on a thin wedge that is the whole patch."""
+    if dot3(normal_plus, normal_minus) >= 0.0:
+        return 1.0  # normals 90° or less apart (the angle is 180° less theirs): not acute
+    opening = norm3(np.cross(normal_plus, normal_minus))
+    return 1.0 / max(opening, 1e-12)
+
+
+def _normals_hide_the_crease(normals, tangent, angle) -> bool:
+    """Whether the vertex normals' noise is larger than the turn that tells the faces apart.
+
+    On any crease both faces' normals are perpendicular to the tangent, so the normals' root mean
+    square component along it is noise alone; each face's normal turns ``(180 - angle) / 2`` from
+    their mean. Where that noise is the larger, a vertex's normal does not say which face it is
+    on, the tangent Algorithm 1 draws the split along is the noise's, and its sides can be mixed
+    across the whole patch (every perturbed run and every band shares that)."""
+    along = row_dot(normals, tangent)
+    noise = math.sqrt(total(along * along) / along.size)
+    return noise > math.sin(math.radians(180.0 - angle) / 2.0)
 
 
 def _plane_normal(points, normals) -> np.ndarray | None:
@@ -88,14 +126,17 @@ def crease_change(surface, m) -> tuple[float, int]:
     -------
     change : float
         The largest change of the angle, in degrees, when the vertices within each band of
-        :data:`BAND_SPACINGS` mesh spacings and :data:`BAND_RADII` radii of the crease line are
-        left out and each side's plane is fitted again to the rest (no band wider than the
-        widest of :data:`BAND_RADII`). Also where the planes fit their vertices exactly: two rows
-        of vertices always fit a plane, on the face or not.
+        :data:`BAND_SPACINGS` mesh spacings (at an acute crease, of the other face: ``1 /
+        sin(angle)`` times farther from the line) and :data:`BAND_RADII` radii of the crease
+        line are left out and each side's plane is fitted again to the rest (no spacing band
+        wider than the widest of :data:`BAND_RADII` at a right or obtuse crease). Also where the
+        planes fit their vertices exactly: two rows of vertices always fit a plane, on the face
+        or not.
     refused : int
-        How many bands left a side too few vertices, a line, or a band narrower than
-        :data:`MIN_REACH` to fit its plane: then how far the vertices next to the crease tilt the
-        reading is not known.
+        How many distinct bands left a side too few vertices, a line, or a band narrower than
+        :data:`MIN_REACH` to fit its plane, plus one where the vertex normals' noise is larger
+        than the turn between the faces (:func:`_normals_hide_the_crease`): then how far the
+        reading is off is not known.
     """
     spacing = mean_edge_length(m.radius, m.n_vertices)
     points = surface.points[m.indices] - m.center
@@ -104,11 +145,18 @@ def crease_change(surface, m) -> tuple[float, int]:
     sides = (m.labels & used, ~m.labels & used)
     # On a patch of few vertices two spacings can be more than half the radius: no band is wider.
     widest = max(BAND_RADII) * m.radius
-    widths = [min(k * spacing, widest) for k in BAND_SPACINGS] + [k * m.radius for k in BAND_RADII]
+    # At an acute crease the cells that hold both faces reach farther from the line (no cap
+    # there: where they cover the patch, the mesh does not resolve the two faces at all).
+    reach = _acute_reach(m.normal_plus, m.normal_minus)
+    widths = [min(k * spacing, widest) * reach for k in BAND_SPACINGS]
+    # A small patch clamps both spacing bands to the widest: that is one band, counted once.
+    widths = list(dict.fromkeys(widths + [k * m.radius for k in BAND_RADII]))
     to_line = _distance_to_crease(points, sides, m.normal_plus, m.normal_minus)
     if to_line is None:
         return 0.0, len(widths)
     change, refused = 0.0, 0
+    if _normals_hide_the_crease(normals, m.tangent, m.angle):
+        refused += 1
     for width in widths:
         kept = [side & (to_line > width) for side in sides]
         fitted = [

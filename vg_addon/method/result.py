@@ -79,7 +79,9 @@ def stability_warning(
     if crease_refused > 0:
         reasons.append(
             "Undetermined: without the vertices next to the crease a face keeps too few "
-            "vertices off it to fit its plane, so how far they tilt the reading is not known "
+            "vertices off it to fit its plane (on a thin wedge the mesh's cells hold both faces "
+            "across the patch), or the vertex normals' noise is larger than the turn between "
+            "the faces (the sides can be mixed), so how far the reading is off is not known "
             "and the ± figure may be far too small."
         )
     if not reasons:
@@ -147,8 +149,9 @@ class Stability:
         the crease give both planes, which every perturbed run above shares. Added to the
         largest of the other parts, not compared with them: it is a bias, they are spreads.
     crease_refused : int
-        Bands whose refit was refused (a side kept too few vertices, or a line): the figure is
-        then undetermined.
+        Checks of the crease that could not be made: bands whose refit was refused (a side
+        kept too few vertices, or a line), and one more where the vertex normals' noise is
+        larger than the turn between the faces. The figure is then undetermined.
     """
 
     spread: float
