@@ -52,7 +52,6 @@ from .fixed_order import (
     gram,
     norm3,
     offset_columns,
-    row_dot,
     solve,
     total,
 )
@@ -178,19 +177,18 @@ def _distance_to_line(points, on_line, direction) -> np.ndarray:
 def _side_plane(points, normals, mask):
     """PCA plane of the masked points: unit normal (oriented by the side's mean normal), centroid
     and mean squared distance; ``None`` when the points do not span a plane."""
-    # One gather and one sum (row after row, each column on its own) for points and normals.
-    rows = np.compress(mask, np.concatenate((points, normals), axis=1), axis=0)
+    # Sums row after row, each column on its own (joining points and normals costs more).
+    rows = np.compress(mask, points, axis=0)
     count = rows.shape[0]
-    sums = np.add.reduce(rows, axis=0)
-    centroid = sums[:3] / count
+    centroid = np.add.reduce(rows, axis=0) / count
     centred = np.empty((3, count))
-    np.subtract(rows[:, :3].T, centroid[:, None], out=centred)
+    np.subtract(rows.T, centroid[:, None], out=centred)
     xx, xy, xz, yy, yz, zz = (value / count for value in column_moments(centred))
     values, vectors = eigh3_entries(xx, xy, xz, yy, yz, zz)
     if not values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny):
         return None
     normal = vectors[:, 0]
-    if dot3(normal, sums[3:]) < 0:
+    if dot3(normal, np.add.reduce(np.compress(mask, normals, axis=0), axis=0)) < 0:
         normal = -normal
     return normal, centroid, max(float(values[0]), 0.0)
 
@@ -244,7 +242,7 @@ def _face_coordinates(points, plane, frame, radius):
     normal, centroid, _ = plane
     on_line, direction, into_face = frame
     u, w = columns_dots(offset_columns(points, on_line), [into_face, direction]) / radius
-    return u, w, row_dot(points - centroid, normal)
+    return u, w, columns_dot(offset_columns(points, centroid), normal)
 
 
 def _residuals(basis, height, fitted_on):
@@ -307,7 +305,7 @@ def _planar(points, side, plane, frame, spacing, radius, gain=None) -> bool | No
     quadratic fits markedly better (a curved face); ``None`` where they are too few rows, or too
     narrow a band, to tell. ``gain``: the quadratic's largest allowed gain, if not
     :data:`CURVED_GAIN`."""
-    u, w, height = _face_coordinates(points[side], plane, frame, radius)
+    u, w, height = _face_coordinates(np.compress(side, points, axis=0), plane, frame, radius)
     if float(u.max() - u.min()) * radius < MIN_CURVATURE_SPREAD * spacing:
         return None
     basis = np.stack([np.ones_like(u), u, w, u * w, w * w, u * u])
@@ -471,24 +469,29 @@ def _strip_width(points, side, kept, plane, toward_other, to_line, spacing) -> f
     normal, centroid, _ = plane
     if dot3(normal, toward_other) < 0:
         normal = -normal
-    if not kept[side].any():
+    kept_here = np.compress(side, kept)
+    if not kept_here.any():
         return 0.0
-    height = row_dot(points[side] - centroid, normal)
-    distance = to_line[side]
-    outer = kept[side] & (distance >= _median(distance[kept[side]]))
+    height = columns_dot(offset_columns(np.compress(side, points, axis=0), centroid), normal)
+    distance = np.compress(side, to_line)
+    outer = kept_here & (distance >= _median(np.compress(kept_here, distance)))
     if not outer.any():
         return 0.0
-    spread = 1.4826 * _median(np.abs(height[outer] - _median(height[outer])))
+    outer_height = np.compress(outer, height)
+    spread = 1.4826 * _median(np.abs(outer_height - _median(outer_height)))
     spread = max(spread, NOISE_FLOOR * spacing)
-    # Only the bands that hold vertices: a line far from the patch (planes near parallel) would
-    # otherwise make a bin for every spacing up to it. The sums run in the same order.
-    bands, slot, counts = np.unique(
-        (distance / spacing).astype(np.int64), return_inverse=True, return_counts=True
-    )
-    sums = np.bincount(slot.ravel(), weights=height)
+    # A bin per spacing where the line runs through the patch; only the bands that hold vertices
+    # where it lies far from it (planes near parallel). The sums run in the same order.
+    index_of = (distance / spacing).astype(np.int64)
+    if int(index_of.max()) <= 4 * index_of.size:
+        counts = np.bincount(index_of)
+        bands, sums = None, np.bincount(index_of, weights=height)
+    else:
+        bands, slot, counts = np.unique(index_of, return_inverse=True, return_counts=True)
+        sums = np.bincount(slot.ravel(), weights=height)
     width = 0.0
     for index in np.flatnonzero(counts >= MIN_BAND_VERTICES).tolist():
-        band, count = int(bands[index]), int(counts[index])
+        band, count = index if bands is None else int(bands[index]), int(counts[index])
         if float(sums[index]) / count <= STRIP_SPREADS * spread / math.sqrt(count):
             break
         width = (band + 1) * spacing
