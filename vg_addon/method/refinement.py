@@ -198,10 +198,10 @@ def _cross(a, b) -> np.ndarray:
     return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
-def _half_plane_distances(points, center, planes):
-    """Each vertex's distance to the two half-planes that meet at the planes' line; ``None``
-    when the planes are parallel. Also returns the line's frame for the smooth-surface fits."""
-    (normal_plus, centroid_plus, _), (normal_minus, centroid_minus, _) = planes
+def _crease_line(planes, center):
+    """The line where two planes (unit normal, a point on it, ...) meet: its point nearest
+    ``center`` and its unit direction; ``None`` when the planes are parallel."""
+    (normal_plus, centroid_plus, *_), (normal_minus, centroid_minus, *_) = planes
     direction = _cross(normal_plus, normal_minus)
     length = norm3(direction)
     if length <= 1e-12:
@@ -213,7 +213,17 @@ def _half_plane_distances(points, center, planes):
     on_line = solve(rows, offsets)
     if on_line is None:
         return None
-    on_line = np.array(on_line)
+    return np.array(on_line), direction
+
+
+def _half_plane_distances(points, center, planes):
+    """Each vertex's distance to the two half-planes that meet at the planes' line; ``None``
+    when the planes are parallel. Also returns the line's frame for the smooth-surface fits."""
+    (normal_plus, centroid_plus, _), (normal_minus, centroid_minus, _) = planes
+    line = _crease_line(planes, center)
+    if line is None:
+        return None
+    on_line, direction = line
     relative = offset_columns(points, on_line)
     along = columns_dot(relative, direction)
     across = relative - direction[:, None] * along
@@ -268,6 +278,13 @@ def _median(values) -> float:
     return (float(middle[half - 1]) + float(middle[half])) / 2  # the same IEEE sum and halving
 
 
+def _robust_spread(median_deviation, spacing) -> float:
+    """The robust standard deviation of values whose median absolute deviation is
+    ``median_deviation`` (1.4826 times it, as for a normal distribution), at least
+    :data:`NOISE_FLOOR` mesh spacings."""
+    return max(1.4826 * median_deviation, NOISE_FLOOR * spacing)
+
+
 def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
     """Vertices of ``side`` that lie off the face's plane, fitted robustly to ``fitted_on``.
 
@@ -293,8 +310,7 @@ def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
         subset = fit_here & (residual <= middle)
         if np.count_nonzero(subset) < MIN_FAR_VERTICES:
             break
-    spread = max(1.4826 * middle, NOISE_FLOOR * spacing)
-    off[members] = residual > OUTLIER_SPREADS * spread
+    off[members] = residual > OUTLIER_SPREADS * _robust_spread(middle, spacing)
     return off
 
 
@@ -478,8 +494,7 @@ def _strip_width(points, side, kept, plane, toward_other, to_line, spacing) -> f
     if not outer.any():
         return 0.0
     outer_height = np.compress(outer, height)
-    spread = 1.4826 * _median(np.abs(outer_height - _median(outer_height)))
-    spread = max(spread, NOISE_FLOOR * spacing)
+    spread = _robust_spread(_median(np.abs(outer_height - _median(outer_height))), spacing)
     # A bin per spacing where the line runs through the patch; only the bands that hold vertices
     # where it lies far from it (planes near parallel). The sums run in the same order.
     index_of = (distance / spacing).astype(np.int64)
