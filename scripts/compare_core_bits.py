@@ -1,6 +1,6 @@
 """Check that a change to the measuring core left every reading's bits as they were.
 
-Run: ``.venv/bin/python scripts/compare_core_bits.py [--commit ec2841d] [--quick]``. The core at
+Run: ``.venv/bin/python scripts/compare_core_bits.py [--commit d4444ed] [--quick]``. The core at
 ``--commit`` is extracted with ``git archive`` and imported beside today's; both measure the same
 patches and every field of every :class:`~vg_addon.Measurement` (or the text of every refusal) is
 compared bit for bit. Prints the count of measurements, refusals, refinements applied and
@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
 
-from benchmark import SPEED_BASE, _core_at  # noqa: E402
+from benchmark import REFINED_SPEED_BASE, _core_at  # noqa: E402
 from benchmark_drag import ridge_mesh  # noqa: E402
 
 SAMPLE = ROOT.parent / "shared" / "data" / "sample_mesh.ply"
@@ -124,7 +124,7 @@ def readings(package: str, quick: bool) -> list:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--commit", default=SPEED_BASE, help="the core to compare with")
+    parser.add_argument("--commit", default=REFINED_SPEED_BASE, help="the core to compare with")
     parser.add_argument("--quick", action="store_true", help="fewer cases (about a quarter)")
     args = parser.parse_args(argv)
     name = "vg_addon_at_" + "".join(c for c in args.commit if c.isalnum())

@@ -267,3 +267,26 @@ def test_strip_bands_far_from_the_line_make_no_bin_per_spacing_up_to_it():
     width = _strip_width(points, side, side, plane, np.array([0.0, 0.0, 1.0]), to_line, 0.1)
     assert width == 0.0  # a flat side: no band lies towards the other face
     assert _strip_width(points, side, ~side, plane, plane[0], to_line, 0.1) == 0.0
+
+
+def test_strip_width_is_the_raised_bands_whether_the_line_is_near_or_far():
+    # A side whose vertices within three spacings of the line lie towards the other face: the
+    # strip is those three bands, counted from the line, whether the bands are binned one per
+    # spacing (line through the patch) or by what they hold (line far away). Binary fractions
+    # keep every band number exact.
+    from vg_addon.method.refinement import _strip_width
+
+    rng = np.random.default_rng(11)
+    count, spacing = 400, 0.125
+    distance = rng.uniform(0.0, 2.0, count)
+    height = np.where(distance < 3 * spacing, 0.5, rng.normal(scale=0.01, size=count))
+    points = np.column_stack([distance, np.zeros(count), height])
+    side = np.ones(count, dtype=bool)
+    plane = (np.array([0.0, 0.0, 1.0]), np.zeros(3), 0.0)
+    up = np.array([0.0, 0.0, 1.0])
+    for offset in (0.0, 2.0**20 * spacing):
+        width = _strip_width(points, side, side, plane, up, offset + distance, spacing)
+        assert width == offset + 3 * spacing
+    flat = points.copy()
+    flat[:, 2] = rng.normal(scale=0.01, size=count)
+    assert _strip_width(flat, side, side, plane, up, distance, spacing) == 0.0

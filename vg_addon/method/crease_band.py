@@ -17,18 +17,8 @@ import math
 import numpy as np
 
 from .algorithm import MIN_SIDE_VERTICES
-from .fixed_order import (
-    acos_degrees,
-    dot3,
-    eigh3,
-    moments,
-    norm3,
-    row_dot,
-    rows_dot,
-    solve,
-    total,
-)
-from .refinement import mean_edge_length
+from .fixed_order import acos_degrees, dot3, norm3, row_dot, total
+from .refinement import _crease_line, _distance_to_line, _side_plane, mean_edge_length
 
 BAND_SPACINGS = (1.0, 2.0)
 """Bands of this many mesh spacings either side of the crease line: the vertices of the
@@ -43,8 +33,6 @@ MIN_REACH = 1.0
 """What is left of a side must reach this many mesh spacings across the crease (from its vertex
 nearest the crease line to its farthest): else it is one row of vertices, which any plane through
 it fits, noise or none."""
-
-_RANK_TOLERANCE = 1e-10  # as Algorithm 1's test for a side on a line
 
 
 def _acute_reach(normal_plus, normal_minus) -> float:
@@ -73,39 +61,25 @@ def _normals_hide_the_crease(normals, tangent, angle) -> bool:
     return noise > math.sin(math.radians(180.0 - angle) / 2.0)
 
 
-def _plane_normal(points, normals) -> np.ndarray | None:
-    """The PCA plane's unit normal, oriented by the side's mean normal; ``None`` where the side
-    has too few vertices or they lie on a line."""
-    count = points.shape[0]
-    if count < MIN_SIDE_VERTICES:
+def _plane_normal(points, normals, side) -> np.ndarray | None:
+    """The PCA plane's unit normal of the ``side`` vertices, oriented by their mean normal;
+    ``None`` where the side has too few vertices or they lie on a line."""
+    if int(np.count_nonzero(side)) < MIN_SIDE_VERTICES:
         return None
-    centroid = np.add.reduce(points, axis=0) / count
-    values, vectors = eigh3(moments(points - centroid) / count)
-    if not values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny):
-        return None
-    normal = vectors[:, 0]
-    return -normal if dot3(normal, np.add.reduce(normals, axis=0)) < 0 else normal
+    plane = _side_plane(points, normals, side)
+    return None if plane is None else plane[0]
 
 
 def _distance_to_crease(points, sides, normal_plus, normal_minus) -> np.ndarray | None:
     """Each point's distance to the line where the two planes meet (each plane through its
     side's centroid); ``None`` where the planes do not meet in a line."""
-    direction = np.cross(normal_plus, normal_minus)
-    length = norm3(direction)
-    if length <= 1e-12:
-        return None
-    direction = direction / length
-    offsets = [
-        dot3(normal, np.add.reduce(points[side], axis=0) / int(side.sum()))
+    planes = [
+        (normal, np.add.reduce(points[side], axis=0) / int(side.sum()))
         for normal, side in zip((normal_plus, normal_minus), sides, strict=True)
     ]
     # The line's point nearest the centre (the origin of ``points``).
-    on_line = solve(np.array([normal_plus, normal_minus, direction]), [*offsets, 0.0])
-    if on_line is None:
-        return None
-    relative = points - np.array(on_line)
-    along = row_dot(relative, direction)
-    return np.sqrt(np.maximum(rows_dot(relative, relative) - along * along, 0.0))
+    line = _crease_line(planes, np.zeros(3))
+    return None if line is None else _distance_to_line(points, *line)
 
 
 def _reaches(to_line, spacing) -> bool:
@@ -160,7 +134,7 @@ def crease_change(surface, m) -> tuple[float, int]:
     for width in widths:
         kept = [side & (to_line > width) for side in sides]
         fitted = [
-            _plane_normal(points[side], normals[side]) if _reaches(to_line[side], spacing) else None
+            _plane_normal(points, normals, side) if _reaches(to_line[side], spacing) else None
             for side in kept
         ]
         if fitted[0] is None or fitted[1] is None:

@@ -52,7 +52,6 @@ from .fixed_order import (
     gram,
     norm3,
     offset_columns,
-    row_dot,
     solve,
     total,
 )
@@ -178,19 +177,18 @@ def _distance_to_line(points, on_line, direction) -> np.ndarray:
 def _side_plane(points, normals, mask):
     """PCA plane of the masked points: unit normal (oriented by the side's mean normal), centroid
     and mean squared distance; ``None`` when the points do not span a plane."""
-    # One gather and one sum (row after row, each column on its own) for points and normals.
-    rows = np.compress(mask, np.concatenate((points, normals), axis=1), axis=0)
+    # Sums row after row, each column on its own (joining points and normals costs more).
+    rows = np.compress(mask, points, axis=0)
     count = rows.shape[0]
-    sums = np.add.reduce(rows, axis=0)
-    centroid = sums[:3] / count
+    centroid = np.add.reduce(rows, axis=0) / count
     centred = np.empty((3, count))
-    np.subtract(rows[:, :3].T, centroid[:, None], out=centred)
+    np.subtract(rows.T, centroid[:, None], out=centred)
     xx, xy, xz, yy, yz, zz = (value / count for value in column_moments(centred))
     values, vectors = eigh3_entries(xx, xy, xz, yy, yz, zz)
     if not values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny):
         return None
     normal = vectors[:, 0]
-    if dot3(normal, sums[3:]) < 0:
+    if dot3(normal, np.add.reduce(np.compress(mask, normals, axis=0), axis=0)) < 0:
         normal = -normal
     return normal, centroid, max(float(values[0]), 0.0)
 
@@ -200,10 +198,10 @@ def _cross(a, b) -> np.ndarray:
     return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
-def _half_plane_distances(points, center, planes):
-    """Each vertex's distance to the two half-planes that meet at the planes' line; ``None``
-    when the planes are parallel. Also returns the line's frame for the smooth-surface fits."""
-    (normal_plus, centroid_plus, _), (normal_minus, centroid_minus, _) = planes
+def _crease_line(planes, center):
+    """The line where two planes (unit normal, a point on it, ...) meet: its point nearest
+    ``center`` and its unit direction; ``None`` when the planes are parallel."""
+    (normal_plus, centroid_plus, *_), (normal_minus, centroid_minus, *_) = planes
     direction = _cross(normal_plus, normal_minus)
     length = norm3(direction)
     if length <= 1e-12:
@@ -215,7 +213,17 @@ def _half_plane_distances(points, center, planes):
     on_line = solve(rows, offsets)
     if on_line is None:
         return None
-    on_line = np.array(on_line)
+    return np.array(on_line), direction
+
+
+def _half_plane_distances(points, center, planes):
+    """Each vertex's distance to the two half-planes that meet at the planes' line; ``None``
+    when the planes are parallel. Also returns the line's frame for the smooth-surface fits."""
+    (normal_plus, centroid_plus, _), (normal_minus, centroid_minus, _) = planes
+    line = _crease_line(planes, center)
+    if line is None:
+        return None
+    on_line, direction = line
     relative = offset_columns(points, on_line)
     along = columns_dot(relative, direction)
     across = relative - direction[:, None] * along
@@ -244,7 +252,7 @@ def _face_coordinates(points, plane, frame, radius):
     normal, centroid, _ = plane
     on_line, direction, into_face = frame
     u, w = columns_dots(offset_columns(points, on_line), [into_face, direction]) / radius
-    return u, w, row_dot(points - centroid, normal)
+    return u, w, columns_dot(offset_columns(points, centroid), normal)
 
 
 def _residuals(basis, height, fitted_on):
@@ -268,6 +276,13 @@ def _median(values) -> float:
         return float(np.partition(values, half)[half])
     middle = np.partition(values, (half - 1, half))
     return (float(middle[half - 1]) + float(middle[half])) / 2  # the same IEEE sum and halving
+
+
+def _robust_spread(median_deviation, spacing) -> float:
+    """The robust standard deviation of values whose median absolute deviation is
+    ``median_deviation`` (1.4826 times it, as for a normal distribution), at least
+    :data:`NOISE_FLOOR` mesh spacings."""
+    return max(1.4826 * median_deviation, NOISE_FLOOR * spacing)
 
 
 def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
@@ -295,8 +310,7 @@ def _off_surface(points, side, fitted_on, plane, frame, spacing, radius):
         subset = fit_here & (residual <= middle)
         if np.count_nonzero(subset) < MIN_FAR_VERTICES:
             break
-    spread = max(1.4826 * middle, NOISE_FLOOR * spacing)
-    off[members] = residual > OUTLIER_SPREADS * spread
+    off[members] = residual > OUTLIER_SPREADS * _robust_spread(middle, spacing)
     return off
 
 
@@ -307,7 +321,7 @@ def _planar(points, side, plane, frame, spacing, radius, gain=None) -> bool | No
     quadratic fits markedly better (a curved face); ``None`` where they are too few rows, or too
     narrow a band, to tell. ``gain``: the quadratic's largest allowed gain, if not
     :data:`CURVED_GAIN`."""
-    u, w, height = _face_coordinates(points[side], plane, frame, radius)
+    u, w, height = _face_coordinates(np.compress(side, points, axis=0), plane, frame, radius)
     if float(u.max() - u.min()) * radius < MIN_CURVATURE_SPREAD * spacing:
         return None
     basis = np.stack([np.ones_like(u), u, w, u * w, w * w, u * u])
@@ -471,24 +485,28 @@ def _strip_width(points, side, kept, plane, toward_other, to_line, spacing) -> f
     normal, centroid, _ = plane
     if dot3(normal, toward_other) < 0:
         normal = -normal
-    if not kept[side].any():
+    kept_here = np.compress(side, kept)
+    if not kept_here.any():
         return 0.0
-    height = row_dot(points[side] - centroid, normal)
-    distance = to_line[side]
-    outer = kept[side] & (distance >= _median(distance[kept[side]]))
+    height = columns_dot(offset_columns(np.compress(side, points, axis=0), centroid), normal)
+    distance = np.compress(side, to_line)
+    outer = kept_here & (distance >= _median(np.compress(kept_here, distance)))
     if not outer.any():
         return 0.0
-    spread = 1.4826 * _median(np.abs(height[outer] - _median(height[outer])))
-    spread = max(spread, NOISE_FLOOR * spacing)
-    # Only the bands that hold vertices: a line far from the patch (planes near parallel) would
-    # otherwise make a bin for every spacing up to it. The sums run in the same order.
-    bands, slot, counts = np.unique(
-        (distance / spacing).astype(np.int64), return_inverse=True, return_counts=True
-    )
-    sums = np.bincount(slot.ravel(), weights=height)
+    outer_height = np.compress(outer, height)
+    spread = _robust_spread(_median(np.abs(outer_height - _median(outer_height))), spacing)
+    # A bin per spacing where the line runs through the patch; only the bands that hold vertices
+    # where it lies far from it (planes near parallel). The sums run in the same order.
+    index_of = (distance / spacing).astype(np.int64)
+    if int(index_of.max()) <= 4 * index_of.size:
+        counts = np.bincount(index_of)
+        bands, sums = None, np.bincount(index_of, weights=height)
+    else:
+        bands, slot, counts = np.unique(index_of, return_inverse=True, return_counts=True)
+        sums = np.bincount(slot.ravel(), weights=height)
     width = 0.0
     for index in np.flatnonzero(counts >= MIN_BAND_VERTICES).tolist():
-        band, count = int(bands[index]), int(counts[index])
+        band, count = index if bands is None else int(bands[index]), int(counts[index])
         if float(sums[index]) / count <= STRIP_SPREADS * spread / math.sqrt(count):
             break
         width = (band + 1) * spacing
