@@ -426,10 +426,16 @@ class BreakEdgeFinder:
         faces = np.bincount(surface.triangles.ravel(), minlength=surface.n_points)
         reach = math.ceil(1.5 * params.scale / graph.mean_edge_length) + 2
         pieces = ridge_pieces(graph, flooded, band, used & (degree != faces), reach)
+        # A mesh edge as sharp as a ridge (on a noisy scan, clear of the noise as the bar is).
+        edge_bar = max(
+            math.radians(params.min_bend_deg),
+            params.noise_factor * _median(graph.vertex_bend[used]),
+        )
+        sharp = graph.vertex_bend >= edge_bar
         yield 0.7
         traced = []
         for k, piece in enumerate(pieces):
-            candidate = self._candidate(graph, piece, bend_field, ridge_min_deg, params)
+            candidate = self._candidate(graph, piece, bend_field, ridge_min_deg, params, sharp)
             if candidate is not None:
                 traced.append(candidate)
             yield 0.7 + 0.25 * (k + 1) / len(pieces)
@@ -466,13 +472,13 @@ class BreakEdgeFinder:
         min_area = math.pi * (NEW_FACE_RINGS * h) ** 2
         return recovered_regions(graph, region, flat, sums[:, 0], min_area)
 
-    def _candidate(self, graph, piece, spread, ridge_min_deg, params):
+    def _candidate(self, graph, piece, spread, ridge_min_deg, params, sharp=None):
         """The candidate traced along ``piece``, or None if it is too short."""
         points = self.surface.points[piece.vertices]
         extent = math.hypot(*(points.max(axis=0) - points.min(axis=0)))  # fixed order, no BLAS
         if extent < params.min_length / math.pi:  # not even a loop of min_length fits
             return None
-        traced = trace_piece(self.surface, graph, piece)
+        traced = trace_piece(self.surface, graph, piece, sharp)
         if traced is None or traced[0].length < params.min_length:
             return None
         path, closed = traced

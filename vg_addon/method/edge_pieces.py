@@ -246,16 +246,23 @@ def _longest_run(flags: np.ndarray):
     return int(begins[k]), int(ends[k])
 
 
-def trace_piece(surface, graph, piece: Piece) -> tuple[EdgePath, bool] | None:
+def trace_piece(surface, graph, piece: Piece, sharp=None) -> tuple[EdgePath, bool] | None:
     """The path along ``piece`` and whether it is a loop (None if it cannot be traced).
 
-    The path may only stray one ring off the piece's crest before a via point pulls it back."""
+    The path may only stray off the piece's crest for a few vertices before a via point pulls
+    it back. ``sharp`` (bool per vertex, optional): vertices with a mesh edge as sharp as a
+    ridge; the ring beside the crest counts as on it where it is sharp."""
     stops, closed = piece_stops(surface.points, piece)
     if len(set(stops)) < 2:
         return None
     crest = np.zeros(surface.n_points, dtype=bool)
     crest[piece.vertices] = True
     near = crest
+    if sharp is not None:
+        # Where the floods meet is known to the fine field's two rings; a crease whose corner
+        # the mesh cuts (edges between vertices) has two rows of bent edges, the sharper the
+        # nearer the true edge, and the cheapest path keeps to it if allowed one ring.
+        near = crest | (dilate(graph.starts, graph.target, crest, 1) & sharp)
     crest_points = surface.points[piece.vertices]
     legs = []
     try:
