@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import GoniometerError
 from .edge_profile import EdgePath, assemble_path, trace_leg
-from .fixed_order import eigh3, moments, row_dot, rows_dot
+from .fixed_order import eigh3, moments, norm3, row_dot, rows_dot, total
 from .mesh_regions import connected_part_steps, connected_parts, dilate, sorted_unique
 from .ranges import expand_ranges
 from .stepping import STEP
@@ -223,12 +223,25 @@ def follow(surface, graph, start: int, end: int, near: np.ndarray, crest_points,
             legs.append(leg)
             continue
         middle = surface.points[leg[(run[0] + run[1]) // 2]]
-        via = int(crest_ids[_nearest(crest_points, middle)])
+        via = _via(surface.points, a, b, middle, crest_points, crest_ids)
         if via in (a, b):
             legs.append(leg)
             continue
         pending += [(via, b, depth + 1), (a, via, depth + 1)]
     return legs
+
+
+def _via(points, a: int, b: int, middle, crest_points, crest_ids) -> int:
+    """The crest vertex nearest ``middle`` among those nearer both ``a`` and ``b`` than they
+    are to each other (a via point behind either end would send the path back over itself);
+    ``a`` if there is none."""
+    chord = _squared((points[b] - points[a])[None])[0]
+    between = (_squared(crest_points - points[a]) < chord) & (
+        _squared(crest_points - points[b]) < chord
+    )
+    if not between.any():
+        return a
+    return int(crest_ids[between][_nearest(crest_points[between], middle)])
 
 
 def _nearest(points: np.ndarray, to: np.ndarray) -> int:
@@ -282,3 +295,73 @@ def retraced_legs(surface, vertices: np.ndarray, stops: list[int]) -> list[np.nd
             middle = (i + j) // 2
             pending += [(middle, j), (i, middle)]
     return legs
+
+
+FLAT_SIDE_MIN = 0.95
+"""A side of a piece whose unit normals near it average to a vector this long (they spread
+less than about 18°) is flat enough that the bisector of the two sides' normals marks the edge."""
+
+
+def balanced_crest(graph, piece: Piece, flooded, band, normals, rings: int) -> Piece:
+    """``piece`` with its crest moved to where the surface faces halfway between its two sides.
+
+    Where the floods of two regions meet on a rounded edge (a fillet) the bend is about the
+    same across it, so on a noisy scan the meeting line wanders from side to side. The middle
+    of the rounding is where the normal turns halfway from one side's normal to the other's:
+    there ``n·(nA − nB)`` changes sign, across a sharp crease as across a fillet (``nA``,
+    ``nB``: the mean normals of the two regions near the piece). The new crest is, of each mesh
+    edge across that sign change between vertices flooded by either side within ``rings`` of
+    the old crest, the end nearer the balance: one vertex wide, so via points on it hold the
+    path to the middle. Kept as it is: a ridge inside one region, a piece with a side that is
+    curved near it (its mean normal would not stand for it), and one whose new crest would
+    be empty.
+
+    Parameters
+    ----------
+    graph : RidgeGraph
+    piece : Piece
+    flooded : ndarray of int, shape (n,)
+        The regions flooded into the band.
+    band : ndarray of bool, shape (n,)
+        The ridge band (off it, each side's own region).
+    normals : ndarray, shape (n, 3)
+        Smoothed (area-weighted) vertex normals, not necessarily of unit length.
+    rings : int
+        How far from the old crest the new one may lie.
+    """
+    first, second = piece.regions
+    if first < 0:
+        return piece
+    near = np.zeros(flooded.size, dtype=bool)
+    near[piece.vertices] = True
+    local = np.flatnonzero(dilate(graph.starts, graph.target, near, rings))
+    local = local[(flooded[local] == first) | (flooded[local] == second)]
+    unit = normals[local]
+    length = np.sqrt(rows_dot(unit, unit))
+    unit = unit / np.where(length > 0, length, 1.0)[:, None]
+    axes = []
+    for label in (first, second):
+        own = (flooded[local] == label) & ~band[local] & (length > 0)
+        if not own.any():
+            return piece
+        mean = np.array([total(unit[own, k]) for k in range(3)]) / own.sum()
+        size = norm3(mean)
+        if size < FLAT_SIDE_MIN:
+            return piece
+        axes.append(mean / size)
+    balance = row_dot(unit, axes[0] - axes[1])
+    lookup = np.full(flooded.size, -1, dtype=np.int64)
+    lookup[local] = np.arange(local.size)
+    own, neighbour = _rows(graph, local)
+    other = lookup[neighbour]
+    mine = lookup[own]
+    inside = other >= 0
+    own, mine, other = own[inside], mine[inside], other[inside]
+    # Of the two ends of a mesh edge the sign change crosses, the one nearer the balance.
+    across = ((balance[mine] >= 0) != (balance[other] >= 0)) & (
+        np.abs(balance[mine]) <= np.abs(balance[other])
+    )
+    crest = sorted_unique(own[across])
+    if crest.size < 2:
+        return piece
+    return Piece(crest, piece.regions, piece.ends)
