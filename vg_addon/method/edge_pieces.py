@@ -198,9 +198,15 @@ def piece_stops(points: np.ndarray, piece: Piece) -> tuple[list[int], bool]:
     return [first, middle, last], False
 
 
-def follow(surface, graph, start: int, end: int, near: np.ndarray, crest_points, crest_ids):
+def follow(
+    surface, graph, start: int, end: int, near: np.ndarray, crest_points, crest_ids, ahead=False
+):
     """Legs from ``start`` to ``end`` along the crest: the cheapest ridge path, split by a via
-    point on the crest wherever it strays off ``near`` for :data:`MIN_OFF_RUN` vertices."""
+    point on the crest wherever it strays off ``near`` for :data:`MIN_OFF_RUN` vertices.
+
+    ``ahead``: take via points only between the two ends of the leg they split (see
+    :func:`_via`); an open crest's path otherwise went back over itself. A loop's quarters
+    keep the nearest crest vertex, which follows a loop round better."""
     legs = []
     pending = [(start, end, 0)]
     while pending:
@@ -223,7 +229,10 @@ def follow(surface, graph, start: int, end: int, near: np.ndarray, crest_points,
             legs.append(leg)
             continue
         middle = surface.points[leg[(run[0] + run[1]) // 2]]
-        via = _via(surface.points, a, b, middle, crest_points, crest_ids)
+        if ahead:
+            via = _via(surface.points, a, b, middle, crest_points, crest_ids)
+        else:
+            via = int(crest_ids[_nearest(crest_points, middle)])
         if via in (a, b):
             legs.append(leg)
             continue
@@ -273,12 +282,45 @@ def trace_piece(surface, graph, piece: Piece) -> tuple[EdgePath, bool] | None:
     legs = []
     try:
         for a, b in itertools.pairwise(stops):
-            legs += follow(surface, graph, a, b, near, crest_points, piece.vertices)
+            legs += follow(surface, graph, a, b, near, crest_points, piece.vertices, not closed)
     except GoniometerError:
         return None
     if not legs:
         return None
+    if not closed:
+        legs = _without_loops(surface, legs)
     return assemble_path(surface, legs), closed
+
+
+def _without_loops(surface, legs: list[np.ndarray]) -> list[np.ndarray]:
+    """``legs`` with every stretch that comes back to a vertex it left cut out (a via point
+    a little off the crest makes the path go out to it and back), if the rest retraces leg by
+    leg; otherwise ``legs`` as they are."""
+    kept: list[int] = []
+    where: dict[int, int] = {}
+    stops: set[int] = {0}
+    for k, leg in enumerate(legs):
+        for vertex in leg[1:] if k else leg:
+            vertex = int(vertex)
+            if vertex in where:  # a loop: back to where it was
+                cut = where[vertex]
+                for dropped in kept[cut + 1 :]:
+                    del where[dropped]
+                del kept[cut + 1 :]
+                stops = {s for s in stops if s <= cut} | {cut}
+            else:
+                where[vertex] = len(kept)
+                kept.append(vertex)
+        stops.add(len(kept) - 1)
+    if len(kept) == sum(leg.size - 1 for leg in legs) + 1:
+        return legs
+    vertices = np.array(kept, dtype=np.int64)
+    out = retraced_legs(surface, vertices, sorted(stops))
+    if all(
+        np.array_equal(trace_leg(surface, leg[0], leg[-1]), leg) for leg in out if leg.size == 2
+    ):
+        return out
+    return legs
 
 
 def retraced_legs(surface, vertices: np.ndarray, stops: list[int]) -> list[np.ndarray]:
