@@ -71,6 +71,7 @@ HARDER = {
     "bevelled cube, noise 0.3": (bevelled_cube, 0.3, None),
     "bevelled cube, marched": (fragments.marched_bevelled_cube, 0.0, MARCH_STEP),
     "bevelled cube, marched, noise 0.1": (fragments.marched_bevelled_cube, 0.1, MARCH_STEP),
+    "bevelled cube, marched, noise 0.1, one edge": (fragments.marched_bevelled_cube, 0.1, None),
     "flake, marched": (fragments.marched_flake, 0.0, MARCH_STEP),
     "flake, marched, noise 0.1": (fragments.marched_flake, 0.1, MARCH_STEP),
 }
@@ -80,7 +81,8 @@ HARDER = {
 def test_the_harder_cases_that_docs_claim_pass_do(name):
     """The rows of EDGE_DETECTION.md's limits table marked pass: noise of 0.3 mean edge
     lengths on the shaft, the flake and the bevelled cube, and fragments meshed by marching
-    tetrahedra (no vertex on an edge) scored within the marching step."""
+    tetrahedra (no vertex on an edge) scored within the marching step (the noisy marched cube
+    also within one mean edge length)."""
     _, surface, result, figures = found_on(*HARDER[name])
     assert figures["recall"] >= 0.95, figures
     assert figures["false"] <= 0.05, figures
