@@ -68,8 +68,10 @@ about this much, so the mesh's own crease lies that far from the true edge."""
 HARDER = {
     "bone shaft, noise 0.3": (lambda: bone_shaft(0.3), 0.3, None),
     "flake, noise 0.3": (flake, 0.3, None),
+    "bevelled cube, noise 0.3": (bevelled_cube, 0.3, None),
     "bevelled cube, marched": (fragments.marched_bevelled_cube, 0.0, MARCH_STEP),
     "bevelled cube, marched, noise 0.1": (fragments.marched_bevelled_cube, 0.1, MARCH_STEP),
+    "bevelled cube, marched, noise 0.1, one edge": (fragments.marched_bevelled_cube, 0.1, None),
     "flake, marched": (fragments.marched_flake, 0.0, MARCH_STEP),
     "flake, marched, within one mean edge": (fragments.marched_flake, 0.0, None),
     "flake, marched, noise 0.1": (fragments.marched_flake, 0.1, MARCH_STEP),
@@ -79,10 +81,10 @@ HARDER = {
 @pytest.mark.parametrize("name", sorted(HARDER))
 def test_the_harder_cases_that_docs_claim_pass_do(name):
     """The rows of EDGE_DETECTION.md's limits table marked pass: noise of 0.3 mean edge
-    lengths on the shaft and the flake, and fragments meshed by marching tetrahedra (no vertex
-    on an edge) scored within the marching step, the flake also within one mean edge length
-    (its path keeps to the sharper of the two rows of bent edges a cut corner leaves). The
-    bevelled cube at 0.3 fails, and is not claimed."""
+    lengths on the shaft, the flake and the bevelled cube, and fragments meshed by marching
+    tetrahedra (no vertex on an edge) scored within the marching step, the noisy marched cube
+    and the flake also within one mean edge length (the flake's path keeps to the sharper of the
+    two rows of bent edges a cut corner leaves)."""
     _, surface, result, figures = found_on(*HARDER[name])
     assert figures["recall"] >= 0.95, figures
     assert figures["false"] <= 0.05, figures
@@ -90,6 +92,41 @@ def test_the_harder_cases_that_docs_claim_pass_do(name):
         points = candidate.waypoint_points
         again = surface.trace_edge(points[0], points[-1], via=points[1:-1])
         assert np.array_equal(again.vertices, candidate.path.vertices), candidate.number
+
+
+@pytest.mark.parametrize("seed", [2, 3])
+def test_the_bevelled_cube_at_noise_0_3_passes_with_other_noise_seeds(seed):
+    """The seeds on which its fillets' paths wandered most and noise ridges inside its faces
+    were candidates (a fifth of the found length false, before the balanced crest and the
+    local noise bar). No open path passes a vertex twice (it went out to a via point and back
+    over the same vertices before)."""
+    fragment = bevelled_cube()
+    h = mean_edge_length(fragment.points, fragment.triangles)
+    fragment = with_noise(fragment, 0.3 * h, seed=seed)
+    surface = Surface(fragment.points, fragment.triangles)
+    result = surface.find_break_edges()
+    figures = score(fragment, [c.path.points for c in result.candidates])
+    assert figures["recall"] >= 0.95, figures
+    assert figures["false"] <= 0.05, figures
+    for candidate in result.candidates:
+        vertices = candidate.path.vertices
+        assert candidate.closed or np.unique(vertices).size == vertices.size, candidate.number
+        points = candidate.waypoint_points
+        again = surface.trace_edge(points[0], points[-1], via=points[1:-1])
+        assert np.array_equal(again.vertices, vertices), candidate.number
+
+
+def test_the_local_noise_bar_keeps_the_flakes_weakest_edge():
+    """With noise seed 3 at 0.3 mean edges the flake's platform edge stands out from the noise
+    round it by only about 30 times; the bar must keep it (a bar of 30 dropped it, recall 88.9%)."""
+    fragment = flake()
+    h = mean_edge_length(fragment.points, fragment.triangles)
+    fragment = with_noise(fragment, 0.3 * h, seed=3)
+    result = Surface(fragment.points, fragment.triangles).find_break_edges()
+    figures = score(fragment, [c.path.points for c in result.candidates])
+    assert len(result.candidates) == len(fragment.edges), figures
+    assert figures["recall"] >= 0.95, figures
+    assert figures["false"] <= 0.05, figures
 
 
 @pytest.mark.parametrize("case", [c for c in CASES if c[0] != "bevelled cube"], ids=case_id)

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import GoniometerError
 from .edge_profile import EdgePath, assemble_path, trace_leg
-from .fixed_order import eigh3, moments, row_dot, rows_dot
+from .fixed_order import eigh3, moments, norm3, row_dot, rows_dot, total
 from .mesh_regions import connected_part_steps, connected_parts, dilate, sorted_unique
 from .ranges import expand_ranges
 from .stepping import STEP
@@ -198,9 +198,15 @@ def piece_stops(points: np.ndarray, piece: Piece) -> tuple[list[int], bool]:
     return [first, middle, last], False
 
 
-def follow(surface, graph, start: int, end: int, near: np.ndarray, crest_points, crest_ids):
+def follow(
+    surface, graph, start: int, end: int, near: np.ndarray, crest_points, crest_ids, ahead=False
+):
     """Legs from ``start`` to ``end`` along the crest: the cheapest ridge path, split by a via
-    point on the crest wherever it strays off ``near`` for :data:`MIN_OFF_RUN` vertices."""
+    point on the crest wherever it strays off ``near`` for :data:`MIN_OFF_RUN` vertices.
+
+    ``ahead``: take via points only between the two ends of the leg they split (see
+    :func:`_via`); an open crest's path otherwise went back over itself. A loop's quarters
+    keep the nearest crest vertex, which follows a loop round better."""
     legs = []
     pending = [(start, end, 0)]
     while pending:
@@ -223,12 +229,28 @@ def follow(surface, graph, start: int, end: int, near: np.ndarray, crest_points,
             legs.append(leg)
             continue
         middle = surface.points[leg[(run[0] + run[1]) // 2]]
-        via = int(crest_ids[_nearest(crest_points, middle)])
+        if ahead:
+            via = _via(surface.points, a, b, middle, crest_points, crest_ids)
+        else:
+            via = int(crest_ids[_nearest(crest_points, middle)])
         if via in (a, b):
             legs.append(leg)
             continue
         pending += [(via, b, depth + 1), (a, via, depth + 1)]
     return legs
+
+
+def _via(points, a: int, b: int, middle, crest_points, crest_ids) -> int:
+    """The crest vertex nearest ``middle`` among those nearer both ``a`` and ``b`` than they
+    are to each other (a via point behind either end would send the path back over itself);
+    ``a`` if there is none."""
+    chord = _squared((points[b] - points[a])[None])[0]
+    between = (_squared(crest_points - points[a]) < chord) & (
+        _squared(crest_points - points[b]) < chord
+    )
+    if not between.any():
+        return a
+    return int(crest_ids[between][_nearest(crest_points[between], middle)])
 
 
 def _nearest(points: np.ndarray, to: np.ndarray) -> int:
@@ -267,12 +289,45 @@ def trace_piece(surface, graph, piece: Piece, sharp=None) -> tuple[EdgePath, boo
     legs = []
     try:
         for a, b in itertools.pairwise(stops):
-            legs += follow(surface, graph, a, b, near, crest_points, piece.vertices)
+            legs += follow(surface, graph, a, b, near, crest_points, piece.vertices, not closed)
     except GoniometerError:
         return None
     if not legs:
         return None
+    if not closed:
+        legs = _without_loops(surface, legs)
     return assemble_path(surface, legs), closed
+
+
+def _without_loops(surface, legs: list[np.ndarray]) -> list[np.ndarray]:
+    """``legs`` with every stretch that comes back to a vertex it left cut out (a via point
+    a little off the crest makes the path go out to it and back), if the rest retraces leg by
+    leg; otherwise ``legs`` as they are."""
+    kept: list[int] = []
+    where: dict[int, int] = {}
+    stops: set[int] = {0}
+    for k, leg in enumerate(legs):
+        for vertex in leg[1:] if k else leg:
+            vertex = int(vertex)
+            if vertex in where:  # a loop: back to where it was
+                cut = where[vertex]
+                for dropped in kept[cut + 1 :]:
+                    del where[dropped]
+                del kept[cut + 1 :]
+                stops = {s for s in stops if s <= cut} | {cut}
+            else:
+                where[vertex] = len(kept)
+                kept.append(vertex)
+        stops.add(len(kept) - 1)
+    if len(kept) == sum(leg.size - 1 for leg in legs) + 1:
+        return legs
+    vertices = np.array(kept, dtype=np.int64)
+    out = retraced_legs(surface, vertices, sorted(stops))
+    if all(
+        np.array_equal(trace_leg(surface, leg[0], leg[-1]), leg) for leg in out if leg.size == 2
+    ):
+        return out
+    return legs
 
 
 def retraced_legs(surface, vertices: np.ndarray, stops: list[int]) -> list[np.ndarray]:
@@ -289,3 +344,73 @@ def retraced_legs(surface, vertices: np.ndarray, stops: list[int]) -> list[np.nd
             middle = (i + j) // 2
             pending += [(middle, j), (i, middle)]
     return legs
+
+
+FLAT_SIDE_MIN = 0.95
+"""A side of a piece whose unit normals near it average to a vector this long (they spread
+less than about 18°) is flat enough that the bisector of the two sides' normals marks the edge."""
+
+
+def balanced_crest(graph, piece: Piece, flooded, band, normals, rings: int) -> Piece:
+    """``piece`` with its crest moved to where the surface faces halfway between its two sides.
+
+    Where the floods of two regions meet on a rounded edge (a fillet) the bend is about the
+    same across it, so on a noisy scan the meeting line wanders from side to side. The middle
+    of the rounding is where the normal turns halfway from one side's normal to the other's:
+    there ``n·(nA − nB)`` changes sign, across a sharp crease as across a fillet (``nA``,
+    ``nB``: the mean normals of the two regions near the piece). The new crest is, of each mesh
+    edge across that sign change between vertices flooded by either side within ``rings`` of
+    the old crest, the end nearer the balance: one vertex wide, so via points on it hold the
+    path to the middle. Kept as it is: a ridge inside one region, a piece with a side that is
+    curved near it (its mean normal would not stand for it), and one whose new crest would
+    be empty.
+
+    Parameters
+    ----------
+    graph : RidgeGraph
+    piece : Piece
+    flooded : ndarray of int, shape (n,)
+        The regions flooded into the band.
+    band : ndarray of bool, shape (n,)
+        The ridge band (off it, each side's own region).
+    normals : ndarray, shape (n, 3)
+        Smoothed (area-weighted) vertex normals, not necessarily of unit length.
+    rings : int
+        How far from the old crest the new one may lie.
+    """
+    first, second = piece.regions
+    if first < 0:
+        return piece
+    near = np.zeros(flooded.size, dtype=bool)
+    near[piece.vertices] = True
+    local = np.flatnonzero(dilate(graph.starts, graph.target, near, rings))
+    local = local[(flooded[local] == first) | (flooded[local] == second)]
+    unit = normals[local]
+    length = np.sqrt(rows_dot(unit, unit))
+    unit = unit / np.where(length > 0, length, 1.0)[:, None]
+    axes = []
+    for label in (first, second):
+        own = (flooded[local] == label) & ~band[local] & (length > 0)
+        if not own.any():
+            return piece
+        mean = np.array([total(unit[own, k]) for k in range(3)]) / own.sum()
+        size = norm3(mean)
+        if size < FLAT_SIDE_MIN:
+            return piece
+        axes.append(mean / size)
+    balance = row_dot(unit, axes[0] - axes[1])
+    lookup = np.full(flooded.size, -1, dtype=np.int64)
+    lookup[local] = np.arange(local.size)
+    own, neighbour = _rows(graph, local)
+    other = lookup[neighbour]
+    mine = lookup[own]
+    inside = other >= 0
+    own, mine, other = own[inside], mine[inside], other[inside]
+    # Of the two ends of a mesh edge the sign change crosses, the one nearer the balance.
+    across = ((balance[mine] >= 0) != (balance[other] >= 0)) & (
+        np.abs(balance[mine]) <= np.abs(balance[other])
+    )
+    crest = sorted_unique(own[across])
+    if crest.size < 2:
+        return piece
+    return Piece(crest, piece.regions, piece.ends)
