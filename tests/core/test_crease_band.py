@@ -194,3 +194,37 @@ def test_a_side_that_borrows_the_edge_row_is_always_undetermined():
     assert m.n_shared > 0 and abs(m.angle - 170.0) < 0.01
     s = m.stability
     assert s.text() == "± ?" and s.crease_refused > 0 and s.n_failed == s.n_runs
+
+
+@pytest.mark.parametrize("jitter", [0.01, 0.02])
+@pytest.mark.parametrize("angle", [120, 135, 150, 165])
+def test_normals_that_tell_the_faces_apart_do_not_make_the_figure_undetermined(angle, jitter):
+    """A guard against refusing right readings: on obtuse creases jittered by 1-2% of the grid
+    the vertex normals' noise along the tangent is far below each face's turn, the reading lies
+    within its figure (oracle: the angle the wedge was built with), and the figure is a number."""
+    from vg_addon.method.crease_band import _normals_hide_the_crease
+
+    spacing = 0.0106
+    points, triangles = stretched_wedge(angle, spacing)
+    rng = np.random.default_rng(1)
+    surface = Surface(points + rng.normal(scale=jitter * spacing, size=points.shape), triangles)
+    m = surface.measure(nearest_the_crease(points), 0.2, stability=True)
+    assert abs(m.angle - angle) <= m.stability.spread, (m.angle - angle, m.stability)
+    assert not _normals_hide_the_crease(surface.normals[m.indices], m.tangent, m.angle)
+    assert m.stability.text() != "± ?"
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_a_non_finite_distance_to_the_crease_line_measures_no_strip(bad):
+    """The strip's bands are binned by distance to the line; a non-finite one cast to an integer
+    is a negative bin, which ``np.bincount`` refuses with a traceback. No strip is measured."""
+    from vg_addon.method.refinement import _side_plane, _strip_width
+
+    mesh = wedge(120, n=30, irregular=True, seed=2)
+    points = mesh.points - mesh.points.mean(axis=0)
+    side = np.ones(points.shape[0], dtype=bool)
+    plane = _side_plane(points, np.tile([0.0, 0.0, 1.0], (points.shape[0], 1)), side)
+    to_line = np.linalg.norm(points[:, :2], axis=1)
+    assert _strip_width(points, side, side, plane, plane[0], to_line, 0.05) >= 0.0
+    to_line[3] = bad
+    assert _strip_width(points, side, side, plane, plane[0], to_line, 0.05) == 0.0

@@ -490,6 +490,8 @@ def _strip_width(points, side, kept, plane, toward_other, to_line, spacing) -> f
         return 0.0
     height = columns_dot(offset_columns(np.compress(side, points, axis=0), centroid), normal)
     distance = np.compress(side, to_line)
+    if not np.isfinite(distance).all():
+        return 0.0  # no line to bin from (a cast NaN would be a negative bin): no strip measured
     outer = kept_here & (distance >= _median(np.compress(kept_here, distance)))
     if not outer.any():
         return 0.0
