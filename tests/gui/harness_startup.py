@@ -7,7 +7,7 @@ writes what the test needs to read to ``$VG_GUI_STATE`` (JSON, replaced atomical
 measurements of every mesh object with their exact numbers, the active tool, the 3D view's
 regions in X screen pixels, the sidebar's tab, the 3D cursor, the running drag (found by
 looking, read-only, at the live ``DragSession`` objects), the running Find Break Edges review
-(its ``FindEdgesSession``, likewise), what a Ctrl+Shift+C copied, the
+(its ``FindEdgesSession``, likewise, with the header text it shows), what a Ctrl+Shift+C copied, the
 regions of an open file browser and what it offers (folder, file name, filter), the screen
 positions of the 3D points listed in ``$VG_GUI_POINTS``, each mesh's edge profiles and active
 list rows, the scenes and every "VG Map" data-block in the file, the window's running modal
@@ -125,7 +125,7 @@ def _drag(window, area):
 
 def _find_edges(window, area):
     """The running Find Break Edges review (found, read-only, among the live
-    ``FindEdgesSession`` objects): its phase, selection and message, and each candidate's
+    ``FindEdgesSession`` objects): its phase, selection, message and header text, and each candidate's
     number, confidence, decision and 24 points along it on screen (None: not in view)."""
     from bpy_extras import view3d_utils
     from mathutils import Matrix, Vector
@@ -168,6 +168,7 @@ def _find_edges(window, area):
             "progress": machine.progress,
             "selected": machine.selected,
             "message": machine.message,
+            "header": obj.header_text(bpy.context.scene),
             "candidates": candidates,
         }
     return None
