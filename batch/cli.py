@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
+from ..bridge.map_edges import EDGE_ENDS
 from ..vg_addon import GoniometerError
 from ..vg_addon.method.sweep import sweep_radii
 
@@ -301,6 +302,15 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="N",
         help="Cycles samples per pixel, 1 to 4096 (default 16)",
     )
+    out.add_argument(
+        "--render-edge-ends",
+        type=int,
+        default=EDGE_ENDS,
+        metavar="N",
+        help="of the edges' stations no view has room to label, the first and last station of "
+        "the first N edges by number (for --find-edges the most confident) get close-ups; the "
+        f"others are labelled where a view has room. 0 or more (default {EDGE_ENDS})",
+    )
     out.add_argument("--quiet", action="store_true", help="no progress lines (summary only)")
     scale = parser.add_argument_group("scaling")
     scale.add_argument(
@@ -451,6 +461,8 @@ def check_args(args) -> None:
     if args.jobs < 1:
         raise UsageError(f"--jobs must be 1 or more (got {args.jobs}).")
     check_render_settings(args.render_size, args.render_samples)
+    if args.render_edge_ends < 0:
+        raise UsageError(f"--render-edge-ends must be 0 or more (got {args.render_edge_ends}).")
     check_edge_points(args.edge)
     if args.sweep:
         start, stop, count = args.sweep

@@ -29,6 +29,7 @@ from pathlib import Path
 
 import bpy
 
+from ..bridge.map_edges import EDGE_ENDS
 from ..vg_addon import GoniometerError
 from . import child_process, extension
 from .pictures import reason
@@ -121,6 +122,7 @@ def draw_map(obj, directory: Path, options: dict, stem: str, name: str) -> Path:
         "render_views": options.get("render_views", "SIX"),
         "render_size": list(options.get("render_size", (640, 480))),
         "render_samples": options.get("render_samples", 16),
+        "render_edge_ends": options.get("render_edge_ends", EDGE_ENDS),
         "quiet": bool(options.get("quiet")),
     }
     try:

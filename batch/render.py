@@ -9,6 +9,7 @@ from pathlib import Path
 import bpy
 
 from ..bridge import colors, measurement_map
+from ..bridge.map_edges import EDGE_ENDS
 from .outputs import refuse_input
 from .stdio import quiet_stdout
 
@@ -62,6 +63,7 @@ def render_map(obj, directory: Path, options: dict, stem: str, progress=None) ->
             size=tuple(options.get("render_size", (640, 480))),
             samples=options.get("render_samples", 16),
             staging=options.get("staging"),
+            edge_ends=options.get("render_edge_ends", EDGE_ENDS),
         )
         try:
             while not job.done:

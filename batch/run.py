@@ -392,6 +392,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "render_size": list(args.render_size),
         "render_samples": args.render_samples,
         "render_views": args.render_views.upper(),
+        "render_edge_ends": args.render_edge_ends,
         "quiet": bool(args.quiet),
         "save_blend": bool(args.save_blend),
         "units": units,

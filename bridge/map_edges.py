@@ -6,11 +6,13 @@ throwaway scene, made here and removed with it.
 
 An edge's stations are numbered in order along its line, a few millimetres apart, so most views
 have room for only some of their labels. Of a label no chosen view draws, the map makes a
-close-up (or a view of its own) only for the first and last station of each edge
-(:func:`inner_stations` names the others): at most two extra views per edge. The numbers
-between them follow along the magenta line, and each station's angle is in the CSV and the
-edge's profile plot. One close-up per crowded station made the map of a bone with four found
-edges 36 views long (30 close-ups, two minutes of rendering at 1M vertices).
+close-up (or a view of its own) only for the first and last station of an edge, and only for
+the first ``EDGE_ENDS`` edges by number (:func:`stations_without_views` names the others): at
+most two extra views per edge and ``2 * EDGE_ENDS`` in all. The numbers between them follow
+along the magenta line, and each station's angle is in the CSV and the edge's profile plot. One
+close-up per crowded station made the map of a bone with four found edges 36 views long (30
+close-ups, two minutes of rendering at 1M vertices); two per edge with no cap would make a
+scan with 60 found edges 120 close-ups long.
 """
 
 from __future__ import annotations
@@ -23,6 +25,14 @@ from ..vg_addon.formats import record_codec
 
 LINE_WIDTH = 0.003
 """The tube's radius, as a fraction of the object's bounding-box diagonal."""
+
+EDGE_ENDS = 10
+"""How many edges (the lowest-numbered) may have their first and last stations given views of
+their own: the batch's ``--render-edge-ends`` default and Render Map's. The first edges by number,
+not a choice by the stations' numbers: an edge's number is the order it was made in (clicked,
+an edges CSV's rows) or, for ``--find-edges``, the finder's order, most confident first, so the
+cap keeps the edges an analyst made first or trusts most, and which ones it keeps is read off
+the CSV's ``Edge #`` column, whatever crowds the views."""
 
 LINE_COLOUR = (0.9, 0.0, 0.9, 1.0)
 """Magenta: in no side colour pair (Okabe-Ito), so it stands out on every side and the sky."""
@@ -40,19 +50,22 @@ def edge_paths(obj) -> list[tuple[np.ndarray, bool]]:
     return paths
 
 
-def inner_stations(obj) -> set[int]:
-    """The numbers of ``obj``'s edge stations that are neither the first nor the last (by arc
-    length) of their edge's current stations: those the map labels only where a view has room."""
+def stations_without_views(obj, edge_ends: int = EDGE_ENDS) -> set[int]:
+    """The numbers of ``obj``'s edge stations that get no view of their own, only a label where
+    a view has room: of the first ``edge_ends`` edges (by number) those that are neither the
+    first nor the last (by arc length) of their edge's current stations, of the later edges
+    every station."""
     by_edge: dict[int, list[tuple[float, int]]] = {}
     for item in obj.vg.measurements:
         if item.edge_number > 0 and not item.stale:
             arc = float(record_codec.exact_numbers(item).get("arc_length", 0.0))
             by_edge.setdefault(item.edge_number, []).append((arc, item.number))
-    inner = set()
-    for stations in by_edge.values():
-        stations.sort()
-        inner.update(number for _arc, number in stations[1:-1])
-    return inner
+    unviewed = set()
+    for rank, edge_number in enumerate(sorted(by_edge)):
+        stations = sorted(by_edge[edge_number])
+        kept = stations[1:-1] if rank < edge_ends else stations
+        unviewed.update(number for _arc, number in kept)
+    return unviewed
 
 
 def add_edge_lines(scene, obj, material, size: float, keep) -> int:

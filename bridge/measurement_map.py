@@ -18,7 +18,8 @@ onto its surface along its mean normal (or tilted from it, or from the other sid
 reaches its centre). One that no direction sees (inside a closed cavity) is listed on a last
 picture, "not shown", which the contact sheet includes. The stations of an edge profile between
 its first and last are the exception: they are labelled where a view has room, and get no view
-of their own (``map_edges.inner_stations``; their numbers run in order along the edge's line).
+of their own (their numbers run in order along the edge's line); so are all the stations of the
+edges after the first ``edge_ends`` (``map_edges.stations_without_views``, ``EDGE_ENDS``).
 The labels are set in DejaVu Sans Mono, which Blender ships: its "1" has a flag and a foot, so
 "11" never reads "II".
 Each edge profile's traced path is drawn as a thin magenta line (``map_edges``). Everything made
@@ -41,7 +42,7 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, looks_at, place_labels, view_up
 from .colors import new_sides_material
 from .label_data import labels_of
-from .map_edges import LINE_COLOUR, add_edge_lines, inner_stations
+from .map_edges import EDGE_ENDS, LINE_COLOUR, add_edge_lines, stations_without_views
 from .mesh_data import read_positions, world_points
 
 MAP_VIEWS = ("SIX", "FLAKE")
@@ -91,9 +92,24 @@ class MapJob:
     same file system); by default one is made.
     """
 
-    def __init__(self, obj, directory, *, views="SIX", size=(800, 600), samples=16, staging=None):
+    def __init__(
+        self,
+        obj,
+        directory,
+        *,
+        views="SIX",
+        size=(800, 600),
+        samples=16,
+        staging=None,
+        edge_ends=EDGE_ENDS,
+    ):
         if obj is None or obj.type != "MESH":
             raise GoniometerError("Select the measured mesh object to make its map.")
+        if isinstance(edge_ends, bool) or not isinstance(edge_ends, int) or edge_ends < 0:
+            raise GoniometerError(
+                f"The edges whose ends get views of their own must be a whole number, 0 or more "
+                f"(got {edge_ends!r})."
+            )
         width, height = (int(v) for v in size)
         if width < 16 or height < 16 or samples < 1:
             raise GoniometerError(
@@ -107,9 +123,9 @@ class MapJob:
         self.depsgraph = bpy.context.evaluated_depsgraph_get()
         self.views = list(view_list(obj, views, self.depsgraph))
         self.labels = labels_of(obj)
-        inner = inner_stations(obj)
+        unviewed = stations_without_views(obj, edge_ends)
         # Labels that get no view of their own when no chosen view draws them (see map_edges).
-        self._inner = {i for i, label in enumerate(self.labels) if label.number in inner}
+        self._unviewed = {i for i, label in enumerate(self.labels) if label.number in unviewed}
         self.placements: list[list] = []  # per view: (label index, side) of each label drawn
         self.not_shown: list = []  # labels no view can show (listed on the last picture)
         self.written: list[Path] = []
@@ -266,8 +282,8 @@ class MapJob:
     def _layout(self, look, up, focus=None, zoom=None) -> list:
         """The labels a view looking along ``look`` draws: ``(label index, side)`` of each one
         whose centre it sees, on the picture, and that has room there; ``focus`` (a label
-        index) first, then the selected measurement, then all but the inner stations of edges,
-        then the newest."""
+        index) first, then the selected measurement, then all but the edge stations that get
+        no view of their own, then the newest."""
         right, up, back, centre, _front, scale = self._frame(look, up, zoom)
         width, height = self.size
         pixel = scale / width
@@ -283,12 +299,12 @@ class MapJob:
         if not shown:
             return []
         total = len(shown)
-        # Focus, then the selected measurement, then any but an edge's inner stations (which
-        # get no view of their own), then the newest.
+        # Focus, then the selected measurement, then any but the edge stations that get no
+        # view of their own, then the newest.
         priority = [
             4 * total * (i == focus)
             + 2 * total * self.labels[i].active
-            + total * (i not in self._inner)
+            + total * (i not in self._unviewed)
             + rank
             for rank, i in enumerate(shown)
         ]
@@ -309,8 +325,8 @@ class MapJob:
         self._zooms: dict[int, tuple] = {}
         drawn = {index for placed in self.placements for index, _side in placed}
         for index, label in enumerate(self.labels):
-            if index in drawn or index in self._inner:
-                continue  # an inner station of an edge gets no view of its own (map_edges)
+            if index in drawn or index in self._unviewed:
+                continue  # an edge station that gets no view of its own (map_edges)
             if not self._add_view_for(index, label, drawn):
                 self.not_shown.append(label)
         if self.not_shown:

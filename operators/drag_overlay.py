@@ -42,13 +42,41 @@ LINE_WIDTH = 2.0
 CIRCLE_SEGMENTS = 96
 
 
-def point_shader():
-    """``(shader, uses_size_uniform)``: POINT_UNIFORM_COLOR where Blender has it, else the 4.2
-    fallback UNIFORM_COLOR (sized by ``gpu.state.point_size_set``)."""
-    try:
-        return gpu.shader.from_builtin("POINT_UNIFORM_COLOR"), True
-    except (ValueError, TypeError):  # 4.2: not one of its built-in shaders
-        return gpu.shader.from_builtin("UNIFORM_COLOR"), False
+class PointShader:
+    """The built-in shader for points of a chosen size on every Blender the extension supports:
+    ``POINT_UNIFORM_COLOR`` (its size a uniform), else Blender 4.2's ``UNIFORM_COLOR`` sized by
+    ``gpu.state.point_size_set``. Used as a context manager, it sets the global point size back
+    to 1 on the way out where it changed it."""
+
+    def __init__(self):
+        try:
+            self.shader = gpu.shader.from_builtin("POINT_UNIFORM_COLOR")
+            self.uniform_size = True
+        except (ValueError, TypeError):  # 4.2: not one of its built-in shaders
+            self.shader = gpu.shader.from_builtin("UNIFORM_COLOR")
+            self.uniform_size = False
+
+    def draw(self, batch, color, size: float) -> None:
+        """Draw ``batch`` (built for :attr:`shader`) as points of ``size`` pixels in ``color``."""
+        self.shader.bind()
+        if self.uniform_size:
+            self.shader.uniform_float("size", size)
+        else:
+            gpu.state.point_size_set(size)
+        self.shader.uniform_float("color", color)
+        batch.draw(self.shader)
+
+    def __enter__(self) -> PointShader:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if not self.uniform_size:
+            gpu.state.point_size_set(1.0)
+
+
+def point_shader() -> PointShader:
+    """A :class:`PointShader` for one drawing (the overlays' and the labels' points)."""
+    return PointShader()
 
 
 def patch_vertex_data(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
@@ -168,23 +196,14 @@ class DragOverlay(ViewOverlay):
         region = bpy.context.region
         if region_data is None or region is None or self.center is None:
             return
-        points, sized = point_shader()
         gpu.state.blend_set("ALPHA")
         gpu.state.depth_test_set("NONE")  # the whole patch is measured, hidden side included
-        with gpu.matrix.push_pop():
+        with gpu.matrix.push_pop(), point_shader() as points:
             gpu.matrix.multiply_matrix(Matrix(self.matrix.tolist()))
-            points.bind()
             if self._batches is None:
-                self._batches = self._build_batches(points)
-            if sized:
-                points.uniform_float("size", POINT_SIZE)
-            else:
-                gpu.state.point_size_set(POINT_SIZE)
+                self._batches = self._build_batches(points.shader)
             for batch, color in self._batches:
-                points.uniform_float("color", color)
-                batch.draw(points)
-            if not sized:
-                gpu.state.point_size_set(1.0)
+                points.draw(batch, color, POINT_SIZE)
             if self.radius > 0.0:
                 # The view plane's axes, brought into mesh coordinates: the circle is drawn
                 # there, so it is the patch's outline under any object transform.

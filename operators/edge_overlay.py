@@ -87,25 +87,20 @@ def draw_batches(overlay) -> None:
     if bpy.context.region_data is None or region is None:
         return
     # Line width and point size as shader uniforms (Metal and Vulkan ignore line_width_set);
-    # points fall back to UNIFORM_COLOR on 4.2, as in the drag overlay.
+    # the points' shader falls back on 4.2 (drag_overlay.PointShader).
     lines = gpu.shader.from_builtin("POLYLINE_UNIFORM_COLOR")
-    points, sized = point_shader()
-    if overlay._batches is None:
-        overlay._batches = overlay._build(lines, points)
     gpu.state.blend_set("ALPHA")
     gpu.state.depth_test_set("NONE")
-    for kind, batch, color, size in overlay._batches:
-        shader = lines if kind == "LINES" else points
-        shader.bind()
-        if kind == "LINES":
-            shader.uniform_float("viewportSize", (region.width, region.height))
-            shader.uniform_float("lineWidth", size)
-        elif sized:
-            shader.uniform_float("size", size)
-        else:
-            gpu.state.point_size_set(size)
-        shader.uniform_float("color", color)
-        batch.draw(shader)
-    if not sized:
-        gpu.state.point_size_set(1.0)
+    with point_shader() as points:
+        if overlay._batches is None:
+            overlay._batches = overlay._build(lines, points.shader)
+        for kind, batch, color, size in overlay._batches:
+            if kind == "POINTS":
+                points.draw(batch, color, size)
+                continue
+            lines.bind()
+            lines.uniform_float("viewportSize", (region.width, region.height))
+            lines.uniform_float("lineWidth", size)
+            lines.uniform_float("color", color)
+            batch.draw(lines)
     gpu.state.blend_set("NONE")

@@ -305,16 +305,17 @@ class FindEdgesSession(ViewSession):
                 f"#{c.number} {c.confidence:.0%} {format_length(scene, c.length, self.obj)} "
                 f"bend {c.mean_bend_deg:.0f}°"
             )
+        message = machine.message.splitlines()[0] if machine.message else ""
         if machine.phase is FindPhase.TRIMMING:
-            if len(machine.trim_arcs) < 2:
-                ends = "first" if not machine.trim_arcs else "second"
-                parts.append(f"Trim: click the {ends} end of the part to keep · Esc back")
-            else:
-                parts.append("Trim: click the part of the loop to keep · Esc back")
+            # The machine's message, when it has one (a loop's third click, a miss), is the
+            # trim's next step: said once, as the hint.
+            ends = "first" if not machine.trim_arcs else "second"
+            hint = message or f"Click the {ends} end of the part to keep."
+            parts.append(f"Trim: {hint[0].lower()}{hint[1:].rstrip('.')} · Esc back")
         else:
             parts.append(KEYS)
-        if machine.message:
-            parts.append(machine.message.splitlines()[0])
+            if message:
+                parts.append(message)
         return " · ".join(parts)
 
     def finish(self) -> None:

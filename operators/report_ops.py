@@ -21,6 +21,7 @@ from ..vg_addon.analysis import missing_message
 from ..vg_addon.analysis.report import write_report
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
+from .csv_ops import offered_import_path
 
 SCENE_SESSION = "scene_measurements.csv"
 
@@ -76,11 +77,17 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
 
     def invoke(self, context, event):
         """Refuse at once where the libraries are missing (no files to choose in vain), else
-        open the file browser on CSV files."""
+        open the file browser on CSV files, offering the CSV this session last exported or
+        imported, as Import does."""
         missing = missing_message(batch_command(context.scene.vg_settings.report_folder, []))
         if missing:
             self.report({"ERROR"}, missing)
             return {"CANCELLED"}
+        offered = offered_import_path(
+            self.filepath if self.properties.is_property_set("filepath") else ""
+        )
+        if offered:
+            self.filepath = offered
         self.filter_glob = "*.csv"
         context.window_manager.fileselect_add(self)
         return {"RUNNING_MODAL"}

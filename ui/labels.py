@@ -89,20 +89,12 @@ def _visible_right(context, region) -> float:
 
 def _dots(positions: np.ndarray, diameter: float) -> None:
     """A white dot ringed in black at each labelled centre (pixel coordinates)."""
-    shader, sized = point_shader()
     coords = np.column_stack([positions, np.zeros(len(positions))]).astype(np.float32)
-    batch = batch_for_shader(shader, "POINTS", {"pos": coords})
-    shader.bind()
     gpu.state.blend_set("ALPHA")
-    for color, size in ((OUTLINE_COLOR, diameter + 3.0), (TEXT_COLOR, diameter)):
-        if sized:
-            shader.uniform_float("size", size)
-        else:
-            gpu.state.point_size_set(size)
-        shader.uniform_float("color", color)
-        batch.draw(shader)
-    if not sized:
-        gpu.state.point_size_set(1.0)
+    with point_shader() as points:
+        batch = batch_for_shader(points.shader, "POINTS", {"pos": coords})
+        for color, size in ((OUTLINE_COLOR, diameter + 3.0), (TEXT_COLOR, diameter)):
+            points.draw(batch, color, size)
     gpu.state.blend_set("NONE")
 
 

@@ -300,6 +300,24 @@ def test_render_views_flake(meshes, tmp_path):
     assert png_size(renders / "w90_map.png") == (2 * 48, 32)
 
 
+def test_render_edge_ends_caps_the_edges_close_ups(meshes, tmp_path):
+    """``--render-edge-ends`` reaches the map drawn in the batch's child process: two edges
+    meeting end to end (their ends crowd each other out of the six views) get close-ups by
+    default, none with 0 (the six views and the contact sheet only)."""
+    names = {}
+    for ends in (None, 0):
+        renders = tmp_path / f"renders{ends}"
+        cap = () if ends is None else ("--render-edge-ends", ends)
+        ok(batch(meshes["ply"], "--edge", -0.45, 0, 0, -0.02, 0, 0, "--edge", 0.02, 0, 0, 0.45,
+                 0, 0, "--spacing", 0.1, "--radius", RADIUS, "--out", tmp_path / f"out{ends}.csv", "--render", renders,
+                 "--render-size", 160, 120, "--render-samples", 1, *cap))  # fmt: skip
+        names[ends] = sorted(p.name for p in renders.iterdir())
+    views = ("front", "back", "right", "left", "top", "bottom")
+    assert names[0] == sorted(["w90_map.png", *(f"w90_map_{view}.png" for view in views)])
+    extra = set(names[None]) - set(names[0])
+    assert extra and all("close-up" in n or "measurement" in n for n in extra), names[None]
+
+
 # --------------------------------------------------------------------------- against the extension
 
 

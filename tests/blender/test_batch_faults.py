@@ -302,7 +302,11 @@ def test_render_onto_a_full_disk_says_no_space_left(scan, tmp_path, full_disk):
 
 @pytest.mark.parametrize(
     "option, said",
-    [(("--render-size", "60000", "60000"), "8,192"), (("--render-samples", "100000"), "4,096")],
+    [
+        (("--render-size", "60000", "60000"), "8,192"),
+        (("--render-samples", "100000"), "4,096"),
+        (("--render-edge-ends", "-1"), "--render-edge-ends must be 0 or more"),
+    ],
 )
 def test_the_map_size_and_samples_are_bounded_before_anything_renders(scan, tmp_path, option,
                                                                       said):  # fmt: skip

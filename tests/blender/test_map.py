@@ -368,3 +368,41 @@ def test_an_edges_inner_stations_get_no_close_ups(vg, tmp_path):
         assert len(plain.views) > len(job.views)  # each crowded reading gets a close-up
     finally:
         plain.close()
+
+
+def test_only_the_first_edges_ends_get_views_of_their_own(vg, tmp_path):
+    """Issue 22, item 3: the close-ups for edges' ends are capped (``edge_ends``, the batch's
+    ``--render-edge-ends``): three crowded edges along one crease, and only the ends of the first
+    ``edge_ends`` edges by number get extra views; with 0 none does, and nothing is listed as not
+    shown (the stations stay labelled where the six views have room). The oracle for the ends is
+    each edge's stations' stored arc lengths."""
+    obj = wedge_object(100.0, "Edges", n=40)
+    for start, end in ((-0.7, -0.25), (-0.2, 0.25), (0.3, 0.75)):
+        vg.bridge.edges.measure_edge_on_object(obj, [(start, 0.0, 0.0), (end, 0.0, 0.0)], 0.06, 0.2)
+    by_edge: dict[int, list] = {}
+    for item in obj.vg.measurements:
+        by_edge.setdefault(item.edge_number, []).append((exact(item)["arc_length"], item.number))
+    assert sorted(by_edge) == [1, 2, 3]
+    ends = {edge: {min(s)[1], max(s)[1]} for edge, s in by_edge.items()}
+
+    def extra_views(edge_ends):
+        job = vg.bridge.measurement_map.MapJob(
+            obj, tmp_path / str(edge_ends), size=(320, 240), samples=1, edge_ends=edge_ends
+        )
+        try:
+            assert not job.not_shown
+            return [int(name.rsplit(" ", 1)[1]) for name, _look, _up in job.views[6:]]
+        finally:
+            job.close()
+
+    uncapped = extra_views(3)
+    # The test's point: more than the first edge's ends are crowded out of the six views.
+    assert set(uncapped) - ends[1], uncapped
+    assert set(uncapped) <= ends[1] | ends[2] | ends[3]
+    first = extra_views(1)
+    assert first and set(first) <= ends[1], first
+    assert extra_views(0) == []
+    assert extra_views(vg.bridge.map_edges.EDGE_ENDS) == uncapped
+    for bad in (-1, True, 2.0):
+        with pytest.raises(vg.vg_addon.GoniometerError, match="0 or more"):
+            vg.bridge.measurement_map.MapJob(obj, tmp_path / "bad", edge_ends=bad)

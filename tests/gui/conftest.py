@@ -11,6 +11,8 @@ import math
 import os
 import shutil
 import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 from driver import REPO, GuiBlender
@@ -44,6 +46,23 @@ POINTS = {
 _provisioned: dict[str, str | None] = {}
 
 
+def provision(script: str, suite: str, **env) -> str | None:
+    """Run ``scripts/SCRIPT SUITE`` (it reuses what it made before); None, or why it failed."""
+    result = subprocess.run(
+        ["bash", str(REPO / "scripts" / script), suite],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=1800,
+        env={**os.environ, **env},
+    )
+    return (
+        None
+        if result.returncode == 0
+        else f"scripts/{script} {suite} failed:\n{result.stderr[-2000:]}"
+    )
+
+
 def blender_root(suite: str) -> None:
     """Make (or reuse) the root of ``suite``; skip, saying why, where it cannot be made."""
     if suite not in _provisioned:
@@ -52,20 +71,26 @@ def blender_root(suite: str) -> None:
                 "the GUI lane needs root (debootstrap, chroot, mounts); run the tests as root"
             )
         else:
-            result = subprocess.run(
-                ["bash", str(REPO / "scripts" / "provision_blender.sh"), suite],
-                capture_output=True,
-                text=True,
-                check=False,
-                timeout=1800,
-            )
-            _provisioned[suite] = (
-                None
-                if result.returncode == 0
-                else f"scripts/provision_blender.sh {suite} failed:\n{result.stderr[-2000:]}"
-            )
+            _provisioned[suite] = provision("provision_blender.sh", suite)
     if _provisioned[suite] is not None:
         pytest.skip(f"no real Blender from Debian {suite}: {_provisioned[suite]}")
+
+
+_report_libs: dict[str, str | None] = {}
+
+
+def report_libraries(suite: str) -> tuple[Path | None, str]:
+    """The replication report's libraries for the Python of ``suite``'s root
+    (``scripts/provision_report_libs.sh``, made once and cached beside the root): their folder,
+    or None and why they could not be made."""
+    if suite not in _report_libs:
+        _report_libs[suite] = provision(
+            "provision_report_libs.sh", suite, PIP_PYTHON=sys.executable
+        )
+    if _report_libs[suite] is not None:
+        return None, _report_libs[suite]
+    cache = Path(os.environ.get("VG_BLENDER_CACHE", "/var/cache/vg-blender"))
+    return cache / f"{suite}-report-libs", ""
 
 
 @pytest.fixture(autouse=True)
@@ -88,11 +113,19 @@ def console_stays_clean(request):
 @pytest.fixture(scope="module", params=SUITES)
 def gui(request, extension_zip):
     """A GUI Blender of one Debian suite, extension installed, the wedge scene set up (or the
-    scene a test module names in ``GUI_SCENE``: ``"fragment"``, the bone fragment)."""
+    scene a test module names in ``GUI_SCENE``: ``"fragment"``, the bone fragment). A module
+    with ``REPORT_LIBS = True`` gets the report's libraries bound into the root (not on
+    ``sys.path`` until a test asks); ``session.report_libs_missing`` says why they are not."""
     blender_root(request.param)
     failed_before = request.session.testsfailed
     scene = getattr(request.module, "GUI_SCENE", "wedge")
-    session = GuiBlender(request.param, extension_zip, POINTS, scene=scene)
+    libs, missing = (
+        report_libraries(request.param)
+        if getattr(request.module, "REPORT_LIBS", False)
+        else (None, "the test module does not ask for them (REPORT_LIBS)")
+    )
+    session = GuiBlender(request.param, extension_zip, POINTS, scene=scene, report_libs=libs)
+    session.report_libs_missing = missing
     try:
         yield session
     finally:

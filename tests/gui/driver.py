@@ -26,6 +26,7 @@ REPO = Path(__file__).resolve().parents[2]
 ROOT_SCRIPT = REPO / "scripts" / "blender_root.sh"
 SCREEN = (1280, 1800)  # tall: the whole sidebar shows without scrolling
 GUEST_REPO, GUEST_TMP = "/vg/repo", "/vg/tmp"
+GUEST_REPORT_LIBS = "/vg/report-libs"  # harness_startup.REPORT_LIBS
 END = "__vg_end__"
 EXTENSION_PACKAGE = "virtual_goniometer"  # in every path and module name of the installed zip
 
@@ -33,7 +34,7 @@ EXTENSION_PACKAGE = "virtual_goniometer"  # in every path and module name of the
 class RootShell:
     """A bash inside a Blender root; :meth:`run` runs one command line and returns its output."""
 
-    def __init__(self, suite: str, host_tmp: Path, log: Path):
+    def __init__(self, suite: str, host_tmp: Path, log: Path, report_libs: Path | None = None):
         # Background jobs (Xvfb, Blender) end with the shell, which ends when this side closes
         # its input (also when the test process is killed).
         loop = (
@@ -51,6 +52,7 @@ class RootShell:
                 "--bind",
                 str(host_tmp),
                 GUEST_TMP,
+                *(("--ro-bind", str(report_libs), GUEST_REPORT_LIBS) if report_libs else ()),
                 "--",
                 "bash",
                 "-c",
@@ -103,15 +105,21 @@ class GuiBlender:
     """One real Blender window under Xvfb, with the extension installed from ``zip_path``."""
 
     def __init__(
-        self, suite: str, zip_path: Path, points: dict[str, list[float]], scene: str = "wedge"
+        self,
+        suite: str,
+        zip_path: Path,
+        points: dict[str, list[float]],
+        scene: str = "wedge",
+        report_libs: Path | None = None,
     ):
         self.suite = suite
         self.scene = scene
+        self.report_libs = report_libs
         self.tmp = Path(tempfile.mkdtemp(prefix=f"vg-gui-{suite}-"))
         os.chmod(self.tmp, 0o755)
         shutil.copy(zip_path, self.tmp / "extension.zip")
         (self.tmp / "points.json").write_text(json.dumps(points))
-        self.shell = RootShell(suite, self.tmp, self.tmp / "shell.log")
+        self.shell = RootShell(suite, self.tmp, self.tmp / "shell.log", report_libs)
         self.display = None
         self.state_path = self.tmp / "state.json"
         try:

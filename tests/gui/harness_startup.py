@@ -7,16 +7,18 @@ writes what the test needs to read to ``$VG_GUI_STATE`` (JSON, replaced atomical
 measurements of every mesh object with their exact numbers, the active tool, the 3D view's
 regions in X screen pixels, the sidebar's tab, the 3D cursor, the running drag (found by
 looking, read-only, at the live ``DragSession`` objects), the running Find Break Edges review
-(its ``FindEdgesSession``, likewise), what a Ctrl+Shift+C copied, the
+(its ``FindEdgesSession``, likewise, with the header text it shows), what a Ctrl+Shift+C copied, the
 regions of an open file browser and what it offers (folder, file name, filter), the screen
 positions of the 3D points listed in ``$VG_GUI_POINTS``, each mesh's edge profiles and active
 list rows, the scenes and every "VG Map" data-block in the file, the window's running modal
-operators and the .blend's path; on request, the Info log's reports (as copied text).
+operators and the .blend's path; on request, the Info log's reports (as copied text), and the
+replication report's libraries put on ``sys.path``.
 """
 
 from __future__ import annotations
 
 import gc
+import importlib
 import json
 import os
 import sys
@@ -29,7 +31,8 @@ import scene
 
 STATE = os.environ["VG_GUI_STATE"]
 POINTS = os.environ.get("VG_GUI_POINTS", "")
-_status = {"seq": 0, "ready": False, "errors": [], "clipboard": []}
+REPORT_LIBS = "/vg/report-libs"
+_status = {"seq": 0, "ready": False, "errors": [], "clipboard": [], "report_libs": False}
 
 
 def _view3d(window):
@@ -125,7 +128,7 @@ def _drag(window, area):
 
 def _find_edges(window, area):
     """The running Find Break Edges review (found, read-only, among the live
-    ``FindEdgesSession`` objects): its phase, selection and message, and each candidate's
+    ``FindEdgesSession`` objects): its phase, selection, message and header text, and each candidate's
     number, confidence, decision and 24 points along it on screen (None: not in view)."""
     from bpy_extras import view3d_utils
     from mathutils import Matrix, Vector
@@ -168,6 +171,7 @@ def _find_edges(window, area):
             "progress": machine.progress,
             "selected": machine.selected,
             "message": machine.message,
+            "header": obj.header_text(bpy.context.scene),
             "candidates": candidates,
         }
     return None
@@ -255,6 +259,18 @@ def _copy_reports(window) -> None:
         area.type = "VIEW_3D"
 
 
+def _add_report_libraries() -> None:
+    """On the test's request (the file ``$VG_GUI_STATE.report_libs``), put the report's
+    libraries (``scripts/provision_report_libs.sh``, bound at ``/vg/report-libs``) on
+    ``sys.path`` after Blender's own entries, as a user who installs them would: the root's
+    NumPy stays the one imported."""
+    os.remove(STATE + ".report_libs")
+    if REPORT_LIBS not in sys.path:
+        sys.path.append(REPORT_LIBS)
+        importlib.invalidate_caches()
+    _status["report_libs"] = True
+
+
 def _tick():
     try:
         window = bpy.context.window_manager.windows[0]
@@ -264,6 +280,8 @@ def _tick():
         wm = bpy.context.window_manager
         if os.path.exists(STATE + ".reports") and _view3d(window):
             _copy_reports(window)
+        if os.path.exists(STATE + ".report_libs"):
+            _add_report_libraries()
         if wm.clipboard:
             _status["clipboard"].append([_status["seq"], wm.clipboard])
             wm.clipboard = ""
@@ -288,6 +306,7 @@ def _tick():
             "find_edges": _find_edges(window, area) if area else None,
             "points": _projections(window, area) if area else {},
             "clipboard": _status["clipboard"][-20:],
+            "report_libs": _status["report_libs"],
             "blend": bpy.data.filepath,
             "scenes": [s.name for s in bpy.data.scenes],
             "map_blocks": _map_blocks(),

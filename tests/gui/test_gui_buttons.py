@@ -1,12 +1,14 @@
 """The panel's file-browser, modal and list buttons in a real Blender window, pressed with real
-mouse and key events (xdotool): CSV Import (Re-measure), Replication Report, Render Map, the
-Edge Profiles list.
+mouse and key events (xdotool): CSV Import (Re-measure), Replication Report (refused in the
+distribution's Blender, then written once its libraries are importable), Render Map, the Edge
+Profiles list.
 
 One GUI Blender per Debian suite (trixie: Blender 4.3, unstable: 5.2) on the 100° wedge of
 ``scene.py``, the tests in file order on that one window, as one user session: measure, save the
 .blend, export, re-import, trace three edge profiles and pick them in their list, cancel and
-render the map. Every test also fails on an error from the extension in Blender's console
-(``conftest.console_stays_clean``). ``VG_GUI_PICTURES=DIR`` keeps the screenshots and the map.
+render the map, and last write the report once its libraries are importable. Every test also
+fails on an error from the extension in Blender's console (``conftest.console_stays_clean``).
+``VG_GUI_PICTURES=DIR`` keeps the screenshots and the map.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import numpy as np
 import pytest
 
 OBJ = "Wedge"
+REPORT_LIBS = True  # conftest binds the report's libraries into the root (one test uses them)
 WEDGE_ANGLE = 100.0
 VIEWS = ("front", "back", "right", "left", "top", "bottom")
 EXTRA_VIEWS = (f"{OBJ}_map_close-up_", f"{OBJ}_map_measurement_")  # see bridge.measurement_map
@@ -298,3 +301,51 @@ def test_render_map_writes_every_view_and_leaves_no_scene(gui, places):
     sheet = gui.tmp / f"map_{gui.suite}.png"
     shutil.copy(folder / f"{OBJ}_map.png", sheet)
     keep_picture(sheet)
+
+
+def report_button(gui) -> tuple[float, float]:
+    """The Replication Report button: in the CSV panel if it is open, else opened."""
+    try:
+        return gui.find_button("UI", "vg.report", upward=True)
+    except LookupError:
+        export = gui.open_panel_with("vg.export_csv", below=gui.state()["regions"]["UI"][1])
+        return gui.find_button("UI", "vg.report", rows=range(export[1], export[1] + 140, 6))
+
+
+def test_replication_report_writes_the_report_once_its_libraries_are_there(gui, places):
+    """Replication Report pressed again once SciPy, statsmodels and matplotlib are importable
+    (``scripts/provision_report_libs.sh``'s wheels for this Blender's Python, put on its
+    ``sys.path`` as a user who installed them would have them): the file browser opens on the
+    exported CSV, its button pressed, and the report is written beside it with this scene's
+    measurements as one more session. Oracles: the scene's measurements (their exact angles,
+    from the harness) for the scene's session CSV, and the chosen file's name in the page. Last
+    in the file: with the libraries importable the window is no longer the distribution's
+    Blender the tests before it are about."""
+    if gui.report_libs is None:
+        pytest.skip(f"no report libraries for this Blender's Python: {gui.report_libs_missing}")
+    Path(f"{gui.state_path}.report_libs").touch()
+    gui.wait_for(lambda s: s.get("report_libs"), 20, "the report's libraries on sys.path")
+    browser = open_browser(gui, report_button(gui))
+    params = browser["params"]
+    assert (params["filename"], params["filter_glob"]) == (places["csv"].name, "*.csv")
+    press_browser_button(gui, browser)  # the exported CSV, offered as Import offers it
+    folder = places["csv"].parent / "vg_report"  # beside the first CSV chosen
+    gui.wait_for(lambda s: (folder / "report.html").exists(), 180, "report.html")
+    gui.wait_for(
+        lambda s: not any("vg.report" in op.lower() for op in s["modal_operators"]), 60, ""
+    )
+    seq = gui.state()["seq"]
+    Path(f"{gui.state_path}.reports").touch()
+    state = gui.wait_for(
+        lambda s: any(n >= seq and "report.html" in t for n, t in s["clipboard"]), 20, "reports"
+    )
+    reports = "\n".join(t for n, t in state["clipboard"] if n >= seq)
+    assert "Wrote /vg/tmp/home/vg_report/report.html: " in reports, reports
+    with (folder / "scene_measurements.csv").open(newline="") as handle:
+        scene_rows = list(csv.DictReader(handle))
+    assert [float(row["Angle"]) for row in scene_rows] == [
+        m["exact"]["angle"] for m in measurements(gui)
+    ]
+    page = (folder / "report.html").read_text(encoding="utf-8")
+    assert places["csv"].name in page and "scene_measurements.csv" in page
+    assert places["csv"].exists()  # the chosen session is read, never written

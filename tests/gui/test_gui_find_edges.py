@@ -86,14 +86,13 @@ def trim_third(gui, found) -> dict:
     gui.click(tuple(before["screen"][ends[0]]))
     assert review(gui.settle())["selected"] == 2
     gui.key("t")
+    says_once(gui.settle()["find_edges"], "TRIMMING", "click the first end of the part to keep")
     gui.click(tuple(before["screen"][ends[1]]))  # either order
+    says_once(gui.settle()["find_edges"], "TRIMMING", "click the second end of the part to keep")
     gui.click(tuple(before["screen"][ends[0]]))
     if before["closed"]:
-        trimming = gui.settle()["find_edges"]
-        assert (trimming["phase"], trimming["message"]) == (
-            "TRIMMING",
-            "Click the part of the loop to keep.",
-        )
+        trimming = says_once(gui.settle()["find_edges"], "TRIMMING", "part of the loop to keep")
+        assert trimming["message"] == "Click the part of the loop to keep."
         between = next((k for k in clear if ends[0] < k < ends[1]), None)
         assert between is not None, "no clear point on candidate 3 between the trim's ends"
         gui.click(tuple(before["screen"][between]))
@@ -108,6 +107,16 @@ def trim_third(gui, found) -> dict:
     share = (ends[1] - ends[0]) / len(before["screen"])
     assert abs(trimmed["length"] / before["length"] - share) < 0.08
     return after
+
+
+def says_once(found, phase: str, hint: str) -> dict:
+    """The review is in ``phase`` and its header (the text over the viewport) gives ``hint``
+    once, with Esc's way back once and no review keys; the review."""
+    assert found["phase"] == phase
+    header = found["header"].lower()
+    assert header.count(hint) == 1, found["header"]
+    assert header.count("esc") == 1 and "a accept" not in header, found["header"]
+    return found
 
 
 def clear_of(found, index, xy) -> float:
