@@ -75,6 +75,7 @@ HARDER = {
     "flake, marched": (fragments.marched_flake, 0.0, MARCH_STEP),
     "flake, marched, within one mean edge": (fragments.marched_flake, 0.0, None),
     "flake, marched, noise 0.1": (fragments.marched_flake, 0.1, MARCH_STEP),
+    "flake, marched, noise 0.1, one edge": (fragments.marched_flake, 0.1, None),
 }
 
 
@@ -116,12 +117,16 @@ def test_the_bevelled_cube_at_noise_0_3_passes_with_other_noise_seeds(seed):
         assert np.array_equal(again.vertices, vertices), candidate.number
 
 
-def test_the_local_noise_bar_keeps_the_flakes_weakest_edge():
-    """With noise seed 3 at 0.3 mean edges the flake's platform edge stands out from the noise
-    round it by only about 30 times; the bar must keep it (a bar of 30 dropped it, recall 88.9%)."""
+@pytest.mark.parametrize("seed", [3, 6, 11])
+def test_the_noisy_flake_passes_with_other_noise_seeds(seed):
+    """Noise of 0.3 mean edges with seeds that failed before: with seed 3 the platform edge
+    stands out from the noise round it by only about 30 times, and the local noise bar must keep
+    it (a bar of 30 dropped it, recall 88.9%); with seeds 6 and 11 the dorsal/platform crest ran
+    on the platform's row and the margin's path partly off the edge (5.1% and 9.0% false)
+    before the outer crest."""
     fragment = flake()
     h = mean_edge_length(fragment.points, fragment.triangles)
-    fragment = with_noise(fragment, 0.3 * h, seed=3)
+    fragment = with_noise(fragment, 0.3 * h, seed=seed)
     result = Surface(fragment.points, fragment.triangles).find_break_edges()
     figures = score(fragment, [c.path.points for c in result.candidates])
     assert len(result.candidates) == len(fragment.edges), figures

@@ -34,6 +34,7 @@ import numpy as np
 from ..errors import GoniometerError
 from .edge_pieces import (
     balanced_crest,
+    outer_crest,
     retraced_legs,
     ridge_pieces,
     smooth_regions,
@@ -48,6 +49,7 @@ from .ridge_field import (
     bend_of_anisotropy,
     blurred,
     cell_spread,
+    pooled_at,
     ring_spread,
     spread_of,
     vertex_moments,
@@ -92,6 +94,10 @@ of the region vertices round it: a chain of noise bumps on a noisy face does not
 the noise around it, a true edge stands out by more. Measured on the noisy cube and flake
 (noise 0.2 and 0.3 mean edges, seeds 1 to 12): noise ridges 0 to 12.7, true edges 28 and up;
 20 is about the middle of that gap on a log scale (docs/EDGE_DETECTION.md)."""
+
+OUTWARD_RINGS = 4
+"""A crest's outward direction (for :func:`.edge_pieces.outer_crest`) is the smoothed normal
+pooled this many rings deep: one ring reads the noise, four the crease as a whole."""
 
 MIN_REGION_SCALES = 2.0
 """Default ``min_region_area``: a disc of this many times ``scale`` in radius."""
@@ -455,8 +461,20 @@ class BreakEdgeFinder:
         sharp = graph.vertex_bend >= edge_bar
         yield 0.7
         traced = []
+        # The outward direction of each crest: its smoothed normals pooled a few rings deep.
+        crests = [p.vertices for p in pieces if p.regions[0] >= 0]
+        outward = (
+            pooled_at(
+                graph.starts, graph.target, sums[:, 1:4], OUTWARD_RINGS, np.concatenate(crests)
+            )
+            if crests
+            else sums[:, 1:4]
+        )
         for k, piece in enumerate(pieces):
-            piece = balanced_crest(graph, piece, flooded, band, sums[:, 1:4], reach)
+            balanced = balanced_crest(graph, piece, flooded, band, sums[:, 1:4], reach)
+            if balanced is piece:
+                balanced = outer_crest(graph, piece, self.surface.points, outward)
+            piece = balanced
             candidate = self._candidate(graph, piece, bend_field, ridge_min_deg, params, sharp)
             if candidate is not None:
                 traced.append(candidate)

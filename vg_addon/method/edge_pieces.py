@@ -414,3 +414,44 @@ def balanced_crest(graph, piece: Piece, flooded, band, normals, rings: int) -> P
     if crest.size < 2:
         return piece
     return Piece(crest, piece.regions, piece.ends)
+
+
+def outer_crest(graph, piece: Piece, points: np.ndarray, outward: np.ndarray) -> Piece:
+    """``piece`` with each crest vertex moved to the neighbour that stands out most beyond it
+    along the crest's outward direction ``outward`` (if any does), on a convex crease.
+
+    Used where :func:`balanced_crest` keeps the floods' meeting line (a side curved near the
+    piece). The floods locate a crest to within the fine field's two rings; on a convex crease
+    the mesh vertices nearest the true edge are those that stand out most along the bisector
+    of its sides, whether the edge runs through vertices (a noisy crest's row) or between them
+    (a reconstruction cuts its corner: the outer of the rows it leaves). A rounded edge's
+    middle stands out by no more than the noise, which is why the balanced crest, not this,
+    places it. Kept as it is: a ridge inside one region and a piece whose neighbours do not
+    lie below it on the whole (a valley or a flat).
+
+    Parameters
+    ----------
+    graph : RidgeGraph
+    piece : Piece
+    points : ndarray, shape (n, 3)
+    outward : ndarray, shape (n, 3)
+        A direction out of the surface at each crest vertex (need not be of unit length).
+    """
+    if piece.regions[0] < 0:
+        return piece
+    own, neighbour = _rows(graph, piece.vertices)
+    if own.size == 0:
+        return piece
+    height = rows_dot(points[neighbour] - points[own], outward[own])
+    if total(height) >= 0.0:
+        return piece
+    # The highest neighbour of each crest vertex standing out beyond it (ties: the least).
+    up = height > 0.0
+    own, neighbour, height = own[up], neighbour[up], height[up]
+    order = np.lexsort((-neighbour, height, own))
+    last = np.flatnonzero(np.diff(np.concatenate([own[order], [-1]])) != 0)
+    vertices = piece.vertices  # sorted
+    moved = vertices.copy()
+    moved[np.searchsorted(vertices, own[order][last])] = neighbour[order][last]
+    ends = moved[np.searchsorted(vertices, piece.ends)]
+    return Piece(sorted_unique(moved), piece.regions, sorted_unique(ends))
