@@ -296,12 +296,15 @@ class Run:
         return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
 
 
-def _counts(row) -> tuple[int, int, int]:
-    """A row's stability runs, refused runs and refused crease bands (0 where empty)."""
+def _counts(row) -> tuple:
+    """A row's stability runs, refused runs and refused crease bands (0 where empty), and
+    whether the normals' noise hides the crease (``None`` where empty)."""
+    noise = row.stability_noise_hides_crease
     return (
         row.stability_runs or 0,
         row.stability_refused or 0,
         row.stability_crease_refused or 0,
+        None if noise is None else bool(noise),
     )
 
 

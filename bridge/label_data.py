@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..vg_addon.formats.record_codec import exact_numbers
-from ..vg_addon.method.result import stability_undetermined
+from ..vg_addon.method.result import stored_stability_undetermined
 from ..vg_addon.workflow.labels import label_text
 from . import records
 from .mesh_data import world_points
@@ -53,8 +53,7 @@ def stability_flag(item) -> str:
     if not item.stability_warning:
         return ""
     parts = exact_numbers(item).get("stability") or {}
-    counts = (int(parts.get(key) or 0) for key in ("runs", "refused", "crease_refused"))
-    if stability_undetermined(*counts):
+    if stored_stability_undetermined(parts):
         return "±?"  # the figure itself may be far too small: no number that looks steady
     return f"±{float(parts.get('spread', 0.0)):.0f}°"
 

@@ -252,6 +252,11 @@ _KEYS = (
 )
 
 
+def _as_flag(value) -> int | None:
+    """A stored yes/no as a CSV's 1 or 0; ``None`` (not recorded) stays empty."""
+    return None if value is None else int(bool(value))
+
+
 def numbers_of(item) -> dict:
     """The exact numbers of ``item`` (see ``properties.exact_numbers``), all of them or an error."""
     numbers = exact_numbers(item)
@@ -404,6 +409,7 @@ def measurement_row(
         stability_refused=stability.get("refused"),
         stability_crease=stability.get("crease"),
         stability_crease_refused=stability.get("crease_refused"),
+        stability_noise_hides_crease=_as_flag(stability.get("noise_hides_crease")),
         error="",
     )
 

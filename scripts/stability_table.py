@@ -152,7 +152,10 @@ def change_rows():
         before = np.array([b for (_, b, _), _ in rows])
         after = np.array([s.spread for (_, _, s), _ in rows])
         crease = np.array([s.crease for (_, _, s), _ in rows])
-        newly = sum(s.crease_refused > 0 and s.n_failed <= 0.1 * s.n_runs for (_, _, s), _ in rows)
+        newly = sum(
+            (s.crease_refused > 0 or s.noise_hides_crease) and s.n_failed <= 0.1 * s.n_runs
+            for (_, _, s), _ in rows
+        )
         errors = [(abs(m.angle - e), b, s) for (m, b, s), e in rows if e is not None]
         covered = (
             f"{sum(err <= b for err, b, _ in errors)} → "

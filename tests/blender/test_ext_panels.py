@@ -219,17 +219,23 @@ def test_an_undetermined_figure_shows_no_number_that_looks_steady(vg, lists):
     item = bpy.context.active_object.vg.measurements[0]
     recorded = item.exact
     try:
-        for spread, runs, refused, crease_refused, shown in (
-            (0.2, 83, 79, 0, "±?"),
-            (0.2, 83, 0, 2, "±?"),
-            (150.0, 83, 0, 0, "±150°"),
+        for spread, runs, refused, crease_refused, noise, shown, reason in (
+            (0.2, 83, 79, 0, False, "±?", "79 of 83 perturbed measurements were refused"),
+            (0.2, 83, 0, 2, False, "±?", "a face keeps too few vertices off it"),
+            (0.2, 83, 0, 0, True, "±?", "the vertex normals' noise is larger than the turn"),
+            (0.2, 83, 0, 1, None, "±?", "or the vertex normals' noise"),  # an older record
+            (150.0, 83, 0, 0, False, "±150°", "moves by up to 150.0°"),
         ):
             numbers = json.loads(recorded)
             numbers["stability"].update(
                 spread=spread, runs=runs, refused=refused, crease_refused=crease_refused
             )
+            numbers["stability"].pop("noise_hides_crease", None)
+            if noise is not None:
+                numbers["stability"]["noise_hides_crease"] = noise
             item.exact = json.dumps(numbers)
             assert item.stability_warning and lists.row_flag(item) == shown
+            assert reason in item.stability_warning
     finally:
         item.exact = recorded  # the record as measured, for the checks after the test
 

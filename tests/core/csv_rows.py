@@ -53,6 +53,7 @@ OUR_EXTRA_COLUMNS = [
     "Stability Refused",
     "Stability Crease",
     "Stability Crease Refused",
+    "Stability Noise Hides Crease",
     "error",
 ]
 
@@ -103,6 +104,7 @@ def good_row(**changes) -> MeasurementRow:
         stability_refused=1,
         stability_crease=0.1,
         stability_crease_refused=0,
+        stability_noise_hides_crease=0,
         error="",
     )
     values.update(changes)

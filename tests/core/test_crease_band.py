@@ -87,11 +87,15 @@ def test_a_face_left_without_vertices_beyond_the_band_makes_the_figure_undetermi
     s = m.stability
     assert s.crease_refused > 0 and s.text() == "± ?"
     assert "without the vertices next to the crease a face keeps too few" in s.warning
+    assert not s.noise_hides_crease and "noise" not in s.warning  # the one reason that holds
     # The stored record (the list, the panel, the CSV) says the same.
     stored = {"spread": s.spread, "runs": s.n_runs, "refused": s.n_failed}
     assert stored_stability_text(stored) != "± ?"  # a record made before the crease part
     stored["crease_refused"] = s.crease_refused
     assert stored_stability_text(stored) == "± ?"
+    # A record made before the noise was kept apart: its count may hold either reason.
+    assert "or the vertex normals' noise is larger" in stored_stability_warning(stored)
+    stored["noise_hides_crease"] = s.noise_hides_crease
     assert stored_stability_warning(stored) == s.warning
 
 
@@ -103,7 +107,7 @@ def test_the_crease_part_is_reproducible_and_added_to_the_spread():
     s = m.stability
     others = max(s.center, s.radius, s.lam, s.bootstrap, s.orientation)
     assert s.spread == others + s.crease and s.crease > 0
-    assert crease_change(surface, m) == (s.crease, s.crease_refused)
+    assert crease_change(surface, m) == (s.crease, s.crease_refused, s.noise_hides_crease)
     again = surface.measure(nearest_the_crease(points), 0.2, rule="oriented", stability=True)
     assert again.stability == s
 
@@ -126,6 +130,36 @@ def test_the_crease_columns_round_trip_and_older_exports_still_read():
     (old,) = csvio.read_measurements_csv(text)
     assert old.stability_crease is None and old.stability_crease_refused is None
     assert old.stability == good_row().stability
+
+
+def test_the_noise_column_round_trips_and_older_exports_keep_both_reasons():
+    """The noise reason has a column of its own; an export written before it counted the noise
+    in ``Stability Crease Refused``, so its undetermined figures name both reasons."""
+    from csv_rows import cells, good_row
+
+    from vg_addon.formats import csvio
+    from vg_addon.method.result import stability_warning
+
+    def warning(row):
+        noise = row.stability_noise_hides_crease
+        counts = (row.stability_runs, row.stability_refused, row.stability_crease_refused)
+        return stability_warning(row.stability, *counts, None if noise is None else bool(noise))
+
+    noisy = good_row(stability_crease_refused=0, stability_noise_hides_crease=1)
+    (back,) = csvio.read_measurements_csv(csvio.format_measurements_csv([noisy]))
+    assert back.stability_noise_hides_crease == 1
+    assert "noise is larger than the turn" in warning(back)
+    assert "a face keeps too few" not in warning(back)
+    banded = good_row(stability_crease_refused=1, stability_noise_hides_crease=0)
+    (back,) = csvio.read_measurements_csv(csvio.format_measurements_csv([banded]))
+    assert "a face keeps too few" in warning(back) and "noise" not in warning(back)
+    written = cells(csvio.format_measurements_csv([banded]))
+    keep = [i for i, c in enumerate(written[0]) if c not in csvio.NOISE_COLUMNS]
+    assert len(keep) == len(written[0]) - 1
+    text = "\n".join(",".join(f'"{line[i]}"' for i in keep) for line in written) + "\n"
+    (old,) = csvio.read_measurements_csv(text)
+    assert old.stability_noise_hides_crease is None
+    assert "a face keeps too few" in warning(old) and "or the vertex normals' noise" in warning(old)
 
 
 @pytest.mark.parametrize(("angle", "spacing"), [(5, 0.03), (10, 0.04)])
@@ -167,6 +201,11 @@ def test_near_flat_creases_whose_normals_hide_the_crease_are_undetermined(
     assert result is not None
     m, ok = result
     assert ok, (m.angle - angle, m.stability)
+    # The reason given is the noise, not a band left without a plane (none was).
+    s = m.stability
+    assert s.noise_hides_crease and s.crease_refused == 0 and s.text() == "± ?"
+    assert "the vertex normals' noise is larger than the turn" in s.warning
+    assert "a face keeps too few" not in s.warning
 
 
 def test_a_small_patch_counts_each_band_once():
@@ -179,7 +218,7 @@ def test_a_small_patch_counts_each_band_once():
     m = surface.measure([0.0, 0.0, 0.0], 0.45, stability=True)
     assert mean_edge_length(m.radius, m.n_vertices) > 0.5 * m.radius
     assert abs(m.angle - 120.0) < 1e-9
-    assert crease_change(surface, m) == (pytest.approx(0.0, abs=1e-9), 2)
+    assert crease_change(surface, m) == (pytest.approx(0.0, abs=1e-9), 2, False)
     assert m.stability.crease_refused == 2
 
 

@@ -47,6 +47,7 @@ def _stability(stability) -> dict:
         "refused": int(stability.n_failed),
         "crease": float(stability.crease),
         "crease_refused": int(stability.crease_refused),
+        "noise_hides_crease": bool(stability.noise_hides_crease),
     }
 
 

@@ -88,7 +88,7 @@ def _reaches(to_line, spacing) -> bool:
     return to_line.size > 0 and float(to_line.max() - to_line.min()) >= MIN_REACH * spacing
 
 
-def crease_change(surface, m) -> tuple[float, int]:
+def crease_change(surface, m) -> tuple[float, int, bool]:
     """The crease part of a measurement's stability figure.
 
     Parameters
@@ -108,9 +108,11 @@ def crease_change(surface, m) -> tuple[float, int]:
         or not.
     refused : int
         How many distinct bands left a side too few vertices, a line, or a band narrower than
-        :data:`MIN_REACH` to fit its plane, plus one where the vertex normals' noise is larger
-        than the turn between the faces (:func:`_normals_hide_the_crease`): then how far the
-        reading is off is not known.
+        :data:`MIN_REACH` to fit its plane: then how far the reading is off is not known.
+    noise_hides_crease : bool
+        Whether the vertex normals' noise is larger than the turn between the faces
+        (:func:`_normals_hide_the_crease`): the sides can be mixed across the whole patch, and
+        how far the reading is off is not known either.
     """
     spacing = mean_edge_length(m.radius, m.n_vertices)
     points = surface.points[m.indices] - m.center
@@ -126,11 +128,10 @@ def crease_change(surface, m) -> tuple[float, int]:
     # A small patch clamps both spacing bands to the widest: that is one band, counted once.
     widths = list(dict.fromkeys(widths + [k * m.radius for k in BAND_RADII]))
     to_line = _distance_to_crease(points, sides, m.normal_plus, m.normal_minus)
+    noise_hides_crease = _normals_hide_the_crease(normals, m.tangent, m.angle)
     if to_line is None:
-        return 0.0, len(widths)
+        return 0.0, len(widths), noise_hides_crease
     change, refused = 0.0, 0
-    if _normals_hide_the_crease(normals, m.tangent, m.angle):
-        refused += 1
     for width in widths:
         kept = [side & (to_line > width) for side in sides]
         fitted = [
@@ -142,7 +143,7 @@ def crease_change(surface, m) -> tuple[float, int]:
             continue
         angle = 180.0 - acos_degrees(dot3(fitted[0], fitted[1]))
         change = max(change, abs(angle - m.angle))
-    return change, refused
+    return change, refused, noise_hides_crease
 
 
 __all__ = ["BAND_RADII", "BAND_SPACINGS", "MIN_REACH", "crease_change"]

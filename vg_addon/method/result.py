@@ -36,33 +36,75 @@ UNDETERMINED_REFUSED = 0.1
 undetermined: the refused runs add nothing to it, so it may be far too small."""
 
 
-def stability_text(spread: float, runs: int = 0, refused: int = 0, crease_refused: int = 0) -> str:
+def stability_text(
+    spread: float,
+    runs: int = 0,
+    refused: int = 0,
+    crease_refused: int = 0,
+    noise_hides_crease: bool | None = False,
+) -> str:
     """The stability figure as shown: ``"± 0.4°"`` (two decimals below 0.1°), or ``"± ?"`` when
     it is undetermined (see :func:`stability_undetermined`): a spread of the few runs that were
     not refused says nothing, and printed as a number it would vouch for the reading."""
-    if stability_undetermined(runs, refused, crease_refused):
+    if stability_undetermined(runs, refused, crease_refused, noise_hides_crease):
         return "± ?"
     return f"± {spread:.2f}°" if spread < 0.1 else f"± {spread:.1f}°"
 
 
-def stability_undetermined(runs: int, refused: int, crease_refused: int = 0) -> bool:
-    """Whether more than :data:`UNDETERMINED_REFUSED` of a figure's ``runs`` were ``refused``,
-    or a band left out along the crease left a face without a plane (``crease_refused`` > 0):
+def stability_undetermined(
+    runs: int, refused: int, crease_refused: int = 0, noise_hides_crease: bool | None = False
+) -> bool:
+    """Whether more than :data:`UNDETERMINED_REFUSED` of a figure's ``runs`` were ``refused``, a
+    band left out along the crease left a face without a plane (``crease_refused`` > 0), or the
+    vertex normals' noise is larger than the turn between the faces (``noise_hides_crease``):
     the figure is then undetermined (it may be far too small)."""
-    return (runs > 0 and refused > UNDETERMINED_REFUSED * runs) or crease_refused > 0
+    return (
+        (runs > 0 and refused > UNDETERMINED_REFUSED * runs)
+        or crease_refused > 0
+        or bool(noise_hides_crease)
+    )
+
+
+_UNKNOWN_OFF = "how far the reading is off is not known and the ± figure may be far too small."
+
+_REASONS = {
+    "bands": (
+        "Undetermined: without the vertices next to the crease a face keeps too few vertices "
+        "off it to fit its plane (on a thin wedge the mesh's cells hold both faces across the "
+        f"patch), so {_UNKNOWN_OFF}"
+    ),
+    "noise": (
+        "Undetermined: the vertex normals' noise is larger than the turn between the faces, so "
+        f"the two sides can be mixed across the patch: {_UNKNOWN_OFF}"
+    ),
+    # A record made before the two were kept apart counted both in ``crease_refused``.
+    "either": (
+        "Undetermined: without the vertices next to the crease a face keeps too few vertices "
+        "off it to fit its plane (on a thin wedge the mesh's cells hold both faces across the "
+        "patch), or the vertex normals' noise is larger than the turn between the faces (the "
+        f"sides can be mixed), so {_UNKNOWN_OFF}"
+    ),
+}
 
 
 def stability_warning(
-    spread: float, runs: int = 0, refused: int = 0, crease_refused: int = 0
+    spread: float,
+    runs: int = 0,
+    refused: int = 0,
+    crease_refused: int = 0,
+    noise_hides_crease: bool | None = False,
 ) -> str:
     """Why a reading with this stability figure should not be trusted as it stands, or ``""``.
 
     The one rule every place that shows a reading uses (the list, the Selected Measurement
     panel, the operator's report, the batch's summary): unstable when the figure (``spread``,
     degrees) is more than :data:`UNSTABLE_DEGREES`; undetermined when more than
-    :data:`UNDETERMINED_REFUSED` of its ``runs`` perturbed measurements were ``refused``, or
-    when leaving out the vertices next to the crease left a face too few vertices to fit its
-    plane (``crease_refused`` bands).
+    :data:`UNDETERMINED_REFUSED` of its ``runs`` perturbed measurements were ``refused``, when
+    leaving out the vertices next to the crease left a face too few vertices to fit its plane
+    (``crease_refused`` bands), or when the vertex normals' noise is larger than the turn
+    between the faces (``noise_hides_crease``). Each reason that holds is given; ``None`` for
+    ``noise_hides_crease`` is a record made before the last two were kept apart (its
+    ``crease_refused`` may count either), whose reason names both.
     """
     reasons = []
     if spread > UNSTABLE_DEGREES:
@@ -76,28 +118,32 @@ def stability_warning(
             f"Undetermined: {refused} of {runs} perturbed measurements were refused (more than "
             f"{UNDETERMINED_REFUSED:.0%}), so the ± figure may be far too small."
         )
-    if crease_refused > 0:
-        reasons.append(
-            "Undetermined: without the vertices next to the crease a face keeps too few "
-            "vertices off it to fit its plane (on a thin wedge the mesh's cells hold both faces "
-            "across the patch), or the vertex normals' noise is larger than the turn between "
-            "the faces (the sides can be mixed), so how far the reading is off is not known "
-            "and the ± figure may be far too small."
-        )
+    if noise_hides_crease is None:
+        if crease_refused > 0:
+            reasons.append(_REASONS["either"])
+    else:
+        if crease_refused > 0:
+            reasons.append(_REASONS["bands"])
+        if noise_hides_crease:
+            reasons.append(_REASONS["noise"])
     if not reasons:
         return ""
     return " ".join(reasons) + " Measure again on the edge, or with a larger radius."
 
 
-def _stored_counts(parts: dict) -> tuple[int, int, int]:
-    """``runs``, ``refused`` and ``crease_refused`` of a stored stability record (0 where absent:
-    records made before the crease part)."""
-    return tuple(int(parts.get(key) or 0) for key in ("runs", "refused", "crease_refused"))
+def _stored_counts(parts: dict) -> tuple:
+    """``runs``, ``refused``, ``crease_refused`` (0 where absent: records made before the crease
+    part) and ``noise_hides_crease`` (``None`` where absent: records made before it was kept
+    apart from ``crease_refused``) of a stored stability record."""
+    counts = tuple(int(parts.get(key) or 0) for key in ("runs", "refused", "crease_refused"))
+    noise = parts.get("noise_hides_crease")
+    return (*counts, None if noise is None else bool(noise))
 
 
 def stored_stability_text(parts: dict | None) -> str:
     """:func:`stability_text` of a stored stability record (the JSON dict with ``spread``,
-    ``runs``, ``refused`` and ``crease_refused``); ``"not computed"`` for none."""
+    ``runs``, ``refused``, ``crease_refused`` and ``noise_hides_crease``); ``"not computed"``
+    for none."""
     if not parts:
         return "not computed"
     return stability_text(float(parts["spread"]), *_stored_counts(parts))
@@ -105,11 +151,18 @@ def stored_stability_text(parts: dict | None) -> str:
 
 def stored_stability_warning(parts: dict | None) -> str:
     """:func:`stability_warning` of a stored stability record (the JSON dict with ``spread``,
-    ``runs``, ``refused`` and ``crease_refused``, as a measurement record and the CSV keep it);
-    ``""`` for none."""
+    ``runs``, ``refused``, ``crease_refused`` and ``noise_hides_crease``, as a measurement
+    record and the CSV keep it); ``""`` for none."""
     if not parts:
         return ""
     return stability_warning(float(parts.get("spread", 0.0)), *_stored_counts(parts))
+
+
+def stored_stability_undetermined(parts: dict | None) -> bool:
+    """:func:`stability_undetermined` of a stored stability record; ``False`` for none."""
+    if not parts:
+        return False
+    return stability_undetermined(*_stored_counts(parts))
 
 
 @dataclass(frozen=True)
@@ -150,8 +203,11 @@ class Stability:
         largest of the other parts, not compared with them: it is a bias, they are spreads.
     crease_refused : int
         Checks of the crease that could not be made: bands whose refit was refused (a side
-        kept too few vertices, or a line), and one more where the vertex normals' noise is
-        larger than the turn between the faces. The figure is then undetermined.
+        kept too few vertices, or a line). The figure is then undetermined.
+    noise_hides_crease : bool
+        The vertex normals' noise is larger than the turn between the faces, so a vertex's
+        normal does not say which face it is on and the sides can be mixed across the patch.
+        The figure is then undetermined.
     """
 
     spread: float
@@ -164,16 +220,20 @@ class Stability:
     n_failed: int
     crease: float = 0.0
     crease_refused: int = 0
+    noise_hides_crease: bool = False
+
+    def _counts(self) -> tuple:
+        return (self.n_runs, self.n_failed, self.crease_refused, self.noise_hides_crease)
 
     def text(self) -> str:
         """The figure as shown: ``"± 0.4°"`` (two decimals below 0.1°), ``"± ?"`` when undetermined."""
-        return stability_text(self.spread, self.n_runs, self.n_failed, self.crease_refused)
+        return stability_text(self.spread, *self._counts())
 
     @property
     def warning(self) -> str:
         """Why the reading is flagged (unstable, or the figure undetermined), or ``""``: see
         :func:`stability_warning`."""
-        return stability_warning(self.spread, self.n_runs, self.n_failed, self.crease_refused)
+        return stability_warning(self.spread, *self._counts())
 
 
 @dataclass(frozen=True, eq=False)

@@ -485,7 +485,7 @@ def estimate_stability(surface, m: Measurement) -> Stability:
     parts["orientation"] = m.orientation_difference
     # The runs above all keep the vertices next to the crease, and so share the tilt they give
     # the planes: that bias is measured apart and added to the spread, not compared with it.
-    crease, crease_refused = crease_change(surface, m)
+    crease, crease_refused, noise_hides_crease = crease_change(surface, m)
     return Stability(
         spread=max(parts.values()) + crease,
         **parts,
@@ -493,6 +493,7 @@ def estimate_stability(surface, m: Measurement) -> Stability:
         n_failed=int((~measured).sum() + (~kept).sum()),
         crease=crease,
         crease_refused=crease_refused,
+        noise_hides_crease=noise_hides_crease,
     )
 
 

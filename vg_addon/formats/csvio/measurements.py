@@ -99,6 +99,7 @@ SCHEMA = (
     ("stability_refused", "int", ("Stability Refused",)),
     ("stability_crease", "float", ("Stability Crease",)),
     ("stability_crease_refused", "int", ("Stability Crease Refused",)),
+    ("stability_noise_hides_crease", "int", ("Stability Noise Hides Crease",)),
     ("error", "text", ("error",)),
 )
 
@@ -125,6 +126,12 @@ RULE_COLUMNS = (
 CREASE_COLUMNS = ("Stability Crease", "Stability Crease Refused")
 
 
+#: Column added when the normals' noise was kept apart from the refused crease bands (issue 19).
+#: Exports written before lack it; their ``Stability Crease Refused`` may count either reason,
+#: and an undetermined figure of theirs gives both.
+NOISE_COLUMNS = ("Stability Noise Hides Crease",)
+
+
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
 EXPORT_COLUMNS = tuple(column for _, _, columns in SCHEMA for column in columns)
 
@@ -138,6 +145,7 @@ LATER_COLUMNS = (
     "Spacing",
     "Coordinates",
     *CREASE_COLUMNS,
+    *NOISE_COLUMNS,
 )
 
 
@@ -218,6 +226,11 @@ class MeasurementRow:
         left out (included in ``stability``, added to the largest of the other parts).
     stability_crease_refused : int or None
         Bands along the crease whose refit was refused; more than 0 makes the figure undetermined.
+        In exports without ``stability_noise_hides_crease`` it may also count that reason (one).
+    stability_noise_hides_crease : int or None
+        1 where the vertex normals' noise is larger than the turn between the faces (the figure
+        is then undetermined), 0 where not; empty when the figure was not computed or the
+        export predates the column.
     error : str
         Empty for a good row; why it failed otherwise.
     """
@@ -267,6 +280,7 @@ class MeasurementRow:
     stability_refused: int | None = None
     stability_crease: float | None = None
     stability_crease_refused: int | None = None
+    stability_noise_hides_crease: int | None = None
     error: str = ""
 
 
