@@ -257,12 +257,13 @@ def test_normals_that_tell_the_faces_apart_do_not_make_the_figure_undetermined(a
 def test_a_non_finite_distance_to_the_crease_line_measures_no_strip(bad):
     """The strip's bands are binned by distance to the line; a non-finite one cast to an integer
     is a negative bin, which ``np.bincount`` refuses with a traceback. No strip is measured."""
-    from vg_addon.method.refinement import _side_plane, _strip_width
+    from vg_addon.method.planes import side_plane
+    from vg_addon.method.refinement import _strip_width
 
     mesh = wedge(120, n=30, irregular=True, seed=2)
     points = mesh.points - mesh.points.mean(axis=0)
     side = np.ones(points.shape[0], dtype=bool)
-    plane = _side_plane(points, np.tile([0.0, 0.0, 1.0], (points.shape[0], 1)), side)
+    plane = side_plane(points, np.tile([0.0, 0.0, 1.0], (points.shape[0], 1)), side)
     to_line = np.linalg.norm(points[:, :2], axis=1)
     assert _strip_width(points, side, side, plane, plane[0], to_line, 0.05) >= 0.0
     to_line[3] = bad

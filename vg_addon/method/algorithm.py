@@ -18,6 +18,7 @@ from .fixed_order import (
     row_dot,
     total,
 )
+from .planes import RANK_TOLERANCE
 from .refinement import NOISE_FLOOR, mean_edge_length, refine_sides
 from .result import Measurement
 from .withinss import withinss_split
@@ -55,8 +56,6 @@ SHARED_ROW_FACTOR = 1.5
 """A side whose vertices lie on one line borrows the other side's vertices within this factor of
 the nearest one's distance to that line: the row of vertices on the edge, which belongs to both
 faces."""
-
-_RANK_TOLERANCE = 1e-10
 
 MAX_MAGNITUDE = 1e150
 """Largest coordinate and radius, in any unit: squares of larger values, and sums of them over
@@ -107,7 +106,7 @@ def _plane(points: np.ndarray, mean: np.ndarray | None = None) -> tuple[np.ndarr
     error, normal, values = _smallest_eigenvector(
         [value / count for value in column_moments(centred)]
     )
-    spans = bool(values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny))
+    spans = bool(values[1] > RANK_TOLERANCE * max(values[2], np.finfo(float).tiny))
     return normal, max(error, 0.0), spans
 
 

@@ -18,7 +18,8 @@ import numpy as np
 
 from .algorithm import MIN_SIDE_VERTICES
 from .fixed_order import acos_degrees, dot3, norm3, row_dot, total
-from .refinement import _crease_line, _distance_to_line, _side_plane, mean_edge_length
+from .planes import crease_line, distance_to_line, side_plane
+from .refinement import mean_edge_length
 
 BAND_SPACINGS = (1.0, 2.0)
 """Bands of this many mesh spacings either side of the crease line: the vertices of the
@@ -66,7 +67,7 @@ def _plane_normal(points, normals, side) -> np.ndarray | None:
     ``None`` where the side has too few vertices or they lie on a line."""
     if int(np.count_nonzero(side)) < MIN_SIDE_VERTICES:
         return None
-    plane = _side_plane(points, normals, side)
+    plane = side_plane(points, normals, side)
     return None if plane is None else plane[0]
 
 
@@ -78,8 +79,8 @@ def _distance_to_crease(points, sides, normal_plus, normal_minus) -> np.ndarray 
         for normal, side in zip((normal_plus, normal_minus), sides, strict=True)
     ]
     # The line's point nearest the centre (the origin of ``points``).
-    line = _crease_line(planes, np.zeros(3))
-    return None if line is None else _distance_to_line(points, *line)
+    line = crease_line(planes, np.zeros(3))
+    return None if line is None else distance_to_line(points, *line)
 
 
 def _reaches(to_line, spacing) -> bool:

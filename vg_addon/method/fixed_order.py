@@ -69,6 +69,12 @@ def dot3(a, b) -> float:
     return a0 * b0 + a1 * b1 + a2 * b2
 
 
+def cross3(a, b) -> np.ndarray:
+    """The cross product of two 3-vectors, on Python floats."""
+    (a0, a1, a2), (b0, b1, b2) = (float(x) for x in a), (float(x) for x in b)
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
 def norm3(a) -> float:
     """The length of a 3-vector."""
     return math.sqrt(dot3(a, a))

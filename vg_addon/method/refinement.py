@@ -44,17 +44,16 @@ import numpy as np
 
 from ..errors import GoniometerError
 from .fixed_order import (
-    column_moments,
     columns_dot,
     columns_dots,
+    cross3,
     dot3,
-    eigh3_entries,
     gram,
-    norm3,
     offset_columns,
     solve,
     total,
 )
+from .planes import crease_line, distance_to_line, side_plane
 
 NEAR_SPACINGS = 3.0
 """How close to the other side's half-plane, in mesh spacings, a vertex may be handed over or
@@ -154,8 +153,6 @@ FIRST_BAND = 2.0
 crease line are left out once and the planes fitted again: Algorithm 1's planes are tilted by the
 strip, and so is their line, beside which the strip's bands would be measured."""
 
-_RANK_TOLERANCE = 1e-10
-
 
 def mean_edge_length(radius: float, n_vertices: int) -> float:
     """Mean edge length of a triangulated disk of ``radius`` holding ``n_vertices`` vertices.
@@ -166,61 +163,11 @@ def mean_edge_length(radius: float, n_vertices: int) -> float:
     return radius * math.sqrt(2.0 * math.pi / (math.sqrt(3.0) * n_vertices))
 
 
-def _distance_to_line(points, on_line, direction) -> np.ndarray:
-    """Each point's distance to the line through ``on_line`` along the unit ``direction``."""
-    relative = offset_columns(points, on_line)
-    along = columns_dot(relative, direction)
-    squares = relative * relative
-    return np.sqrt(np.maximum(squares[0] + squares[1] + squares[2] - along * along, 0.0))
-
-
-def _side_plane(points, normals, mask):
-    """PCA plane of the masked points: unit normal (oriented by the side's mean normal), centroid
-    and mean squared distance; ``None`` when the points do not span a plane."""
-    # Sums row after row, each column on its own (joining points and normals costs more).
-    rows = np.compress(mask, points, axis=0)
-    count = rows.shape[0]
-    centroid = np.add.reduce(rows, axis=0) / count
-    centred = np.empty((3, count))
-    np.subtract(rows.T, centroid[:, None], out=centred)
-    xx, xy, xz, yy, yz, zz = (value / count for value in column_moments(centred))
-    values, vectors = eigh3_entries(xx, xy, xz, yy, yz, zz)
-    if not values[1] > _RANK_TOLERANCE * max(values[2], np.finfo(float).tiny):
-        return None
-    normal = vectors[:, 0]
-    if dot3(normal, np.add.reduce(np.compress(mask, normals, axis=0), axis=0)) < 0:
-        normal = -normal
-    return normal, centroid, max(float(values[0]), 0.0)
-
-
-def _cross(a, b) -> np.ndarray:
-    (a0, a1, a2), (b0, b1, b2) = (float(x) for x in a), (float(x) for x in b)
-    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
-
-
-def _crease_line(planes, center):
-    """The line where two planes (unit normal, a point on it, ...) meet: its point nearest
-    ``center`` and its unit direction; ``None`` when the planes are parallel."""
-    (normal_plus, centroid_plus, *_), (normal_minus, centroid_minus, *_) = planes
-    direction = _cross(normal_plus, normal_minus)
-    length = norm3(direction)
-    if length <= 1e-12:
-        return None
-    direction = direction / length
-    rows = np.array([normal_plus, normal_minus, direction])
-    offsets = [dot3(normal_plus, centroid_plus), dot3(normal_minus, centroid_minus)]
-    offsets.append(dot3(direction, center))
-    on_line = solve(rows, offsets)
-    if on_line is None:
-        return None
-    return np.array(on_line), direction
-
-
 def _half_plane_distances(points, center, planes):
     """Each vertex's distance to the two half-planes that meet at the planes' line; ``None``
     when the planes are parallel. Also returns the line's frame for the smooth-surface fits."""
     (normal_plus, centroid_plus, _), (normal_minus, centroid_minus, _) = planes
-    line = _crease_line(planes, center)
+    line = crease_line(planes, center)
     if line is None:
         return None
     on_line, direction = line
@@ -231,7 +178,7 @@ def _half_plane_distances(points, center, planes):
     distance_to_line = np.sqrt(squares[0] + squares[1] + squares[2])
     outward = []
     for normal, centroid in ((normal_plus, centroid_plus), (normal_minus, centroid_minus)):
-        into_face = _cross(direction, normal)
+        into_face = cross3(direction, normal)
         if dot3(into_face, centroid - on_line) < 0:
             into_face = -into_face
         outward.append(into_face)
@@ -356,7 +303,7 @@ def _refuse_a_lost_face(points, plus, used, planes, frame, split_error) -> None:
     whole = [plane for plane in planes if plane is not None]
     if len(whole) != 1 or split_error < MIN_IMPROVEMENT * whole[0][2]:
         return
-    to_line = _distance_to_line(points, frame[0], frame[1])
+    to_line = distance_to_line(points, frame[0], frame[1])
     lost = plus if planes[0] is None else ~plus
     if not (lost & ~used).any() or _beside_the_crease(to_line, lost, used):
         raise GoniometerError(
@@ -389,7 +336,7 @@ def _refine_by_outliers(points, normals, labels, center, radius, spacing, split_
     given, frame = planes or [None, None], None
     for round_number in range(MAX_ROUNDS):
         planes = [
-            _side_plane(points, normals, side) if round_number or plane is None else plane
+            side_plane(points, normals, side) if round_number or plane is None else plane
             for side, plane in zip((plus & used, ~plus & used), given, strict=True)
         ]
         if planes[0] is None or planes[1] is None:
@@ -425,7 +372,7 @@ def _refine_by_outliers(points, normals, labels, center, radius, spacing, split_
         if min(int((plus & used).sum()), int((~plus & used).sum())) < 5:
             return None
     else:
-        planes = [_side_plane(points, normals, side) for side in (plus & used, ~plus & used)]
+        planes = [side_plane(points, normals, side) for side in (plus & used, ~plus & used)]
         if planes[0] is None or planes[1] is None:
             _refuse_a_lost_face(points, plus, used, planes, frame, split_error)
             return None
@@ -439,9 +386,9 @@ def _refine_by_outliers(points, normals, labels, center, radius, spacing, split_
     if split_error < MIN_IMPROVEMENT * refined_error:
         return None
     on_line, direction, into_faces = frame
-    if _distance_to_line(center[None, :], on_line, direction)[0] > CREASE_REACH * radius:
+    if distance_to_line(center[None, :], on_line, direction)[0] > CREASE_REACH * radius:
         return None  # the planes of two other faces: the crease is not where the user measured
-    to_line = _distance_to_line(points, on_line, direction)
+    to_line = distance_to_line(points, on_line, direction)
     # An acute corner's strip reaches 1 / sin(angle) times as far into each face.
     opening = math.sqrt(max(0.0, 1.0 - dot3(planes[0][0], planes[1][0]) ** 2))
     share = MAX_LEFT_OUT_OF_PATCH / max(opening, MAX_LEFT_OUT_OF_PATCH / MAX_LEFT_OUT)
@@ -524,7 +471,7 @@ def _refine_by_strip(points, normals, labels, center, radius, spacing, planes):
     shown to be planes (:func:`_planar`) and meet near the centre; ``None`` otherwise."""
     plus = labels
     planes = [
-        plane if plane is not None else _side_plane(points, normals, side)
+        plane if plane is not None else side_plane(points, normals, side)
         for plane, side in zip(planes or [None, None], (plus, ~plus), strict=True)
     ]
     kept = np.ones(points.shape[0], dtype=bool)
@@ -535,10 +482,10 @@ def _refine_by_strip(points, normals, labels, center, radius, spacing, planes):
             return None
         (to_plus, to_minus), frame = found
         plus = to_plus < to_minus
-        kept = _distance_to_line(points, frame[0], frame[1]) >= FIRST_BAND * spacing
+        kept = distance_to_line(points, frame[0], frame[1]) >= FIRST_BAND * spacing
         if min(int((plus & kept).sum()), int((~plus & kept).sum())) < MIN_FAR_VERTICES:
             return None
-        planes = [_side_plane(points, normals, side) for side in (plus & kept, ~plus & kept)]
+        planes = [side_plane(points, normals, side) for side in (plus & kept, ~plus & kept)]
     for round_number in range(MAX_ROUNDS):
         if planes[0] is None or planes[1] is None:
             return None
@@ -547,7 +494,7 @@ def _refine_by_strip(points, normals, labels, center, radius, spacing, planes):
             return None
         (to_plus, to_minus), frame = found
         on_line, direction, into_faces = frame
-        to_line = _distance_to_line(points, on_line, direction)
+        to_line = distance_to_line(points, on_line, direction)
         new_plus = to_plus < to_minus
         new_kept = np.ones(points.shape[0], dtype=bool)
         sides = (new_plus, ~new_plus)
@@ -563,12 +510,12 @@ def _refine_by_strip(points, normals, labels, center, radius, spacing, planes):
         plus, kept = new_plus, new_kept
         if min(int((plus & kept).sum()), int((~plus & kept).sum())) < MIN_FAR_VERTICES:
             return None
-        planes = [_side_plane(points, normals, side) for side in (plus & kept, ~plus & kept)]
+        planes = [side_plane(points, normals, side) for side in (plus & kept, ~plus & kept)]
     else:
         return None
     if max(widths) == 0.0:
         return None  # no strip: Algorithm 1's planes stand
-    if _distance_to_line(center[None, :], on_line, direction)[0] > CREASE_REACH * radius:
+    if distance_to_line(center[None, :], on_line, direction)[0] > CREASE_REACH * radius:
         return None
     for k, side in enumerate((plus, ~plus)):
         face_frame = (on_line, direction, into_faces[k])

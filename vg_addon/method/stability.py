@@ -24,6 +24,7 @@ from .fixed_order import (
     rows_dot,
     split_exactly,
 )
+from .planes import RANK_TOLERANCE
 from .refinement import mean_edge_length
 from .result import Measurement, Stability
 
@@ -51,8 +52,6 @@ MAX_RUN_VERTICES = 4_000_000
 few dozen bytes per run and vertex: about 250 MB at this limit). 95 runs over a patch of 30,000
 vertices fit; a radius that takes in most of a large scan does not, and is refused before
 anything is allocated."""
-
-_RANK_TOLERANCE = 1e-10  # as Algorithm 1's test for a side on a line
 
 
 def _moved_centers(surface, m: Measurement) -> np.ndarray:
@@ -107,7 +106,7 @@ def _side_normals(values, vectors, mean_normals, count) -> tuple[np.ndarray, np.
     """Plane normals (oriented by the side's mean normal) from the covariances' eigen-pairs, and
     whether each set spans a plane with at least the minimum number of vertices."""
     normal = vectors[:, :, 0]
-    spans = values[:, 1] > _RANK_TOLERANCE * np.maximum(values[:, 2], np.finfo(float).tiny)
+    spans = values[:, 1] > RANK_TOLERANCE * np.maximum(values[:, 2], np.finfo(float).tiny)
     flip = rows_dot(normal, mean_normals) < 0
     normal[flip] = -normal[flip]
     return normal, spans & (count >= MIN_SIDE_VERTICES)
