@@ -117,3 +117,32 @@ def test_the_summary_flags_unstable_readings_in_the_words_of_the_list(tmp_path):
     # Off the crease the patch holds barely a row of one face: unstable, and undetermined too.
     assert f"{rows[1].angle:.2f}° ± ?: Unstable: the angle moves" in flagged[0]
     assert "Undetermined: without the vertices next to the crease" in flagged[0]
+
+
+def test_the_summary_and_the_csv_name_the_normals_noise_alone_where_only_it_holds(tmp_path):
+    """A 172° crease on a grid of 0.0067 jittered by 5% of the grid: every band keeps its planes
+    (no band is refused) but the vertex normals' noise is larger than the turn between the faces.
+    The summary says that, not the band's reason, and the CSV keeps it in its own column."""
+    from vg_addon.reference_shapes import stretched_wedge
+
+    angle, spacing = 172.0, 0.0067
+    flat, triangles = stretched_wedge(90.0, spacing)
+    clean = flat * np.array([1.0, np.tan(np.radians(angle) / 2.0), 1.0])
+    jitter = np.random.default_rng(1787).normal(scale=0.05 * spacing, size=clean.shape)
+    path = tmp_path / "near_flat.ply"
+    meshio.write_ply(path, clean + jitter, triangles)
+    centre = clean[np.argmin(np.linalg.norm(clean, axis=1))]
+    points = tmp_path / "points.csv"
+    points.write_text("x,y,z\n" + ",".join(repr(float(c)) for c in centre) + "\n")
+    out = tmp_path / "angles.csv"
+    run = batch(path, "--points", points, "--radius", "0.2", "--stability", "--out", out)
+    (row,) = csvio.read_measurements_csv(out)
+    assert abs(row.angle - angle) > 5.0  # the mixed sides: a figure is owed its "± ?"
+    surface = core_surface(path)
+    along = surface.normals[surface.measure(centre, 0.2).indices][:, 2]  # the crease is z
+    assert np.sqrt(np.mean(along**2)) > 2.0 * np.sin(np.radians(180.0 - row.angle) / 2.0)
+    assert (row.stability_crease_refused, row.stability_noise_hides_crease) == (0, 1)
+    flagged = [line for line in run.stderr.splitlines() if "flagged:" in line]
+    assert len(flagged) == 1 and "± ?" in flagged[0], run.stderr
+    assert "Undetermined: the vertex normals' noise is larger than the turn" in flagged[0]
+    assert "a face keeps too few" not in flagged[0]

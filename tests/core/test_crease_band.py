@@ -208,6 +208,60 @@ def test_near_flat_creases_whose_normals_hide_the_crease_are_undetermined(
     assert "a face keeps too few" not in s.warning
 
 
+BANDS = "without the vertices next to the crease a face keeps too few"
+NOISE = "the vertex normals' noise is larger than the turn"
+EITHER = "or the vertex normals' noise is larger"
+
+
+def test_each_reason_that_holds_is_given_and_the_record_keeps_them_apart():
+    """A 168° crease on a grid of 0.017 reads 7.5° flat with every vertex on its face: each side
+    is a few rows, and a band leaves one too few to fit its plane. Its vertex normals have no
+    component along the crease (the z axis), so they cannot hide it: the band is the one reason.
+    Jittered by 5% of the grid, the normals' component along the crease (measured against the
+    true axis, not the reading's tangent) exceeds the turn between the faces the reading shows,
+    and the band still fails: both reasons hold, each with its own sentence."""
+    from vg_addon.formats import record_codec
+
+    angle, spacing = 168.0, 0.017
+    flat, triangles = stretched_wedge(90.0, spacing)
+    points = flat.copy()
+    points[:, 1] *= math.tan(math.radians(angle) / 2.0)
+    center = nearest_the_crease(points)
+    jitter = np.random.default_rng(0).normal(scale=0.05 * spacing, size=points.shape)
+    clean, noisy = Surface(points, triangles), Surface(points + jitter, triangles)
+    mc = clean.measure(center, 0.2, stability=True)
+    mn = noisy.measure(center, 0.2, stability=True)
+
+    def along_crease(surface, m):
+        return float(np.sqrt(np.mean(surface.normals[m.indices][:, 2] ** 2)))
+
+    assert abs(mc.angle - angle) > 5.0 and abs(mn.angle - angle) > 5.0  # a "± ?" is owed
+    assert along_crease(clean, mc) < 1e-12
+    assert along_crease(noisy, mn) > 2.0 * math.sin(math.radians(180.0 - mn.angle) / 2.0)
+
+    s = mc.stability
+    assert s.text() == "± ?" and s.crease_refused > 0 and not s.noise_hides_crease
+    assert BANDS in s.warning and "noise" not in s.warning
+    s = mn.stability
+    assert s.text() == "± ?" and s.crease_refused > 0 and s.noise_hides_crease
+    assert BANDS in s.warning and NOISE in s.warning and EITHER not in s.warning
+    assert s.warning.count("Undetermined:") == 2
+
+    # The record (the list, the panel, the label) keeps the two apart and reads back the same.
+    stored = record_codec.decode(record_codec.encode(record_codec.measurement_numbers(mn)))
+    parts = stored["stability"]
+    assert parts["noise_hides_crease"] is True and parts["crease_refused"] == s.crease_refused
+    assert stored_stability_warning(parts) == s.warning
+    assert stored_stability_text(parts) == "± ?"
+    # A record made before them counted the noise as one more band and has no key of its own:
+    # it reads as then, undetermined, with the sentence naming both.
+    del parts["noise_hides_crease"]
+    parts["crease_refused"] += 1
+    older = stored_stability_warning(parts)
+    assert stored_stability_text(parts) == "± ?" and EITHER in older
+    assert older.count("Undetermined:") == 1
+
+
 def test_a_small_patch_counts_each_band_once():
     """Where a mesh spacing is more than half the radius both spacing bands clamp to half the
     radius: with the quarter radius band that is two distinct bands, each counted once."""
