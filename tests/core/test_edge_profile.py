@@ -301,3 +301,26 @@ def test_given_points_off_the_mesh_are_refused_with_their_distance(ramp):
     assert f"farther than {max(0.3, 3 * h):.6g}" in message
     # The limit is the radius when that is larger: 1.5 away is accepted with a radius of 2.
     check_given_points(surface, shifted, 2.0, "wide.pp")
+
+
+@pytest.mark.parametrize("spacing", [2.0, 5.0])
+def test_the_pooled_angle_lies_within_its_stations_range(spacing):
+    """The whole-edge mean angle of a found edge, on the flake whose margin curves round a
+    spherical cap and whose platform edges turn: one plane pair fitted to every station's
+    vertices read 42.23° for the margin's stations of 43.06° to 45.12°, and 120.35° for stations
+    of 45.69° to 118.28°. The oracle is the stations' own readings."""
+    from vg_addon import fragments
+
+    fragment = fragments.flake(spacing=0.5)
+    surface = Surface(fragment.points, fragment.triangles)
+    profiled = 0
+    for candidate in surface.find_break_edges().candidates:
+        try:
+            profile = surface.measure_along(candidate.path, spacing, 2.5)
+        except GoniometerError:
+            continue  # a spacing finer than one of the path's segments: refused, said why
+        profiled += 1
+        assert profile.min <= profile.pooled_angle <= profile.max, profile.figures
+        if profile.max - profile.min < 3.0:  # the margin: the pooled angle is its mean's
+            assert profile.pooled_angle == pytest.approx(profile.mean, abs=0.5)
+    assert profiled >= 2

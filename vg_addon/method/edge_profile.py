@@ -34,11 +34,9 @@ import numpy as np
 
 from ..errors import GoniometerError, bounded_list
 from .algorithm import as_center, as_radius
-from .break_figures import break_figures, fragment_axis
-from .fixed_order import acos_degrees, dot3, eigh3, in_frame, moments, norm3
+from .edge_summary import EdgeSummary, summarize
 from .mesh_edges import MeshEdges
 from .ranges import expand_ranges
-from .result import Measurement
 
 FLOOR = 0.02
 """Smallest cost per unit length (on the sharpest edges): bounds the detour a ridge can draw."""
@@ -526,112 +524,6 @@ def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
             f"least {longest:.4g}."
         )
     return positions
-
-
-@dataclass(frozen=True)
-class EdgeSummary:
-    """What the stations of one edge say together (see :func:`summarize`).
-
-    Attributes
-    ----------
-    n_stations : int
-    mean, std, min, max : float
-        Of the stations' angles (degrees); ``std`` is the sample standard deviation (0 for one
-        station).
-    pooled_angle, pooled_fit_error : float
-        One plane pair fitted to all stations' sides at once, each station's patch expressed in
-        its own frame (along the edge, across it, along its mean normal), so that a curved edge
-        pools like a straight one: the whole-edge mean angle, and its summed mean squared
-        plane-fit distance.
-    plus_left : tuple of bool
-        Per station, whether its "+" side lies to the left of the path's direction (seen from
-        outside, along the mean normal). A station's "+" side follows its own binormal, which can
-        turn over along a curved edge; painting the left side in one colour keeps the sides of
-        the whole edge consistent.
-    median, range, arc_length, chord_length, arc_angle : float or None
-        The break-agent study's figures (see :mod:`.break_figures`): the stations' median angle
-        and range (degrees), the length of the polyline through their centres and from the
-        first to the last, and the angle between the edge's and the fragment's principal axes
-        (degrees; None where undefined).
-    """
-
-    n_stations: int
-    mean: float
-    std: float
-    min: float
-    max: float
-    pooled_angle: float
-    pooled_fit_error: float
-    plus_left: tuple = ()
-    median: float | None = None
-    range: float | None = None
-    arc_length: float | None = None
-    chord_length: float | None = None
-    arc_angle: float | None = None
-
-
-def _frame(m: Measurement, direction: np.ndarray) -> np.ndarray:
-    """Rows: along the edge (oriented like ``direction``), across it, and the mean normal."""
-    tangent = m.tangent if dot3(m.tangent, direction) >= 0 else -m.tangent
-    normal = m.mean_normal - dot3(m.mean_normal, tangent) * tangent
-    normal /= norm3(normal)
-    return np.array([tangent, np.cross(normal, tangent), normal])
-
-
-def _plane(points: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, float]:
-    centred = points - points.mean(axis=0)
-    values, vectors = eigh3(moments(centred) / points.shape[0])
-    normal = vectors[:, 0]
-    if dot3(normal, normals.sum(axis=0)) < 0:
-        normal = -normal
-    return normal, max(float(values[0]), 0.0)
-
-
-def summarize(surface, stations) -> EdgeSummary:
-    """Summary figures of an edge's station measurements, in order along the edge.
-
-    The direction along the edge at each station comes from its neighbours' centres; it only
-    orients each station's frame, so that every station's left side pools with the others' left.
-    """
-    if not stations:
-        raise GoniometerError("An edge profile needs at least one station.")
-    angles = np.array([m.angle for m in stations])
-    centers = np.array([m.center for m in stations])
-    sides = {True: ([], []), False: ([], [])}
-    plus_left = []
-    for k, m in enumerate(stations):
-        ahead, behind = centers[min(k + 1, len(stations) - 1)], centers[max(k - 1, 0)]
-        direction = ahead - behind if len(stations) > 1 else m.tangent
-        frame = _frame(m, direction)
-        local = in_frame(surface.points[m.indices] - m.center, frame)
-        normals = in_frame(surface.normals[m.indices], frame)
-        plus_is_left = bool(local[m.labels, 1].mean() >= local[~m.labels, 1].mean())
-        plus_left.append(plus_is_left)
-        for mask, is_plus in ((m.labels, True), (~m.labels, False)):
-            key = is_plus == plus_is_left
-            sides[key][0].append(local[mask])
-            sides[key][1].append(normals[mask])
-    (left, left_error), (right, right_error) = (
-        _plane(np.concatenate(sides[key][0]), np.concatenate(sides[key][1]))
-        for key in (True, False)
-    )
-    pooled = 180.0 - acos_degrees(dot3(left, right))
-    study = break_figures(angles, centers, fragment_axis(surface))
-    return EdgeSummary(
-        n_stations=len(stations),
-        mean=float(angles.mean()),
-        std=float(angles.std(ddof=1)) if angles.size > 1 else 0.0,
-        min=float(angles.min()),
-        max=float(angles.max()),
-        pooled_angle=pooled,
-        pooled_fit_error=left_error + right_error,
-        plus_left=tuple(plus_left),
-        median=study.median,
-        range=study.range,
-        arc_length=study.arc_length,
-        chord_length=study.chord_length,
-        arc_angle=study.arc_angle,
-    )
 
 
 def measure_along(
