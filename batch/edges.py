@@ -15,6 +15,7 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, picked_points, profile_plot
 from ..vg_addon.formats.record_codec import exact_numbers
+from ..vg_addon.method.algorithm import DEFAULT_RULE
 from ..vg_addon.method.edge_profile import check_station_count
 from .cli import UsageError
 from .find_edges import found_edge_specs
@@ -226,7 +227,9 @@ def failed_edge_row(number: int | None, spec: dict, mesh_name: str, message: str
 def measure_edges(obj, source, options: dict, units: str, safe_name: str, surface, precision):
     """Measure the run's edges that apply to ``source`` on its object ``obj`` (on ``surface``,
     the surface the points are measured on: the file's float64 coordinates where Blender's
-    float32 copy would round them), and record each as one break of stations.
+    float32 copy would round them), and record each as one break of stations, each station
+    measured with the run's rule and, with ``--stability``, its stability figure (the options'
+    ``rule`` and ``stability``; an edge summary file records no rule of its own).
 
     Returns
     -------
@@ -266,6 +269,8 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
                 space=spec.get("space", "mesh"),
                 surface=surface,
                 given=spec.get("given", ""),
+                rule=options.get("rule", DEFAULT_RULE),
+                stability=bool(options.get("stability")),
             )
             # Recorded without repainting: the colours are painted once, after every edge. The
             # plot kept in the object is drawn only for a .blend that is saved (--save-blend);

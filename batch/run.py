@@ -84,14 +84,20 @@ class Run:
         say(text)
 
     def say_flagged(self, by_index: dict) -> None:
-        """The summary's lines for unstable readings: how many, and the first ten with why."""
-        flagged = flagged_rows(self.rows)
+        """The summary's lines for unstable readings (points, then edge stations): how many,
+        and the first ten with why."""
+        flagged = []
+        for index, row, warning in flagged_rows(self.rows):
+            task = by_index[index]
+            where = f"row {task.source_row}" if task.source_row else f"point {task.number}"
+            flagged.append((where, row, warning))
+        for _, row, warning in flagged_rows(dict(enumerate(self.station_rows))):
+            where = f"edge {row.edge_number} station at arc length {row.arc_length:.4g}"
+            flagged.append((where, row, warning))
         if not flagged:
             return
         self.say(f"{len(flagged):,} flagged reading(s): unstable, or the ± figure undetermined")
-        for index, row, warning in flagged[:10]:
-            task = by_index[index]
-            where = f"row {task.source_row}" if task.source_row else f"point {task.number}"
+        for where, row, warning in flagged[:10]:
             self.say(
                 f"  flagged: {where} on {row.mesh_name!r}: {row.angle:.2f}° "
                 f"{stability_text(row.stability, *_counts(row))}"
@@ -400,6 +406,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "save_blend": bool(args.save_blend),
         "units": units,
         "stability": bool(args.stability),
+        "rule": args.rule,  # of the edge stations; the points' rule is each task's own
         "sweep": list(args.sweep) if args.sweep else None,
         "sweep_plots": str(sweep_paths(args.out)[1]) if args.sweep else "",
         "edges": edges,

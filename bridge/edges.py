@@ -15,6 +15,7 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, profile_plot, record_codec
 from ..vg_addon.formats.record_codec import exact_numbers
+from ..vg_addon.method.algorithm import DEFAULT_RULE
 from ..vg_addon.method.edge_profile import summarize
 from ..vg_addon.method.given_points import check_given_points
 from . import measuring, records
@@ -55,6 +56,8 @@ def measure_edge(
     space="mesh",
     surface=None,
     given="",
+    rule=DEFAULT_RULE,
+    stability=False,
 ):
     """Trace and measure the edge through ``points`` on ``obj`` without recording anything:
     ``(EdgeProfile, Geometry, points)``, the last the points in mesh coordinates.
@@ -66,7 +69,8 @@ def measure_edge(
     A spacing that would make more than ``edge_profile.MAX_STATIONS`` stations is refused
     before anything is allocated for them. ``given``: where points read from a file came from
     (a file or edge name); if set, points far from the mesh are refused naming it
-    (``edge_profile.check_given_points``) instead of snapping to the nearest vertex.
+    (``edge_profile.check_given_points``) instead of snapping to the nearest vertex. ``rule``
+    and ``stability``: how every station is measured (as for ``Surface.measure``).
     """
     check_measurable(obj)
     points = np.asarray(points, dtype=np.float64)
@@ -84,7 +88,7 @@ def measure_edge(
         surface = surface_for(obj, geometry)
     if given:
         check_given_points(surface, points, radius, given)
-    profile = surface.measure_along(points, spacing, radius, lam, patch)
+    profile = surface.measure_along(points, spacing, radius, lam, patch, rule, stability)
     return profile, geometry, points
 
 
@@ -100,6 +104,8 @@ def measure_edge_on_object(
     note="",
     space="mesh",
     surface=None,
+    rule=DEFAULT_RULE,
+    stability=False,
 ):
     """Measure the edge through ``points`` and record every station as a measurement of one new
     break (its own colour pair), plus the edge's record with its summary and plot.
@@ -113,13 +119,17 @@ def measure_edge_on_object(
     spacing, radius, lam, patch
         Station spacing (arc length) and the measuring settings of every station, lengths in
         mesh units. Every station replays with ``vg.measure_xyz(..., space="MESH")`` at its
-        stored centre, radius, λ and patch mode.
+        stored centre, radius, λ, patch mode and rule.
     note : str
         Free text stored with the edge and each station.
     space : {"mesh", "world"}
         The coordinates ``points`` are given in; the edge records them in mesh coordinates.
     surface : Surface, optional
         Measure on this surface instead of the object's (see :func:`measure_edge`).
+    rule : {"refined", "oriented", "paper"}
+        The rule every station is measured with (default ``"refined"``).
+    stability : bool
+        Also compute every station's stability figure.
 
     Returns
     -------
@@ -132,7 +142,17 @@ def measure_edge_on_object(
         recorded then.
     """
     profile, geometry, clicks = measure_edge(
-        obj, points, spacing, radius, lam, patch, depsgraph=depsgraph, space=space, surface=surface
+        obj,
+        points,
+        spacing,
+        radius,
+        lam,
+        patch,
+        depsgraph=depsgraph,
+        space=space,
+        surface=surface,
+        rule=rule,
+        stability=stability,
     )
     edge = record_profile(obj, profile, geometry, clicks, note=note)
     measuring.repaint(obj, depsgraph=depsgraph, geometry=geometry)
@@ -186,13 +206,23 @@ def record_profile(obj, profile, geometry, clicks, *, note="", plot=True):
 
 
 def import_edges_csv(
-    obj, path, *, ignore_mesh_names=False, lam=2.0, patch="euclidean", depsgraph=None
+    obj,
+    path,
+    *,
+    ignore_mesh_names=False,
+    lam=2.0,
+    patch="euclidean",
+    depsgraph=None,
+    rule=DEFAULT_RULE,
+    stability=False,
 ):
     """Re-measure every edge of an edge summary file on ``obj``: all of them, or none.
 
     Each row's ``Points`` are traced again and measured with its ``Spacing``, ``Radius``,
     ``SegParam`` and ``Patch Mode`` (``lam`` and ``patch`` for blank cells), and recorded like
-    an edge measured here, with the row's User Data as its note.
+    an edge measured here, with the row's User Data as its note. An edge summary file records
+    no rule: every station is measured with ``rule`` (the panel's), and with its stability
+    figure if ``stability``.
 
     Returns
     -------
@@ -237,7 +267,8 @@ def import_edges_csv(
                 lam if row.lam is None else row.lam,
                 row.patch or patch,
             )
-            measure_edge(obj, points, *settings, depsgraph=depsgraph)  # checked before recording
+            # checked before recording
+            measure_edge(obj, points, *settings, depsgraph=depsgraph, rule=rule)
         except GoniometerError as error:
             failures.append(f"row {number}: {error}")
             continue
@@ -248,7 +279,9 @@ def import_edges_csv(
             f"'{obj.name}'; nothing was imported.\n" + bounded_list(failures, lines=True)
         )
     return [
-        measure_edge_on_object(obj, points, *settings, depsgraph=depsgraph, note=note).number
+        measure_edge_on_object(
+            obj, points, *settings, depsgraph=depsgraph, note=note, rule=rule, stability=stability
+        ).number
         for points, settings, note in jobs
     ]
 

@@ -11,10 +11,10 @@ from __future__ import annotations
 import contextlib
 
 import numpy as np
-from bpy.props import EnumProperty, FloatProperty, FloatVectorProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty
 
 from ..bridge.mesh_data import check_measurable
-from ..properties import PATCH_ITEMS
+from ..properties import PATCH_ITEMS, RULE_ITEMS
 from ..vg_addon import GoniometerError
 
 SPACE_ITEMS = (
@@ -68,6 +68,16 @@ class PatchProperties:
     patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="Default: the panel's")
 
 
+class RuleProperties:
+    """How each measurement is taken: its rule and whether its stability figure is computed
+    (defaults: the panel's)."""
+
+    rule: EnumProperty(name="Rule", items=RULE_ITEMS, description="Default: the panel's")
+    stability: BoolProperty(
+        name="Stability", description="Compute the stability figure; default: the panel's"
+    )
+
+
 def typed_value(value: float) -> float:
     """The float64 of the shortest decimal that a 32-bit operator property rounds to ``value``.
 
@@ -91,12 +101,14 @@ def defaults_from_panel(operator, context, settings_of: dict) -> None:
 
 
 #: The panel settings an edge-measuring operator takes by default: ``defaults_from_panel``'s
-#: ``settings_of`` for ``spacing`` and the patch properties.
+#: ``settings_of`` for ``spacing``, the patch properties and the rule properties.
 EDGE_SETTINGS = {
     "spacing": "edge_spacing",
     "radius": "radius",
     "seg_param": "seg_param",
     "patch": "patch",
+    "rule": "rule",
+    "stability": "stability",
 }
 
 

@@ -205,6 +205,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                     lam=typed_value(settings.seg_param),
                     patch=settings.patch,
                     depsgraph=context.evaluated_depsgraph_get(),
+                    rule=settings.rule,
+                    stability=settings.stability,
                 )
                 self.report(
                     {"INFO"},

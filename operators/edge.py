@@ -26,6 +26,7 @@ from .common import (
     EDGE_SETTINGS,
     SPACE_ITEMS,
     PatchProperties,
+    RuleProperties,
     defaults_from_panel,
     length_property,
     poll_measurable,
@@ -133,6 +134,7 @@ class EdgeSession(ViewSession):
                 typed_value(settings.radius),
                 typed_value(settings.seg_param),
                 settings.patch,
+                settings.rule,  # the stations' failures depend on it; their stability does not
             )
         elif action == "cancel":
             machine.cancel()
@@ -170,7 +172,7 @@ class EdgeSession(ViewSession):
         return " · ".join(parts)
 
 
-class VG_OT_measure_edge(PatchProperties, bpy.types.Operator):
+class VG_OT_measure_edge(PatchProperties, RuleProperties, bpy.types.Operator):
     """Measure a whole break edge: click its start, any via points and its end on the active
     mesh, then Enter; every station is recorded as a measurement of one new break"""
 
@@ -216,6 +218,8 @@ class VG_OT_measure_edge(PatchProperties, bpy.types.Operator):
                 depsgraph=context.evaluated_depsgraph_get(),
                 note=self.note,
                 space=self.space.lower(),
+                rule=self.rule,
+                stability=self.stability,
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))

@@ -40,6 +40,7 @@ from .common import (
     EDGE_SETTINGS,
     FIND_SETTINGS,
     PatchProperties,
+    RuleProperties,
     defaults_from_panel,
     length_property,
     poll_measurable,
@@ -146,7 +147,7 @@ def parse_accept(text: str, numbers) -> list[int]:
 
 def measure_all(surface, found, settings, names=None) -> list:
     """Measure each edge of ``found`` (its points) on ``surface`` with ``settings`` (spacing,
-    radius, λ, patch): ``(points, EdgeProfile)`` pairs, all of them or none.
+    radius, λ, patch, rule, stability): ``(points, EdgeProfile)`` pairs, all of them or none.
 
     Raises
     ------
@@ -258,6 +259,8 @@ class FindEdgesSession(ViewSession):
                 typed_value(settings.radius),
                 typed_value(settings.seg_param),
                 settings.patch,
+                settings.rule,
+                settings.stability,
             )
         else:
             return "running"
@@ -329,7 +332,7 @@ def _optional(value: float) -> float | None:
     return None if value == 0.0 else typed_value(value)
 
 
-class VG_OT_find_break_edges(PatchProperties, bpy.types.Operator):
+class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator):
     """Find the break edges of the active mesh, review them (click, A accept, X reject, T trim)
     and record the accepted ones as Edge Profiles with stations every Spacing"""
 
@@ -387,6 +390,8 @@ class VG_OT_find_break_edges(PatchProperties, bpy.types.Operator):
             typed_value(self.radius),
             typed_value(self.seg_param),
             self.patch,
+            self.rule,
+            self.stability,
         )
 
     def execute(self, context):
@@ -491,6 +496,7 @@ class VG_OT_find_break_edges(PatchProperties, bpy.types.Operator):
         settings = context.scene.vg_settings
         self.spacing, self.radius = settings.edge_spacing, settings.radius
         self.seg_param, self.patch = settings.seg_param, settings.patch
+        self.rule, self.stability = settings.rule, settings.stability
         self.edges = format_edges_json([points for points, _ in machine.profiles])  # for redo
         return self.recorded(obj, record_all(obj, machine.profiles, geometry, self.note))
 

@@ -5,20 +5,18 @@ from __future__ import annotations
 import bpy
 import numpy as np
 from bpy.props import (
-    BoolProperty,
-    EnumProperty,
     IntProperty,
     StringProperty,
 )
 
 from ..bridge import measuring, records
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, uniform_scale
-from ..properties import RULE_ITEMS
 from ..vg_addon import GoniometerError
 from ..vg_addon.method.result import fit_text
 from .common import (
     LocationProperties,
     PatchProperties,
+    RuleProperties,
     defaults_from_panel,
     poll_measurable,
     poll_measured,
@@ -52,14 +50,10 @@ def non_uniform_scale_note(obj) -> str:
     )
 
 
-class MeasureProperties(LocationProperties, PatchProperties):
+class MeasureProperties(LocationProperties, PatchProperties, RuleProperties):
     """The inputs of a measurement, shared by every operator that records one (a mixin, so
     the drag tool's recorded values mean exactly what xyz entry's do)."""
 
-    rule: EnumProperty(name="Rule", items=RULE_ITEMS, description="Default: the panel's")
-    stability: BoolProperty(
-        name="Stability", description="Compute the stability figure; default: the panel's"
-    )
     note: StringProperty(name="Note", description="Free text stored with the measurement")
 
 

@@ -123,7 +123,7 @@ class VG_OT_import_picked_points(bpy.types.Operator, ImportHelper):
             measured = measure_all(
                 surface,
                 [points for _, points in found],
-                (spacing, radius, lam, patch),
+                (spacing, radius, lam, patch, settings.rule, settings.stability),
                 [f"'{Path(path).name}'" for path, _ in found],
             )
         except GoniometerError as error:

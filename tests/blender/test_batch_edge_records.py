@@ -14,7 +14,7 @@ import numpy as np
 from bpy_helpers import batch, exact
 
 from vg_addon import Surface
-from vg_addon.formats import meshio, profile_plot
+from vg_addon.formats import csvio, meshio, profile_plot
 from vg_addon.synthetic_meshes import wedge
 
 EDGES = ([-0.8, 0.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.8, 0.0, 0.0], [-0.6, 0, 0, 0.6, 0, 0])
@@ -59,3 +59,45 @@ def test_a_run_not_saved_still_writes_every_edges_plot_file(vg, tmp_path):
     assert sorted(p.name for p in tmp_path.glob("out_w_edge*.png")) == [
         f"out_w_edge{n}.png" for n in (1, 2, 3)
     ]
+
+
+def test_edge_stations_take_the_runs_rule_and_stability(tmp_path):
+    # A concave crease: the paper's rule reads it about 134°, the default rule 100°.
+    shape = wedge(100.0, half_width=2.0, n=40, irregular=True, concave=True)
+    mesh = meshio.write_ply(tmp_path / "c.ply", shape.points, shape.triangles)
+    data = meshio.read_mesh(mesh)
+    surface = Surface(data.points, data.triangles)
+    edge = ("--edge", -1.5, 0, 0, 1.5, 0, 0, "--spacing", 0.5, "--radius", 0.4)
+    out = tmp_path / "paper.csv"
+    result = batch(mesh, *edge, "--rule", "paper", "--stability", "--out", out)
+    assert result.returncode == 0, result.stdout + result.stderr
+    rows = csvio.read_measurements_csv(out)
+    assert len(rows) >= 5 and all(r.edge_number == 1 for r in rows)
+    fresh = Surface(data.points, data.triangles)
+    flagged = 0
+    for row in rows:
+        # Oracle: a single measurement at the station's centre with the run's settings.
+        alone = fresh.measure((row.x, row.y, row.z), 0.4, rule="paper", stability=True)
+        assert row.rule == "paper"
+        assert row.angle == alone.angle and row.angle > 120.0
+        assert row.stability == alone.stability.spread
+        flagged += bool(alone.stability.warning)
+    # The paper's misreading of a concave edge is unstable (about ± 75°) at every station: the
+    # summary counts flagged stations like flagged points, naming each by edge and arc length.
+    assert flagged == len(rows)
+    assert f"{flagged} flagged reading(s)" in result.stderr, result.stderr
+    assert "flagged: edge 1 station at arc length " in result.stderr
+    profile = surface.measure_along([[-1.5, 0, 0], [1.5, 0, 0]], 0.5, 0.4, rule="paper")
+    assert [r.angle for r in rows] == profile.angles.tolist()
+
+    # The edges CSV records no rule: a replay takes the run's, the default refined without one.
+    edges_csv = csvio.edges_path_for(out)
+    again, default = tmp_path / "again.csv", tmp_path / "default.csv"
+    for target, extra in ((again, ("--rule", "paper")), (default, ())):
+        result = batch(mesh, "--edges", edges_csv, *extra, "--out", target)
+        assert result.returncode == 0, result.stdout + result.stderr
+    replayed = csvio.read_measurements_csv(again)
+    assert [(r.angle, r.x, r.y, r.z) for r in replayed] == [(r.angle, r.x, r.y, r.z) for r in rows]
+    assert all(r.rule == "paper" and r.stability is None for r in replayed)
+    refined = csvio.read_measurements_csv(default)
+    assert all(r.rule == "refined" and abs(r.angle - 100.0) < 0.01 for r in refined)

@@ -11,7 +11,7 @@ from bpy_helpers import exact, local_points, mesh_object, world
 from test_ext_measure import core_surface
 
 from vg_addon.formats import csvio
-from vg_addon.synthetic_meshes import varying_wedge
+from vg_addon.synthetic_meshes import varying_wedge, wedge
 
 POINTS = [[-1.5, 0.01, 0.0], [0.0, -0.01, 0.0], [1.5, 0.0, 0.0]]
 
@@ -285,3 +285,37 @@ def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):
     with pytest.raises(RuntimeError, match="names the mesh 'Ramp'"):
         bpy.ops.vg.import_csv(filepath=str(edge_file))
     assert len(other.vg.edges) == 0 and len(other.vg.measurements) == 0
+
+
+def test_stations_take_the_panels_rule_and_stability_and_an_import_the_panels_rule(vg, tmp_path):
+    # A concave crease: the paper's rule reads it about 134°, the default rule 100°.
+    shape = wedge(100.0, half_width=2.0, n=40, irregular=True, concave=True)
+    obj = mesh_object("Concave", shape.points, shape.triangles)
+    settings = bpy.context.scene.vg_settings
+    settings.rule, settings.stability = "paper", True
+    points = [[-1.5, 0.0, 0.0], [1.5, 0.0, 0.0]]
+    assert measure_edge(points=points, spacing=0.5, radius=0.4, space="MESH") == {"FINISHED"}
+    surface = core_surface(obj)
+    stations = [exact(item) for item in obj.vg.measurements]
+    assert len(stations) >= 5
+    for numbers in stations:
+        # Oracle: a single measurement at the station's centre with the panel's settings.
+        alone = surface.measure(numbers["center"], 0.4, rule="paper", stability=True)
+        assert numbers["rule"] == "paper" and numbers["angle"] == alone.angle > 120.0
+        assert numbers["stability"]["spread"] == alone.stability.spread
+    path = tmp_path / "m.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    # The edge file records no rule: an import measures with the panel's.
+    settings.stability = False
+    for rule, name in (("paper", "Paper"), ("refined", "Refined")):
+        settings.rule = rule
+        copy = mesh_object(name, shape.points, shape.triangles)
+        edge_file = str(csvio.edges_path_for(path))
+        assert bpy.ops.vg.import_csv(filepath=edge_file, ignore_mesh_names=True) == {"FINISHED"}
+        again = [exact(item) for item in copy.vg.measurements]
+        assert {a["rule"] for a in again} == {rule}
+        assert all(a["stability"] is None for a in again)
+        if rule == "paper":
+            assert [a["angle"] for a in again] == [s["angle"] for s in stations]
+        else:
+            assert all(abs(a["angle"] - 100.0) < 0.01 for a in again)

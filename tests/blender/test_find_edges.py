@@ -252,3 +252,19 @@ def test_picked_points_off_the_mesh_are_refused_naming_the_file(vg, tmp_path):
     assert f"is {nearest[0]:.6g} from the mesh" in str(error.value)
     assert f"is {nearest[1]:.6g} from the mesh" in str(error.value)
     assert len(obj.vg.edges) == len(obj.vg.measurements) == 0
+
+
+def test_stations_take_the_panels_rule_and_stability(vg):
+    obj = fragment_object()
+    settings = bpy.context.scene.vg_settings
+    settings.rule, settings.stability = "paper", True
+    surface = core_surface(obj)
+    number = next(iter(core_profiles(surface, find_break_edges(surface).candidates)))
+    assert bpy.ops.vg.find_break_edges(accept=str(number)) == {"FINISHED"}
+    got = stations(obj, obj.vg.edges[0].number)
+    assert got
+    for numbers in got:
+        # Oracle: a single measurement at the station's centre with the panel's settings.
+        alone = surface.measure(numbers["center"], RADIUS, rule="paper", stability=True)
+        assert numbers["rule"] == "paper" and numbers["angle"] == alone.angle
+        assert numbers["stability"]["spread"] == alone.stability.spread

@@ -324,3 +324,40 @@ def test_the_pooled_angle_lies_within_its_stations_range(spacing):
         if profile.max - profile.min < 3.0:  # the margin: the pooled angle is its mean's
             assert profile.pooled_angle == pytest.approx(profile.mean, abs=0.5)
     assert profiled >= 2
+
+
+@pytest.fixture(scope="module")
+def concave():
+    """A concave 100° crease on an irregular mesh: the paper's rule misreads it (about 134°)."""
+    shape = wedge(100.0, half_width=2.0, n=40, irregular=True, concave=True)
+    return Surface(shape.points, shape.triangles)
+
+
+def test_stations_are_measured_with_the_rule_asked_for(concave):
+    path = [[-1.5, 0, 0], [1.5, 0, 0]]
+    paper = concave.measure_along(path, spacing=0.5, radius=0.4, rule="paper")
+    default = concave.measure_along(path, spacing=0.5, radius=0.4)
+    # Oracle: single measurements at each station's centre, each on a fresh surface.
+    fresh = Surface(concave.points, concave.triangles)
+    for station in paper.stations:
+        single = fresh.measure(station.center, 0.4, rule="paper")
+        assert station.rule == "paper"
+        assert station.angle == single.angle and station.stability is None
+    for station in default.stations:
+        assert station.rule == "refined"
+        assert station.angle == fresh.measure(station.center, 0.4).angle
+    # The rule changed the reading: the concave edge reads 100° only under the refined rule.
+    assert np.abs(default.angles - 100.0).max() < 0.01
+    assert np.abs(paper.angles - 100.0).min() > 20.0
+
+
+def test_stations_carry_the_stability_figure_when_asked(concave):
+    path = [[-1.0, 0, 0], [1.0, 0, 0]]
+    profile = concave.measure_along(path, spacing=1.0, radius=0.4, rule="oriented", stability=True)
+    fresh = Surface(concave.points, concave.triangles)
+    assert profile.n_stations >= 2
+    for station in profile.stations:
+        single = fresh.measure(station.center, 0.4, rule="oriented", stability=True)
+        assert station.stability is not None
+        assert station.stability == single.stability
+        assert station.angle == single.angle

@@ -66,3 +66,14 @@ def test_a_click_off_the_ridge_shows_the_flat_warning_while_picking():
     half = np.radians(80.0) / 2
     machine.click([-1.5, 0.8 * np.sin(half), -0.8 * np.cos(half)])  # straight down face +
     assert machine.path.flat_spans and "no ridge" in machine.message
+
+
+def test_confirm_measures_every_station_with_the_rule_given():
+    machine = EdgeMachine(SURFACE)
+    for x in (-1.5, 1.5):
+        machine.click([x, 0.0, 0.0])
+    profile = machine.confirm(0.5, 0.3, rule="paper", stability=True)
+    for station in profile.stations:
+        alone = SURFACE.measure(station.center, 0.3, rule="paper", stability=True)
+        assert station.rule == "paper"
+        assert (station.angle, station.stability) == (alone.angle, alone.stability)

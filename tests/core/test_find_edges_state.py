@@ -246,3 +246,16 @@ def test_next_prefers_undecided_candidates(surface):
     assert machine.select_next() and machine.selected == 2  # 1 is decided
     assert machine.select_next(-1) and machine.selected == 0
     assert edge_points(machine.candidates[0]).dtype == np.float64
+
+
+def test_accepted_candidates_are_measured_with_the_rule_and_stability_given(surface):
+    machine = found(surface)
+    assert machine.accept()  # candidate 1 alone
+    assert machine.finish(SPACING, RADIUS, rule="paper", stability=True)
+    while machine.step():
+        pass
+    ((_, profile),) = machine.profiles
+    for station in profile.stations:
+        alone = surface.measure(station.center, RADIUS, rule="paper", stability=True)
+        assert station.rule == "paper"
+        assert (station.angle, station.stability) == (alone.angle, alone.stability)

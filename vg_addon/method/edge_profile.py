@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import GoniometerError, bounded_list
-from .algorithm import as_center, as_radius
+from .algorithm import DEFAULT_RULE, as_center, as_radius
 from .edge_summary import EdgeSummary, summarize
 from .mesh_edges import MeshEdges
 from .ranges import expand_ranges
@@ -527,7 +527,7 @@ def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
 
 
 def measure_along(
-    surface, path, spacing: float, radius: float, lam: float = 2.0, patch: str = "euclidean"
+    surface, path, spacing, radius, lam=2.0, patch="euclidean", rule=DEFAULT_RULE, stability=False
 ) -> EdgeProfile:
     """Measure the break angle at stations every ``spacing`` along ``path``.
 
@@ -539,8 +539,9 @@ def measure_along(
         traced through (start, its inner points as via points, end) first.
     spacing : float
         Arc length between stations, in the surface's units.
-    radius, lam, patch
-        As for ``Surface.measure``; the same for every station.
+    radius, lam, patch, rule, stability
+        As for ``Surface.measure``; the same for every station (``stability=True`` gives each
+        station its :attr:`Measurement.stability` figure).
 
     Returns
     -------
@@ -563,7 +564,9 @@ def measure_along(
     stations, failures = [], []
     for position in positions:
         try:
-            stations.append(surface.measure(path.points[position], radius, lam, patch))
+            stations.append(
+                surface.measure(path.points[position], radius, lam, patch, rule, stability)
+            )
         except GoniometerError as error:
             failures.append(f"station at arc length {path.arc_lengths[position]:.6g}: {error}")
     if failures:

@@ -270,12 +270,15 @@ class Surface:
 
         return trace_edge(self, start, end, via)
 
-    def measure_along(self, path, spacing, radius, lam=2.0, patch="euclidean"):
-        """Measure stations every ``spacing`` along ``path``: an ``EdgeProfile``; see
+    def measure_along(
+        self, path, spacing, radius, lam=2.0, patch="euclidean", rule=DEFAULT_RULE, stability=False
+    ):
+        """Measure stations every ``spacing`` along ``path`` with ``rule`` (and each station's
+        stability figure if ``stability``): an ``EdgeProfile``; see
         :func:`vg_addon.method.edge_profile.measure_along`."""
         from .edge_profile import measure_along
 
-        return measure_along(self, path, spacing, radius, lam, patch)
+        return measure_along(self, path, spacing, radius, lam, patch, rule, stability)
 
     def find_break_edges(self, **parameters):
         """Find the break edges of this mesh: a ``BreakEdgeResult`` of candidates and regions.

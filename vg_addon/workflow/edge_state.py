@@ -119,17 +119,23 @@ class EdgeMachine:
         self.path = assemble_path(self.surface, self._legs) if self._legs else None
         self.message = self.path.warning if self.path is not None else ""
 
-    def confirm(self, spacing: float, radius: float, lam: float = 2.0, patch: str = "euclidean"):
-        """Measure the stations along the path; the :class:`EdgeProfile`, or ``None`` with
+    def confirm(self, spacing: float, radius: float, *settings, **options):
+        """Measure the stations along the path: the :class:`EdgeProfile`, or ``None`` with
         :attr:`message` saying why (the machine then stays in picking, so the user can fix the
-        settings or the clicks)."""
+        settings or the clicks).
+
+        ``spacing``, ``radius`` and the further ``settings`` (``lam``, ``patch``, ``rule``,
+        ``stability``, by position or name) are those of :func:`~.edge_profile.measure_along`.
+        """
         if not self.picking:
             return None
         if self.path is None:
             self.message = "Click at least the start and the end of the edge before confirming."
             return None
         try:
-            self.profile = measure_along(self.surface, self.path, spacing, radius, lam, patch)
+            self.profile = measure_along(
+                self.surface, self.path, spacing, radius, *settings, **options
+            )
         except GoniometerError as error:
             self.message = str(error)
             return None

@@ -171,7 +171,8 @@ class FindEdgesMachine:
         index = self._queue[len(self.profiles)]
         points = edge_points(self.candidates[index])
         try:
-            profile = measure_along(self.surface, points, *self._settings)
+            settings, options = self._settings
+            profile = measure_along(self.surface, points, *settings, **options)
         except GoniometerError as error:
             self.phase = FindPhase.REVIEW
             self.selected = index
@@ -336,14 +337,16 @@ class FindEdgesMachine:
         return True
 
     # -- the end ----------------------------------------------------------------------------
-    def finish(
-        self, spacing: float, radius: float, lam: float = 2.0, patch: str = "euclidean"
-    ) -> bool:
+    def finish(self, spacing: float, radius: float, *settings, **options) -> bool:
         """Start measuring the accepted candidates (one per :meth:`step`). With none accepted
-        the review ends at once with nothing measured."""
+        the review ends at once with nothing measured.
+
+        ``spacing``, ``radius`` and the further ``settings`` (``lam``, ``patch``, ``rule``,
+        ``stability``, by position or name) are those of :func:`~.edge_profile.measure_along`.
+        """
         if not self.reviewing:
             return False
-        self._settings = (spacing, radius, lam, patch)
+        self._settings = ((spacing, radius, *settings), options)
         self._queue = self.accepted
         self.profiles = []
         if not self._queue:
