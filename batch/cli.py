@@ -40,8 +40,10 @@ points:
   the defaults for rows that carry none.
 
 rule and checks:
-  --rule oriented (the default) reads concave edges and inward-wound meshes right; --rule paper
-  is Algorithm 1 as printed. Rows of MeshLab and earlier add-on CSVs, and extension exports
+  --rule refined (the default) is the oriented rule, then each face's plane from the vertices
+  on it (exact where the crease runs between vertex rows); --rule oriented (the earlier
+  default) reads concave edges and inward-wound meshes right; --rule paper is Algorithm 1 as
+  printed. Rows of MeshLab and earlier add-on CSVs, and extension exports
   without a Rule column, are always re-measured with the paper's rule they were taken with.
   --stability adds each measurement's stability figure (the Stability columns; it costs about
   ten measurements). A closed mesh wound inward is named once in the output: its angles are
@@ -132,7 +134,7 @@ def build_parser() -> argparse.ArgumentParser:
         "ARGS:  MESH... [--object NAME] (--at X Y Z ... | --points CSV) [--radius R]\n"
         "       [--edge X1 Y1 Z1 X2 Y2 Z2 [--via X Y Z]... --spacing D]... [--edges CSV|PP]\n"
         "       [--find-edges --spacing D [--min-length L]]\n"
-        "       [--lambda L] [--patch euclidean|geodesic] [--rule oriented|paper]\n"
+        "       [--lambda L] [--patch euclidean|geodesic] [--rule refined|oriented|paper]\n"
         "       [--stability] [--sweep R0 R1 N] --out CSV [--save-blend PATH]\n"
         "       [--render DIR] [--jobs N] [--shard K/N]\n"
         "   or: --report DIR CSV... [--method M]... [--observer O]... [--compare A B]...\n"
