@@ -253,9 +253,33 @@ def test_a_point_cloud_is_one_failed_row_saying_why(tmp_path):
         (("--find-edges", "--spacing", 1, "--radius", 1, "--shard", "1/2"), "drop --shard"),
         (("--find-edges", "--spacing", 1, "--radius", 1, "--min-length", -1), "positive"),
         (("--at", 0, 0, 0, "--radius", 1, "--min-length", 2), "--min-length L is for"),
+        *[
+            (
+                (*how, "--spacing", spacing, "--radius", 1),
+                f"--spacing must be a positive, finite number (got {spacing})",
+            )
+            for how in (("--find-edges",), ("--edge", 0, 0, 0, 1, 0, 0), ("--edges", "e.pp"))
+            for spacing in ("0", "-1", "nan", "inf")
+        ],
+        *[
+            (
+                (*how, "--spacing", 1, "--radius", radius),
+                f"--radius must be a positive, finite number (got {radius})",
+            )
+            for how in (("--find-edges",), ("--edge", 0, 0, 0, 1, 0, 0), ("--edges", "e.pp"))
+            for radius in ("0", "-1", "nan")
+        ],
+        *[
+            (
+                (*how, "--spacing", 1, "--radius", 1, "--lambda", -1),
+                "--lambda: λ (SegParam) must be a number from 0 to",
+            )
+            for how in (("--find-edges",), ("--edge", 0, 0, 0, 1, 0, 0), ("--edges", "e.csv"))
+        ],
     ],
 )
 def test_bad_find_edges_arguments_are_refused_before_anything_runs(tmp_path, arguments, words):
+    # Each before any mesh or edges file is read: neither exists.
     out = tmp_path / "out.csv"
     result = ok(batch(tmp_path / "none.ply", *arguments, "--out", out), 2)
     assert words in result.stderr
