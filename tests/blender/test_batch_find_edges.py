@@ -192,8 +192,7 @@ def test_find_edges_with_jobs_writes_the_serial_runs_rows(tmp_path):
 
 def test_a_min_length_longer_than_every_edge_finds_none(tmp_path):
     # The bevelled cube: its edges (about 20 long) are shorter than its diagonal (35), so a min
-    # length between the two is allowed (one beyond the diagonal is refused as a mistake) and
-    # longer than every edge the core finds.
+    # length between the two is longer than every edge the core finds.
     shape = bevelled_cube()
     mesh = tmp_path / "cube.ply"
     meshio.write_ply(mesh, shape.points, shape.triangles)
