@@ -7,6 +7,7 @@ import math
 
 from ..bridge.map_edges import EDGE_ENDS
 from ..vg_addon import GoniometerError
+from ..vg_addon.method.algorithm import as_lambda
 from ..vg_addon.method.sweep import sweep_radii
 
 # --units: Blender's unit system, unit scale and length unit for what one coordinate unit is.
@@ -40,13 +41,15 @@ points:
   the defaults for rows that carry none.
 
 rule and checks:
-  --rule refined (the default) is exact where the crease runs between vertex rows; --rule
-  oriented reads concave edges and inward-wound meshes right; --rule paper is Algorithm 1 as
+  --rule refined (the default) is the oriented rule, then each face's plane from the vertices
+  on it (exact where the crease runs between vertex rows); --rule oriented (the earlier
+  default) reads concave edges and inward-wound meshes right; --rule paper is Algorithm 1 as
   printed. Rows of MeshLab and earlier add-on CSVs, and extension exports without a Rule
   column, are always re-measured with the paper's rule they were taken with. Edge stations
   (--edge, --edges, --find-edges) are measured with --rule, also when replayed from an edges
   CSV (it records no rule). --stability adds each measurement's and each station's stability
-  figure (the Stability columns; it costs about ten measurements). A closed mesh wound inward is named once in the output: its angles are
+  figure (the Stability columns; it costs about ten measurements). A closed mesh wound
+  inward is named once in the output: its angles are
   right, its convex/concave labels swapped.
   --sweep R0 R1 N also measures every point at N radii from R0 to R1: rows in
   <out>_sweep.csv, and a plot per point in the folder <out>_sweep/.
@@ -415,9 +418,27 @@ def check_find_edges(args) -> None:
             "--find-edges profiles every edge of each mesh, which does not split into shares of "
             "rows: drop --shard (--jobs N measures N meshes at a time)."
         )
-    length = args.min_length
-    if length is not None and not (math.isfinite(length) and length > 0):
-        raise UsageError(f"--min-length must be a positive number (got {length:g}).")
+    check_positive("--min-length", args.min_length)
+
+
+def check_positive(flag: str, value) -> None:
+    """Refuse ``value`` of ``flag`` unless it is absent or a finite number greater than 0."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise UsageError(f"{flag} must be a positive, finite number (got {value:g}).")
+
+
+def check_edge_settings(args) -> None:
+    """Refuse, for ``--edge``, ``--edges`` and ``--find-edges``, a ``--spacing`` or ``--radius``
+    that is not a finite number greater than 0 and a ``--lambda`` outside its range, before any
+    mesh is read: otherwise every edge of the run is traced and fails."""
+    if not (args.edge or args.edges_csv or args.find_edges):
+        return
+    check_positive("--spacing", args.spacing)
+    check_positive("--radius", args.radius)
+    try:
+        as_lambda(args.lam)
+    except GoniometerError as error:
+        raise UsageError(f"--lambda: {error}") from None
 
 
 def check_args(args) -> None:
@@ -458,6 +479,7 @@ def check_args(args) -> None:
     if (args.edge or args.edges_csv) and (args.jobs > 1 or args.shard):
         raise UsageError("edges are measured in this process: drop --jobs and --shard.")
     check_find_edges(args)
+    check_edge_settings(args)
     if not args.out:
         raise UsageError("--out CSV is required: the measurements CSV to write.")
     if args.jobs < 1:

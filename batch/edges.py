@@ -24,7 +24,8 @@ from .find_edges import found_edge_specs
 def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
     """The edges of a run: ``--edge`` (with ``--via``, on every mesh) and the rows of
     ``--edges CSV`` (each on the mesh its Mesh Name names), as dicts of ``points``, ``spacing``,
-    ``radius``, ``lam``, ``patch`` and ``mesh_name`` ("" for every mesh). A line naming the
+    ``radius``, ``lam``, ``patch``, ``mesh_name`` ("" for every mesh) and ``note`` (its User
+    Data; an edges CSV row's own). A line naming the
     ``.pp`` files of an ``--edges`` folder that name no mesh given is appended to
     ``passed_over`` (for the run's summary).
 
@@ -74,6 +75,7 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
             "lam": args.lam if row.lam is None else row.lam,
             "patch": row.patch or args.patch,
             "mesh_name": name,
+            "note": row.user_data,  # kept on the replayed edge, as Blender's import keeps it
             # Files of earlier versions hold world-space points (a mesh file's object is
             # untransformed: the same numbers).
             "space": "world" if row.coordinates == csvio.WORLD_COORDINATES else "mesh",

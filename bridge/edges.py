@@ -6,6 +6,7 @@ Each raises :class:`GoniometerError` for bad input before changing anything.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import bpy
@@ -309,6 +310,23 @@ def make_plot(obj, edge):
     return image
 
 
+def station_points(centers: list, first_arc: float, spacing: float) -> list:
+    """The Points of an edge rebuilt from its stations: every centre in order (start, via
+    points, end), so the edge retraces through them, closed again (ending on its first centre)
+    where the stations went round a loop.
+
+    Stations sit ``spacing`` apart with the same gap ``g`` (under a spacing) at both ends of
+    the path; the first is ``g`` from the start. On a loop the last one is then at most ``2g``
+    (plus the snap to a vertex at each) from the first, across the loop's start; an open edge's
+    ends are as far apart as the edge is long.
+    """
+    if len(centers) < 3:
+        return centers
+    gap = math.dist(centers[-1], centers[0])
+    closed = gap <= 2.0 * first_arc + 0.5 * spacing and gap < spacing
+    return [*centers, centers[0]] if closed else centers
+
+
 def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
     """Rebuild edge records from re-measured stations (a CSV import).
 
@@ -331,7 +349,7 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
         figures = summarize(surface, measurements)
         centers = [[float(v) for v in m.center] for m in measurements]
         numbers = {
-            "points": [centers[0], centers[-1]] if len(centers) > 1 else centers,
+            "points": station_points(centers, float(group[0][2]), float(group[0][3])),
             "path": centers,
             "spacing": float(group[0][3]),
             "radius": float(measurements[0].radius),

@@ -127,11 +127,14 @@ def test_each_found_edge_re_measures_identically_from_the_edges_csv(found, tmp_p
     ok(batch(mesh, "--edges", csvio.edges_path_for(out), "--out", again))
     first = [r for r in csvio.read_measurements_csv(out) if r.edge_number]
     second = csvio.read_measurements_csv(again)
-    keys = ("edge_number", "angle", "arc_length", "x", "y", "z", "fit", "n_vertices")
+    # The User Data ("found edge 2: confidence ...") stays with each edge and its stations.
+    assert first and all(r.user_data.startswith("found edge ") for r in first)
+    keys = ("edge_number", "angle", "arc_length", "x", "y", "z", "fit", "n_vertices", "user_data")
     assert [[getattr(r, k) for k in keys] for r in second] == [
         [getattr(r, k) for k in keys] for r in first
     ]
-    skip = {"date", "user_data"}
+    assert all(e.user_data for e in csvio.read_edges_csv(csvio.edges_path_for(out)))
+    skip = {"date"}
 
     def summaries(path):
         rows = csvio.read_edges_csv(csvio.edges_path_for(path))
@@ -192,8 +195,7 @@ def test_find_edges_with_jobs_writes_the_serial_runs_rows(tmp_path):
 
 def test_a_min_length_longer_than_every_edge_finds_none(tmp_path):
     # The bevelled cube: its edges (about 20 long) are shorter than its diagonal (35), so a min
-    # length between the two is allowed (one beyond the diagonal is refused as a mistake) and
-    # longer than every edge the core finds.
+    # length between the two is longer than every edge the core finds.
     shape = bevelled_cube()
     mesh = tmp_path / "cube.ply"
     meshio.write_ply(mesh, shape.points, shape.triangles)
@@ -253,9 +255,33 @@ def test_a_point_cloud_is_one_failed_row_saying_why(tmp_path):
         (("--find-edges", "--spacing", 1, "--radius", 1, "--shard", "1/2"), "drop --shard"),
         (("--find-edges", "--spacing", 1, "--radius", 1, "--min-length", -1), "positive"),
         (("--at", 0, 0, 0, "--radius", 1, "--min-length", 2), "--min-length L is for"),
+        *[
+            (
+                (*how, "--spacing", spacing, "--radius", 1),
+                f"--spacing must be a positive, finite number (got {spacing})",
+            )
+            for how in (("--find-edges",), ("--edge", 0, 0, 0, 1, 0, 0), ("--edges", "e.pp"))
+            for spacing in ("0", "-1", "nan", "inf")
+        ],
+        *[
+            (
+                (*how, "--spacing", 1, "--radius", radius),
+                f"--radius must be a positive, finite number (got {radius})",
+            )
+            for how in (("--find-edges",), ("--edge", 0, 0, 0, 1, 0, 0), ("--edges", "e.pp"))
+            for radius in ("0", "-1", "nan")
+        ],
+        *[
+            (
+                (*how, "--spacing", 1, "--radius", 1, "--lambda", -1),
+                "--lambda: λ (SegParam) must be a number from 0 to",
+            )
+            for how in (("--find-edges",), ("--edge", 0, 0, 0, 1, 0, 0), ("--edges", "e.csv"))
+        ],
     ],
 )
 def test_bad_find_edges_arguments_are_refused_before_anything_runs(tmp_path, arguments, words):
+    # Each before any mesh or edges file is read: neither exists.
     out = tmp_path / "out.csv"
     result = ok(batch(tmp_path / "none.ply", *arguments, "--out", out), 2)
     assert words in result.stderr

@@ -10,6 +10,7 @@ import pytest
 from bpy_helpers import exact, local_points, mesh_object, world
 from test_ext_measure import core_surface
 
+from vg_addon import Surface
 from vg_addon.formats import csvio
 from vg_addon.synthetic_meshes import varying_wedge, wedge
 
@@ -319,3 +320,62 @@ def test_stations_take_the_panels_rule_and_stability_and_an_import_the_panels_ru
             assert [a["angle"] for a in again] == [s["angle"] for s in stations]
         else:
             assert all(abs(a["angle"] - 100.0) < 0.01 for a in again)
+
+
+def rim_object(shared_data):
+    """The intersecting spheres and the points of their rim, a loop, as the core finds it."""
+    from vg_addon.formats.meshio import read_mesh
+    from vg_addon.method.break_edges import find_break_edges
+
+    mesh = read_mesh(shared_data / "IntersectingSpheres.ply")
+    (rim,) = find_break_edges(Surface(mesh.points, mesh.triangles)).candidates
+    assert rim.closed
+
+    def copy(name):
+        return mesh_object(name, mesh.points, mesh.triangles)
+
+    return copy, rim.waypoint_points.tolist(), 0.1, 0.06
+
+
+def ramp_copies(shared_data):
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+
+    def copy(name):
+        return mesh_object(name, shape.points, shape.triangles)
+
+    # Bent, so the centres are more than the two ends: the edge must pass through each.
+    return copy, [[-1.5, 0.01, 0.0], [-0.2, -0.01, 0.0], [1.5, 0.0, 0.0]], 0.37, 0.3
+
+
+@pytest.mark.parametrize("shape", [ramp_copies, rim_object], ids=["open ramp", "rim loop"])
+def test_an_edge_rebuilt_from_its_stations_replays_through_them(vg, tmp_path, shared_data, shape):
+    # Export, import the station CSV, export again, replay that edges CSV: the edge goes
+    # through every station centre of the first measurement (the core's vertices), with as
+    # many stations. The rebuilt edge once kept only its first and last centre as its points:
+    # the rim's loop replayed as one station.
+    copy, points, spacing, radius = shape(shared_data)
+    obj = copy("Edge")
+    assert measure_edge(points=points, spacing=spacing, radius=radius) == {"FINISHED"}
+    (first,) = [exact(e) for e in obj.vg.edges]
+    centres = [tuple(exact(item)["center"]) for item in obj.vg.measurements]
+    assert len(centres) > 3
+    stations_csv, again_csv = tmp_path / "m.csv", tmp_path / "again.csv"
+    assert bpy.ops.vg.export_csv(filepath=str(stations_csv)) == {"FINISHED"}
+
+    copy("Edge.stations")
+    assert bpy.ops.vg.import_csv(filepath=str(stations_csv), ignore_mesh_names=True) == {"FINISHED"}
+    assert bpy.ops.vg.export_csv(filepath=str(again_csv)) == {"FINISHED"}
+    (row,) = csvio.read_edges_csv(csvio.edges_path_for(again_csv))
+    rebuilt_points = csvio.parse_points(row.points)
+    # In order, the loop closed again on its first centre.
+    closed = shape is rim_object
+    assert rebuilt_points == centres + centres[:1] if closed else rebuilt_points == centres
+
+    replay = copy("Edge.replay")
+    edges_csv = csvio.edges_path_for(again_csv)
+    assert bpy.ops.vg.import_csv(filepath=str(edges_csv), ignore_mesh_names=True) == {"FINISHED"}
+    (replayed,) = [exact(e) for e in replay.vg.edges]
+    path = {tuple(p) for p in replayed["path"]}
+    assert all(c in path for c in centres)
+    assert len(replayed["angles"]) == len(first["angles"])
+    assert replayed["mean"] == pytest.approx(first["mean"], abs=0.5)

@@ -4,12 +4,14 @@ Oracles: the generators' own labels of which vertices lie on a rim (the exact ge
 ``trace_edge`` for replication (a candidate's waypoints retrace its path).
 """
 
+import math
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from vg_addon import GoniometerError, Surface
+from vg_addon.fragments import flake
 from vg_addon.method.break_edges import (
     BreakEdgeFinder,
     BreakEdgeParameters,
@@ -151,15 +153,24 @@ def test_bad_input_is_refused():
 
 
 def test_a_scale_or_length_beyond_the_mesh_is_refused_and_one_within_it_returns():
-    """A scale of 1e12 once froze the finder; the oracle for the bound is the bounding box."""
+    """A scale of 1e12 once froze the finder; the oracle for the scale's bound is the bounding
+    box, for the length's the mesh's distinct edges (each once) added up."""
     fragment = bone_fragment(spacing=2.0)
     surface = Surface(fragment.points, fragment.triangles)
     extent = surface.points.max(axis=0) - surface.points.min(axis=0)
     diagonal = float(np.sqrt(np.sum(extent**2)))
+    for value in (1e12, 1.01 * diagonal):
+        with pytest.raises(GoniometerError, match=r"scale.*larger than the whole mesh"):
+            find_break_edges(surface, scale=value)
+    triangles = np.asarray(fragment.triangles)
+    pairs = np.unique(np.sort(triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
+    points = np.asarray(fragment.points)
+    edge_total = float(np.linalg.norm(points[pairs[:, 0]] - points[pairs[:, 1]], axis=1).sum())
+    assert edge_total > 10 * diagonal
+    # Beyond twice every edge (the bound counts an interior edge twice): nothing can reach it.
+    with pytest.raises(GoniometerError, match=r"min_length.*no edge can reach it"):
+        find_break_edges(surface, min_length=2.01 * edge_total)
     for name in ("scale", "min_length"):
-        for value in (1e12, 1.01 * diagonal):
-            with pytest.raises(GoniometerError, match=f"{name}.*larger than the whole mesh"):
-                find_break_edges(surface, **{name: value})
         for value in (float("nan"), float("inf"), -1.0, 0.0):
             with pytest.raises(GoniometerError, match=name):
                 find_break_edges(surface, **{name: value})
@@ -170,6 +181,22 @@ def test_a_scale_or_length_beyond_the_mesh_is_refused_and_one_within_it_returns(
     assert result.region.shape == (surface.n_points,)
     result = find_break_edges(surface, min_length=0.99 * diagonal)
     assert all(c.length >= 0.99 * diagonal for c in result.candidates)
+    result = find_break_edges(surface, min_length=1.01 * diagonal)  # allowed: finds none here
+    assert all(c.length >= 1.01 * diagonal for c in result.candidates)
+
+
+def test_a_min_length_beyond_the_bounding_box_finds_a_rim_that_long():
+    """The flake's margin, the arc of a circle of radius 20 left by the platform at x = 14, is
+    longer (93.8) than the flake is across (53.1); the oracle for its length is that arc."""
+    fragment = flake()
+    surface = Surface(fragment.points, fragment.triangles)
+    extent = surface.points.max(axis=0) - surface.points.min(axis=0)
+    diagonal = float(np.sqrt(np.sum(extent**2)))
+    arc = 2 * (math.pi - math.acos(14 / 20)) * 20
+    assert diagonal < 60 < arc
+    result = find_break_edges(surface, min_length=60.0)
+    (margin,) = result.candidates
+    assert margin.length == pytest.approx(arc, rel=0.01)
 
 
 def test_the_reference_lens_rim_is_found_as_one_loop(shared_data):

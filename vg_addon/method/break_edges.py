@@ -41,6 +41,7 @@ from .edge_pieces import (
     trace_piece,
 )
 from .edge_profile import EdgePath, assemble_path, has_ridge_graph, ridge_graph
+from .fixed_order import rows_dot, total
 from .mesh_edges import MeshEdges
 from .mesh_regions import dilate, flood_labels
 from .narrow_faces import flat_band, recovered_regions
@@ -138,15 +139,20 @@ class BreakEdgeParameters:
     noise_factor: float = 4.0
     max_candidates: int = 200
 
-    def check(self, diagonal: float | None = None) -> BreakEdgeParameters:
+    def check(
+        self, diagonal: float | None = None, edge_total: float | None = None
+    ) -> BreakEdgeParameters:
         """The parameters, or a :class:`GoniometerError` naming the first bad one.
 
         Parameters
         ----------
         diagonal : float, optional
-            The mesh's bounding-box diagonal: ``scale`` and ``min_length`` may not exceed it
-            (a neighbourhood or an edge longer than the whole mesh means a slip of the units,
-            and would only cost time).
+            The mesh's bounding-box diagonal: ``scale`` may not exceed it (a neighbourhood
+            larger than the whole mesh means a slip of the units, and would only cost time).
+        edge_total : float, optional
+            The length of all the mesh's edges together: ``min_length`` may not exceed it (no
+            edge, which runs along mesh edges, can be longer). Not the diagonal: a loop or a
+            curved rim is longer than the bounding box is across.
         """
         if not (_is_number(self.noise_factor) and 0 <= self.noise_factor < math.inf):
             raise GoniometerError(f"noise_factor must be a number ≥ 0; got {self.noise_factor!r}.")
@@ -157,15 +163,19 @@ class BreakEdgeParameters:
                     f"The break-edge parameter {name} must be a positive number (or None for the "
                     f"default); got {value!r}."
                 )
-        if diagonal is not None:
-            for name in ("scale", "min_length"):
-                value = getattr(self, name)
-                if value is not None and value > diagonal:
-                    raise GoniometerError(
-                        f"The break-edge parameter {name} ({value:g}) is larger than the whole "
-                        f"mesh (its bounding box is {diagonal:g} across); choose a smaller one "
-                        "or None for the default."
-                    )
+        if diagonal is not None and self.scale is not None and self.scale > diagonal:
+            raise GoniometerError(
+                f"The break-edge parameter scale ({self.scale:g}) is larger than the whole mesh "
+                f"(its bounding box is {diagonal:g} across); choose a smaller one or None for the "
+                "default."
+            )
+        length = self.min_length
+        if edge_total is not None and length is not None and length > edge_total:
+            raise GoniometerError(
+                f"The break-edge parameter min_length ({length:g}) is longer than all the mesh's "
+                f"edges together ({edge_total:g}): no edge can reach it; choose a smaller one or "
+                "None for the default."
+            )
         bend = self.min_bend_deg
         if not (_is_number(bend) and 0 < bend < 180):
             raise GoniometerError(
@@ -359,6 +369,17 @@ def _phase(work, low: float, high: float):
         yield progress
 
 
+def _mesh_edge_total(surface) -> float | None:
+    """The length of every triangle's three sides together (``None`` without triangles): an
+    interior mesh edge counts twice, so no path along the mesh's edges is longer."""
+    triangles = surface.triangles
+    if triangles is None or len(triangles) == 0:
+        return None
+    points = surface.points
+    sides = [points[triangles[:, k]] - points[triangles[:, k - 1]] for k in range(3)]
+    return sum(total(np.sqrt(rows_dot(side, side))) for side in sides)
+
+
 class BreakEdgeFinder:
     """Find break edges step by step (a modal operator steps it on a timer).
 
@@ -389,7 +410,7 @@ class BreakEdgeFinder:
         self.surface = surface
         points = surface.points
         diagonal = math.hypot(*(points.max(axis=0) - points.min(axis=0))) if len(points) else None
-        self.parameters = parameters.check(diagonal)
+        self.parameters = parameters.check(diagonal, _mesh_edge_total(surface))
         self.result: BreakEdgeResult | None = None
 
     def steps(self) -> Iterator[float]:
