@@ -12,6 +12,7 @@ from bpy.props import (
 from ..bridge import measuring, records
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, uniform_scale
 from ..vg_addon import GoniometerError
+from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.result import fit_text
 from .common import (
     LocationProperties,
@@ -98,7 +99,8 @@ class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
 def report_measurement(operator, obj, item) -> None:
     """Say what a measuring operator just recorded (``item`` on ``obj``), and warn of stale
     measurements, an unstable reading and a non-uniform scale."""
-    spread = f" {item.stability_text}" if operator.stability else ""
+    computed = exact_numbers(item).get("stability")  # asked for, or a small patch's own
+    spread = f" {item.stability_text}" if computed else ""
     operator.report(
         {"INFO"},
         f"Measurement {item.number} (break {item.break_number}) on '{obj.name}': "

@@ -104,6 +104,23 @@ def test_reports_the_angle(vg, capfd):
     assert f"{angle:.2f}°" in out.out + out.err
 
 
+def test_a_small_patch_reports_its_stability_figure_unasked(vg, capfd):
+    """Fewer than 100 vertices: the figure is computed, recorded and reported though the
+    Stability option is off; a larger patch records none."""
+    obj = wedge_object(90.0, n=20)
+    spacing = np.sqrt(2.0) / 20
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=2.5 * spacing, stability=False)
+    small = obj.vg.measurements[-1]
+    out = capfd.readouterr()
+    assert small.n_vertices < 100
+    assert small.stability_text.startswith("±")
+    assert small.stability_text in out.out + out.err
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5, stability=False)
+    large = obj.vg.measurements[-1]
+    assert large.n_vertices >= 100 and large.stability_text == "not computed"
+    assert "not computed" not in capfd.readouterr().out
+
+
 def test_colour_attribute_paints_the_sides_and_spares_the_users_colours(vg):
     obj = wedge_object(80.0)
     mine = obj.data.color_attributes.new("Scan colour", "BYTE_COLOR", "CORNER")

@@ -102,3 +102,36 @@ def test_the_stability_figure_covers_what_noise_costs(angle, spacing):
     covered = error <= max(tolerance(angle), m.stability.spread)
     assert covered or m.stability.warning, (m.angle, m.stability.text())
     assert not (m.stability.text() == "± 0.00°" and error > 0.1)
+
+
+def noisy_fold(angle, spacing, seed, noise):
+    points, triangles = folded(angle, spacing, seed)
+    normals = Surface(points, triangles).normals
+    offsets = np.random.default_rng(seed + 1).normal(0.0, noise * spacing, len(points))
+    return Surface(points + normals * offsets[:, None], triangles)
+
+
+@pytest.mark.parametrize("spacings", [2.0, 2.5, 3.0, 4.0])
+@pytest.mark.parametrize("angle", [30, 90, 135, 165])
+def test_a_small_patch_carries_its_stability_figure_unasked(angle, spacings):
+    """A patch of a few rows of vertices can read degrees off with no sign in its fit error; it
+    gets its stability figure without being asked, and the figure covers the error or flags it."""
+    spacing, missed = 0.02, []
+    surface = noisy_fold(angle, spacing, seed=angle + int(spacings * 10), noise=0.02)
+    for along in np.linspace(-0.2, 0.2, 5):
+        try:
+            m = surface.measure([0.0, along, 0.0], spacings * spacing)
+        except GoniometerError:
+            continue
+        assert m.indices.size < 100 and m.stability is not None
+        error = abs(m.angle - angle)
+        if not (error <= max(tolerance(angle), m.stability.spread) or m.stability.warning):
+            missed.append((along, m.angle, m.stability.text()))
+    assert not missed
+
+
+def test_a_large_patch_gets_its_figure_only_when_asked():
+    surface = noisy_fold(90, 0.02, seed=7, noise=0.02)
+    m = surface.measure([0.0, 0.0, 0.0], RADIUS)
+    assert m.indices.size >= 100 and m.stability is None
+    assert surface.measure([0.0, 0.0, 0.0], RADIUS, stability=True).stability is not None

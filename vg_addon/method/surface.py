@@ -23,7 +23,7 @@ from .normals import pca_normals, vertex_normals
 from .ordering import canonical_ranks
 from .result import Measurement
 from .spatial import GridIndex
-from .stability import estimate_stability
+from .stability import SMALL_PATCH_VERTICES, estimate_stability
 from .winding import mesh_winding
 
 PATCH_MODES = ("euclidean", "geodesic")
@@ -209,7 +209,9 @@ class Surface:
             printed, for replicating old measurements; see ``algorithm.RULES``).
         stability : bool, optional
             Also compute :attr:`Measurement.stability` (about as costly as a dozen measurements,
-            batched; default ``False``).
+            batched; default ``False``). A patch of fewer than
+            :data:`~vg_addon.method.stability.SMALL_PATCH_VERTICES` vertices always gets it: a
+            reading there can be degrees off with nothing else to show it.
 
         Returns
         -------
@@ -259,7 +261,7 @@ class Surface:
             lam=lam,
             patch=mode,
         )
-        if stability:
+        if stability or indices.size < SMALL_PATCH_VERTICES:
             measurement = replace(measurement, stability=estimate_stability(self, measurement))
         return measurement
 
