@@ -268,8 +268,8 @@ def import_edges_csv(
                 lam if row.lam is None else row.lam,
                 row.patch or patch,
             )
-            # checked before recording
-            measure_edge(obj, points, *settings, depsgraph=depsgraph, rule=rule)
+            # checked before recording; points picked on another mesh are refused, not snapped
+            measure_edge(obj, points, *settings, depsgraph=depsgraph, rule=rule, given=source)
         except GoniometerError as error:
             failures.append(f"row {number}: {error}")
             continue

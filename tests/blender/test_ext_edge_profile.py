@@ -286,6 +286,25 @@ def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):
     with pytest.raises(RuntimeError, match="names the mesh 'Ramp'"):
         bpy.ops.vg.import_csv(filepath=str(edge_file))
     assert len(other.vg.edges) == 0 and len(other.vg.measurements) == 0
+    # Points picked on another mesh (here 3 units above this one): refused as the batch's
+    # --edges refuses them, not snapped to the nearest vertex and measured; nothing recorded.
+    with open(edge_file, newline="", encoding="utf-8") as handle:
+        table = list(csv.DictReader(handle))
+    vertices = np.array([v.co for v in other.data.vertices], dtype=np.float64)
+    for row in table:
+        lifted = np.array(csvio.parse_points(row["Points"].removeprefix("'")))
+        lifted[:, 2] += 3.0
+        assert np.linalg.norm(vertices[:, None] - lifted[None], axis=2).min() > 2.9
+        text = csvio.format_points(lifted)
+        row["Points"] = "'" + text if text.startswith("-") else text
+    far_file = tmp_path / "far_edges.csv"
+    with open(far_file, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(table[0]))
+        writer.writeheader()
+        writer.writerows(table)
+    with pytest.raises(RuntimeError, match="from the mesh"):
+        bpy.ops.vg.import_csv(filepath=str(far_file), ignore_mesh_names=True)
+    assert len(other.vg.edges) == 0 and len(other.vg.measurements) == 0
 
 
 def test_stations_take_the_panels_rule_and_stability_and_an_import_the_panels_rule(vg, tmp_path):
