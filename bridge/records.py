@@ -477,6 +477,7 @@ def edge_row(obj, edge, *, units: str) -> csvio.EdgeRow:
         radius=numbers.get("radius"),
         lam=numbers.get("lam"),
         patch=edge.patch,
+        rule=numbers.get("rule", ""),
         length=numbers.get("length"),
         mean=numbers.get("mean"),
         std=numbers.get("std"),

@@ -9,6 +9,8 @@ drawing (``profile_plot.render_profile``) of the edge's stored numbers for the p
 
 from __future__ import annotations
 
+import csv
+
 import bpy
 import numpy as np
 from bpy_helpers import batch, exact
@@ -90,14 +92,30 @@ def test_edge_stations_take_the_runs_rule_and_stability(tmp_path):
     profile = surface.measure_along([[-1.5, 0, 0], [1.5, 0, 0]], 0.5, 0.4, rule="paper")
     assert [r.angle for r in rows] == profile.angles.tolist()
 
-    # The edges CSV records no rule: a replay takes the run's, the default refined without one.
+    # The edges CSV records each edge's rule: a replay measures with it, whatever --rule says.
     edges_csv = csvio.edges_path_for(out)
-    again, default = tmp_path / "again.csv", tmp_path / "default.csv"
-    for target, extra in ((again, ("--rule", "paper")), (default, ())):
-        result = batch(mesh, "--edges", edges_csv, *extra, "--out", target)
-        assert result.returncode == 0, result.stdout + result.stderr
+    assert [e.rule for e in csvio.read_edges_csv(edges_csv)] == ["paper"]
+    again = tmp_path / "again.csv"
+    result = batch(mesh, "--edges", edges_csv, "--out", again)  # --rule refined by default
+    assert result.returncode == 0, result.stdout + result.stderr
     replayed = csvio.read_measurements_csv(again)
     assert [(r.angle, r.x, r.y, r.z) for r in replayed] == [(r.angle, r.x, r.y, r.z) for r in rows]
     assert all(r.rule == "paper" and r.stability is None for r in replayed)
-    refined = csvio.read_measurements_csv(default)
-    assert all(r.rule == "refined" and abs(r.angle - 100.0) < 0.01 for r in refined)
+    # An edges CSV of an earlier version (no Rule column): a replay takes the run's --rule.
+    with open(edges_csv, newline="", encoding="utf-8") as handle:
+        table = list(csv.DictReader(handle))
+    for row in table:
+        del row["Rule"]
+    older = tmp_path / "older_edges.csv"
+    with open(older, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(table[0]))
+        writer.writeheader()
+        writer.writerows(table)
+    by_run = {}
+    for rule in ("paper", "refined"):
+        target = tmp_path / f"{rule}.csv"
+        result = batch(mesh, "--edges", older, "--rule", rule, "--out", target)
+        assert result.returncode == 0, result.stdout + result.stderr
+        by_run[rule] = csvio.read_measurements_csv(target)
+    assert [r.angle for r in by_run["paper"]] == [r.angle for r in rows]
+    assert all(r.rule == "refined" and abs(r.angle - 100.0) < 0.01 for r in by_run["refined"])

@@ -325,13 +325,28 @@ def test_stations_take_the_panels_rule_and_stability_and_an_import_the_panels_ru
         assert numbers["stability"]["spread"] == alone.stability.spread
     path = tmp_path / "m.csv"
     bpy.ops.vg.export_csv(filepath=str(path))
-    # The edge file records no rule: an import measures with the panel's.
+    # The edge file records each edge's rule: an import measures with it, whatever the panel's.
     settings.stability = False
+    settings.rule = "refined"
+    edge_file = csvio.edges_path_for(path)
+    copy = mesh_object("Replayed", shape.points, shape.triangles)
+    assert bpy.ops.vg.import_csv(filepath=str(edge_file), ignore_mesh_names=True) == {"FINISHED"}
+    again = [exact(item) for item in copy.vg.measurements]
+    assert [(a["rule"], a["angle"]) for a in again] == [("paper", s["angle"]) for s in stations]
+    # An edge file of an earlier version (no Rule column): an import takes the panel's Rule.
+    with open(edge_file, newline="", encoding="utf-8") as handle:
+        table = list(csv.DictReader(handle))
+    for row in table:
+        del row["Rule"]
+    older = tmp_path / "older_edges.csv"
+    with open(older, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(table[0]))
+        writer.writeheader()
+        writer.writerows(table)
     for rule, name in (("paper", "Paper"), ("refined", "Refined")):
         settings.rule = rule
         copy = mesh_object(name, shape.points, shape.triangles)
-        edge_file = str(csvio.edges_path_for(path))
-        assert bpy.ops.vg.import_csv(filepath=edge_file, ignore_mesh_names=True) == {"FINISHED"}
+        assert bpy.ops.vg.import_csv(filepath=str(older), ignore_mesh_names=True) == {"FINISHED"}
         again = [exact(item) for item in copy.vg.measurements]
         assert {a["rule"] for a in again} == {rule}
         assert all(a["stability"] is None for a in again)

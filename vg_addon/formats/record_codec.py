@@ -126,6 +126,7 @@ def edge_numbers(profile, clicks) -> dict:
         **figure_numbers(profile.figures),
         "flat_spans": [[float(a), float(b)] for a, b in spans],
         "space": MESH,
+        "rule": profile.stations[0].rule,  # every station's
     }
 
 
