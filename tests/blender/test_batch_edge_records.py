@@ -9,11 +9,9 @@ drawing (``profile_plot.render_profile``) of the edge's stored numbers for the p
 
 from __future__ import annotations
 
-import csv
-
 import bpy
 import numpy as np
-from bpy_helpers import batch, exact
+from bpy_helpers import batch, edited_csv, exact
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio, profile_plot
@@ -102,15 +100,7 @@ def test_edge_stations_take_the_runs_rule_and_stability(tmp_path):
     assert [(r.angle, r.x, r.y, r.z) for r in replayed] == [(r.angle, r.x, r.y, r.z) for r in rows]
     assert all(r.rule == "paper" and r.stability is None for r in replayed)
     # An edges CSV of an earlier version (no Rule column): a replay takes the run's --rule.
-    with open(edges_csv, newline="", encoding="utf-8") as handle:
-        table = list(csv.DictReader(handle))
-    for row in table:
-        del row["Rule"]
-    older = tmp_path / "older_edges.csv"
-    with open(older, "w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(table[0]))
-        writer.writeheader()
-        writer.writerows(table)
+    older = edited_csv(edges_csv, tmp_path / "older_edges.csv", drop=["Rule"])
     by_run = {}
     for rule in ("paper", "refined"):
         target = tmp_path / f"{rule}.csv"

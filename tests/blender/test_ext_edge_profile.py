@@ -7,7 +7,7 @@ import json
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import exact, local_points, mesh_object, world
+from bpy_helpers import edited_csv, exact, local_points, mesh_object, world
 from test_ext_measure import core_surface
 
 from vg_addon import Surface
@@ -288,20 +288,16 @@ def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):
     assert len(other.vg.edges) == 0 and len(other.vg.measurements) == 0
     # Points picked on another mesh (here 3 units above this one): refused as the batch's
     # --edges refuses them, not snapped to the nearest vertex and measured; nothing recorded.
-    with open(edge_file, newline="", encoding="utf-8") as handle:
-        table = list(csv.DictReader(handle))
     vertices = np.array([v.co for v in other.data.vertices], dtype=np.float64)
-    for row in table:
+
+    def lift(row):
         lifted = np.array(csvio.parse_points(row["Points"].removeprefix("'")))
         lifted[:, 2] += 3.0
         assert np.linalg.norm(vertices[:, None] - lifted[None], axis=2).min() > 2.9
         text = csvio.format_points(lifted)
         row["Points"] = "'" + text if text.startswith("-") else text
-    far_file = tmp_path / "far_edges.csv"
-    with open(far_file, "w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(table[0]))
-        writer.writeheader()
-        writer.writerows(table)
+
+    far_file = edited_csv(edge_file, tmp_path / "far_edges.csv", lift)
     with pytest.raises(RuntimeError, match="from the mesh"):
         bpy.ops.vg.import_csv(filepath=str(far_file), ignore_mesh_names=True)
     assert len(other.vg.edges) == 0 and len(other.vg.measurements) == 0
@@ -334,15 +330,7 @@ def test_stations_take_the_panels_rule_and_stability_and_an_import_the_panels_ru
     again = [exact(item) for item in copy.vg.measurements]
     assert [(a["rule"], a["angle"]) for a in again] == [("paper", s["angle"]) for s in stations]
     # An edge file of an earlier version (no Rule column): an import takes the panel's Rule.
-    with open(edge_file, newline="", encoding="utf-8") as handle:
-        table = list(csv.DictReader(handle))
-    for row in table:
-        del row["Rule"]
-    older = tmp_path / "older_edges.csv"
-    with open(older, "w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(table[0]))
-        writer.writeheader()
-        writer.writerows(table)
+    older = edited_csv(edge_file, tmp_path / "older_edges.csv", drop=["Rule"])
     for rule, name in (("paper", "Paper"), ("refined", "Refined")):
         settings.rule = rule
         copy = mesh_object(name, shape.points, shape.triangles)
