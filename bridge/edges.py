@@ -391,6 +391,17 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
     return numbers_made
 
 
+def redraw_plots(obj) -> None:
+    """Draw every edge's plot of ``obj`` again (after its Scan Units changed: the axis names
+    them), each replacing the image it had."""
+    for edge in obj.vg.edges:
+        old = bpy.data.images.get(edge.plot)
+        if old is None:
+            continue  # a batch run's object that is never saved has none
+        bpy.data.images.remove(old)  # first: the new image takes its name
+        edge.plot = make_plot(obj, edge).name
+
+
 def delete_edge(obj, index: int, *, depsgraph=None) -> int:
     """Delete the edge at list position ``index``, its stations and its plot; repaint.
 

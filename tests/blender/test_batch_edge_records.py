@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-from bpy_helpers import batch, edited_csv, exact
+from bpy_helpers import batch, edited_csv, exact, mesh_object
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio, profile_plot
@@ -52,6 +52,36 @@ def test_saved_edges_keep_their_stations_and_plots(vg, tmp_path):
         )  # fmt: skip
         want = (drawn[::-1].astype(np.float32) / 255.0).ravel()
         assert np.abs(pixels - want).max() < 1.0 / 255.0
+
+
+def plot_pixels(edge) -> np.ndarray:
+    image = bpy.data.images[edge.plot]
+    pixels = np.empty(image.size[0] * image.size[1] * 4, dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    return pixels
+
+
+def test_a_runs_units_come_back_with_its_csvs(vg, tmp_path):
+    """A run with --units cm writes the scene's description ("BU (1 BU = 0.01 m, ...)"); its CSV
+    and its edges CSV imported in Blender take cm as the Scan Units, and every edge's plot names
+    cm on its axis (before: Scan Units untouched, the plots in "BU")."""
+    run(tmp_path, "--units", "cm")
+    out = tmp_path / "out.csv"
+    assert csvio.read_measurements_csv(out)[0].units.startswith("BU (1 BU = 0.01 m")
+    shape = wedge(90.0, n=30, irregular=True, seed=2)
+    for name, path in (("stations", out), ("edges", csvio.edges_path_for(out))):
+        obj = mesh_object(name, shape.points, shape.triangles)
+        assert bpy.ops.vg.import_csv(filepath=str(path), ignore_mesh_names=True) == {"FINISHED"}
+        assert obj.vg.unit == "CM", name
+        assert len(obj.vg.edges) == 3 and len(bpy.data.images) == 3 * (1 + (name == "edges"))
+        for edge in obj.vg.edges:
+            numbers = exact(edge)
+            drawn = profile_plot.render_profile(
+                numbers["arc_lengths"], numbers["angles"], width=480, height=240, units="cm",
+                title=f"{obj.name}, edge {edge.number}", pooled=numbers["pooled_angle"],
+            )  # fmt: skip
+            want = (drawn[::-1].astype(np.float32) / 255.0).ravel()
+            assert np.abs(plot_pixels(edge) - want).max() < 1.0 / 255.0, (name, edge.number)
 
 
 def test_a_run_not_saved_still_writes_every_edges_plot_file(vg, tmp_path):
