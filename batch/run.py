@@ -272,8 +272,8 @@ class Run:
         for edge in self.edge_rows:
             self.say(
                 f"edge {edge.edge_number} on {edge.mesh_name!r}: {edge.n_stations} stations every "
-                f"{edge.spacing:g} over {edge.length:.4g}: mean {edge.mean:.2f}° ± {edge.std:.2f}° "
-                f"(min {edge.min:.2f}°, max {edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°"
+                f"{edge.spacing:g} over {edge.length:.4g}: mean {edge.mean:.2f}° "
+                f"(SD {edge.std:.2f}°, min {edge.min:.2f}°, max {edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°"
                 + (
                     f"; the path crosses no ridge at arc lengths {edge.flat_spans}"
                     if edge.flat_spans

@@ -401,3 +401,43 @@ def test_an_edge_rebuilt_from_its_stations_replays_through_them(vg, tmp_path, sh
     assert all(c in path for c in centres)
     assert len(replayed["angles"]) == len(first["angles"])
     assert replayed["mean"] == pytest.approx(first["mean"], abs=0.5)
+
+
+def test_the_panel_shows_the_study_figures_of_the_edge(vg, tmp_path):
+    """Issue 22, item 5, in the Edge Profiles panel: median, range, arc and chord length and arc
+    angle, as the stations' own angles and centres give them (oracle: the standard library and
+    NumPy's SVD on the stored stations), lengths in the Scan Units; an older record says they
+    are not recorded."""
+    import importlib
+    import itertools
+    import math
+    import statistics
+
+    codec = importlib.import_module(f"{vg.__name__}.vg_addon.formats.record_codec")
+    panels = importlib.import_module(f"{vg.__name__}.ui.panels")
+    assert panels.study_texts is codec.study_texts  # what the panel draws its rows with
+    obj, _ = ramp_object()
+    assert measure_edge() == {"FINISHED"}
+    (edge,) = obj.vg.edges
+    stations = [exact(m) for m in obj.vg.measurements if m.edge_number == edge.number]
+    angles = [s["angle"] for s in stations]
+    centres = [s["center"] for s in stations]
+    arc = sum(math.dist(a, b) for a, b in itertools.pairwise(centres))
+
+    def axis(points):
+        points = np.asarray(points, dtype=np.float64)
+        return np.linalg.svd(points - points.mean(axis=0), full_matrices=False)[2][0]
+
+    cosine = abs(float(np.dot(axis(centres), axis(local_points(obj)))))
+    arc_angle = math.degrees(math.acos(min(cosine, 1.0)))
+    median, spread = statistics.median(angles), max(angles) - min(angles)
+    rows = dict(codec.study_texts(exact(edge), "mm"))
+    assert rows == {
+        "Median, range": f"{median:.2f}°, {spread:.2f}°",
+        "Arc, chord": f"{arc:.4g}, {math.dist(centres[0], centres[-1]):.4g} mm",
+        "Arc angle": f"{arc_angle:.2f}°",
+    }
+    older = {k: v for k, v in exact(edge).items() if k not in codec.STUDY_FIGURES}
+    assert codec.study_texts(older, "mm") == [
+        ("Study figures", "not recorded (an older version): measure again")
+    ]
