@@ -139,3 +139,18 @@ def test_edge_stations_take_the_runs_rule_and_stability(tmp_path):
         by_run[rule] = csvio.read_measurements_csv(target)
     assert [r.angle for r in by_run["paper"]] == [r.angle for r in rows]
     assert all(r.rule == "refined" and abs(r.angle - 100.0) < 0.01 for r in by_run["refined"])
+
+
+def test_failed_edges_are_listed_up_to_ten_then_counted(tmp_path):
+    """Twelve edges picked off the mesh: every one refused (its own error row), the summary
+    names ten and counts the rest, as it does for failed points."""
+    shape = wedge(90.0, n=30, irregular=True, seed=2)
+    mesh = meshio.write_ply(tmp_path / "w.ply", shape.points, shape.triangles)
+    far = [arg for k in range(12) for arg in ("--edge", 50, k, 0, 51, k, 0)]
+    out = tmp_path / "far.csv"
+    result = batch(mesh, *far, "--spacing", 0.1, "--radius", 0.2, "--out", out)
+    rows = csvio.read_measurements_csv(out)
+    assert len(rows) == 12 and all(r.error.startswith("edge not measured") for r in rows)
+    listed = [line for line in result.stderr.splitlines() if "  failed: edge " in line]
+    assert len(listed) == 10, result.stderr
+    assert "... and 2 more failed edges (see the error column)" in result.stderr

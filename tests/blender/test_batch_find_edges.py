@@ -88,8 +88,13 @@ def test_every_edge_found_is_profiled_as_the_core_profiles_it(found):
     # tests/core/test_break_edges*.py measure it against the true edges).
     assert len(candidates) >= 4
     assert f"bone: found {len(candidates)} break edge(s)" in result.stderr
-    assert f", {len(candidates)} edge(s) profiled" in result.stderr
     rows = csvio.read_measurements_csv(out)
+    # An edges-only run says what it did, not "0 measured, 0 failed, 0 points".
+    done = f"{len(candidates)} edge(s) profiled ({len(rows)} stations)"
+    assert (
+        f"bone: {done}, " in result.stderr and f"{done}, 0 failed, on 1 mesh(es)" in result.stderr
+    )
+    assert "0 measured" not in result.stderr and "measurements/s" not in result.stderr
     edges = csvio.read_edges_csv(csvio.edges_path_for(out))
     assert [e.edge_number for e in edges] == list(range(1, len(candidates) + 1))
     for edge, candidate in zip(edges, candidates, strict=True):
