@@ -435,8 +435,8 @@ class VG_SceneSettings(PropertyGroup):
         description="Find Break Edges: a ridge bends at least this much (180° minus its angle), "
         "in degrees",
         default=BreakEdgeParameters().min_bend_deg,
-        min=0.0,
-        max=180.0,
+        min=0.1,  # above 0 and below 180, as the finder needs
+        max=179.9,
         soft_max=90.0,
     )
     sweep_stop: FloatProperty(

@@ -89,9 +89,18 @@ def check_saved(path: Path, names) -> None:
         )
 
 
+def plot_images(obj) -> list:
+    """The images holding the profile plots of ``obj``'s edges (only the edges name them)."""
+    return [image for edge in obj.vg.edges if (image := bpy.data.images.get(edge.plot))]
+
+
 def forget(object_name: str) -> None:
-    """Remove an object and its mesh, and the cached surfaces (frees memory between meshes)."""
+    """Remove an object, its mesh and its edges' plots, and the cached surfaces (frees memory
+    between meshes)."""
     obj = bpy.data.objects.get(object_name)
+    if obj is not None:
+        for image in plot_images(obj):
+            bpy.data.images.remove(image)
     if obj is not None:
         mesh = obj.data
         bpy.data.objects.remove(obj)
@@ -102,15 +111,27 @@ def forget(object_name: str) -> None:
 
 
 def append_objects(results: list[MeshResult]) -> list:
-    """Bring the objects the workers saved into this file, in mesh order."""
+    """Bring the objects the workers saved into this file, in mesh order, with their edges'
+    plots (a worker's file holds its object and those images only)."""
     objects = []
     for result in sorted(results, key=lambda r: r.mesh):
         if not result.blend or not Path(result.blend).is_file():
             continue
         with bpy.data.libraries.load(result.blend, link=False) as (source, target):
             target.objects = [name for name in source.objects if name == result.object_name]
+            names = list(source.images)
+            target.images = list(names)  # Blender turns this list's names into the images
+        # An image whose name this file already has arrives renamed: the edges follow it. Only
+        # the edges name the images, so a fake user keeps them in the saved file.
+        renamed = {}
+        for name, image in zip(names, target.images, strict=True):
+            if image is not None:
+                image.use_fake_user = True
+                renamed[name] = image.name
         for obj in target.objects:
             if obj is not None:
                 bpy.context.scene.collection.objects.link(obj)
+                for edge in obj.vg.edges:
+                    edge.plot = renamed.get(edge.plot, "")
                 objects.append(obj)
     return objects

@@ -46,8 +46,8 @@ rule and checks:
   default) reads concave edges and inward-wound meshes right; --rule paper is Algorithm 1 as
   printed. Rows of MeshLab and earlier add-on CSVs, and extension exports without a Rule
   column, are always re-measured with the paper's rule they were taken with. Edge stations
-  (--edge, --edges, --find-edges) are measured with --rule, also when replayed from an edges
-  CSV (it records no rule). --stability adds each measurement's and each station's stability
+  (--edge, --edges, --find-edges) are measured with --rule; an edges CSV's edges with the
+  Rule of their row (with --rule for files written before that column). --stability adds each measurement's and each station's stability
   figure (the Stability columns; it costs about ten measurements). A closed mesh wound
   inward is named once in the output: its angles are
   right, its convex/concave labels swapped.

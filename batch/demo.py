@@ -126,7 +126,7 @@ def print_edge(run) -> None:
     for edge in run.edge_rows:
         print(
             f"  {edge.n_stations} stations over {edge.length:.1f} mm: mean {edge.mean:.2f}° "
-            f"± {edge.std:.2f}°, min {edge.min:.2f}°, max {edge.max:.2f}°, pooled "
+            f"(SD {edge.std:.2f}°), min {edge.min:.2f}°, max {edge.max:.2f}°, pooled "
             f"{edge.pooled_angle:.2f}°"
         )
     if not stations:

@@ -76,6 +76,7 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
             "patch": row.patch or args.patch,
             "mesh_name": name,
             "note": row.user_data,  # kept on the replayed edge, as Blender's import keeps it
+            "rule": row.rule.strip().lower(),  # "" (a file of an earlier version): the run's
             # Files of earlier versions hold world-space points (a mesh file's object is
             # untransformed: the same numbers).
             "space": "world" if row.coordinates == csvio.WORLD_COORDINATES else "mesh",
@@ -230,8 +231,8 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
     """Measure the run's edges that apply to ``source`` on its object ``obj`` (on ``surface``,
     the surface the points are measured on: the file's float64 coordinates where Blender's
     float32 copy would round them), and record each as one break of stations, each station
-    measured with the run's rule and, with ``--stability``, its stability figure (the options'
-    ``rule`` and ``stability``; an edge summary file records no rule of its own).
+    measured with the edge's rule (an edges CSV row's ``Rule``; else the options' ``rule``) and,
+    with ``--stability``, its stability figure.
 
     Returns
     -------
@@ -271,7 +272,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
                 space=spec.get("space", "mesh"),
                 surface=surface,
                 given=spec.get("given", ""),
-                rule=options.get("rule", DEFAULT_RULE),
+                rule=spec.get("rule") or options.get("rule", DEFAULT_RULE),
                 stability=bool(options.get("stability")),
             )
             # Recorded without repainting: the colours are painted once, after every edge. The

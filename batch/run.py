@@ -158,12 +158,18 @@ class Run:
         failed = len(result.picture_errors)
         note = f", {failed} picture(s) not written" if failed else ""
         if not self.args.quiet:
-            self.say(
-                f"{source.name}: {result.measured:,} measured, {result.failed:,} failed"
-                + (f" ({result.n_vertices:,} vertices, {rate:,.0f}/s)" if result.n_vertices else "")
-                + (f", {len(result.edge_rows)} edge(s) profiled" if result.edge_rows else "")
-                + note
-            )
+            points = result.measured + result.failed
+            stations = sum(edge.n_stations or 0 for edge in result.edge_rows)
+            edges = f"{len(result.edge_rows)} edge(s) profiled ({stations:,} stations)"
+            if points or not result.edge_rows:  # an edges-only run has no points to count
+                self.say(
+                    f"{source.name}: {result.measured:,} measured, {result.failed:,} failed"
+                    + (f" ({result.n_vertices:,} vertices, {rate:,.0f}/s)" if points else "")
+                    + (f", {edges}" if result.edge_rows else "")
+                    + note
+                )
+            else:
+                self.say(f"{source.name}: {edges}, {result.n_vertices:,} vertices{note}")
         elif note:
             self.say(f"{source.name}{note}")
         if message := winding_message(result.object_name or source.name, result.winding):
@@ -252,15 +258,25 @@ class Run:
         measuring = sum(r.measure_seconds for r in self.results)
         tried = sum(r.measured + r.failed for r in self.results if r.measure_seconds > 0)
         rate = tried / measuring if measuring > 0 else 0.0
-        self.say(
-            f"{measured:,} measured, {len(failed):,} failed, {len(self.rows):,} points on "
-            f"{self.total_meshes:,} mesh(es) in {elapsed:.1f} s"
-        )
+        edge_rows = self.edge_rows
+        if self.rows or not edge_rows:
+            self.say(
+                f"{measured:,} measured, {len(failed):,} failed, {len(self.rows):,} points on "
+                f"{self.total_meshes:,} mesh(es) in {elapsed:.1f} s"
+            )
+        else:  # edges only: say what was done, not "0 measured"
+            stations = sum(edge.n_stations or 0 for edge in edge_rows)
+            self.say(
+                f"{len(edge_rows):,} edge(s) profiled ({stations:,} stations), "
+                f"{len(failed_edges):,} failed, on {self.total_meshes:,} mesh(es) in {elapsed:.1f} s"
+            )
         per = f" per process, {self.jobs} processes" if self.jobs > 1 else ""
-        self.say(
-            f"mesh import {load:.1f} s, surface preparation {prepare:.1f} s, measuring "
-            f"{measuring:.2f} s: {rate:,.0f} measurements/s{per} (import excluded)"
+        speed = (
+            f", measuring {measuring:.2f} s: {rate:,.0f} measurements/s{per} (import excluded)"
+            if tried
+            else ""  # no points: the edges' time is in the run's total
         )
+        self.say(f"mesh import {load:.1f} s, surface preparation {prepare:.1f} s{speed}")
         by_index = {t.index: t for t in self.tasks}
         self.say_flagged(by_index)
         for index, row in failed[:10]:
@@ -272,17 +288,19 @@ class Run:
         for edge in self.edge_rows:
             self.say(
                 f"edge {edge.edge_number} on {edge.mesh_name!r}: {edge.n_stations} stations every "
-                f"{edge.spacing:g} over {edge.length:.4g}: mean {edge.mean:.2f}° ± {edge.std:.2f}° "
-                f"(min {edge.min:.2f}°, max {edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°"
+                f"{edge.spacing:g} over {edge.length:.4g}: mean {edge.mean:.2f}° "
+                f"(SD {edge.std:.2f}°, min {edge.min:.2f}°, max {edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°"
                 + (
                     f"; the path crosses no ridge at arc lengths {edge.flat_spans}"
                     if edge.flat_spans
                     else ""
                 )
             )
-        for row in failed_edges:
+        for row in failed_edges[:10]:
             what = "finding edges" if row.edge_number is None else f"edge {row.edge_number}"
             self.say(f"  failed: {what} on {row.mesh_name!r}: {row.error}")
+        if len(failed_edges) > 10:
+            self.say(f"  ... and {len(failed_edges) - 10} more failed edges (see the error column)")
         if self.edge_rows or failed_edges:
             self.say(f"wrote {csvio.edges_path_for(self.args.out)}")
         for message in self.bad_files:

@@ -31,7 +31,7 @@ import bpy
 from ..vg_addon.formats import csvio
 from ..vg_addon.workflow import batchplan
 from . import child_process, extension, map_process
-from .blend_file import forget
+from .blend_file import forget, plot_images
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
 from .sources import MeshSource
 from .stdio import quiet_stdout
@@ -245,7 +245,7 @@ def _measure_from_stdin(plan: dict) -> int:
             if obj is not None:
                 path = str(Path(plan["folder"]) / f"mesh-{mesh}.blend")
                 with quiet_stdout():
-                    bpy.data.libraries.write(path, {obj})
+                    bpy.data.libraries.write(path, {obj, *plot_images(obj)})
                 result.blend = path
         if result.object_name:
             forget(result.object_name)

@@ -221,9 +221,9 @@ def import_edges_csv(
 
     Each row's ``Points`` are traced again and measured with its ``Spacing``, ``Radius``,
     ``SegParam`` and ``Patch Mode`` (``lam`` and ``patch`` for blank cells), and recorded like
-    an edge measured here, with the row's User Data as its note. An edge summary file records
-    no rule: every station is measured with ``rule`` (the panel's), and with its stability
-    figure if ``stability``.
+    an edge measured here, with the row's User Data as its note. Every station is measured with
+    the row's ``Rule`` (``rule``, the panel's, where the file is of a version without that
+    column), and with its stability figure if ``stability``.
 
     Returns
     -------
@@ -268,12 +268,15 @@ def import_edges_csv(
                 lam if row.lam is None else row.lam,
                 row.patch or patch,
             )
-            # checked before recording
-            measure_edge(obj, points, *settings, depsgraph=depsgraph, rule=rule)
+            edge_rule = (
+                row.rule.strip().lower() or rule
+            )  # a file of an earlier version: the panel's
+            # checked before recording; points picked on another mesh are refused, not snapped
+            measure_edge(obj, points, *settings, depsgraph=depsgraph, rule=edge_rule, given=source)
         except GoniometerError as error:
             failures.append(f"row {number}: {error}")
             continue
-        jobs.append((points, settings, row.user_data))
+        jobs.append((points, settings, edge_rule, row.user_data))
     if failures:
         raise GoniometerError(
             f"{len(failures)} of {len(rows)} edges of {source} could not be measured on "
@@ -281,9 +284,15 @@ def import_edges_csv(
         )
     return [
         measure_edge_on_object(
-            obj, points, *settings, depsgraph=depsgraph, note=note, rule=rule, stability=stability
+            obj,
+            points,
+            *settings,
+            depsgraph=depsgraph,
+            note=note,
+            rule=edge_rule,
+            stability=stability,
         ).number
-        for points, settings, note in jobs
+        for points, settings, edge_rule, note in jobs
     ]
 
 
@@ -360,6 +369,7 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
             **record_codec.figure_numbers(figures),
             "flat_spans": [],
             "space": records.MESH,
+            "rule": measurements[0].rule,
         }
         edge = records.add_edge_from_numbers(
             obj,
@@ -379,6 +389,17 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
         edge.plot = make_plot(obj, edge).name
         numbers_made.append(edge.number)
     return numbers_made
+
+
+def redraw_plots(obj) -> None:
+    """Draw every edge's plot of ``obj`` again (after its Scan Units changed: the axis names
+    them), each replacing the image it had."""
+    for edge in obj.vg.edges:
+        old = bpy.data.images.get(edge.plot)
+        if old is None:
+            continue  # a batch run's object that is never saved has none
+        bpy.data.images.remove(old)  # first: the new image takes its name
+        edge.plot = make_plot(obj, edge).name
 
 
 def delete_edge(obj, index: int, *, depsgraph=None) -> int:

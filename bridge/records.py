@@ -16,6 +16,7 @@ from ..vg_addon import GoniometerError, palette, units
 from ..vg_addon.formats import csvio, record_codec
 from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.break_sides import paint_swapped
+from ..vg_addon.method.result import stored_stability_warning
 from .mesh_data import uniform_scale
 
 _MANIFEST = Path(__file__).resolve().parents[1] / "blender_manifest.toml"
@@ -410,6 +411,7 @@ def measurement_row(
         stability_crease=stability.get("crease"),
         stability_crease_refused=stability.get("crease_refused"),
         stability_noise_hides_crease=_as_flag(stability.get("noise_hides_crease")),
+        stability_flag=stored_stability_warning(stability or None),
         error="",
     )
 
@@ -477,6 +479,7 @@ def edge_row(obj, edge, *, units: str) -> csvio.EdgeRow:
         radius=numbers.get("radius"),
         lam=numbers.get("lam"),
         patch=edge.patch,
+        rule=numbers.get("rule", ""),
         length=numbers.get("length"),
         mean=numbers.get("mean"),
         std=numbers.get("std"),

@@ -208,10 +208,11 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                     rule=settings.rule,
                     stability=settings.stability,
                 )
+                extra = adopt_units(obj, [row.units for row in csvio.read_edges_csv(path)])
                 self.report(
                     {"INFO"},
                     f"Re-measured {len(edge_numbers)} edge profile(s) of "
-                    f"{bpy.path.basename(path)} on '{obj.name}'",
+                    f"{bpy.path.basename(path)} on '{obj.name}'{extra}",
                 )
                 _remember(path)
                 return {"FINISHED"}
@@ -329,6 +330,21 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             progress.__exit__(None, None, None)
 
 
+def adopt_units(obj, texts) -> str:
+    """Take the unit the Units cells ``texts`` of a file of this extension all name as ``obj``'s
+    Scan Units, unless the user chose them, and redraw its edges' plots (their axes name the
+    unit); returns what to add to the report ("" where nothing changed)."""
+    found = {units.unit_of_text(text) for text in texts}
+    if len(found) != 1 or None in found or obj.vg.unit_chosen:
+        return ""
+    (key,) = found
+    if obj.vg.unit == key:
+        return ""
+    set_unit(obj.vg, key, guessed=False)
+    edges.redraw_plots(obj)
+    return f"; Scan Units {units.SYMBOLS[key]}, as the file says"
+
+
 def follow_export(obj, path, numbers) -> str:
     """After re-measuring an export of this extension: take its Units as ``obj``'s Scan Units
     (unless the user chose them) and paint each new measurement's sides the way round its
@@ -339,13 +355,7 @@ def follow_export(obj, path, numbers) -> str:
         return ""  # MeshLab's, the earlier add-on's or a points file: no Units, no Colors
     if len(rows) != len(numbers):
         return ""
-    extra = ""
-    found = {units.unit_of_text(row.units) for row in rows}
-    if len(found) == 1 and None not in found and not obj.vg.unit_chosen:
-        (key,) = found
-        if obj.vg.unit != key:
-            set_unit(obj.vg, key, guessed=False)
-            extra += f"; Scan Units {units.SYMBOLS[key]}, as the file says"
+    extra = adopt_units(obj, [row.units for row in rows])
     by_number = {item.number: item for item in obj.vg.measurements}
     turned = sum(
         records.honour_colours(by_number[number], row.colors)

@@ -227,7 +227,7 @@ class VG_OT_measure_edge(PatchProperties, RuleProperties, bpy.types.Operator):
         self.report(
             {"INFO"},
             f"Edge {edge.number} (break {edge.break_number}) on '{obj.name}': {edge.n_stations} "
-            f"stations, mean {edge.mean:.2f}° ± {edge.std:.2f}° (min {edge.min:.2f}°, max "
+            f"stations, mean {edge.mean:.2f}° (SD {edge.std:.2f}°, min {edge.min:.2f}°, max "
             f"{edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°",
         )
         warning = json.loads(edge.exact).get("flat_spans")

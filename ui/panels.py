@@ -4,7 +4,7 @@ import bpy
 
 from ..bridge.records import unit_symbol, units_label
 from ..operators.measure import non_uniform_scale_note
-from ..vg_addon.formats.record_codec import exact_numbers
+from ..vg_addon.formats.record_codec import exact_numbers, study_texts
 from ..vg_addon.method.winding import winding_message
 from .text import fits_beside, region_width, text_width, ui_scale, wrapped_label
 
@@ -305,8 +305,11 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
             "Stations",
             f"{edge.n_stations} every {edge.spacing:.4g} over {edge.length:.4g} {unit}",
         )
-        _text_fitted(column, context, "Mean ± SD", f"{edge.mean:.2f}° ± {edge.std:.2f}°")
+        # "SD", never "±": in this extension "±" is a reading's stability figure.
+        _text_fitted(column, context, "Mean, SD", f"{edge.mean:.2f}°, {edge.std:.2f}°")
         _text_fitted(column, context, "Min, max", f"{edge.min:.2f}°, {edge.max:.2f}°")
+        for label, text in study_texts(exact_numbers(edge), unit):
+            _text_fitted(column, context, label, text)
         _text_fitted(column, context, "Pooled", f"{edge.pooled_angle:.2f}°")
         image = bpy.data.images.get(edge.plot)
         if image is not None:  # the image's preview icon, made on demand by layout.icon

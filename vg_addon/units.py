@@ -9,6 +9,7 @@ own, usually millimetres, whatever the scene says.
 from __future__ import annotations
 
 import math
+import re
 
 #: The units one can choose: key, name, symbol and metres per unit.
 UNITS = (
@@ -46,12 +47,31 @@ def scene_symbol(system: str, scale_length: float) -> str:
     return "BU"
 
 
+_SCENE_LENGTH = re.compile(r"^BU \(1 BU = ([0-9.eE+-]+) m\b")
+
+
 def unit_of_text(text: str) -> str | None:
-    """The unit a CSV's Units cell names (``"mm"``, ``"mm (the scan's coordinates)"``), or None
-    when it names none of :data:`UNITS` on its own (e.g. the scene description ``"BU (...)"``)."""
+    """The unit a CSV's Units cell names: a symbol (``"mm"``, ``"mm (the scan's coordinates)"``),
+    or a scene description whose unit is exactly one of :data:`UNITS` (``"BU (1 BU = 0.001 m,
+    shown in millimeters)"``, what a batch run with ``--units mm`` writes); None otherwise
+    (``"BU"`` alone, a length no unit has, 1 BU = 1 m: Blender's default scene, which says
+    nothing about the scan, or "mesh units (...)" of a scaled object)."""
     word = text.strip().split(" ", 1)[0] if text else ""
     word = {"um": "µm", "μm": "µm"}.get(word, word)  # the Greek mu for the micro sign
-    return next((key for key, symbol in SYMBOLS.items() if symbol == word), None)
+    key = next((key for key, symbol in SYMBOLS.items() if symbol == word), None)
+    if key is not None or not text:
+        return key
+    found = _SCENE_LENGTH.search(text)
+    if found is None:
+        return None
+    try:
+        metres = float(found.group(1))
+    except ValueError:
+        return None
+    if metres == 1.0:
+        return None
+    # Written with %g (6 significant digits): 0.0254 and 0.3048 survive it exactly.
+    return next((k for k, m in METRES.items() if math.isclose(metres, m, rel_tol=1e-9)), None)
 
 
 def length_text(value: float, symbol: str) -> str:

@@ -3,6 +3,7 @@ and the batch run as a user runs it."""
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 import subprocess
@@ -33,6 +34,24 @@ def batch(*args, cwd=None, env=None, timeout=600) -> subprocess.CompletedProcess
         env=None if env is None else {**os.environ, **env},
         check=False,
     )  # fmt: skip
+
+
+def edited_csv(source, target, edit_row=None, drop=()) -> Path:
+    """Copy the CSV file ``source`` to ``target`` without the columns ``drop``, each row (a dict
+    of its cells) first passed to ``edit_row`` if given; as a file of another version or tool
+    would hold it."""
+    with open(source, newline="", encoding="utf-8") as handle:
+        table = list(csv.DictReader(handle))
+    for row in table:
+        if edit_row is not None:
+            edit_row(row)
+        for column in drop:
+            del row[column]
+    with open(target, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(table[0]))
+        writer.writeheader()
+        writer.writerows(table)
+    return Path(target)
 
 
 def mesh_object(

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-from bpy_helpers import batch, exact
+from bpy_helpers import batch, edited_csv, exact, mesh_object
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio, profile_plot
@@ -54,6 +54,36 @@ def test_saved_edges_keep_their_stations_and_plots(vg, tmp_path):
         assert np.abs(pixels - want).max() < 1.0 / 255.0
 
 
+def plot_pixels(edge) -> np.ndarray:
+    image = bpy.data.images[edge.plot]
+    pixels = np.empty(image.size[0] * image.size[1] * 4, dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    return pixels
+
+
+def test_a_runs_units_come_back_with_its_csvs(vg, tmp_path):
+    """A run with --units cm writes the scene's description ("BU (1 BU = 0.01 m, ...)"); its CSV
+    and its edges CSV imported in Blender take cm as the Scan Units, and every edge's plot names
+    cm on its axis (before: Scan Units untouched, the plots in "BU")."""
+    run(tmp_path, "--units", "cm")
+    out = tmp_path / "out.csv"
+    assert csvio.read_measurements_csv(out)[0].units.startswith("BU (1 BU = 0.01 m")
+    shape = wedge(90.0, n=30, irregular=True, seed=2)
+    for name, path in (("stations", out), ("edges", csvio.edges_path_for(out))):
+        obj = mesh_object(name, shape.points, shape.triangles)
+        assert bpy.ops.vg.import_csv(filepath=str(path), ignore_mesh_names=True) == {"FINISHED"}
+        assert obj.vg.unit == "CM", name
+        assert len(obj.vg.edges) == 3 and len(bpy.data.images) == 3 * (1 + (name == "edges"))
+        for edge in obj.vg.edges:
+            numbers = exact(edge)
+            drawn = profile_plot.render_profile(
+                numbers["arc_lengths"], numbers["angles"], width=480, height=240, units="cm",
+                title=f"{obj.name}, edge {edge.number}", pooled=numbers["pooled_angle"],
+            )  # fmt: skip
+            want = (drawn[::-1].astype(np.float32) / 255.0).ravel()
+            assert np.abs(plot_pixels(edge) - want).max() < 1.0 / 255.0, (name, edge.number)
+
+
 def test_a_run_not_saved_still_writes_every_edges_plot_file(vg, tmp_path):
     run(tmp_path)  # the plot kept in Blender is skipped; the run's own files are not
     assert sorted(p.name for p in tmp_path.glob("out_w_edge*.png")) == [
@@ -90,14 +120,37 @@ def test_edge_stations_take_the_runs_rule_and_stability(tmp_path):
     profile = surface.measure_along([[-1.5, 0, 0], [1.5, 0, 0]], 0.5, 0.4, rule="paper")
     assert [r.angle for r in rows] == profile.angles.tolist()
 
-    # The edges CSV records no rule: a replay takes the run's, the default refined without one.
+    # The edges CSV records each edge's rule: a replay measures with it, whatever --rule says.
     edges_csv = csvio.edges_path_for(out)
-    again, default = tmp_path / "again.csv", tmp_path / "default.csv"
-    for target, extra in ((again, ("--rule", "paper")), (default, ())):
-        result = batch(mesh, "--edges", edges_csv, *extra, "--out", target)
-        assert result.returncode == 0, result.stdout + result.stderr
+    assert [e.rule for e in csvio.read_edges_csv(edges_csv)] == ["paper"]
+    again = tmp_path / "again.csv"
+    result = batch(mesh, "--edges", edges_csv, "--out", again)  # --rule refined by default
+    assert result.returncode == 0, result.stdout + result.stderr
     replayed = csvio.read_measurements_csv(again)
     assert [(r.angle, r.x, r.y, r.z) for r in replayed] == [(r.angle, r.x, r.y, r.z) for r in rows]
     assert all(r.rule == "paper" and r.stability is None for r in replayed)
-    refined = csvio.read_measurements_csv(default)
-    assert all(r.rule == "refined" and abs(r.angle - 100.0) < 0.01 for r in refined)
+    # An edges CSV of an earlier version (no Rule column): a replay takes the run's --rule.
+    older = edited_csv(edges_csv, tmp_path / "older_edges.csv", drop=["Rule"])
+    by_run = {}
+    for rule in ("paper", "refined"):
+        target = tmp_path / f"{rule}.csv"
+        result = batch(mesh, "--edges", older, "--rule", rule, "--out", target)
+        assert result.returncode == 0, result.stdout + result.stderr
+        by_run[rule] = csvio.read_measurements_csv(target)
+    assert [r.angle for r in by_run["paper"]] == [r.angle for r in rows]
+    assert all(r.rule == "refined" and abs(r.angle - 100.0) < 0.01 for r in by_run["refined"])
+
+
+def test_failed_edges_are_listed_up_to_ten_then_counted(tmp_path):
+    """Twelve edges picked off the mesh: every one refused (its own error row), the summary
+    names ten and counts the rest, as it does for failed points."""
+    shape = wedge(90.0, n=30, irregular=True, seed=2)
+    mesh = meshio.write_ply(tmp_path / "w.ply", shape.points, shape.triangles)
+    far = [arg for k in range(12) for arg in ("--edge", 50, k, 0, 51, k, 0)]
+    out = tmp_path / "far.csv"
+    result = batch(mesh, *far, "--spacing", 0.1, "--radius", 0.2, "--out", out)
+    rows = csvio.read_measurements_csv(out)
+    assert len(rows) == 12 and all(r.error.startswith("edge not measured") for r in rows)
+    listed = [line for line in result.stderr.splitlines() if "  failed: edge " in line]
+    assert len(listed) == 10, result.stderr
+    assert "... and 2 more failed edges (see the error column)" in result.stderr

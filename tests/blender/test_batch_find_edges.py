@@ -88,8 +88,13 @@ def test_every_edge_found_is_profiled_as_the_core_profiles_it(found):
     # tests/core/test_break_edges*.py measure it against the true edges).
     assert len(candidates) >= 4
     assert f"bone: found {len(candidates)} break edge(s)" in result.stderr
-    assert f", {len(candidates)} edge(s) profiled" in result.stderr
     rows = csvio.read_measurements_csv(out)
+    # An edges-only run says what it did, not "0 measured, 0 failed, 0 points".
+    done = f"{len(candidates)} edge(s) profiled ({len(rows)} stations)"
+    assert (
+        f"bone: {done}, " in result.stderr and f"{done}, 0 failed, on 1 mesh(es)" in result.stderr
+    )
+    assert "0 measured" not in result.stderr and "measurements/s" not in result.stderr
     edges = csvio.read_edges_csv(csvio.edges_path_for(out))
     assert [e.edge_number for e in edges] == list(range(1, len(candidates) + 1))
     for edge, candidate in zip(edges, candidates, strict=True):
@@ -174,11 +179,34 @@ def test_the_map_draws_the_edges(found, tmp_path):
     assert magenta_pixels(plain / "bone_map_top.png") == 0
 
 
-def test_find_edges_with_jobs_writes_the_serial_runs_rows(tmp_path):
+def saved_edges(path: Path) -> dict:
+    """Each object's edges in a saved .blend: number, stations, and its plot's size and pixels
+    (None where the edge names no image the file holds)."""
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    found = {}
+    for obj in bpy.data.objects:
+        for edge in obj.vg.edges:
+            image = bpy.data.images.get(edge.plot)
+            plot = None
+            if image is not None:
+                pixels = np.empty(image.size[0] * image.size[1] * 4, dtype=np.float32)
+                image.pixels.foreach_get(pixels)
+                plot = (tuple(image.size), image.packed_file is not None, pixels.tobytes())
+            found[(obj.name, edge.number)] = (edge.n_stations, plot)
+    return found
+
+
+def test_find_edges_with_jobs_writes_the_serial_runs_rows(vg, tmp_path):
     meshes = [write_bone(tmp_path / "a.ply"), write_bone(tmp_path / "b.ply", oblique_deg=20.0)]
     common = ("--find-edges", "--spacing", SPACING, "--radius", RADIUS)
-    ok(batch(*meshes, *common, "--out", tmp_path / "serial.csv"))
-    ok(batch(*meshes, *common, "--jobs", 2, "--out", tmp_path / "jobs.csv"))
+    ok(batch(*meshes, *common, "--out", tmp_path / "serial.csv",
+             "--save-blend", tmp_path / "serial.blend"))  # fmt: skip
+    ok(batch(*meshes, *common, "--jobs", 2, "--out", tmp_path / "jobs.csv",
+             "--save-blend", tmp_path / "jobs.blend"))  # fmt: skip
+    # The saved file keeps every edge with its plot, as the serial run's does.
+    serial_blend = saved_edges(tmp_path / "serial.blend")
+    assert len(serial_blend) >= 8 and all(plot for _, plot in serial_blend.values())
+    assert saved_edges(tmp_path / "jobs.blend") == serial_blend
 
     def dated(rows):
         return [{k: v for k, v in dataclasses.asdict(r).items() if k != "date"} for r in rows]

@@ -7,7 +7,7 @@ import json
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import exact, local_points, mesh_object, world
+from bpy_helpers import edited_csv, exact, local_points, mesh_object, world
 from test_ext_measure import core_surface
 
 from vg_addon import Surface
@@ -286,6 +286,21 @@ def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):
     with pytest.raises(RuntimeError, match="names the mesh 'Ramp'"):
         bpy.ops.vg.import_csv(filepath=str(edge_file))
     assert len(other.vg.edges) == 0 and len(other.vg.measurements) == 0
+    # Points picked on another mesh (here 3 units above this one): refused as the batch's
+    # --edges refuses them, not snapped to the nearest vertex and measured; nothing recorded.
+    vertices = np.array([v.co for v in other.data.vertices], dtype=np.float64)
+
+    def lift(row):
+        lifted = np.array(csvio.parse_points(row["Points"].removeprefix("'")))
+        lifted[:, 2] += 3.0
+        assert np.linalg.norm(vertices[:, None] - lifted[None], axis=2).min() > 2.9
+        text = csvio.format_points(lifted)
+        row["Points"] = "'" + text if text.startswith("-") else text
+
+    far_file = edited_csv(edge_file, tmp_path / "far_edges.csv", lift)
+    with pytest.raises(RuntimeError, match="from the mesh"):
+        bpy.ops.vg.import_csv(filepath=str(far_file), ignore_mesh_names=True)
+    assert len(other.vg.edges) == 0 and len(other.vg.measurements) == 0
 
 
 def test_stations_take_the_panels_rule_and_stability_and_an_import_the_panels_rule(vg, tmp_path):
@@ -306,13 +321,20 @@ def test_stations_take_the_panels_rule_and_stability_and_an_import_the_panels_ru
         assert numbers["stability"]["spread"] == alone.stability.spread
     path = tmp_path / "m.csv"
     bpy.ops.vg.export_csv(filepath=str(path))
-    # The edge file records no rule: an import measures with the panel's.
+    # The edge file records each edge's rule: an import measures with it, whatever the panel's.
     settings.stability = False
+    settings.rule = "refined"
+    edge_file = csvio.edges_path_for(path)
+    copy = mesh_object("Replayed", shape.points, shape.triangles)
+    assert bpy.ops.vg.import_csv(filepath=str(edge_file), ignore_mesh_names=True) == {"FINISHED"}
+    again = [exact(item) for item in copy.vg.measurements]
+    assert [(a["rule"], a["angle"]) for a in again] == [("paper", s["angle"]) for s in stations]
+    # An edge file of an earlier version (no Rule column): an import takes the panel's Rule.
+    older = edited_csv(edge_file, tmp_path / "older_edges.csv", drop=["Rule"])
     for rule, name in (("paper", "Paper"), ("refined", "Refined")):
         settings.rule = rule
         copy = mesh_object(name, shape.points, shape.triangles)
-        edge_file = str(csvio.edges_path_for(path))
-        assert bpy.ops.vg.import_csv(filepath=edge_file, ignore_mesh_names=True) == {"FINISHED"}
+        assert bpy.ops.vg.import_csv(filepath=str(older), ignore_mesh_names=True) == {"FINISHED"}
         again = [exact(item) for item in copy.vg.measurements]
         assert {a["rule"] for a in again} == {rule}
         assert all(a["stability"] is None for a in again)
@@ -379,3 +401,43 @@ def test_an_edge_rebuilt_from_its_stations_replays_through_them(vg, tmp_path, sh
     assert all(c in path for c in centres)
     assert len(replayed["angles"]) == len(first["angles"])
     assert replayed["mean"] == pytest.approx(first["mean"], abs=0.5)
+
+
+def test_the_panel_shows_the_study_figures_of_the_edge(vg, tmp_path):
+    """Issue 22, item 5, in the Edge Profiles panel: median, range, arc and chord length and arc
+    angle, as the stations' own angles and centres give them (oracle: the standard library and
+    NumPy's SVD on the stored stations), lengths in the Scan Units; an older record says they
+    are not recorded."""
+    import importlib
+    import itertools
+    import math
+    import statistics
+
+    codec = importlib.import_module(f"{vg.__name__}.vg_addon.formats.record_codec")
+    panels = importlib.import_module(f"{vg.__name__}.ui.panels")
+    assert panels.study_texts is codec.study_texts  # what the panel draws its rows with
+    obj, _ = ramp_object()
+    assert measure_edge() == {"FINISHED"}
+    (edge,) = obj.vg.edges
+    stations = [exact(m) for m in obj.vg.measurements if m.edge_number == edge.number]
+    angles = [s["angle"] for s in stations]
+    centres = [s["center"] for s in stations]
+    arc = sum(math.dist(a, b) for a, b in itertools.pairwise(centres))
+
+    def axis(points):
+        points = np.asarray(points, dtype=np.float64)
+        return np.linalg.svd(points - points.mean(axis=0), full_matrices=False)[2][0]
+
+    cosine = abs(float(np.dot(axis(centres), axis(local_points(obj)))))
+    arc_angle = math.degrees(math.acos(min(cosine, 1.0)))
+    median, spread = statistics.median(angles), max(angles) - min(angles)
+    rows = dict(codec.study_texts(exact(edge), "mm"))
+    assert rows == {
+        "Median, range": f"{median:.2f}°, {spread:.2f}°",
+        "Arc, chord": f"{arc:.4g}, {math.dist(centres[0], centres[-1]):.4g} mm",
+        "Arc angle": f"{arc_angle:.2f}°",
+    }
+    older = {k: v for k, v in exact(edge).items() if k not in codec.STUDY_FIGURES}
+    assert codec.study_texts(older, "mm") == [
+        ("Study figures", "not recorded (an older version): measure again")
+    ]

@@ -209,10 +209,13 @@ def test_an_unstable_reading_is_flagged_in_its_list_row(vg, lists, panels, capfd
     assert viewport.label_colour(label_of[stable.number]) != red
 
 
-def test_an_undetermined_figure_shows_no_number_that_looks_steady(vg, lists):
+def test_an_undetermined_figure_shows_no_number_that_looks_steady(vg, lists, tmp_path):
     """More than a tenth of the figure's runs refused, or a band along the crease that leaves a
-    face without a plane: the row says "±?", not a small "±0°"."""
+    face without a plane: the row says "±?", not a small "±0°", and the export's Stability Flag
+    says why beside the number."""
     import json
+
+    from vg_addon.formats import csvio
 
     wedge_object(90.0)
     bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.3)
@@ -236,6 +239,12 @@ def test_an_undetermined_figure_shows_no_number_that_looks_steady(vg, lists):
             item.exact = json.dumps(numbers)
             assert item.stability_warning and lists.row_flag(item) == shown
             assert reason in item.stability_warning
+            path = tmp_path / "flag.csv"
+            assert bpy.ops.vg.export_csv(filepath=str(path)) == {"FINISHED"}
+            (row,) = csvio.read_measurements_csv(path)
+            assert row.stability == spread and reason in row.stability_flag
+            kind = "Unstable" if spread > 5 else "Undetermined"
+            assert row.stability_flag.startswith(kind)
     finally:
         item.exact = recorded  # the record as measured, for the checks after the test
 

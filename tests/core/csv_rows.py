@@ -54,6 +54,7 @@ OUR_EXTRA_COLUMNS = [
     "Stability Crease",
     "Stability Crease Refused",
     "Stability Noise Hides Crease",
+    "Stability Flag",
     "error",
 ]
 

@@ -95,6 +95,14 @@ def test_trim_keeps_a_part_that_retraces(bone):
     points = part.waypoint_points
     again = surface.trace_edge(points[0], points[-1], via=points[1:-1])
     assert np.array_equal(again.vertices, part.path.vertices)
+    # Arc lengths beyond the candidate are refused, not clamped to its ends; its own ends are
+    # taken as given.
+    length = float(arc[-1])
+    for start, end in ((-1.0, 30.0), (10.0, length + 1.0), (float("nan"), 30.0)):
+        with pytest.raises(GoniometerError, match="both within 0 to"):
+            trim(candidate, start, end)
+    whole = trim(candidate, 0.0, length)
+    assert np.array_equal(whole.path.vertices, candidate.path.vertices)
 
 
 def test_trim_of_a_loop_may_keep_the_part_through_its_start(bone):
@@ -142,8 +150,9 @@ def test_bad_input_is_refused():
     with pytest.raises(GoniometerError, match="point cloud"):
         find_break_edges(cloud)
     surface = Surface(fragment.points, fragment.triangles)
-    with pytest.raises(GoniometerError, match="min_bend_deg"):
-        find_break_edges(surface, min_bend_deg=200)
+    for bend in (200, 0, 180):  # the message says what it takes: above 0, below 180
+        with pytest.raises(GoniometerError, match=r"min_bend_deg must be .* above 0 and below 180"):
+            find_break_edges(surface, min_bend_deg=bend)
     with pytest.raises(GoniometerError, match="scale"):
         find_break_edges(surface, scale=-1.0)
     with pytest.raises(GoniometerError, match="Unknown break-edge parameter"):

@@ -344,6 +344,7 @@ def test_edge_summary_file_round_trips_beside_the_export(tmp_path):
         radius=3.0,
         lam=2.0,
         patch="euclidean",
+        rule="oriented",
         length=5.75,
         mean=101.25,
         std=0.3,
@@ -365,3 +366,14 @@ def test_edge_summary_file_round_trips_beside_the_export(tmp_path):
     assert not csvio.is_edges_csv(csvio.format_measurements_csv([good_row()]))
     with pytest.raises(GoniometerError, match="three numbers"):
         csvio.parse_points("1 2")
+    # A rule no version wrote is refused, naming its row; a file without the column reads.
+    text = path.read_text()
+    with pytest.raises(GoniometerError, match="row 2: Rule: unknown rule 'steep'"):
+        csvio.parse_edges_csv(text.replace(",oriented,", ",steep,"))
+    header, line = text.splitlines()
+    at = header.split(",").index("Rule")
+    older = "\n".join(
+        ",".join(c for i, c in enumerate(r.split(",")) if i != at) for r in (header, line)
+    )
+    (old,) = csvio.parse_edges_csv(older)
+    assert old.rule == "" and old.points == edge.points

@@ -29,6 +29,14 @@ def test_a_units_cell_names_a_unit_only_when_it_is_one():
         assert units.unit_of_text(text) is None
     for key, symbol in units.SYMBOLS.items():  # what the CSV writes reads back
         assert units.unit_of_text(symbol) == key
+    # What a batch run with --units writes: the scene's length of one BU, in metres (%g).
+    for text, key in (("BU (1 BU = 0.001 m, shown in millimeters)", "MM"),
+                      ("BU (1 BU = 1e-06 m, shown in micrometers)", "UM"),
+                      ("BU (1 BU = 0.0254 m, shown in inches)", "IN"),
+                      ("BU (1 BU = 0.3048 m, shown in feet)", "FT"),
+                      ("BU (1 BU = 0.5 m, shown in meters)", None),
+                      ("mesh units (1 unit = 0.001 m in the scene, object scale 2)", None)):  # fmt: skip
+        assert units.unit_of_text(text) == key, text
 
 
 def test_a_length_shows_five_digits_and_its_unit():

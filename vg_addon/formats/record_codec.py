@@ -95,6 +95,23 @@ def _optional(value) -> float | None:
 STUDY_FIGURES = ("median", "range", "arc_length", "chord_length", "arc_angle")
 
 
+def study_texts(numbers: dict, unit: str) -> list[tuple[str, str]]:
+    """The break-agent study's per-break figures of an edge record's ``numbers`` as
+    ``(label, text)`` rows for display, lengths followed by ``unit`` (``"mm"``); one row saying
+    they are not recorded for a record of a version before them."""
+    if any(name not in numbers for name in STUDY_FIGURES):
+        return [("Study figures", "not recorded (an older version): measure again")]
+    arc_angle = numbers["arc_angle"]
+    return [
+        ("Median, range", f"{numbers['median']:.2f}°, {numbers['range']:.2f}°"),
+        ("Arc, chord", f"{numbers['arc_length']:.4g}, {numbers['chord_length']:.4g} {unit}"),
+        (
+            "Arc angle",
+            "undefined (one station, or a ring)" if arc_angle is None else f"{arc_angle:.2f}°",
+        ),
+    ]
+
+
 def figure_numbers(figures) -> dict:
     """The summary numbers an edge record stores for ``figures`` (an ``EdgeSummary``):
     ``mean``, ``std``, ``min``, ``max``, ``pooled_angle``, ``pooled_fit`` and the
@@ -126,6 +143,7 @@ def edge_numbers(profile, clicks) -> dict:
         **figure_numbers(profile.figures),
         "flat_spans": [[float(a), float(b)] for a, b in spans],
         "space": MESH,
+        "rule": profile.stations[0].rule,  # every station's
     }
 
 

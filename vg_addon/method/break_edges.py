@@ -179,7 +179,8 @@ class BreakEdgeParameters:
         bend = self.min_bend_deg
         if not (_is_number(bend) and 0 < bend < 180):
             raise GoniometerError(
-                f"min_bend_deg must be a number of degrees between 0 and 180; got {bend!r}."
+                f"min_bend_deg must be a number of degrees above 0 and below 180 (a ridge that "
+                f"bends 0° is no ridge); got {bend!r}."
             )
         count = self.max_candidates
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
@@ -613,7 +614,8 @@ def trim(candidate: BreakEdgeCandidate, start_arc: float, end_arc: float) -> Bre
     Raises
     ------
     GoniometerError
-        Arc lengths out of order on an open candidate, or leaving less than one mesh edge.
+        Arc lengths out of order on an open candidate or outside 0 to its length (not clamped:
+        a part the caller did not ask for is never kept), or leaving less than one mesh edge.
     """
     path = candidate.path
     arc = path.arc_lengths
@@ -622,7 +624,9 @@ def trim(candidate: BreakEdgeCandidate, start_arc: float, end_arc: float) -> Bre
     except (TypeError, ValueError):
         raise GoniometerError("The trim's arc lengths must be numbers.") from None
     wraps = candidate.closed and start_arc > end_arc
-    if not (math.isfinite(start_arc) and math.isfinite(end_arc) and (start_arc < end_arc or wraps)):
+    slack = 1e-9 * path.length  # a click's arc length computed in another order of sums
+    within = all(-slack <= value <= path.length + slack for value in (start_arc, end_arc))
+    if not (within and (start_arc < end_arc or wraps)):  # also refuses NaN and infinities
         raise GoniometerError(
             f"Trim from arc length {start_arc:g} to {end_arc:g}: the start must come before the "
             f"end, both within 0 to {path.length:.6g}."

@@ -456,7 +456,7 @@ class EdgeProfile:
         f = self.figures
         return (
             f"{f.n_stations} stations every {self.spacing:g} over {self.path.length:.4g}: "
-            f"mean {f.mean:.2f}° ± {f.std:.2f}° (min {f.min:.2f}°, max {f.max:.2f}°), "
+            f"mean {f.mean:.2f}° (SD {f.std:.2f}°, min {f.min:.2f}°, max {f.max:.2f}°), "
             f"pooled {f.pooled_angle:.2f}° (r={self.radius:g}, λ={self.lam:g})"
         )
 

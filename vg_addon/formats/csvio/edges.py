@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ...errors import GoniometerError
+from ...method.algorithm import RULES
 from ..files import replace_atomically
 from .text import (
     MESH_COORDINATES,
@@ -38,6 +39,7 @@ EDGE_SCHEMA = (
     ("radius", "float", ("Radius",)),
     ("lam", "float", ("SegParam",)),
     ("patch", "text", ("Patch Mode",)),
+    ("rule", "text", ("Rule",)),
     ("length", "float", ("Length",)),
     ("mean", "float", ("Mean Angle",)),
     ("std", "float", ("SD Angle",)),
@@ -69,7 +71,7 @@ STUDY_COLUMNS = ("Median Angle", "Angle Range", "Arc Length", "Chord Length", "A
 
 #: Columns added to the edge summary file after its first version: files without them read,
 #: their cells blank.
-LATER_EDGE_COLUMNS = ("Coordinates", *STUDY_COLUMNS)
+LATER_EDGE_COLUMNS = ("Coordinates", "Rule", *STUDY_COLUMNS)
 
 
 @dataclass
@@ -85,6 +87,10 @@ class EdgeRow:
     n_stations : int or None
     spacing, radius, lam : float or None
         The settings every station was measured with; ``patch`` the patch mode.
+    rule : str
+        The rule every station was measured with (``vg_addon.method.algorithm.RULES``); a
+        replay measures with it. Empty in files of earlier versions (a replay then uses the
+        run's ``--rule`` or the panel's Rule).
     length : float or None
         Arc length of the traced path.
     mean, std, min, max : float or None
@@ -119,6 +125,7 @@ class EdgeRow:
     radius: float | None = None
     lam: float | None = None
     patch: str = ""
+    rule: str = ""
     length: float | None = None
     mean: float | None = None
     std: float | None = None
@@ -197,6 +204,9 @@ def parse_edges_csv(text: str, source: str = "The CSV text") -> list[EdgeRow]:
 
 
 def _points_problem(values) -> str | None:
+    rule = values["rule"].strip().lower()
+    if rule and rule not in RULES:
+        return f"Rule: unknown rule {values['rule'].strip()!r} (use {' or '.join(RULES)})"
     if values["points"].strip():
         try:
             parse_points(values["points"])

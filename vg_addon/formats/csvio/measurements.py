@@ -100,6 +100,7 @@ SCHEMA = (
     ("stability_crease", "float", ("Stability Crease",)),
     ("stability_crease_refused", "int", ("Stability Crease Refused",)),
     ("stability_noise_hides_crease", "int", ("Stability Noise Hides Crease",)),
+    ("stability_flag", "text", ("Stability Flag",)),
     ("error", "text", ("error",)),
 )
 
@@ -132,6 +133,12 @@ CREASE_COLUMNS = ("Stability Crease", "Stability Crease Refused")
 NOISE_COLUMNS = ("Stability Noise Hides Crease",)
 
 
+#: Column added so that a spreadsheet shows an undetermined or unstable figure beside its number
+#: (the ``Stability`` cell is the spread of the runs that ran, a number even when too many were
+#: refused). Derived from the other Stability columns; exports written before lack it.
+FLAG_COLUMNS = ("Stability Flag",)
+
+
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
 EXPORT_COLUMNS = tuple(column for _, _, columns in SCHEMA for column in columns)
 
@@ -146,6 +153,7 @@ LATER_COLUMNS = (
     "Coordinates",
     *CREASE_COLUMNS,
     *NOISE_COLUMNS,
+    *FLAG_COLUMNS,
 )
 
 
@@ -231,6 +239,10 @@ class MeasurementRow:
         1 where the vertex normals' noise is larger than the turn between the faces (the figure
         is then undetermined), 0 where not; empty when the figure was not computed or the
         export predates the column.
+    stability_flag : str
+        Why the figure flags the reading, in the panel's words (``"Undetermined: ..."``,
+        ``"Unstable: ..."``); empty for a stable reading, a figure not computed, or an export
+        that predates the column. Derived from the columns above: a reader need not trust it.
     error : str
         Empty for a good row; why it failed otherwise.
     """
@@ -281,6 +293,7 @@ class MeasurementRow:
     stability_crease: float | None = None
     stability_crease_refused: int | None = None
     stability_noise_hides_crease: int | None = None
+    stability_flag: str = ""
     error: str = ""
 
 
