@@ -264,6 +264,11 @@ class VG_EdgeProfile(PropertyGroup):
     )
     patch: EnumProperty(name="Patch", items=PATCH_ITEMS, description="How the patches were chosen")
     n_stations: IntProperty(name="Stations", description="Number of stations measured")
+    stations_changed: BoolProperty(
+        name="Stations changed",
+        description="A station is stale or was deleted since the edge was measured: its summary "
+        "is kept as recorded",
+    )
     date: StringProperty(name="Date", description="When the edge was measured (ISO 8601)")
     note: StringProperty(name="Note", description="Free text, exported with the edge")
     colors: StringProperty(name="Colours", description="Palette colours of the + and − sides")

@@ -348,6 +348,8 @@ def repaint(
         painting.set_state(obj, state)
     state.known, state.generation = remembered, painting.generation()
     state.rows, state.stale = rows, stale
+    if start == 0 or rows[start:, _STALE].any():  # records only added, all fresh: no edge changed
+        records.update_changed_edges(obj)
     with own_write(mesh, depsgraph):
         colors.write_attribute(mesh, state.colours)
     return list(stale)

@@ -455,6 +455,37 @@ def _add_edge(obj, numbers: dict, patch: str, fingerprint: str, *, break_number:
     return edge
 
 
+def update_changed_edges(obj) -> None:
+    """Set each edge profile's ``stations_changed`` of ``obj``: whether any of its stations is
+    stale or was deleted since it was measured.
+
+    The measurements' edge numbers and stale flags are read at once (``foreach_get``), so the
+    panels draw the flag without walking the measurements; only changed flags are written.
+    """
+    data = obj.vg
+    edges, items = data.edges, data.measurements
+    if not len(edges):
+        return
+    owners = np.empty(len(items), dtype=np.int32)  # IntProperty's own type
+    stale = np.empty(len(items), dtype=bool)
+    items.foreach_get("edge_number", owners)
+    items.foreach_get("stale", stale)
+    numbers = np.empty(len(edges), dtype=np.int32)
+    expected = np.empty(len(edges), dtype=np.int32)
+    flags = np.empty(len(edges), dtype=bool)
+    edges.foreach_get("number", numbers)
+    edges.foreach_get("n_stations", expected)
+    edges.foreach_get("stations_changed", flags)
+    owners = np.maximum(owners, 0)  # 0: not a station (edge numbers start at 1)
+    size = int(max(owners.max(initial=0), numbers.max(initial=0))) + 1
+    counts = np.bincount(owners, minlength=size)
+    stale_counts = np.bincount(owners[stale], minlength=size)
+    where = np.maximum(numbers, 0)
+    changed = (counts[where] != expected) | (stale_counts[where] > 0)
+    if not np.array_equal(changed, flags):
+        edges.foreach_set("stations_changed", changed)
+
+
 def add_edge_from_numbers(
     obj, numbers: dict, patch: str, fingerprint: str, *, break_number, note=""
 ):

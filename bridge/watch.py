@@ -27,7 +27,7 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..vg_addon import GoniometerError
-from . import legacy, mesh_data, painting
+from . import legacy, mesh_data, painting, records
 from .measuring import forget_paint, migrate_fingerprints, repaint
 from .mesh_data import check_measurable, evaluated_geometry
 
@@ -112,8 +112,12 @@ def on_load(*_args):
     measurements of earlier versions into mesh coordinates."""
     clear_caches()
     for obj in bpy.data.objects:
-        if obj.type == "MESH" and legacy.has_world_records(obj):
+        if obj.type != "MESH":
+            continue
+        if legacy.has_world_records(obj):
             migrate(obj)
+        if obj.library is None:  # a linked object's data is read-only
+            records.update_changed_edges(obj)  # files saved before the flag was kept
 
 
 def migrate(obj) -> list[int]:

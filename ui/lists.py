@@ -78,13 +78,6 @@ def edge_row_texts(edge) -> tuple[str, str, str]:
     return f"#{edge.number}", f"{edge.mean:.2f}°", f"{edge.n_stations} {stations}"
 
 
-def edge_changed(edge, measurements) -> bool:
-    """Whether any station of ``edge`` is stale or was deleted since the edge was measured
-    (its summary is then kept as recorded; the panel says so too)."""
-    stations = [m for m in measurements if m.edge_number == edge.number]
-    return len(stations) != edge.n_stations or any(m.stale for m in stations)
-
-
 class VG_UL_edges(bpy.types.UIList):
     """One row per edge profile: its number, the mean angle of its stations (with a warning
     icon when a station is stale or deleted) and how many stations it has."""
@@ -98,8 +91,7 @@ class VG_UL_edges(bpy.types.UIList):
         split = layout.split(factor=EDGE_NUMBER_SHARE, align=True)
         split.label(text=number)
         rest = split.split(factor=EDGE_MEAN_SHARE, align=True)
-        changed = edge_changed(item, data.measurements)
-        rest.label(text=mean, icon="ERROR" if changed else "NONE")
+        rest.label(text=mean, icon="ERROR" if item.stations_changed else "NONE")
         rest.label(text=stations)
 
 

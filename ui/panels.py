@@ -289,8 +289,7 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         if not 0 <= obj.vg.active_edge_index < len(obj.vg.edges):
             return
         edge = obj.vg.edges[obj.vg.active_edge_index]
-        stations = [m for m in obj.vg.measurements if m.edge_number == edge.number]
-        if any(m.stale for m in stations) or len(stations) != edge.n_stations:
+        if edge.stations_changed:
             wrapped_label(
                 layout.box(),
                 context,

@@ -147,6 +147,49 @@ def test_delete_edge_removes_its_stations_only(vg):
     assert first not in bpy.data.images
 
 
+def changed_by_definition(obj) -> list[bool]:
+    """Per edge: a station stale, or fewer or more stations than were measured (a plain walk over
+    the measurements, the definition the stored flag must keep)."""
+    flags = []
+    for edge in obj.vg.edges:
+        stations = [m for m in obj.vg.measurements if m.edge_number == edge.number]
+        flags.append(len(stations) != edge.n_stations or any(m.stale for m in stations))
+    return flags
+
+
+def test_an_edge_is_flagged_once_a_station_is_deleted_or_stale_and_the_flag_is_kept(vg, tmp_path):
+    """The list and panel warn from each edge's stored ``stations_changed`` (no walk over the
+    measurements per redraw): it follows a station's deletion and its undo, an edit of the mesh,
+    a save and reload, and is recomputed on load for a file saved without it."""
+    obj, _ = ramp_object()
+    measure_edge()
+    measure_edge(points=[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    flags = lambda o: [edge.stations_changed for edge in o.vg.edges]  # noqa: E731
+    assert flags(obj) == changed_by_definition(obj) == [False, False]
+    first = next(i for i, m in enumerate(obj.vg.measurements) if m.edge_number == 1)
+    bpy.ops.ed.undo_push(message="before the deletion")
+    assert bpy.ops.vg.delete_measurement("EXEC_DEFAULT", True, index=first) == {"FINISHED"}
+    assert flags(obj) == changed_by_definition(obj) == [True, False]
+    bpy.ops.ed.undo()
+    obj = bpy.data.objects["Ramp"]
+    assert flags(obj) == changed_by_definition(obj) == [False, False]
+    obj.data.vertices[0].co.z += 0.25  # the mesh changed: every station is stale
+    obj.data.update()
+    assert bpy.ops.vg.repaint() == {"FINISHED"}
+    assert flags(obj) == changed_by_definition(obj) == [True, True]
+    path = tmp_path / "changed.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    obj = bpy.data.objects["Ramp"]
+    assert flags(obj) == [True, True]
+    for edge in obj.vg.edges:  # as a file from before the flag was kept
+        edge.stations_changed = False
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    obj = bpy.data.objects["Ramp"]
+    assert flags(obj) == changed_by_definition(obj) == [True, True]
+
+
 def test_export_writes_station_rows_and_the_edge_file_and_import_rebuilds_the_edge(vg, tmp_path):
     obj, _ = ramp_object()
     measure_edge()
