@@ -268,10 +268,9 @@ def import_edges_csv(
                 lam if row.lam is None else row.lam,
                 row.patch or patch,
             )
-            edge_rule = (
-                row.rule.strip().lower() or rule
-            )  # a file of an earlier version: the panel's
-            # checked before recording; points picked on another mesh are refused, not snapped
+            # A row without a Rule (a file of an earlier version) takes the panel's. Each edge is
+            # checked before anything is recorded: points picked on another mesh are refused.
+            edge_rule = row.rule.strip().lower() or rule
             measure_edge(obj, points, *settings, depsgraph=depsgraph, rule=edge_rule, given=source)
         except GoniometerError as error:
             failures.append(f"row {number}: {error}")
