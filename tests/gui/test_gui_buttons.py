@@ -257,6 +257,19 @@ def test_edge_profiles_list_shows_each_edge_and_picks_by_click(gui, places):
     for index, y in enumerate(middles):
         band = picture[int(y) - 6 : int(y) + 6, int(left) + 10 : int(left + width) - 60]
         assert (band.min(axis=2) > 170).sum() > 20, f"row {index + 1} has no text ({shot})"
+    # Issue 22, item 5: below the list, the selected edge's figures (study figures among them),
+    # its plot and, last, its note: scrolled into view, the note is the selected edge's.
+    gui.scroll_sidebar(6)
+    _left, top, _width, height = gui.state()["regions"]["UI"]
+    sidebar_shot(gui, "edge_figures", top, height)
+    gui.scroll_sidebar(12)  # on to the plot (its preview made on demand) and the note
+    gui.settle(3)
+    figures = sidebar_shot(gui, "edge_plot", top, height)
+    selected = gui.state()["objects"][OBJ]["active_edge_index"]
+    try:
+        gui.find_button("UI", f"edges[{selected}].note", key="ctrl+shift+c", upward=True, step=6)
+    except LookupError:
+        pytest.fail(f"the Edge Profiles panel does not draw down to the edge's note ({figures})")
 
 
 def test_render_map_cancelled_with_escape_keeps_nothing(gui, places):
