@@ -1,9 +1,10 @@
 """``--jobs N``: meshes measured in worker processes, each a Blender or bpy process of its own.
 
-A worker reads mesh indices on stdin and, per mesh, writes its rows as JSON into the run's
-temporary folder and says ``MARK rows N`` on stdout (the parent writes them into the CSV at
-once), draws the mesh's pictures, then writes its whole result and says ``MARK done N``. A
-worker that dies while drawing costs the pictures, never the rows.
+A worker reads mesh indices on stdin, up to the parent's last line ``end``, and, per mesh,
+writes its rows as JSON into the run's temporary folder and says ``MARK rows N`` on stdout (the
+parent writes them into the CSV at once), draws the mesh's pictures, then writes its whole
+result and says ``MARK done N``. A worker that dies while drawing costs the pictures, never the
+rows.
 
 Nothing outlives the run: a worker watches its parent and, when the parent is gone (killed, even
 with SIGKILL), removes the run's temporary folder and exits; Ctrl-C is the parent's to handle
@@ -22,9 +23,10 @@ import signal
 import subprocess
 import sys
 import threading
+import time
 from collections import deque
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NoReturn
 
 import bpy
 
@@ -41,7 +43,10 @@ if TYPE_CHECKING:
 
 PARENT_POLL_SECONDS = 0.2  # how often a worker checks that its parent is still there
 STOP_SECONDS = 10.0  # how long a stopped worker may take to end before it is killed
+ORPHAN_WAIT_SECONDS = 10.0  # how long a worker whose parent's pipes closed waits to be re-parented
 MARK = child_process.MARK  # prefix of the lines a worker sends to its parent on stdout
+END = "end"  # the parent's last line to a worker; stdin ending without it means the parent died
+_writing = threading.RLock()  # held while a worker writes into the run's folder
 
 
 def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
@@ -137,6 +142,8 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
             )
         if process is not None:
             with contextlib.suppress(OSError):
+                process.stdin.write(f"{END}\n")
+            with contextlib.suppress(OSError):
                 process.stdin.close()
             process.wait()
 
@@ -166,40 +173,63 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
         raise
 
 
-def _quit(folders, status: int) -> None:
+def _quit(folders, status: int) -> NoReturn:
     map_process.kill()  # a map being rendered: its child ends with this worker, at once
+    # Never in the middle of this worker's own write into the folder: a file made after the
+    # removal would be left behind. Reentrant, for SIGTERM arriving during such a write.
+    _writing.acquire(timeout=STOP_SECONDS)
     for folder in folders:
         if folder:
             shutil.rmtree(folder, ignore_errors=True)
     os._exit(status)
 
 
-def watch_parent(folder: str, parent_session: str):
-    """In a worker: when the parent process is gone, remove the run's temporary folder (with
-    this worker's Blender session folder inside it) and the parent's Blender session folder,
-    and exit at once: a parent killed with SIGKILL cannot clean up after itself. SIGTERM (the
-    parent stopping its workers) ends the worker the same way, without a traceback.
+class Parent:
+    """In a worker: the process that started it, and what the worker does when it is gone.
 
-    Returns a function that stops the watching; call it before the worker exits normally (a
-    thread still running at exit makes some bpy versions, e.g. 4.5, hang in their shutdown).
+    When the parent is gone (killed, even with SIGKILL, so it cannot clean up after itself),
+    the worker removes the run's temporary folder (with its own Blender session folder inside)
+    and the parent's Blender session folder, and exits at once. It learns of it from whichever
+    comes first: a thread that checks the parent every :data:`PARENT_POLL_SECONDS`, the end of
+    stdin without the parent's last word (:data:`END`), or a broken pipe when it reports.
+    SIGTERM (the parent stopping its workers) ends the worker without a traceback.
     """
-    parent = os.getppid()
-    signal.signal(signal.SIGTERM, lambda signum, frame: _quit([bpy.app.tempdir], 143))
-    stop = threading.Event()
 
-    def watch():
-        while not stop.wait(PARENT_POLL_SECONDS):
-            if os.getppid() != parent:
-                _quit([folder, parent_session], 1)
+    def __init__(self, folder: str, parent_session: str):
+        self.pid = os.getppid()
+        self.folders = [folder, parent_session]
+        signal.signal(signal.SIGTERM, lambda signum, frame: _quit([bpy.app.tempdir], 143))
+        self._stop = threading.Event()
+        self._watcher = threading.Thread(target=self._watch, name="vg-parent-watch", daemon=True)
+        self._watcher.start()
 
-    watcher = threading.Thread(target=watch, name="vg-parent-watch", daemon=True)
-    watcher.start()
+    def _watch(self) -> None:
+        while not self._stop.wait(PARENT_POLL_SECONDS):
+            if os.getppid() != self.pid:
+                _quit(self.folders, 1)
 
-    def stop_watching():
-        stop.set()
-        watcher.join()
+    def stop_watching(self) -> None:
+        """Call before the worker exits normally (a thread still running at exit makes some
+        bpy versions, e.g. 4.5, hang in their shutdown)."""
+        self._stop.set()
+        self._watcher.join()
 
-    return stop_watching
+    def tell(self, message: str) -> None:
+        """Send ``message`` to the parent on stdout; a pipe that broke means it is gone."""
+        try:
+            print(f"{MARK} {message}", flush=True)
+        except OSError:
+            self.gone()
+
+    def gone(self) -> NoReturn:
+        """The parent's pipes closed: it is ending. The kernel closes a dying process's files
+        before it hands its children to another parent, so wait for that, then clean up."""
+        deadline = time.monotonic() + ORPHAN_WAIT_SECONDS
+        while os.getppid() == self.pid and time.monotonic() < deadline:
+            time.sleep(0.01)
+        if os.getppid() != self.pid:
+            _quit(self.folders, 1)
+        _quit([bpy.app.tempdir], 1)  # the parent lives and left this worker: its folder is its own
 
 
 def worker_main(plan_path: str) -> int:
@@ -209,14 +239,14 @@ def worker_main(plan_path: str) -> int:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with open(plan_path, encoding="utf-8") as handle:
         plan = json.load(handle)
-    stop_watching = watch_parent(plan["folder"], plan.get("parent_session", ""))
+    parent = Parent(plan["folder"], plan.get("parent_session", ""))
     try:
-        return _measure_from_stdin(plan)
+        return _measure_from_stdin(plan, parent)
     finally:
-        stop_watching()
+        parent.stop_watching()
 
 
-def _measure_from_stdin(plan: dict) -> int:
+def _measure_from_stdin(plan: dict, parent: Parent) -> int:
     bpy.ops.wm.read_homefile(use_empty=True)
     extension.activate()
     set_units(bpy.context.scene, plan["options"]["units"])
@@ -228,39 +258,43 @@ def _measure_from_stdin(plan: dict) -> int:
     options = plan["options"]
     for line in sys.stdin:
         line = line.strip()
+        if line == END:
+            return 0
         if not line:
             continue
         mesh = int(line)
 
         def progress(done, mesh=mesh):
-            print(f"{MARK} progress {mesh} {done}", flush=True)
+            parent.tell(f"progress {mesh} {done}")
 
         def send_rows(result, mesh=mesh):
             if _write_result(Path(plan["folder"]) / f"mesh-{mesh}.rows.json", result):
-                print(f"{MARK} rows {mesh}", flush=True)
+                parent.tell(f"rows {mesh}")
 
         result = safe_measure_mesh(mesh, sources[mesh], tasks[mesh], options, progress, send_rows)
         if options.get("save_blend") and result.object_name:
             obj = bpy.data.objects.get(result.object_name)
             if obj is not None:
                 path = str(Path(plan["folder"]) / f"mesh-{mesh}.blend")
-                with quiet_stdout():
+                with _writing, quiet_stdout():
                     bpy.data.libraries.write(path, {obj, *plot_images(obj)})
                 result.blend = path
         if result.object_name:
             forget(result.object_name)
         if not _write_result(Path(plan["folder"]) / f"mesh-{mesh}.json", result):
             return 1  # the run is over and its folder removed: nobody waits for this result
-        print(f"{MARK} done {mesh}", flush=True)
-    return 0
+        parent.tell(f"done {mesh}")
+    parent.gone()  # stdin ended without the parent's last word
 
 
 def _write_result(target: Path, result: MeshResult) -> bool:
     """Write ``result`` as JSON to ``target`` in one step; False when the run's folder is gone."""
     temporary = target.with_name(target.name + ".tmp")
+    text = json.dumps(result.to_json())
     try:
-        temporary.write_text(json.dumps(result.to_json()), encoding="utf-8")
-        temporary.replace(target)
+        with _writing:
+            temporary.write_text(text, encoding="utf-8")
+            temporary.replace(target)
     except FileNotFoundError:
         return False
     return True

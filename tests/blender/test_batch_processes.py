@@ -1,7 +1,8 @@
 """--jobs worker processes under real signals: a worker killed with SIGKILL loses only its mesh;
-the parent killed with SIGKILL leaves no worker and no temporary folder behind; SIGINT or SIGTERM
-to the parent alone, or SIGTERM to the whole process group, stops the run cleanly (exit 130, the
-CSV written, no traceback from any process, nothing left behind).
+the parent killed with SIGKILL leaves no worker and no temporary folder behind, even where a
+worker sees its parent's pipes close before the parent is gone; SIGINT or SIGTERM to the parent
+alone, or SIGTERM to the whole process group, stops the run cleanly (exit 130, the CSV written,
+no traceback from any process, nothing left behind).
 
 The signals are real ones sent from the test to the real processes; a slow mesh (many rows)
 keeps a worker busy long enough to be caught in the middle of its work.
@@ -10,6 +11,7 @@ keeps a worker busy long enough to be caught in the middle of its work.
 from __future__ import annotations
 
 import csv
+import json
 import os
 import signal
 import subprocess
@@ -167,6 +169,77 @@ def test_the_parent_killed_with_sigkill_leaves_no_worker_and_no_temporary_folder
     run.process.wait(timeout=WAIT)
     wait_for(lambda: not any(alive(pid) for pid in workers), "the workers to end")
     wait_for(lambda: list(run.temp.iterdir()) == [], "the temporary folder to be removed")
+
+
+@pytest.fixture(scope="module")
+def plan(inputs, tmp_path_factory) -> dict:
+    """The plan a real ``--jobs 2`` run hands its workers (mesh 0 fast, mesh 1 slow)."""
+    folder = tmp_path_factory.mktemp("plan")
+    run = Batch(folder, inputs["fast"], inputs["slow"], "--points", inputs["points"],
+                "--radius", "0.3", "--jobs", "2", "--out", folder / "out.csv")  # fmt: skip
+    try:
+        wait_for(lambda: len(run.workers()) == 2, "two workers")  # the plan is written by then
+        (path,) = run.temp.glob("vg-batch-*/plan.json")
+        return json.loads(path.read_text(encoding="utf-8"))
+    finally:
+        run.stop()
+
+
+# A stand-in for the parent: it starts one worker, hands it a mesh, and at a chosen moment
+# closes one of its pipes to the worker, then lives on for a while before it exits. A dying
+# process's pipes close before the kernel hands its children to a new parent; here that
+# moment is stretched so a worker is sure to see the pipe end while its parent is still there.
+STAND_IN = """
+import os, subprocess, sys, time
+script, plan, mesh, pipe, folder = sys.argv[1:]
+env = {**os.environ, "TMPDIR": folder, "TEMP": folder, "TMP": folder, "OMP_NUM_THREADS": "1"}
+worker = subprocess.Popen([sys.executable, script, "--worker", plan], env=env, text=True,
+                          stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+print(worker.pid, flush=True)
+worker.stdin.write(mesh + "\\n")
+worker.stdin.flush()
+wanted = "done " + mesh if pipe == "stdin" else "progress " + mesh
+for line in worker.stdout:
+    if wanted in line:
+        break
+(worker.stdin if pipe == "stdin" else worker.stdout).close()
+time.sleep(3)
+"""
+
+
+@pytest.mark.parametrize(
+    ("mesh", "pipe"),
+    [("0", "stdin"), ("1", "stdout")],
+    ids=["stdin ends without the last word", "stdout breaks while it reports"],
+)
+def test_a_worker_whose_parent_is_dying_removes_the_folders_once_it_is_orphaned(
+    plan, tmp_path, mesh, pipe
+):
+    folder, session = tmp_path / "run", tmp_path / "parent-session"
+    folder.mkdir()
+    session.mkdir()
+    (session / "left by the parent").write_text("")
+    plan_path = folder / "plan.json"
+    plan_path.write_text(
+        json.dumps({**plan, "folder": str(folder), "parent_session": str(session)}),
+        encoding="utf-8",
+    )
+    stand_in = subprocess.Popen(
+        [sys.executable, "-c", STAND_IN, str(SCRIPT), str(plan_path), mesh, pipe, str(folder)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    worker = int(stand_in.stdout.readline())
+    try:
+        stand_in.wait(timeout=WAIT)
+        wait_for(lambda: not alive(worker), "the worker to end")
+        stderr = stand_in.stderr.read()  # the worker's too: it ends once the worker has
+    finally:
+        if alive(worker):
+            os.kill(worker, signal.SIGKILL)
+    assert not folder.exists() and not session.exists(), list(folder.rglob("*"))
+    assert "Traceback" not in stderr, stderr
 
 
 @pytest.mark.parametrize(
