@@ -294,9 +294,17 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         # The edge's stations are the items it just appended: read those, not every stored one.
         measurements = obj.vg.measurements
         stations = range(len(measurements) - edge.n_stations, len(measurements))
+        closed = records.edge_is_closed(exact_numbers(edge))
         station_rows.extend(
             dataclasses.replace(
-                records.to_row(obj, measurements[i], stale=False, units=units, precision=precision),
+                records.to_row(
+                    obj,
+                    measurements[i],
+                    stale=False,
+                    units=units,
+                    precision=precision,
+                    edge_closed=closed,
+                ),
                 mesh_name=name,
             )
             for i in stations

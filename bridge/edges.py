@@ -318,20 +318,23 @@ def make_plot(obj, edge):
     return image
 
 
-def station_points(centers: list, first_arc: float, spacing: float) -> list:
+def station_points(centers: list, first_arc: float, spacing: float, closed=None) -> list:
     """The Points of an edge rebuilt from its stations: every centre in order (start, via
     points, end), so the edge retraces through them, closed again (ending on its first centre)
-    where the stations went round a loop.
+    where the stations went round a loop: where ``closed`` (the CSV's ``Edge Closed``) says so.
 
-    Stations sit ``spacing`` apart with the same gap ``g`` (under a spacing) at both ends of
-    the path; the first is ``g`` from the start. On a loop the last one is then at most ``2g``
-    (plus the snap to a vertex at each) from the first, across the loop's start; an open edge's
-    ends are as far apart as the edge is long.
+    A file written before that column leaves ``closed`` None, and the loop is judged by the
+    stations. They sit ``spacing`` apart with the same gap ``g`` (under a spacing) at both
+    ends of the path; the first is ``g`` from the start. On a loop the last one is then at most
+    ``2g`` (plus the snap to a vertex at each) from the first, across the loop's start; an open
+    edge's ends are as far apart as the edge is long (an open edge that nearly closes on itself
+    may be taken for a loop).
     """
     if len(centers) < 3:
         return centers
-    gap = math.dist(centers[-1], centers[0])
-    closed = gap <= 2.0 * first_arc + 0.5 * spacing and gap < spacing
+    if closed is None:
+        gap = math.dist(centers[-1], centers[0])
+        closed = gap <= 2.0 * first_arc + 0.5 * spacing and gap < spacing
     return [*centers, centers[0]] if closed else centers
 
 
@@ -341,8 +344,9 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
     Parameters
     ----------
     stations : dict
-        ``{csv edge number: [(measurement item, Measurement, arc length, spacing), ...]}``;
-        the items are already recorded, in the order the CSV listed them.
+        ``{csv edge number: [(measurement item, Measurement, arc length, spacing, closed),
+        ...]}``, ``closed`` the CSV's ``Edge Closed`` (None where the file lacks it); the
+        items are already recorded, in the order the CSV listed them.
 
     Returns
     -------
@@ -357,7 +361,7 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
         figures = summarize(surface, measurements)
         centers = [[float(v) for v in m.center] for m in measurements]
         numbers = {
-            "points": station_points(centers, float(group[0][2]), float(group[0][3])),
+            "points": station_points(centers, float(group[0][2]), float(group[0][3]), group[0][4]),
             "path": centers,
             "spacing": float(group[0][3]),
             "radius": float(measurements[0].radius),

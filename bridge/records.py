@@ -345,22 +345,36 @@ def units_label(scene, obj=None) -> str:
 
 
 def to_row(
-    obj, item, *, stale: bool, units: str, precision: str = "float32"
+    obj, item, *, stale: bool, units: str, precision: str = "float32", edge_closed=None
 ) -> csvio.MeasurementRow:
     """The CSV row of a stored ``item``, measured on ``obj``, its numbers read from the item
     (see :func:`measurement_row`)."""
     return measurement_row(
-        obj, item, numbers_of(item), stale=stale, units=units, precision=precision
+        obj,
+        item,
+        numbers_of(item),
+        stale=stale,
+        units=units,
+        precision=precision,
+        edge_closed=edge_closed,
     )
 
 
 def measurement_row(
-    obj, item, numbers: dict, *, stale: bool, units: str, precision: str = "float32"
+    obj,
+    item,
+    numbers: dict,
+    *,
+    stale: bool,
+    units: str,
+    precision: str = "float32",
+    edge_closed: bool | None = None,
 ) -> csvio.MeasurementRow:
     """The CSV row of ``item``, measured on ``obj``, with its exact ``numbers``
     (``record_codec.measurement_numbers``: those ``item.exact`` holds); ``precision``: the
     coordinates measured (``"float32"``, Blender's mesh, unless a batch run measured a file's
-    float64 ones)."""
+    float64 ones); ``edge_closed``: for a station, whether its edge is a loop
+    (:func:`closed_edges`)."""
     x, y, z = numbers["center"]
     stability = numbers.get("stability") or {}
     station = item.edge_number > 0
@@ -391,6 +405,7 @@ def measurement_row(
         edge_number=item.edge_number if station else None,
         arc_length=numbers.get("arc_length") if station else None,
         spacing=numbers.get("spacing") if station else None,
+        edge_closed=edge_closed if station else None,
         units=units,
         coordinates=numbers.get("space", WORLD),
         precision=precision,
@@ -492,6 +507,21 @@ def add_edge_from_numbers(
     """Append an edge record from ready numbers (see ``record_codec.edge_numbers``); used when an edge is
     rebuilt from re-measured stations."""
     return _add_edge(obj, numbers, patch, fingerprint, break_number=break_number, note=note)
+
+
+def edge_is_closed(numbers: dict) -> bool:
+    """Whether an edge record's ``numbers`` describe a loop: its traced path, or the points it
+    was traced through, end where they start."""
+    for key in ("path", "points"):
+        line = numbers.get(key) or []
+        if len(line) > 2 and line[0] == line[-1]:
+            return True
+    return False
+
+
+def closed_edges(obj) -> dict[int, bool]:
+    """``{edge number: whether it is a loop}`` for every edge profile of ``obj``."""
+    return {edge.number: edge_is_closed(exact_numbers(edge)) for edge in obj.vg.edges}
 
 
 def edge_row(obj, edge, *, units: str) -> csvio.EdgeRow:

@@ -175,7 +175,7 @@ def replicate_steps(
         numbers.append(item.number)
         if station is not None:
             stations.setdefault(row.edge_number, []).append(
-                (item.number, m, station[1], station[2])
+                (item.number, m, station[1], station[2], row.edge_closed)
             )
     if stations:
         by_number = {item.number: item for item in obj.vg.measurements}
@@ -211,8 +211,15 @@ def export_rows(objects, scene, *, depsgraph=None) -> list:
     for obj in objects:
         units = records.units_label(scene, obj)
         stale = measuring.stale_numbers(obj, depsgraph=depsgraph)
+        closed = records.closed_edges(obj)
         rows.extend(
-            records.to_row(obj, item, stale=item.number in stale, units=units)
+            records.to_row(
+                obj,
+                item,
+                stale=item.number in stale,
+                units=units,
+                edge_closed=closed.get(item.edge_number),
+            )
             for item in obj.vg.measurements
         )
     return rows

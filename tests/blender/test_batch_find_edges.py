@@ -106,6 +106,7 @@ def test_every_edge_found_is_profiled_as_the_core_profiles_it(found):
         stations = [r for r in rows if r.edge_number == edge.edge_number]
         assert [r.angle for r in stations] == profile.angles.tolist()
         assert [r.arc_length for r in stations] == profile.arc_lengths.tolist()
+        assert {r.edge_closed for r in stations} == {bool(candidate.closed)}
         assert (edge.mean, edge.std, edge.pooled_angle) == (
             profile.mean, profile.std, profile.pooled_angle
         )  # fmt: skip

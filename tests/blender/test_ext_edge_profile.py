@@ -12,7 +12,7 @@ from test_ext_measure import core_surface
 
 from vg_addon import Surface
 from vg_addon.formats import csvio
-from vg_addon.synthetic_meshes import varying_wedge, wedge
+from vg_addon.synthetic_meshes import lens, varying_wedge, wedge
 
 POINTS = [[-1.5, 0.01, 0.0], [0.0, -0.01, 0.0], [1.5, 0.0, 0.0]]
 
@@ -444,6 +444,40 @@ def test_an_edge_rebuilt_from_its_stations_replays_through_them(vg, tmp_path, sh
     assert all(c in path for c in centres)
     assert len(replayed["angles"]) == len(first["angles"])
     assert replayed["mean"] == pytest.approx(first["mean"], abs=0.5)
+
+
+@pytest.mark.parametrize("closed", [False, True], ids=["open, ending next to its start", "loop"])
+def test_the_station_csv_says_which_edge_is_a_loop_and_the_import_rebuilds_it_so(
+    vg, tmp_path, closed
+):
+    # An edge rebuilt from a station CSV is the loop or the open path that was measured, as
+    # each station's Edge Closed says. Before that column the import judged a loop by how near
+    # the last station is to the first, and closed an open edge that stops one vertex short
+    # of its start.
+    import importlib
+
+    station_points = importlib.import_module(f"{vg.__name__}.bridge.edges").station_points
+    shape = lens(70.53)
+    rim = shape.points[shape.edge]
+    n = len(rim)
+    ends = [0, n // 3, 2 * n // 3, 0 if closed else n - 1]
+    obj = mesh_object("Lens", shape.points, shape.triangles)
+    assert measure_edge(points=rim[ends].tolist(), spacing=0.1, radius=0.08) == {"FINISHED"}
+    centres = [tuple(exact(item)["center"]) for item in obj.vg.measurements]
+    stations_csv, again_csv = tmp_path / "m.csv", tmp_path / "again.csv"
+    assert bpy.ops.vg.export_csv(filepath=str(stations_csv)) == {"FINISHED"}
+    rows = csvio.read_measurements_csv(stations_csv)
+    assert len(rows) == len(centres) > 30 and {row.edge_closed for row in rows} == {closed}
+    loop = [*centres, centres[0]]
+    # The case the judging got wrong: this open edge's ends are closer than a spacing.
+    assert station_points(centres, rows[0].arc_length, rows[0].spacing) == loop
+
+    mesh_object("Lens.stations", shape.points, shape.triangles)
+    assert bpy.ops.vg.import_csv(filepath=str(stations_csv), ignore_mesh_names=True) == {"FINISHED"}
+    assert bpy.ops.vg.export_csv(filepath=str(again_csv)) == {"FINISHED"}
+    (row,) = csvio.read_edges_csv(csvio.edges_path_for(again_csv))
+    assert csvio.parse_points(row.points) == (loop if closed else centres)
+    assert {r.edge_closed for r in csvio.read_measurements_csv(again_csv)} == {closed}
 
 
 def test_the_panel_shows_the_study_figures_of_the_edge(vg, tmp_path):

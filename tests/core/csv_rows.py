@@ -34,6 +34,7 @@ OUR_EXTRA_COLUMNS = [
     "Edge #",
     "Arc Length",
     "Spacing",
+    "Edge Closed",
     "Units",
     "Coordinates",
     "Precision",

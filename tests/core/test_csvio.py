@@ -322,6 +322,26 @@ def test_station_rows_carry_their_edge_and_replicate_with_it(tmp_path):
     assert rows[1].edge_number is None
 
 
+@pytest.mark.parametrize("closed", [True, False])
+def test_a_station_says_whether_its_edge_is_a_loop_and_an_empty_cell_says_nothing(tmp_path, closed):
+    station = good_row(edge_number=3, arc_length=0.25, spacing=0.5, edge_closed=closed)
+    path = tmp_path / "m.csv"
+    csvio.write_measurements_csv(path, [station, good_row(number=2)])
+    header, first, second = cells(path.read_text(encoding="utf-8"))
+    at = header.index("Edge Closed")
+    assert (first[at], second[at]) == ("TRUE" if closed else "FALSE", "")
+    back = csvio.read_measurements_csv(path)
+    assert (back[0].edge_closed, back[1].edge_closed) == (closed, None)
+    rows = csvio.read_replication_csv(path)
+    assert (rows[0].edge_closed, rows[1].edge_closed) == (closed, None)
+    first[at] = "perhaps"
+    stream = io.StringIO()
+    csv.writer(stream, lineterminator="\n").writerows([header, first])
+    for read in (csvio.read_measurements_csv, csvio.read_replication_csv):
+        with pytest.raises(GoniometerError, match="row 2: Edge Closed is not TRUE or FALSE"):
+            read(stream.getvalue())
+
+
 def test_an_export_from_before_the_edge_columns_still_reads():
     old_columns = [c for c in csvio.EXPORT_COLUMNS if c not in csvio.LATER_COLUMNS]
     written = cells(csvio.format_measurements_csv([good_row()]))
@@ -329,6 +349,7 @@ def test_an_export_from_before_the_edge_columns_still_reads():
     text = "\n".join(",".join(f'"{line[i]}"' for i in keep) for line in written) + "\n"
     (row,) = csvio.read_measurements_csv(text)
     assert row.angle == good_row().angle and row.edge_number is None
+    assert row.edge_closed is None
 
 
 def test_edge_summary_file_round_trips_beside_the_export(tmp_path):

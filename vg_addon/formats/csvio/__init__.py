@@ -31,6 +31,7 @@ from .edges import (
     write_edges_csv,
 )
 from .measurements import (
+    CLOSED_COLUMNS,
     CREASE_COLUMNS,
     EXPORT_COLUMNS,
     LATER_COLUMNS,
@@ -76,6 +77,7 @@ from .text import (
 )
 
 __all__ = [
+    "CLOSED_COLUMNS",
     "COORDINATE_SPACES",
     "CREASE_COLUMNS",
     "EDGE_COLUMNS",

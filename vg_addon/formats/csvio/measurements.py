@@ -80,6 +80,7 @@ SCHEMA = (
     ("edge_number", "int", ("Edge #",)),
     ("arc_length", "float", ("Arc Length",)),
     ("spacing", "float", ("Spacing",)),
+    ("edge_closed", "flag", ("Edge Closed",)),
     ("units", "text", ("Units",)),
     ("coordinates", "text", ("Coordinates",)),
     ("precision", "text", ("Precision",)),
@@ -139,6 +140,12 @@ NOISE_COLUMNS = ("Stability Noise Hides Crease",)
 FLAG_COLUMNS = ("Stability Flag",)
 
 
+#: Column added so that an import rebuilds a station's edge as the loop or the open path it was
+#: (before it, the import judged a loop by how near the last station is to the first). Exports
+#: written before lack it.
+CLOSED_COLUMNS = ("Edge Closed",)
+
+
 #: Every column of an export: :data:`MESHLAB_COLUMNS`, then this extension's own.
 EXPORT_COLUMNS = tuple(column for _, _, columns in SCHEMA for column in columns)
 
@@ -152,6 +159,7 @@ LATER_COLUMNS = (
     "Spacing",
     "Coordinates",
     *CREASE_COLUMNS,
+    *CLOSED_COLUMNS,
     *NOISE_COLUMNS,
     *FLAG_COLUMNS,
 )
@@ -202,6 +210,9 @@ class MeasurementRow:
         The station's arc length along its edge's traced path.
     spacing : float or None
         The edge's station spacing.
+    edge_closed : bool or None
+        Whether a station's edge is a loop (its path ends where it starts); ``None`` for a single
+        measurement, and in files written before the column.
     units : str
         What one coordinate unit is.
     coordinates : str
@@ -273,6 +284,7 @@ class MeasurementRow:
     edge_number: int | None = None
     arc_length: float | None = None
     spacing: float | None = None
+    edge_closed: bool | None = None
     units: str = ""
     coordinates: str = MESH_COORDINATES
     precision: str = ""

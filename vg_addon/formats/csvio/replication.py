@@ -22,6 +22,7 @@ from .text import (
     NUMBER,
     WORLD_COORDINATES,
     XYZ_ALIASES,
+    flag_cell,
     header_of,
     is_blank,
     load,
@@ -68,6 +69,9 @@ class ReplicationRow:
         The ``Edge #`` of an edge profile's station; ``None`` for a single measurement.
     arc_length, spacing : float or None
         A station's ``Arc Length`` and its edge's ``Spacing`` (kept with the re-measured station).
+    edge_closed : bool or None
+        Whether the station's edge is a loop (``Edge Closed``); ``None`` when the file does not
+        say.
     source_format : str
         ``"extension"`` (this extension's export), ``"meshlab"`` (the MeshLab plugin's 14
         columns, also written by the earlier AMAAZE Blender add-on) or ``"points"`` (anything
@@ -97,6 +101,7 @@ class ReplicationRow:
     edge_number: int | None = None
     arc_length: float | None = None
     spacing: float | None = None
+    edge_closed: bool | None = None
     source_format: str = "points"
     coordinates: str = MESH_COORDINATES
     rule: str | None = None
@@ -118,6 +123,7 @@ _REPLICATION_ALIASES = {
     "edge_number": ("edge #", "edge number", "edge"),
     "arc_length": ("arc length", "arc"),
     "spacing": ("spacing",),
+    "edge_closed": ("edge closed",),
     "error": ("error",),
 }
 
@@ -234,6 +240,9 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
             problems.append(
                 f"row {number}: {name_of('lam')} (λ) must be 0 or more (got {cell('lam').strip()})"
             )
+        edge_closed, why = flag_cell(cell("edge_closed"))
+        if why:
+            problems.append(f"row {number}: {name_of('edge_closed')} {why}")
         break_number = break_number_cell(cell("break_number"))
         if isinstance(break_number, str):
             problems.append(f"row {number}: {name_of('break_number')} {break_number}")
@@ -284,6 +293,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 edge_number=edge_number if isinstance(edge_number, int) else None,
                 arc_length=values["arc_length"],
                 spacing=values["spacing"],
+                edge_closed=edge_closed,
                 source_format=fmt,
                 coordinates=coordinates,
                 rule=rule,

@@ -11,7 +11,8 @@ comma delimiter, quotes closed where they should be), header names matched case-
 any other table (:func:`read_table`, :func:`format_table`).
 
 A schema is a tuple of ``(row field, kind, CSV columns)`` in column order; kinds are ``text``,
-``int``, ``float``, ``bool`` and ``vec3`` (three float columns).
+``int``, ``float``, ``bool``, ``flag`` (a ``bool`` that may be left empty, for "not known")
+and ``vec3`` (three float columns).
 
 Row numbers in messages are the rows a spreadsheet shows for the file: the header is row 1, so
 the first data row is row 2. Blank lines count as rows (a spreadsheet shows them as empty rows);
@@ -132,7 +133,7 @@ def row_cells(index: int, row, schema) -> list[str]:
                     cells.append(str(operator.index(value)))
                 except TypeError:
                     raise _cell_error(index, row, columns[0], value, "a whole number") from None
-        elif kind == "bool":
+        elif kind in ("bool", "flag"):
             cells.append("" if value is None else (_TRUE if value else _FALSE))
         else:  # vec3
             if value is None:
@@ -359,6 +360,15 @@ def bool_cell(raw: str) -> bool | None:
     return None
 
 
+def flag_cell(raw: str) -> tuple[bool | None, str]:
+    """A cell that may be left empty: True, False or None (empty), and why it is none of
+    them ("" when it is)."""
+    if not raw.strip():
+        return None, ""
+    value = bool_cell(raw)
+    return value, "" if value is not None else "is not TRUE or FALSE"
+
+
 def resolve_columns(header: list[str], aliases: dict, problems: list[str]) -> dict:
     """Field -> column index for the fields the header has; ambiguous names are problems."""
     positions: dict[str, list[int]] = {}
@@ -453,6 +463,10 @@ def parse_table(text, source, schema, row_type, optional, what, check=None):
                 values[field] = bool_cell(cell(names[0]))
                 if values[field] is None:
                     problems.append(f"row {number}: {names[0]} is not TRUE or FALSE")
+            elif kind == "flag":
+                values[field], why = flag_cell(cell(names[0]))
+                if why:
+                    problems.append(f"row {number}: {names[0]} {why}")
             else:
                 parts = [number_of(name) for name in names]
                 blank = [not cell(name).strip() for name in names]
