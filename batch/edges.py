@@ -294,7 +294,8 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         # The edge's stations are the items it just appended: read those, not every stored one.
         measurements = obj.vg.measurements
         stations = range(len(measurements) - edge.n_stations, len(measurements))
-        closed = records.edge_is_closed(exact_numbers(edge))
+        numbers = exact_numbers(edge)
+        closed = records.edge_is_closed(numbers)
         station_rows.extend(
             dataclasses.replace(
                 records.to_row(
@@ -312,7 +313,6 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         edge_rows.append(
             dataclasses.replace(records.edge_row(obj, edge, units=units), mesh_name=name)
         )
-        numbers = exact_numbers(edge)
         path = f"{options['plots']}_{safe_name}_edge{edge.number}.png"
         data = functools.partial(
             profile_plot.profile_png,
