@@ -76,14 +76,17 @@ def alive(pid: int) -> bool:
     return stat.rpartition(")")[2].split()[0] != "Z"
 
 
-def wait_for(condition, what: str):
+def wait_for(condition, what: str, detail=None):
+    """``condition()`` once it is true; fails after :data:`WAIT` s, saying ``detail()``."""
     deadline = time.monotonic() + WAIT
     while time.monotonic() < deadline:
         value = condition()
         if value:
             return value
         time.sleep(0.1)
-    pytest.fail(f"gave up waiting for {what} after {WAIT:.0f} s")
+    pytest.fail(
+        f"gave up waiting for {what} after {WAIT:.0f} s" + (f": {detail()}" if detail else "")
+    )
 
 
 class Batch:
@@ -168,7 +171,11 @@ def test_the_parent_killed_with_sigkill_leaves_no_worker_and_no_temporary_folder
     os.kill(run.process.pid, signal.SIGKILL)
     run.process.wait(timeout=WAIT)
     wait_for(lambda: not any(alive(pid) for pid in workers), "the workers to end")
-    wait_for(lambda: list(run.temp.iterdir()) == [], "the temporary folder to be removed")
+    wait_for(
+        lambda: list(run.temp.iterdir()) == [],
+        "the temporary folder to be removed",
+        detail=lambda: sorted(str(p.relative_to(run.temp)) for p in run.temp.rglob("*")),
+    )
 
 
 @pytest.fixture(scope="module")
