@@ -461,6 +461,8 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                 plan = {
                     "folder": folder,
                     "parent_session": bpy.app.tempdir,  # removed by the workers if this dies
+                    # A worker still starting when this dies would take its new parent for it.
+                    "parent": os.getpid(),
                     "sources": [dataclasses.asdict(s) for s in sources],
                     "tasks": {
                         str(m): [dataclasses.asdict(t) for t in ts] for m, ts in groups.items()

@@ -193,7 +193,9 @@ def _quit(folders, status: int) -> NoReturn:
 
 
 class Parent:
-    """In a worker: the process that started it, and what the worker does when it is gone.
+    """In a worker: the process that started it (``pid``, from the plan: a worker whose parent
+    died while it was starting would otherwise take its new parent for it), and what the
+    worker does when it is gone.
 
     When the parent is gone (killed, even with SIGKILL, so it cannot clean up after itself),
     the worker removes the run's temporary folder (with its own Blender session folder inside)
@@ -203,8 +205,8 @@ class Parent:
     SIGTERM (the parent stopping its workers) ends the worker without a traceback.
     """
 
-    def __init__(self, folder: str, parent_session: str):
-        self.pid = os.getppid()
+    def __init__(self, pid: int, folder: str, parent_session: str):
+        self.pid = pid
         self.folders = [folder, parent_session]
         signal.signal(signal.SIGTERM, lambda signum, frame: _quit([bpy.app.tempdir], 143))
         self._stop = threading.Event()
@@ -247,7 +249,7 @@ def worker_main(plan_path: str) -> int:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with open(plan_path, encoding="utf-8") as handle:
         plan = json.load(handle)
-    parent = Parent(plan["folder"], plan.get("parent_session", ""))
+    parent = Parent(plan["parent"], plan["folder"], plan.get("parent_session", ""))
     try:
         return _measure_from_stdin(plan, parent)
     finally:

@@ -197,14 +197,20 @@ def plan(inputs, tmp_path_factory) -> dict:
 # process's pipes close before the kernel hands its children to a new parent; here that
 # moment is stretched so a worker is sure to see the pipe end while its parent is still there.
 STAND_IN = """
-import os, subprocess, sys, time
+import json, os, subprocess, sys, time
 script, plan, mesh, pipe, folder = sys.argv[1:]
+with open(plan, encoding="utf-8") as handle:
+    text = json.dumps({**json.load(handle), "parent": os.getpid()})
+with open(plan, "w", encoding="utf-8") as handle:
+    handle.write(text)
 env = {**os.environ, "TMPDIR": folder, "TEMP": folder, "TMP": folder, "OMP_NUM_THREADS": "1"}
 worker = subprocess.Popen([sys.executable, script, "--worker", plan], env=env, text=True,
                           stdin=subprocess.PIPE, stdout=subprocess.PIPE)
 print(worker.pid, flush=True)
 worker.stdin.write(mesh + "\\n")
 worker.stdin.flush()
+if pipe == "none":  # gone before the worker has even started
+    sys.exit()
 wanted = "done " + mesh if pipe == "stdin" else "progress " + mesh
 for line in worker.stdout:
     if wanted in line:
@@ -216,8 +222,12 @@ time.sleep(3)
 
 @pytest.mark.parametrize(
     ("mesh", "pipe"),
-    [("0", "stdin"), ("1", "stdout")],
-    ids=["stdin ends without the last word", "stdout breaks while it reports"],
+    [("0", "stdin"), ("1", "stdout"), ("0", "none")],
+    ids=[
+        "stdin ends without the last word",
+        "stdout breaks while it reports",
+        "gone while the worker starts",
+    ],
 )
 def test_a_worker_whose_parent_is_dying_removes_the_folders_once_it_is_orphaned(
     plan, tmp_path, mesh, pipe
