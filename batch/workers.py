@@ -45,7 +45,6 @@ PARENT_POLL_SECONDS = 0.2  # how often a worker checks that its parent is still 
 STOP_SECONDS = 10.0  # how long a stopped worker may take to end before it is killed
 ORPHAN_WAIT_SECONDS = 10.0  # how long a worker whose parent's pipes closed waits to be re-parented
 MARK = child_process.MARK  # prefix of the lines a worker sends to its parent on stdout
-REMOVE_SECONDS = 5.0  # how long an ending worker keeps trying to remove a folder others write in
 END = "end"  # the parent's last line to a worker; stdin ending without it means the parent died
 _writing = threading.RLock()  # held while a worker writes into the run's folder
 
@@ -179,15 +178,8 @@ def _quit(folders, status: int) -> NoReturn:
     # Never in the middle of this worker's own write into the folder: a file made after the
     # removal would be left behind. Reentrant, for SIGTERM arriving during such a write.
     _writing.acquire(timeout=STOP_SECONDS)
-    deadline = time.monotonic() + REMOVE_SECONDS
     for folder in folders:
-        if not folder:
-            continue
-        shutil.rmtree(folder, ignore_errors=True)
-        # Another worker ending at the same moment (its Blender shutting down) may still write
-        # into the run's folder while this one removes it: try again until it is gone.
-        while os.path.exists(folder) and time.monotonic() < deadline:
-            time.sleep(0.1)
+        if folder:
             shutil.rmtree(folder, ignore_errors=True)
     os._exit(status)
 
