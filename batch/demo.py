@@ -123,7 +123,7 @@ def print_edge(run) -> None:
     print(f"\nWhole edge: {' -> '.join(EDGE_SITES)}, a station every {EDGE_SPACING:g} mm")
     for row in failed:
         print(f"  failed: {row.error}")
-    for edge in run.edge_rows:
+    for edge in run.profiled_edges:
         print(
             f"  {edge.n_stations} stations over {edge.length:.1f} mm: mean {edge.mean:.2f}° "
             f"(SD {edge.std:.2f}°), min {edge.min:.2f}°, max {edge.max:.2f}°, pooled "

@@ -54,8 +54,11 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
         raise UsageError(f"{args.edges_csv}: {error.strerror or error}") from None
     except GoniometerError as error:
         raise UsageError(str(error)) from None
-    problems = []
+    problems, failed = [], []
     for number, row in enumerate(rows, start=2):
+        if row.error:
+            failed.append(number)  # a run could not measure it: nothing to replicate
+            continue
         try:
             points = csvio.parse_points(row.points)
         except GoniometerError as error:
@@ -88,7 +91,19 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
             f"{args.edges_csv}: {len(problems)} edge row(s) cannot be measured:\n"
             + bounded_list(problems, lines=True)
         )
+    if failed and passed_over is not None:
+        passed_over.append(failed_rows_line(args.edges_csv, failed))
     return specs
+
+
+def failed_rows_line(path, numbers: list[int]) -> str:
+    """The summary's line naming the rows of an edges CSV passed over because their ``error``
+    says the run that wrote them could not measure them."""
+    rows = ", ".join(str(n) for n in numbers[:10]) + (", ..." if len(numbers) > 10 else "")
+    return (
+        f"passed over {len(numbers)} edge row(s) of {Path(path).name} whose error says they were "
+        f"not measured (row {rows}): clear a row's error cell to measure it again"
+    )
 
 
 def args_spec(args, points, *, mesh_name: str = "", note: str = "", given: str = "") -> dict:
@@ -196,6 +211,11 @@ def check_spacing(spec: dict) -> None:
     check_station_count(length, spacing)
 
 
+def profiled(edge_rows: list) -> list:
+    """The summary rows of the edges that were measured (a failed edge's row has an ``error``)."""
+    return [row for row in edge_rows if not row.error]
+
+
 def spec_applies(spec: dict, source) -> bool:
     """Whether edge ``spec`` is measured on the mesh ``source``."""
     return csvio.mesh_name_matches(spec["mesh_name"], source.names)
@@ -214,6 +234,7 @@ def failed_edge_row(number: int | None, spec: dict, mesh_name: str, message: str
     return csvio.MeasurementRow(
         mesh_name=mesh_name,
         date=csvio.now_iso(),
+        user_data=spec.get("note", ""),
         radius=spec["radius"],
         lam=spec["lam"],
         patch=spec["patch"],
@@ -221,6 +242,30 @@ def failed_edge_row(number: int | None, spec: dict, mesh_name: str, message: str
         edge_number=number,
         spacing=spec["spacing"],
         units=units,
+        extension_version=records.extension_version(),
+        blender_version=bpy.app.version_string,
+        error=f"edge not measured: {message}",
+    )
+
+
+def failed_edge_summary(number: int, spec: dict, mesh_name: str, message: str, units, rule: str):
+    """The edges CSV row of an edge that could not be measured: its points and settings, so the
+    edge can be looked at or measured again, and why it failed; no figures."""
+    return csvio.EdgeRow(
+        mesh_name=mesh_name,
+        date=csvio.now_iso(),
+        edge_number=number,
+        user_data=spec.get("note", ""),
+        spacing=spec["spacing"],
+        radius=spec["radius"],
+        lam=spec["lam"],
+        patch=spec["patch"],
+        rule=rule,
+        points=csvio.format_points(spec["points"]),
+        units=units,
+        coordinates=(
+            csvio.WORLD_COORDINATES if spec.get("space") == "world" else csvio.MESH_COORDINATES
+        ),
         extension_version=records.extension_version(),
         blender_version=bpy.app.version_string,
         error=f"edge not measured: {message}",
@@ -240,7 +285,8 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         Every edge's stations in order, or one error row for an edge that failed; rows name the
         mesh as the user gave it (``source.name``).
     edge_rows : list of csvio.EdgeRow
-        One summary per measured edge.
+        One summary per edge, in order; an edge that failed has its points, settings and
+        ``error`` and no figures.
     plots : list of (what, path, png bytes function)
         Each profile's plot, to draw beside the output CSV once the rows are written.
     found : int
@@ -261,6 +307,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
             station_rows.append(not_found_row(options, name, str(error), units))
     for spec in specs:
         number = obj.vg.next_edge_number
+        rule = spec.get("rule") or options.get("rule", DEFAULT_RULE)
         try:
             profile, geometry, clicks = edges.measure_edge(
                 obj,
@@ -272,7 +319,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
                 space=spec.get("space", "mesh"),
                 surface=surface,
                 given=spec.get("given", ""),
-                rule=spec.get("rule") or options.get("rule", DEFAULT_RULE),
+                rule=rule,
                 stability=bool(options.get("stability")),
             )
             # Recorded without repainting: the colours are painted once, after every edge. The
@@ -290,6 +337,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         except GoniometerError as error:
             obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
             station_rows.append(failed_edge_row(number, spec, name, str(error), units))
+            edge_rows.append(failed_edge_summary(number, spec, name, str(error), units, rule))
             continue
         # The edge's stations are the items it just appended: read those, not every stored one.
         measurements = obj.vg.measurements

@@ -23,7 +23,7 @@ from ..vg_addon.workflow import batchplan
 from . import extension
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
-from .edges import edge_specs, spec_applies
+from .edges import edge_specs, profiled, spec_applies
 from .find_edges import find_options
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
 from .outputs import check_outputs, input_files, make_folders, sweep_paths
@@ -73,8 +73,13 @@ class Run:
 
     @property
     def edge_rows(self) -> list:
-        """Every edge's summary row, mesh after mesh."""
+        """Every edge's summary row (a failed edge's with its ``error``), mesh after mesh."""
         return [row for mesh in sorted(self.edges_by_mesh) for row in self.edges_by_mesh[mesh][1]]
+
+    @property
+    def profiled_edges(self) -> list:
+        """The summary rows of the edges that were measured."""
+        return profiled(self.edge_rows)
 
     @property
     def done_points(self) -> int:
@@ -159,8 +164,9 @@ class Run:
         note = f", {failed} picture(s) not written" if failed else ""
         if not self.args.quiet:
             points = result.measured + result.failed
-            stations = sum(edge.n_stations or 0 for edge in result.edge_rows)
-            edges = f"{len(result.edge_rows)} edge(s) profiled ({stations:,} stations)"
+            measured_edges = profiled(result.edge_rows)
+            stations = sum(edge.n_stations or 0 for edge in measured_edges)
+            edges = f"{len(measured_edges)} edge(s) profiled ({stations:,} stations)"
             if points or not result.edge_rows:  # an edges-only run has no points to count
                 self.say(
                     f"{source.name}: {result.measured:,} measured, {result.failed:,} failed"
@@ -258,8 +264,8 @@ class Run:
         measuring = sum(r.measure_seconds for r in self.results)
         tried = sum(r.measured + r.failed for r in self.results if r.measure_seconds > 0)
         rate = tried / measuring if measuring > 0 else 0.0
-        edge_rows = self.edge_rows
-        if self.rows or not edge_rows:
+        edge_rows = self.profiled_edges
+        if self.rows or not self.edge_rows:
             self.say(
                 f"{measured:,} measured, {len(failed):,} failed, {len(self.rows):,} points on "
                 f"{self.total_meshes:,} mesh(es) in {elapsed:.1f} s"
@@ -285,7 +291,7 @@ class Run:
             self.say(f"  failed: {where} on {row.mesh_name!r}: {row.error}")
         if len(failed) > 10:
             self.say(f"  ... and {len(failed) - 10} more failed rows (see the error column)")
-        for edge in self.edge_rows:
+        for edge in edge_rows:
             self.say(
                 f"edge {edge.edge_number} on {edge.mesh_name!r}: {edge.n_stations} stations every "
                 f"{edge.spacing:g} over {edge.length:.4g}: mean {edge.mean:.2f}° "

@@ -230,6 +230,9 @@ def import_edges_csv(
     list of int
         The new edges' numbers.
 
+    Rows whose ``error`` is filled (edges the batch run that wrote the file could not measure)
+    are passed over.
+
     Raises
     ------
     GoniometerError
@@ -240,9 +243,16 @@ def import_edges_csv(
     source = f"'{Path(path).name}'"
     if not rows:
         raise GoniometerError(f"{source} has no edges: nothing to import.")
+    if all(row.error for row in rows):
+        raise GoniometerError(
+            f"{source} has no measured edges: the run that wrote it could not measure any of its "
+            f"{len(rows)} edge(s) (their error column says why); clear a row's error to try it."
+        )
     names = (obj.name, obj.data.name)
     failures, jobs = [], []
     for number, row in enumerate(rows, start=2):
+        if row.error:
+            continue  # an edge the run that wrote the file could not measure: nothing to repeat
         try:
             if not ignore_mesh_names and not csvio.mesh_name_matches(row.mesh_name, names):
                 raise GoniometerError(

@@ -208,9 +208,16 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                     rule=settings.rule,
                     stability=settings.stability,
                 )
-                extra = adopt_units(obj, [row.units for row in csvio.read_edges_csv(path)])
+                summaries = csvio.read_edges_csv(path)
+                extra = adopt_units(obj, [row.units for row in summaries])
+                failed = sum(1 for row in summaries if row.error)
+                if failed:
+                    extra += (
+                        f"; passed over {failed} edge(s) the run that wrote it could not "
+                        "measure (their error column)"
+                    )
                 self.report(
-                    {"INFO"},
+                    {"WARNING" if failed else "INFO"},
                     f"Re-measured {len(edge_numbers)} edge profile(s) of "
                     f"{bpy.path.basename(path)} on '{obj.name}'{extra}",
                 )

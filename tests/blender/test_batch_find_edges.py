@@ -19,7 +19,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import batch, colours, exact, expected_colours
+from bpy_helpers import batch, colours, edited_csv, exact, expected_colours
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
@@ -147,6 +147,53 @@ def test_each_found_edge_re_measures_identically_from_the_edges_csv(found, tmp_p
         return [{k: v for k, v in dataclasses.asdict(e).items() if k not in skip} for e in rows]
 
     assert summaries(again) == summaries(out)
+
+
+def test_an_edge_found_but_not_measured_keeps_its_points_in_the_edges_csv(found, tmp_path):
+    """A radius too small for any patch: every found edge fails. Each keeps a row of the edges
+    CSV with the finder's points, its note and why it failed (no figures), a replay passes those
+    rows over and says so, and a row whose error is cleared and radius mended measures the edge
+    as a run with that radius did."""
+    mesh, good_out, _ = found
+    out = tmp_path / "tiny.csv"
+    result = ok(batch(mesh, "--find-edges", "--spacing", SPACING, "--radius", 1e-4,
+                      "--out", out), 1)  # fmt: skip
+    data = meshio.read_mesh(mesh)
+    candidates = find_break_edges(Surface(data.points, data.triangles)).candidates
+    failed = csvio.read_edges_csv(csvio.edges_path_for(out))
+    assert [e.edge_number for e in failed] == list(range(1, len(candidates) + 1))
+    for edge, candidate in zip(failed, candidates, strict=True):
+        assert csvio.parse_points(edge.points) == [tuple(p) for p in candidate.waypoint_points]
+        assert edge.user_data.startswith(f"found edge {candidate.number}: confidence ")
+        assert edge.error.startswith("edge not measured: ") and "radius" in edge.error
+        assert (edge.spacing, edge.radius, edge.rule) == (SPACING, 1e-4, "refined")
+        assert edge.n_stations is None and edge.mean is None and edge.length is None
+    rows = csvio.read_measurements_csv(out)
+    assert [(r.edge_number, r.user_data) for r in rows] == [
+        (e.edge_number, e.user_data) for e in failed
+    ]
+    assert f"0 edge(s) profiled (0 stations), {len(candidates)} failed" in result.stderr
+
+    replay = tmp_path / "replay.csv"
+    result = ok(batch(mesh, "--edges", csvio.edges_path_for(out), "--out", replay))
+    assert (
+        f"passed over {len(candidates)} edge row(s) of tiny_edges.csv whose error says they were "
+        "not measured" in result.stderr
+    )
+    assert csvio.read_measurements_csv(replay) == []
+
+    def mend_the_first(row):
+        if row["Edge #"] == "1":
+            row["Radius"], row["error"] = repr(RADIUS), ""
+
+    mended = edited_csv(csvio.edges_path_for(out), tmp_path / "mended.csv", mend_the_first)
+    result = ok(batch(mesh, "--edges", mended, "--out", replay))
+    assert f"passed over {len(candidates) - 1} edge row(s) of mended.csv" in result.stderr
+    keys = ("edge_number", "angle", "arc_length", "x", "y", "z", "user_data")
+    first = [r for r in csvio.read_measurements_csv(good_out) if r.edge_number == 1]
+    assert [[getattr(r, k) for k in keys] for r in csvio.read_measurements_csv(replay)] == [
+        [getattr(r, k) for k in keys] for r in first
+    ]
 
 
 def test_found_edges_are_painted_as_the_extension_paints_stations(vg, found):

@@ -127,7 +127,14 @@ def test_a_pp_file_picked_on_a_shifted_copy_is_refused_naming_it(tmp_path):
     assert "ramp_shifted.pp: point 1 (" in failed[0].error
     assert failed[0].error.count(" is 1.5 from the mesh") == 2
     edges = csvio.read_edges_csv(out.with_name("out_edges.csv"))
-    assert [e.user_data for e in edges] == ["Ramp_Good.PP"]  # the good file is still measured
+    # The good file is still measured; the failed one keeps its points and why it failed.
+    assert [(e.user_data, bool(e.error)) for e in edges] == [
+        ("Ramp_Good.PP", False),
+        ("ramp_shifted.pp", True),
+    ]
+    assert edges[1].error == failed[0].error and edges[1].n_stations is None
+    shifted = [tuple((p + np.array([0.0, 0.0, 1.5])).tolist()) for p in ends]
+    assert csvio.parse_points(edges[1].points) == shifted
 
     # The same points typed as --edge and --via: the via point is the one refused.
     typed = tmp_path / "typed.csv"

@@ -344,6 +344,27 @@ def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):
     with pytest.raises(RuntimeError, match="from the mesh"):
         bpy.ops.vg.import_csv(filepath=str(far_file), ignore_mesh_names=True)
     assert len(other.vg.edges) == 0 and len(other.vg.measurements) == 0
+    # A row whose error says the run that wrote it could not measure it (a batch run's failed
+    # edge; here one that would be refused if measured) is passed over; the rest is imported.
+
+    def fail_the_second(row):
+        if row["Edge #"] == "2":
+            lift(row)
+            row["error"] = "edge not measured: no vertex within the radius"
+
+    failed_file = edited_csv(edge_file, tmp_path / "failed_edges.csv", fail_the_second)
+    assert bpy.ops.vg.import_csv(filepath=str(failed_file), ignore_mesh_names=True) == {"FINISHED"}
+    assert [e.note for e in other.vg.edges] == ["ridge A"]
+    first_edge = [m for m in obj.vg.measurements if m.edge_number == obj.vg.edges[0].number]
+    assert [exact(a)["angle"] for a in other.vg.measurements] == [
+        exact(b)["angle"] for b in first_edge
+    ]
+    none_file = edited_csv(
+        edge_file, tmp_path / "none_edges.csv", lambda row: row.update(error="x")
+    )
+    with pytest.raises(RuntimeError, match="could not measure any of its 2 edge"):
+        bpy.ops.vg.import_csv(filepath=str(none_file), ignore_mesh_names=True)
+    assert len(other.vg.edges) == 1
 
 
 def test_stations_take_the_panels_rule_and_stability_and_an_import_the_panels_rule(vg, tmp_path):
