@@ -10,6 +10,7 @@ import bpy
 import numpy as np
 
 from ..bridge import measuring, mesh_data
+from ..bridge.plots import plot_image
 from .measure import MeshResult
 from .pictures import disk_full
 from .stdio import quiet_stdout
@@ -91,7 +92,7 @@ def check_saved(path: Path, names) -> None:
 
 def plot_images(obj) -> list:
     """The images holding the profile plots of ``obj``'s edges (only the edges name them)."""
-    return [image for edge in obj.vg.edges if (image := bpy.data.images.get(edge.plot))]
+    return [image for edge in obj.vg.edges if (image := plot_image(edge)) is not None]
 
 
 def forget(object_name: str) -> None:

@@ -9,12 +9,11 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import bpy
 import numpy as np
 
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
-from ..vg_addon.formats import csvio, profile_plot, record_codec
+from ..vg_addon.formats import csvio, record_codec
 from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.algorithm import DEFAULT_RULE
 from ..vg_addon.method.edge_profile import summarize
@@ -27,8 +26,7 @@ from .mesh_data import (
     surface_for,
     uniform_scale,
 )
-
-PLOT_SIZE = (480, 240)
+from .plots import make_plot, plot_image, remove_plots
 
 
 def free_break(obj) -> int:
@@ -305,29 +303,6 @@ def import_edges_csv(
     ]
 
 
-def make_plot(obj, edge):
-    """The profile plot of ``edge`` as a packed image (saved inside the .blend): matplotlib's
-    where Blender's Python has it, else the extension's NumPy drawing."""
-    numbers = exact_numbers(edge)
-    rgba = profile_plot.render_profile(
-        numbers["arc_lengths"],
-        numbers["angles"],
-        width=PLOT_SIZE[0],
-        height=PLOT_SIZE[1],
-        units=records.unit_symbol(obj, bpy.context.scene),
-        title=f"{obj.name}, edge {edge.number}",
-        pooled=numbers.get("pooled_angle"),
-    )
-    width, height = PLOT_SIZE
-    image = bpy.data.images.new(f"VG {obj.name} edge {edge.number}", width, height, alpha=True)
-    # Blender's rows run bottom-up.
-    image.pixels.foreach_set((rgba[::-1].astype(np.float32) / 255.0).ravel())
-    image.pack()
-    image.use_fake_user = True  # only the edge names it: without a user it would not be saved
-    image.preview_ensure()  # the panel shows the plot as the image's preview icon
-    return image
-
-
 def station_points(centers: list, first_arc: float, spacing: float, closed=None) -> list:
     """The Points of an edge rebuilt from its stations: every centre in order (start, via
     points, end), so the edge retraces through them, closed again (ending on its first centre)
@@ -354,9 +329,10 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
     Parameters
     ----------
     stations : dict
-        ``{csv edge number: [(measurement item, Measurement, arc length, spacing, closed),
-        ...]}``, ``closed`` the CSV's ``Edge Closed`` (None where the file lacks it); the
-        items are already recorded, in the order the CSV listed them.
+        ``{(csv mesh name, csv edge number): [(measurement item, Measurement, arc length,
+        spacing, closed), ...]}``, ``closed`` the CSV's ``Edge Closed`` (None where the file
+        lacks it); the items are already recorded, in the order the CSV listed them. Edges are
+        made in the order of the keys.
 
     Returns
     -------
@@ -408,10 +384,9 @@ def redraw_plots(obj) -> None:
     """Draw every edge's plot of ``obj`` again (after its Scan Units changed: the axis names
     them), each replacing the image it had."""
     for edge in obj.vg.edges:
-        old = bpy.data.images.get(edge.plot)
-        if old is None:
+        if plot_image(edge) is None:
             continue  # a batch run's object that is never saved has none
-        bpy.data.images.remove(old)  # first: the new image takes its name
+        remove_plots([edge])  # first: the new image takes its name (kept if a duplicate shows it)
         edge.plot = make_plot(obj, edge).name
 
 
@@ -426,14 +401,12 @@ def delete_edge(obj, index: int, *, depsgraph=None) -> int:
     geometry = evaluated_geometry(obj, depsgraph)
     edge = data.edges[index]
     number = edge.number
-    image = bpy.data.images.get(edge.plot)
+    remove_plots([edge])
     for position in reversed(range(len(data.measurements))):
         if data.measurements[position].edge_number == number:
             data.measurements.remove(position)
     data.active_index = min(data.active_index, max(len(data.measurements) - 1, 0))
     data.edges.remove(index)
     data.active_edge_index = min(index, max(len(data.edges) - 1, 0))
-    if image is not None:
-        bpy.data.images.remove(image)
     measuring.repaint(obj, geometry=geometry)
     return number

@@ -158,7 +158,7 @@ def replicate_steps(
             f"'{obj.name}' changed while {source} was being measured; nothing was imported."
         )
     numbers = []
-    stations: dict[int, list] = {}
+    stations: dict[tuple[str, int], list] = {}  # by mesh and edge: files may hold several
     for row, m in results:
         station = None
         if row.edge_number is not None:  # numbered and oriented when its edge is rebuilt
@@ -174,7 +174,7 @@ def replicate_steps(
         )
         numbers.append(item.number)
         if station is not None:
-            stations.setdefault(row.edge_number, []).append(
+            stations.setdefault((row.mesh_name or "", row.edge_number), []).append(
                 (item.number, m, station[1], station[2], row.edge_closed)
             )
     if stations:
@@ -227,5 +227,8 @@ def export_rows(objects, scene, *, depsgraph=None) -> list:
 
 def export_edge_rows(objects, scene) -> list:
     """Edge summary CSV rows of every edge profile of ``objects``, in list order."""
-    units = records.units_label(scene)
-    return [records.edge_row(obj, edge, units=units) for obj in objects for edge in obj.vg.edges]
+    return [
+        records.edge_row(obj, edge, units=records.units_label(scene, obj))
+        for obj in objects
+        for edge in obj.vg.edges
+    ]

@@ -360,6 +360,8 @@ def follow_export(obj, path, numbers) -> str:
         rows = csvio.read_measurements_csv(path)
     except (GoniometerError, OSError, ValueError):
         return ""  # MeshLab's, the earlier add-on's or a points file: no Units, no Colors
+    # A batch run's failed rows (an error and no coordinates) were not replicated.
+    rows = [row for row in rows if not (row.error and (row.x, row.y, row.z) == (None,) * 3)]
     if len(rows) != len(numbers):
         return ""
     extra = adopt_units(obj, [row.units for row in rows])

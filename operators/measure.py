@@ -9,7 +9,7 @@ from bpy.props import (
     StringProperty,
 )
 
-from ..bridge import measuring, records
+from ..bridge import measuring, plots, records
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, uniform_scale
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats.record_codec import exact_numbers
@@ -213,10 +213,7 @@ class VG_OT_clear_measurements(bpy.types.Operator):
         if obj is None:
             return {"CANCELLED"}
         count = len(obj.vg.measurements)
-        for edge in obj.vg.edges:  # the edge profiles go with their stations
-            image = bpy.data.images.get(edge.plot)
-            if image is not None:
-                bpy.data.images.remove(image)
+        plots.remove_plots(list(obj.vg.edges))  # the edge profiles go with their stations
         obj.vg.edges.clear()
         obj.vg.active_edge_index = 0
         obj.vg.next_edge_number = 1

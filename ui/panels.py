@@ -2,6 +2,7 @@
 
 import bpy
 
+from ..bridge.plots import plot_image
 from ..bridge.records import unit_symbol, units_label
 from ..operators.measure import non_uniform_scale_note
 from ..vg_addon.formats.record_codec import exact_numbers, study_texts
@@ -310,7 +311,7 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
         for label, text in study_texts(exact_numbers(edge), unit):
             _text_fitted(column, context, label, text)
         _text_fitted(column, context, "Pooled", f"{edge.pooled_angle:.2f}°")
-        image = bpy.data.images.get(edge.plot)
+        image = plot_image(edge)
         if image is not None:  # the image's preview icon, made on demand by layout.icon
             # As wide as the sidebar (scale counts 20-pixel icon units): a fixed 10 units left
             # the plot's numbers too small to read.

@@ -2,6 +2,7 @@
 and replayable with vg.measure_xyz; its record, plot, CSV rows, re-import, undo and delete."""
 
 import csv
+import importlib
 import json
 
 import bpy
@@ -105,6 +106,45 @@ def test_plot_image_is_made_packed_and_saved(vg, tmp_path):
     image.pixels.foreach_get(pixels)
     rgba = np.round(pixels.reshape(240, 480, 4)[::-1] * 255).astype(np.uint8)
     assert np.array_equal(rgba, expected)  # the plot drawn from the recorded numbers
+
+
+def test_each_edge_shows_and_deletes_only_its_own_plot(vg, tmp_path):
+    """Names are not identities. A duplicated object shares its edge's plot: deleting the copy's
+    edge keeps the original's (before: removed for good). An object appended from another file,
+    whose plot's name this file's object of the same name already holds, shows no plot rather
+    than the other object's, and deleting its edge leaves that plot alone."""
+    plots = importlib.import_module(f"{vg.__name__}.bridge.plots")
+    obj, _ = ramp_object("Bone")
+    measure_edge()
+    original = bpy.data.images[obj.vg.edges[0].plot]
+    original_name = original.name
+    bpy.ops.object.select_all(action="DESELECT")
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+    bpy.ops.object.duplicate()
+    copy = bpy.context.active_object
+    assert copy is not obj and plots.plot_image(copy.vg.edges[0]) == original
+    assert bpy.ops.vg.delete_edge() == {"FINISHED"}
+    assert not copy.vg.edges and plots.plot_image(obj.vg.edges[0]) == original
+    assert original.name in bpy.data.images
+
+    other = tmp_path / "other.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(other), copy=True)
+    bpy.data.objects.remove(copy)
+    bpy.context.view_layer.objects.active = obj
+    bpy.ops.vg.clear_measurements("EXEC_DEFAULT")
+    assert original_name not in bpy.data.images  # no other edge showed it
+    measure_edge(spacing=0.6)  # this file's Bone: another edge 1, whose plot takes the name
+    mine = plots.plot_image(obj.vg.edges[0])
+    with bpy.data.libraries.load(str(other), link=False) as (_source, target):
+        target.objects = ["Bone"]
+    appended = target.objects[0]
+    bpy.context.scene.collection.objects.link(appended)
+    assert appended.vg.edges[0].plot == mine.name  # the same name, another edge's plot
+    assert plots.plot_image(appended.vg.edges[0]) is None
+    bpy.context.view_layer.objects.active = appended
+    assert bpy.ops.vg.delete_edge() == {"FINISHED"}
+    assert plots.plot_image(obj.vg.edges[0]) == mine and mine.name in bpy.data.images
 
 
 def test_refusals_record_nothing(vg):
@@ -539,3 +579,22 @@ def test_the_panel_shows_the_study_figures_of_the_edge(vg, tmp_path):
     assert codec.study_texts(older, "mm") == [
         ("Study figures", "not recorded (an older version): measure again")
     ]
+
+
+def test_an_export_of_all_objects_imported_on_one_keeps_each_objects_edges_apart(vg, tmp_path):
+    """Edge numbers start at 1 on every object: the stations of A's edge 1 and B's edge 1 are
+    two edges on the object they are imported on, each as it was (before: one edge of both)."""
+    first, _ = ramp_object("A")
+    measure_edge()
+    second, _ = ramp_object("B")
+    measure_edge(spacing=0.4)
+    path = tmp_path / "both.csv"
+    assert bpy.ops.vg.export_csv(filepath=str(path), all_objects=True) == {"FINISHED"}
+    target, _ = ramp_object("C")
+    assert bpy.ops.vg.import_csv(filepath=str(path), ignore_mesh_names=True) == {"FINISHED"}
+    assert len(target.vg.edges) == 2
+    for edge, source in zip(target.vg.edges, (first, second), strict=True):
+        (original,) = source.vg.edges
+        assert edge.n_stations == original.n_stations
+        keys = ("arc_lengths", "angles", "spacing")
+        assert [exact(edge)[k] for k in keys] == [exact(original)[k] for k in keys]

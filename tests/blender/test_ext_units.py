@@ -3,6 +3,7 @@ guessed from its size, shown in the panel, the drag header and the CSV; stored n
 change."""
 
 import importlib
+import json
 
 import bpy
 import numpy as np
@@ -113,3 +114,29 @@ def test_the_csv_round_trip_keeps_the_units_and_the_colours(vg, tmp_path):
     painted_a, painted_b = colours(obj), colours(copy)
     differ = np.any(painted_a[:, :3] != painted_b[:, :3], axis=1)
     assert differ.sum() > 20
+
+
+def test_the_edge_file_and_a_file_with_failed_rows_carry_the_scan_units_on_import(vg, tmp_path):
+    """The edge file says the object's Scan Units as the measurement file does (before: the
+    scene's Blender units), and each import takes them; so does a measurement file holding a
+    batch run's failed row (an error, no coordinates), which before kept the guess."""
+    obj = measured(vg, 15.0)
+    obj.vg.unit = "CM"
+    points = json.dumps([[-9.0, 0.0, 0.0], [9.0, 0.0, 0.0]])
+    assert bpy.ops.vg.measure_edge(points=points, spacing=3.0, radius=6.0) == {"FINISHED"}
+    path = tmp_path / "cm.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    rows = csvio.read_measurements_csv(path)
+    edge_file = csvio.edges_path_for(path)
+    assert {r.units for r in rows} == {e.units for e in csvio.read_edges_csv(edge_file)} == {"cm"}
+    failed = csvio.MeasurementRow(
+        mesh_name=obj.name, radius=6.0, lam=2.0, units="cm", error="edge not measured: why"
+    )
+    with_failed = tmp_path / "with_failed.csv"
+    csvio.write_measurements_csv(with_failed, [*rows, failed])
+    for source in (edge_file, with_failed):
+        copy = measured(vg, 15.0, f"Copy of {source.stem}")
+        copy.vg.measurements.clear()
+        assert copy.vg.unit == "MM" and copy.vg.unit_guessed
+        assert bpy.ops.vg.import_csv(filepath=str(source), ignore_mesh_names=True) == {"FINISHED"}
+        assert copy.vg.unit == "CM", source.name

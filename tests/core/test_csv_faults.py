@@ -38,6 +38,27 @@ def test_a_non_finite_point_in_an_edges_csv_is_refused_with_its_row(bad):
         csvio.parse_points(f"0 0 0; {bad} 0 0")
 
 
+@pytest.mark.parametrize("kind", ["edges", "measurements"])
+def test_a_coordinates_cell_is_mesh_or_world_in_any_case_and_nothing_else(kind):
+    """Before, an edges CSV's "World" or "foo" was read as it stood, and the import took any
+    cell but "world" for mesh coordinates: a world-space edge would be traced at the wrong
+    place. Now the case is folded, an empty cell means world (as a file without the column),
+    and any other word is refused with its row."""
+    if kind == "edges":
+        fmt, read = csvio.format_edges_csv, csvio.read_edges_csv
+        row = edge_row()
+    else:
+        fmt, read = csvio.format_measurements_csv, csvio.read_measurements_csv
+        row = MeasurementRow(mesh_name="a", angle=90.0, radius=0.3, x=0.0, y=0.0, z=0.0)
+    text = fmt([row, dataclasses.replace(row, coordinates="world")])
+    assert [r.coordinates for r in read(text)] == ["mesh", "world"]
+    for cell, read_as in (("World", "world"), ("MESH", "mesh"), ("", "world")):
+        edited = text.replace(",world,", f",{cell},", 1)
+        assert [r.coordinates for r in read(edited)] == ["mesh", read_as]
+    with pytest.raises(GoniometerError, match=r"row 3: Coordinates is 'foo', not mesh or world"):
+        read(text.replace(",world,", ",foo,", 1))
+
+
 def test_a_row_that_cannot_be_written_costs_only_itself():
     good = MeasurementRow(mesh_name="a", angle=90.0, radius=0.3, x=0.0, y=0.0, z=0.0)
     bad = MeasurementRow(mesh_name="b", requested=(math.nan, 0.0, 0.0), radius=0.3, error="x")

@@ -55,7 +55,7 @@ EDGE_SCHEMA = (
     ("points", "text", ("Points",)),
     ("flat_spans", "text", ("Flat Spans",)),
     ("units", "text", ("Units",)),
-    ("coordinates", "text", ("Coordinates",)),
+    ("coordinates", "space", ("Coordinates",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
     ("error", "text", ("error",)),

@@ -51,8 +51,9 @@ MESHLAB_COLUMNS = (
 )
 
 
-# (MeasurementRow field, kind, CSV columns), in column order. Kinds: text, int, float, bool and
-# vec3 (three float columns).
+# (MeasurementRow field, kind, CSV columns), in column order. Kinds: text, int, float, bool,
+# flag (a bool that may be empty), space (mesh or world, see text.space_cell) and vec3 (three
+# float columns).
 SCHEMA = (
     ("mesh_name", "text", ("Mesh Name",)),
     ("date", "text", ("Date",)),
@@ -82,7 +83,7 @@ SCHEMA = (
     ("spacing", "float", ("Spacing",)),
     ("edge_closed", "flag", ("Edge Closed",)),
     ("units", "text", ("Units",)),
-    ("coordinates", "text", ("Coordinates",)),
+    ("coordinates", "space", ("Coordinates",)),
     ("precision", "text", ("Precision",)),
     ("stale", "bool", ("Stale",)),
     ("extension_version", "text", ("Extension Version",)),
@@ -385,7 +386,7 @@ def writable_row(row):
             row_cells(0, row, (entry,))
         except Exception:
             value = getattr(row, field)
-            if kind == "text":
+            if kind in ("text", "space"):
                 changes[field] = as_utf8(str(value))
                 problems.append(f"{columns[0]} {changes[field]!r} had characters UTF-8 cannot hold")
             else:

@@ -118,7 +118,7 @@ def row_cells(index: int, row, schema) -> list[str]:
     cells = []
     for field, kind, columns in schema:
         value = getattr(row, field)
-        if kind == "text":
+        if kind in ("text", "space"):
             text = "" if value is None else str(value)
             if not is_utf8(text):
                 raise _cell_error(index, row, columns[0], value, "text UTF-8 can hold")
@@ -369,6 +369,15 @@ def flag_cell(raw: str) -> tuple[bool | None, str]:
     return value, "" if value is not None else "is not TRUE or FALSE"
 
 
+def space_cell(raw: str) -> tuple[str, str]:
+    """A ``Coordinates`` cell: ``"mesh"`` or ``"world"`` in any case (empty: ``"world"``, as in
+    files written before the column), and why it is neither ("" when it is one)."""
+    value = raw.strip().casefold() or WORLD_COORDINATES
+    if value in COORDINATE_SPACES:
+        return value, ""
+    return WORLD_COORDINATES, f"is {raw.strip()!r}, not {' or '.join(COORDINATE_SPACES)}"
+
+
 def resolve_columns(header: list[str], aliases: dict, problems: list[str]) -> dict:
     """Field -> column index for the fields the header has; ambiguous names are problems."""
     positions: dict[str, list[int]] = {}
@@ -463,8 +472,9 @@ def parse_table(text, source, schema, row_type, optional, what, check=None):
                 values[field] = bool_cell(cell(names[0]))
                 if values[field] is None:
                     problems.append(f"row {number}: {names[0]} is not TRUE or FALSE")
-            elif kind == "flag":
-                values[field], why = flag_cell(cell(names[0]))
+            elif kind in ("flag", "space"):
+                parse = flag_cell if kind == "flag" else space_cell
+                values[field], why = parse(cell(names[0]))
                 if why:
                     problems.append(f"row {number}: {names[0]} {why}")
             else:
