@@ -17,6 +17,7 @@ from ..vg_addon.formats import csvio, picked_points, profile_plot
 from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.algorithm import DEFAULT_RULE
 from ..vg_addon.method.edge_profile import check_station_count
+from ..vg_addon.workflow import batchplan
 from .cli import UsageError
 from .find_edges import found_edge_specs
 
@@ -68,8 +69,9 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
             problems.append(f"row {number}: an edge needs two Points, a Spacing and a Radius")
             continue
         name = "" if args.ignore_mesh_names else row.mesh_name
-        if name and not any(csvio.mesh_name_matches(name, s.names) for s in sources):
-            problems.append(f"row {number}: no mesh given is named {name!r}")
+        mesh, why = closest_source(name, sources, f"row {number}")
+        if why:
+            problems.append(why)
             continue
         spec = {
             "points": [list(p) for p in points],
@@ -78,6 +80,7 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
             "lam": args.lam if row.lam is None else row.lam,
             "patch": row.patch or args.patch,
             "mesh_name": name,
+            "mesh": mesh,
             "note": row.user_data,  # kept on the replayed edge, as Blender's import keeps it
             "rule": row.rule.strip().lower(),  # "" (a file of an earlier version): the run's
             # Files of earlier versions hold world-space points (a mesh file's object is
@@ -184,8 +187,12 @@ def picked_point_specs(args, sources, passed_over: list | None = None) -> list[d
         except GoniometerError as error:
             problems.append(str(error))
             continue
+        mesh, why = closest_source(name, sources, path.name)
+        if why:
+            problems.append(why)
+            continue
         spec = args_spec(args, points.tolist(), mesh_name=name, note=path.name, given=path.name)
-        add_checked(specs, problems, spec, path.name)
+        add_checked(specs, problems, {**spec, "mesh": mesh}, path.name)
     if problems:
         raise UsageError(
             f"--edges {given}: {len(problems)} picked-points file(s) cannot be measured:\n"
@@ -216,9 +223,26 @@ def profiled(edge_rows: list) -> list:
     return [row for row in edge_rows if not row.error]
 
 
+def closest_source(name: str, sources, where: str) -> tuple[list | None, str]:
+    """The mesh an edge naming the mesh ``name`` is measured on, as its key for
+    :func:`spec_applies` (None for every mesh where ``name`` is empty), and why there is none
+    ("" when there is): the closest match among ``sources``, as for points
+    (``batchplan.closest_mesh``)."""
+    if not name:
+        return None, ""
+    index, why = batchplan.closest_mesh(name, [source.names for source in sources], where)
+    if index < 0:
+        return None, why
+    return [sources[index].name, sources[index].path], ""
+
+
 def spec_applies(spec: dict, source) -> bool:
-    """Whether edge ``spec`` is measured on the mesh ``source``."""
-    return csvio.mesh_name_matches(spec["mesh_name"], source.names)
+    """Whether edge ``spec`` is measured on the mesh ``source``: the one its name names most
+    closely (:func:`closest_source`), or every mesh where it names none."""
+    mesh = spec.get("mesh")
+    if mesh is None:
+        return csvio.mesh_name_matches(spec["mesh_name"], source.names)
+    return [source.name, source.path] == list(mesh)
 
 
 def not_found_row(options: dict, mesh_name: str, message: str, units):

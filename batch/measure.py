@@ -268,7 +268,7 @@ def sweep_sites(result: MeshResult, surface, name: str, stem: str, tasks, option
             if task.coordinates == records.WORLD:
                 center, _ = measuring.from_world(center, None, matrix)
             points = radius_sweep(
-                surface, center, start, stop, int(count), task.lam, task.patch, task.rule
+                surface, center, start, stop, count, task.lam, task.patch, task.rule
             )
         except GoniometerError as error:
             points = [

@@ -3,13 +3,14 @@ input (or another output), and every output must be a place the run can write to
 
 from __future__ import annotations
 
+import contextlib
 import os
 from pathlib import Path
 
 import bpy
 
 from ..vg_addon import GoniometerError
-from ..vg_addon.formats import csvio, files
+from ..vg_addon.formats import csvio, files, picked_points
 from ..vg_addon.workflow import batchplan
 from .cli import UsageError
 
@@ -37,8 +38,18 @@ def input_files(args) -> list[tuple[str, str]]:
         found.append(("input .blend", bpy.data.filepath))
     if args.points:
         found.append(("points CSV", args.points))
-    if getattr(args, "edges_csv", None):
-        found.append(("edges CSV", args.edges_csv))
+    edges = getattr(args, "edges_csv", None)
+    if edges and Path(edges).is_dir():  # a folder of MeshLab picked-points files
+        # A folder that cannot be listed is refused when the edges are read.
+        with contextlib.suppress(GoniometerError):
+            found += [("picked-points file", str(path)) for path in picked_points.files_in(edges)]
+    elif edges:
+        what = (
+            "picked-points file"
+            if Path(edges).suffix.lower() == picked_points.SUFFIX
+            else "edges CSV"
+        )
+        found.append((what, edges))
     return found
 
 
@@ -83,6 +94,12 @@ def _kind(out: str) -> str:
         raise UsageError(f"--out {out}: {error}") from None
 
 
+def _given(args, option: str) -> bool:
+    """Whether the command line gave ``option`` (``--find-edges``: ``args.find_edges``)."""
+    name = {"--edges": "edges_csv"}.get(option, option.removeprefix("--").replace("-", "_"))
+    return bool(getattr(args, name, None))
+
+
 def sweep_paths(out) -> tuple[Path, Path]:
     """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``."""
     out = Path(out).resolve()
@@ -99,14 +116,19 @@ def check_outputs(args) -> None:
     """
     outputs = [("--out", args.out), ("--save-blend", args.save_blend)]
     outputs = [(option, path) for option, path in outputs if path and path != files.STDOUT]
-    if (
-        args.out
-        and args.out != files.STDOUT
-        and any(getattr(args, name, None) for name in ("edge", "edges_csv", "find_edges"))
-    ):
+    stream = bool(args.out) and (
+        args.out == files.STDOUT or (os.path.exists(args.out) and _kind(args.out) == "stream")
+    )
+    edges = [name for name in ("--edge", "--edges", "--find-edges") if _given(args, name)]
+    if args.out and edges:
+        if stream:
+            raise UsageError(
+                f"{edges[0]} writes the edge summary <out>_edges.csv and a plot per edge beside "
+                f"--out, so --out {args.out} must be a file name, not standard output or a stream."
+            )
         outputs.append(("--out's edge summary", str(csvio.edges_path_for(args.out))))
     if args.sweep:
-        if args.out == files.STDOUT or (os.path.exists(args.out) and _kind(args.out) == "stream"):
+        if stream:
             raise UsageError(
                 f"--sweep writes <out>_sweep.csv and a plot folder beside --out, so --out "
                 f"{args.out} must be a file name, not standard output or a stream."

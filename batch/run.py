@@ -431,7 +431,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "units": units,
         "stability": bool(args.stability),
         "rule": args.rule,  # of the edge stations; the points' rule is each task's own
-        "sweep": list(args.sweep) if args.sweep else None,
+        "sweep": [*args.sweep[:2], int(args.sweep[2])] if args.sweep else None,
         "sweep_plots": str(sweep_paths(args.out)[1]) if args.sweep else "",
         "edges": edges,
         "find_edges": find_options(args),

@@ -154,3 +154,21 @@ def test_failed_edges_are_listed_up_to_ten_then_counted(tmp_path):
     listed = [line for line in result.stderr.splitlines() if "  failed: edge " in line]
     assert len(listed) == 10, result.stderr
     assert "... and 2 more failed edges (see the error column)" in result.stderr
+
+
+def test_an_edges_csv_row_is_measured_on_the_mesh_it_names_most_closely(tmp_path):
+    """Two meshes whose names both fit the row's " lead" (one exactly, one without the space):
+    the edge is measured on the exact one only, as a --points row is (before: on both)."""
+    shape = wedge(90.0, n=30, irregular=True, seed=2)
+    exact_name = meshio.write_ply(tmp_path / " lead.ply", shape.points, shape.triangles)
+    trimmed = meshio.write_ply(tmp_path / "lead.ply", shape.points, shape.triangles)
+    first = tmp_path / "first.csv"
+    result = batch(exact_name, "--edge", *EDGES[0], "--spacing", 0.1, "--radius", 0.2,
+                   "--out", first)  # fmt: skip
+    assert result.returncode == 0, result.stdout + result.stderr
+    stations = csvio.read_measurements_csv(first)
+    replay = tmp_path / "replay.csv"
+    result = batch(trimmed, exact_name, "--edges", csvio.edges_path_for(first), "--out", replay)
+    assert result.returncode == 0, result.stdout + result.stderr
+    rows = csvio.read_measurements_csv(replay)
+    assert [(r.mesh_name, r.angle) for r in rows] == [(" lead", r.angle) for r in stations]

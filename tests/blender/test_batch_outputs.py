@@ -7,11 +7,13 @@ from __future__ import annotations
 
 import importlib
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import bpy
 import pytest
-from bpy_helpers import arguments, batch, outcome_of_check
+from bpy_helpers import BATCH_SCRIPT, arguments, batch, outcome_of_check
 from unprivileged import as_user
 
 from vg_addon.formats import csvio, meshio
@@ -180,6 +182,22 @@ def test_a_break_number_blender_cannot_store_refuses_the_points_csv(scan, tmp_pa
     refused(batch(scan, "--points", points, "--radius", "0.3", "--out", out),
             f"row 3: Break # must be a whole number from 1 to 2147483647 (got '{cell}')")  # fmt: skip
     assert not out.exists()
+
+
+def test_edges_need_a_file_out_not_standard_output_or_a_stream(scan, tmp_path):
+    """The edge summary and the plots are written beside --out: with standard output or a pipe
+    as --out the run is refused before anything is read (before: "-" wrote -_edges.csv and
+    -_scan_edge1.png into the current folder, and a pipe failed at the end, blaming the CSV)."""
+    edge = ("--edge", "-0.4", "0", "0", "0.4", "0", "0", "--spacing", "0.2", "--radius", "0.3")
+    for option in (edge, ("--find-edges", "--spacing", "0.2", "--radius", "0.3")):
+        refused(batch(scan, *option, "--out", "-", cwd=tmp_path), f"{option[0]} writes the edge summary",
+                "must be a file name, not standard output or a stream")  # fmt: skip
+        piped = subprocess.run(  # --out /dev/stdout into a pipe: a stream
+            [sys.executable, str(BATCH_SCRIPT), str(scan), *option, "--out", "/dev/stdout"],
+            capture_output=True, text=True, cwd=tmp_path, check=False,
+        )  # fmt: skip
+        refused(piped, "must be a file name, not standard output or a stream")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scan.ply"]
 
 
 def test_sweep_outputs_are_checked_like_the_others(scan, tmp_path):

@@ -145,3 +145,20 @@ def test_a_pp_file_picked_on_a_shifted_copy_is_refused_naming_it(tmp_path):
     (row,) = csvio.read_measurements_csv(typed)
     assert "--edge 1: point 2 (" in row.error and " is 1.5 from the mesh" in row.error
     assert "point 1 " not in row.error and "point 3 " not in row.error
+
+
+def test_a_pp_file_in_the_edges_folder_is_never_overwritten(tmp_path):
+    """--out naming a picked-points file of the --edges folder (or the summary beside it) is
+    refused before anything is read, as an edges CSV given by name is (before: the MeshLab file
+    was replaced by the run's CSV)."""
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+    mesh = meshio.write_ply(tmp_path / "ramp.ply", shape.points, shape.triangles)
+    pick = write_pp(tmp_path / "ramp_a.pp", [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    before = pick.read_bytes()
+    for out in (pick, tmp_path / "ramp.pp"):  # the second's summary would be ramp_edges.pp
+        if out != pick:
+            write_pp(tmp_path / "ramp_edges.pp", [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+        result = ok(batch(mesh, "--edges", tmp_path, "--spacing", 0.5, "--radius", 0.3,
+                          "--out", out), 2)  # fmt: skip
+        assert "is the picked-points file" in result.stderr and "nothing was read" in result.stderr
+    assert pick.read_bytes() == before and not (tmp_path / "ramp.pp").exists()

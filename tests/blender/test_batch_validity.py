@@ -55,6 +55,31 @@ def test_concave_wedge_rules_stability_and_sweep(tmp_path):
     assert abs(row.angle - expected) < 1e-5 and abs(expected - 110) > 5  # the old misreading
 
 
+def test_a_sweep_site_that_no_radius_can_measure_fails_alone(tmp_path):
+    """A site on a flat face: its row and its sweep rows fail, saying why; the crease's row and
+    sweep are measured as without it (before: an internal error lost every row of the mesh, with
+    a traceback)."""
+    shape = wedge(100, n=40)
+    path = tmp_path / "wedge.ply"
+    meshio.write_ply(path, shape.points, shape.triangles)
+    flat = shape.points[np.argmax(np.abs(shape.points[:, 1]))]  # a face's far rim
+    sites = ["--at", "0.01", "0", "0", "--at", *(repr(float(v)) for v in flat)]
+    out = tmp_path / "angles.csv"
+    run = run_batch(path, *sites, "--radius", "0.3", "--sweep", "0.1", "0.3", "3", "--out", out)
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert "Traceback" not in run.stderr and "internal error" not in run.stderr
+    crease, rim = csvio.read_measurements_csv(out)
+    expected = core_surface(path).measure([0.01, 0, 0], 0.3)
+    assert not crease.error and abs(crease.angle - expected.angle) < 1e-5
+    assert rim.error and rim.angle is None
+    with open(tmp_path / "angles_sweep.csv", newline="", encoding="utf-8") as handle:
+        sweep = list(csv.DictReader(handle))
+    assert [(r["Measurement #"], float(r["Radius"])) for r in sweep] == [
+        (number, radius) for number in ("1", "2") for radius in (0.1, 0.2, 0.3)
+    ]
+    assert all(r["Angle"] for r in sweep[:3]) and not any(r["Angle"] for r in sweep[3:])
+
+
 def test_meshlab_rows_keep_the_papers_rule(tmp_path):
     shape = wedge(90, n=40, irregular=True, seed=4, concave=True)
     path = tmp_path / "valley.ply"

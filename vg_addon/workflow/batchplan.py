@@ -310,31 +310,41 @@ def plan_rows(
 
 def _match(row: ReplicationRow, meshes: Sequence[Sequence[str]]) -> tuple[int, str]:
     """``(mesh index, "")`` for the mesh ``row`` names, or ``(-1, why not)``."""
-    # The closest match wins: an exact name before one without surrounding spaces before a file
-    # stem, and a mesh's primary name (its object's) before its other names (mesh data).
+    return closest_mesh(row.mesh_name, meshes, f"row {row.row_number}")
+
+
+def closest_mesh(
+    mesh_name: str | None, meshes: Sequence[Sequence[str]], where: str
+) -> tuple[int, str]:
+    """The one mesh ``mesh_name`` names, as ``(index in meshes, "")``, or ``(-1, why not)``
+    (``where`` names the row or file in the reason).
+
+    ``meshes`` holds each mesh's names, its primary name (its object's) first. The closest match
+    wins: an exact name before one without surrounding spaces before a file stem, and a primary
+    name before a mesh's other names (mesh data); a tie between meshes is no match.
+    """
     closeness = {}
     for i, names in enumerate(meshes):
-        primary, any_name = (mesh_name_match(row.mesh_name, n) for n in (names[:1], names))
+        primary, any_name = (mesh_name_match(mesh_name, n) for n in (names[:1], names))
         if any_name is not None:
             closeness[i] = (any_name, 0 if primary == any_name else 1)
     best = min(closeness.values(), default=None)
     found = [i for i, key in closeness.items() if key == best]
     if len(found) == 1:
         return found[0], ""
-    where = f"row {row.row_number}"
     if not found:
         known = ", ".join(repr(names[0]) for names in meshes[:10])
         more = ", ..." if len(meshes) > 10 else ""
         return -1, (
-            f"{where} names mesh {row.mesh_name!r}, which is not among the meshes given "
+            f"{where} names mesh {mesh_name!r}, which is not among the meshes given "
             f"({known}{more}): give that mesh's file, or fix the name"
             + (" (or use --ignore-mesh-names)" if len(meshes) == 1 else "")
             + "."
         )
-    if not (row.mesh_name or "").strip():
+    if not (mesh_name or "").strip():
         return -1, f"{where} names no mesh, and several are given: fill in its mesh column."
     listed = ", ".join(repr(meshes[i][0]) for i in found)
-    return -1, f"{where}: mesh name {row.mesh_name!r} fits several meshes ({listed}): rename one."
+    return -1, f"{where}: mesh name {mesh_name!r} fits several meshes ({listed}): rename one."
 
 
 def _check_defaults(radius, lam, patch) -> tuple[float | None, float, str]:
