@@ -391,14 +391,18 @@ def redraw_plots(obj) -> None:
 
 
 def delete_edge(obj, index: int, *, depsgraph=None) -> int:
-    """Delete the edge at list position ``index``, its stations and its plot; repaint.
+    """Delete the edge at list position ``index``, its stations and its plot; repaint (where
+    the mesh can be read: with every vertex deleted the records still go).
 
     Returns the deleted edge's number.
     """
     data = obj.vg
     if not 0 <= index < len(data.edges):
         raise GoniometerError(f"'{obj.name}' has no edge profile at list position {index}.")
-    geometry = evaluated_geometry(obj, depsgraph)
+    try:
+        geometry = evaluated_geometry(obj, depsgraph)
+    except GoniometerError:
+        geometry = None  # every vertex deleted: the records still go, and nothing is painted
     edge = data.edges[index]
     number = edge.number
     remove_plots([edge])
@@ -408,5 +412,6 @@ def delete_edge(obj, index: int, *, depsgraph=None) -> int:
     data.active_index = min(data.active_index, max(len(data.measurements) - 1, 0))
     data.edges.remove(index)
     data.active_edge_index = min(index, max(len(data.edges) - 1, 0))
-    measuring.repaint(obj, geometry=geometry)
+    if geometry is not None:
+        measuring.repaint(obj, geometry=geometry)
     return number

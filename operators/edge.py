@@ -184,6 +184,7 @@ class VG_OT_measure_edge(PatchProperties, RuleProperties, bpy.types.Operator):
         name="Points",
         description="Start, via points and end of the edge, as JSON [[x, y, z], ...] (exact "
         "float64) in the coordinates Space says; each snaps to the nearest vertex",
+        options={"SKIP_SAVE"},  # never the last call's edge: a call without points is refused
     )
     space: EnumProperty(
         name="Space",
@@ -194,7 +195,9 @@ class VG_OT_measure_edge(PatchProperties, RuleProperties, bpy.types.Operator):
     spacing: length_property(
         "Spacing", "Arc length between stations, in mesh units; default: the panel's"
     )
-    note: StringProperty(name="Note", description="Free text stored with the edge")
+    note: StringProperty(
+        name="Note", description="Free text stored with the edge", options={"SKIP_SAVE"}
+    )
 
     @classmethod
     def poll(cls, context):
@@ -292,7 +295,11 @@ class VG_OT_delete_edge(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
 
     index: IntProperty(
-        name="Index", description="Position in the list; -1: the selected one", default=-1, min=-1
+        name="Index",
+        description="Position in the list; -1: the selected one",
+        default=-1,
+        min=-1,
+        options={"SKIP_SAVE"},  # the panel's button deletes the selected one, never the last index
     )
 
     @classmethod

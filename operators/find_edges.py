@@ -340,15 +340,19 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
     bl_label = "Find Break Edges"
     bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
 
+    # What to record is never taken from an earlier call (SKIP_SAVE): a call that names
+    # nothing is refused, not given the last call's edges.
     edges: StringProperty(
         name="Edges",
         description="The edges to record, as JSON [[[x, y, z], ...], ...] in mesh coordinates "
         "(each its start, via points and end); set by a finished review",
+        options={"SKIP_SAVE"},
     )
     accept: StringProperty(
         name="Accept",
         description="Without Edges: find the candidates and record these, ALL or numbers like "
         "'1 3 4' (the numbers the review shows)",
+        options={"SKIP_SAVE"},
     )
     spacing: length_property(
         "Spacing", "Arc length between stations, in mesh units; default: the panel's"
@@ -370,7 +374,9 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
         soft_min=0.0,
         soft_max=90.0,
     )
-    note: StringProperty(name="Note", description="Free text stored with each edge")
+    note: StringProperty(
+        name="Note", description="Free text stored with each edge", options={"SKIP_SAVE"}
+    )
 
     @classmethod
     def poll(cls, context):
@@ -406,7 +412,8 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        self.edges = format_edges_json([points for points, _ in measured])
+        # Edges found by Accept are not written back: a redo with another Accept, Scale, Min
+        # Length or Min Bend finds them again.
         return self.recorded(obj, record_all(obj, measured, geometry, self.note))
 
     def find(self, surface) -> list[np.ndarray]:

@@ -55,7 +55,9 @@ class MeasureProperties(LocationProperties, PatchProperties, RuleProperties):
     """The inputs of a measurement, shared by every operator that records one (a mixin, so
     the drag tool's recorded values mean exactly what xyz entry's do)."""
 
-    note: StringProperty(name="Note", description="Free text stored with the measurement")
+    note: StringProperty(
+        name="Note", description="Free text stored with the measurement", options={"SKIP_SAVE"}
+    )
 
 
 class VG_OT_measure_xyz(MeasureProperties, bpy.types.Operator):
@@ -126,17 +128,18 @@ def _active_measurable(operator, context):
     return obj
 
 
-def _active_geometry(operator, context):
-    """The measurable active object and its evaluated geometry, or ``(None, None)`` after
-    reporting why not."""
+def _removing(operator, context):
+    """The measurable active object whose records are to be removed, and its evaluated geometry
+    to repaint with: ``(None, None)`` after reporting why the object cannot be changed, or
+    ``(obj, None)`` where its mesh cannot be read now (every vertex deleted): records can always
+    be removed, and then there is nothing to repaint."""
     obj = _active_measurable(operator, context)
     if obj is None:
         return None, None
     try:
         return obj, evaluated_geometry(obj, context.evaluated_depsgraph_get())
-    except GoniometerError as error:
-        operator.report({"ERROR"}, str(error))
-        return None, None
+    except GoniometerError:
+        return obj, None
 
 
 class VG_OT_next_break(bpy.types.Operator):
@@ -168,7 +171,11 @@ class VG_OT_delete_measurement(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
 
     index: IntProperty(
-        name="Index", description="Position in the list; -1: the selected one", default=-1, min=-1
+        name="Index",
+        description="Position in the list; -1: the selected one",
+        default=-1,
+        min=-1,
+        options={"SKIP_SAVE"},  # the panel's button deletes the selected one, never the last index
     )
 
     @classmethod
@@ -182,14 +189,15 @@ class VG_OT_delete_measurement(bpy.types.Operator):
         if data is not None and not 0 <= index < len(data.measurements):
             self.report({"ERROR"}, f"'{obj.name}' has no measurement at list position {index}.")
             return {"CANCELLED"}
-        obj, geometry = _active_geometry(self, context)
+        obj, geometry = _removing(self, context)
         if obj is None:
             return {"CANCELLED"}
         data = obj.vg
         number = data.measurements[index].number
         data.measurements.remove(index)
         data.active_index = min(index, max(len(data.measurements) - 1, 0))
-        measuring.repaint(obj, geometry=geometry)
+        if geometry is not None:
+            measuring.repaint(obj, geometry=geometry)
         self.report({"INFO"}, f"Deleted measurement {number} of '{obj.name}'")
         return {"FINISHED"}
 
@@ -209,7 +217,7 @@ class VG_OT_clear_measurements(bpy.types.Operator):
         return context.window_manager.invoke_confirm(self, event)
 
     def execute(self, context):
-        obj, geometry = _active_geometry(self, context)
+        obj, geometry = _removing(self, context)
         if obj is None:
             return {"CANCELLED"}
         count = len(obj.vg.measurements)
@@ -221,7 +229,8 @@ class VG_OT_clear_measurements(bpy.types.Operator):
         obj.vg.active_index = 0
         obj.vg.next_number = 1
         obj.vg.break_number = 1
-        measuring.repaint(obj, geometry=geometry)
+        if geometry is not None:
+            measuring.repaint(obj, geometry=geometry)
         self.report({"INFO"}, f"Cleared {count} measurement(s) of '{obj.name}'")
         return {"FINISHED"}
 
@@ -289,7 +298,9 @@ class VG_OT_stability_warning(bpy.types.Operator):
         if item is None:
             self.report({"ERROR"}, f"No measurement at list position {self.index}.")
             return {"CANCELLED"}
-        context.active_object.vg.active_index = self.index  # select the row clicked
+        obj = context.active_object
+        if obj.is_editable and obj.library is None and obj.override_library is None:
+            obj.vg.active_index = self.index  # select the row clicked (linked data stays as is)
         warning = item.stability_warning or "not flagged: its stability figure is small."
         self.report({"WARNING"}, f"Measurement {item.number}: {warning}")
         return {"FINISHED"}

@@ -54,6 +54,18 @@ def edited_csv(source, target, edit_row=None, drop=()) -> Path:
     return Path(target)
 
 
+def linked_object(library, name):
+    """The object ``name`` of the .blend ``library``, linked (not appended) into a fresh empty
+    file's scene and made active: data this file cannot change."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    with bpy.data.libraries.load(str(library), link=True) as (_source, target):
+        target.objects = [name]
+    obj = target.objects[0]
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    return obj
+
+
 def mesh_object(
     name, points, triangles, *, location=(0, 0, 0), rotation=(0, 0, 0), scale=(1, 1, 1)
 ):

@@ -7,6 +7,7 @@ from bpy_helpers import (
     colours,
     exact,
     expected_colours,
+    linked_object,
     local_points,
     snapshot,
     wedge_object,
@@ -111,12 +112,7 @@ def test_linked_data_is_read_only(vg, tmp_path):
     wedge_object(100.0, "Linked wedge")
     library = tmp_path / "library.blend"
     bpy.data.libraries.write(str(library), {bpy.data.objects["Linked wedge"]})
-    bpy.ops.wm.read_homefile(use_empty=True)
-    with bpy.data.libraries.load(str(library), link=True) as (_source, target):
-        target.objects = ["Linked wedge"]
-    obj = target.objects[0]
-    bpy.context.scene.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
+    obj = linked_object(library, "Linked wedge")
     assert obj.library is not None
     assert_refused("is linked from .*library.blend.*Make Local", location=(0, 0, 0), radius=0.5)
     assert len(obj.vg.measurements) == 0

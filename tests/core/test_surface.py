@@ -262,3 +262,21 @@ def test_corner_edges_are_checked():
         Surface(mesh.points, mesh.triangles, corner_edges=np.arange(5))
     with pytest.raises(GoniometerError, match="negative"):
         Surface(mesh.points, mesh.triangles, corner_edges=-np.ones(mesh.triangles.shape, dtype=int))
+
+
+@pytest.mark.parametrize("far", [1e308, -1e308, 1.7e308])
+def test_a_centre_as_far_as_a_double_reaches_is_refused_not_a_traceback(far):
+    """Before, a finite centre 1e308 away made the grid's cell number infinite, and turning it
+    into an integer raised OverflowError through measure, measure_along and the operators."""
+    shape = wedge(90.0, n=20)
+    surface = Surface(shape.points, shape.triangles)
+    for axis in range(3):
+        center = [0.0, 0.0, 0.0]
+        center[axis] = far
+        with pytest.raises(GoniometerError, match="farther than the radius"):
+            surface.measure(center, 0.3)
+        with pytest.raises(GoniometerError):
+            surface.measure_along([center, [0.5, 0.0, 0.0]], 0.2, 0.3)
+    grid = GridIndex(shape.points, 0.1)
+    assert grid.ball([far, 0.0, 0.0], 0.3)[0].size == 0
+    assert grid.nearest([far, 0.0, 0.0], 1.0) == (-1, float("inf"))

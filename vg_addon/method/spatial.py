@@ -66,6 +66,15 @@ def _sample_by_position(points: np.ndarray, stride: int) -> np.ndarray:
     return (mixed >> np.uint64(33)) % np.uint64(stride) == 0
 
 
+def _cell_within(position: float, top: int) -> int:
+    """``floor(position)`` clamped to the cells 0 to ``top`` (``position`` may be infinite)."""
+    if position <= 0:
+        return 0
+    if position >= top:
+        return top
+    return math.floor(position)
+
+
 class GridIndex:
     """Points sorted by the cell of a uniform grid they fall in, for fast ball queries.
 
@@ -120,16 +129,18 @@ class GridIndex:
         """Positions (into the sorted arrays) of the points in the cells the ball's box overlaps."""
         # Plain float arithmetic: the same IEEE operations as NumPy's on 3-vectors, without the
         # per-call overhead of tiny arrays.
+        # Cell coordinates stay floats until clamped: a centre 1e308 away is +inf cells away,
+        # beyond the grid, not an integer overflow.
         size = self.cell_size
         low, high = [], []
         for axis in range(3):
             c, o, top = float(center[axis]), float(self.origin[axis]), self._top[axis]
-            lo = math.floor((c - radius - o) / size) if math.isfinite(radius) else -math.inf
-            hi = math.floor((c + radius - o) / size) if math.isfinite(radius) else math.inf
-            if hi < 0 or lo > top:
+            lo = (c - radius - o) / size if math.isfinite(radius) else -math.inf
+            hi = (c + radius - o) / size if math.isfinite(radius) else math.inf
+            if hi < 0 or lo >= top + 1:  # floor(hi) < 0 or floor(lo) > top
                 return np.empty(0, dtype=np.int64)
-            low.append(int(min(max(lo, 0), top)))
-            high.append(int(min(max(hi, 0), top)))
+            low.append(_cell_within(lo, top))
+            high.append(_cell_within(hi, top))
         ix = np.arange(low[0], high[0] + 1, dtype=np.int64)
         iy = np.arange(low[1], high[1] + 1, dtype=np.int64)
         column = ((ix[:, None] * self.dims[1] + iy[None, :]) * self.dims[2]).ravel()
