@@ -109,4 +109,56 @@ def distance_to_line(points, on_line, direction) -> np.ndarray:
     return np.sqrt(np.maximum(squares[0] + squares[1] + squares[2] - along * along, 0.0))
 
 
-__all__ = ["RANK_TOLERANCE", "crease_line", "distance_to_line", "side_plane"]
+SIDE_REACH = 0.1
+"""A side shows which way its face runs from the crease only where its centroid lies at least
+this fraction of the patch radius from the crease line (:func:`sides_contradict_normals`)."""
+
+LINE_REACH = 0.25
+"""The sides show how their faces meet only where the planes' line passes within this fraction
+of the patch radius of the centre: near-parallel planes meet far off, with both sides on one
+side of their line (:func:`sides_contradict_normals`)."""
+
+
+def sides_contradict_normals(points, labels, normal_plus, normal_minus, center, radius) -> bool:
+    """Whether the two sides' plane normals face each other the wrong way round for where the
+    sides lie: the angle between the planes would then read as its supplement.
+
+    Each face runs from the crease line, within its plane, towards its side's centroid, along
+    ``±(d × n)`` (``d`` the line's direction, ``n`` the face's normal). With both normals facing
+    out of the material (or both into it), the two signs differ: the faces' directions then make
+    the angle ``180° − arccos(n₊·n₋)`` that is reported. Equal signs mean that one face's
+    normals were oriented the wrong way round (a point cloud's estimated normals across an
+    acute crease). ``False`` (no verdict) where the planes are parallel, their line passes
+    farther than :data:`LINE_REACH` radii from the centre, or a centroid lies within
+    :data:`SIDE_REACH` radii of the line.
+    """
+    if labels.all() or not labels.any():
+        return False
+    centroids = [
+        np.add.reduce(np.compress(side, points, axis=0), axis=0) / np.count_nonzero(side)
+        for side in (labels, ~labels)
+    ]
+    line = crease_line([(normal_plus, centroids[0]), (normal_minus, centroids[1])], center)
+    if line is None:
+        return False
+    on_line, direction = line
+    if norm3(np.asarray(center, dtype=np.float64) - on_line) > LINE_REACH * radius:
+        return False  # on_line is the line's point nearest the centre
+    reach = [
+        dot3(cross3(direction, normal), centroid - on_line)
+        for normal, centroid in zip((normal_plus, normal_minus), centroids, strict=True)
+    ]
+    if min(abs(value) for value in reach) < SIDE_REACH * radius:
+        return False
+    return (reach[0] > 0) == (reach[1] > 0)
+
+
+__all__ = [
+    "LINE_REACH",
+    "RANK_TOLERANCE",
+    "SIDE_REACH",
+    "crease_line",
+    "distance_to_line",
+    "side_plane",
+    "sides_contradict_normals",
+]

@@ -21,6 +21,7 @@ from .algorithm import (
 from .geodesic import EdgeGraph
 from .normals import pca_normals, vertex_normals
 from .ordering import canonical_ranks
+from .planes import sides_contradict_normals
 from .result import Measurement
 from .spatial import GridIndex
 from .stability import SMALL_PATCH_VERTICES, estimate_stability
@@ -106,6 +107,8 @@ class Surface:
         if self.triangles is not None and corner_edges is not None:
             self._corner_edges = _as_corner_edges(corner_edges, self.triangles.shape[0])
         full_index = None
+        # A point cloud's normals are estimated, and their orientation can fail (see measure).
+        self.estimated_orientation = normals is None and self.triangles is None
         if normals is not None:
             self.normals = as_normals(normals, n)
             self.valid = np.ones(n, dtype=bool)
@@ -250,6 +253,20 @@ class Surface:
             lam,
             rule,
         )
+        if self.estimated_orientation and sides_contradict_normals(
+            np.take(self.points, indices, axis=0),
+            fields["labels"],
+            fields["normal_plus"],
+            fields["normal_minus"],
+            self.points[center_index],
+            radius,
+        ):
+            raise GoniometerError(
+                "The point cloud's estimated normals face opposite ways on the two sides of this "
+                "crease (one face's were oriented the wrong way round, as can happen across an "
+                "acute edge), so the angle would read as its supplement: measure the scan as a "
+                "mesh, or give the cloud normals you trust."
+            )
         measurement = Measurement(
             **fields,
             indices=indices,
