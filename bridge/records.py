@@ -524,8 +524,9 @@ def closed_edges(obj) -> dict[int, bool]:
     return {edge.number: edge_is_closed(exact_numbers(edge)) for edge in obj.vg.edges}
 
 
-def edge_row(obj, edge, *, units: str) -> csvio.EdgeRow:
-    """The edge summary CSV row of ``edge``, measured on ``obj``."""
+def edge_row(obj, edge, *, units: str, stale: bool = False) -> csvio.EdgeRow:
+    """The edge summary CSV row of ``edge``, measured on ``obj`` (``stale``: some of its
+    stations were measured on other geometry than the mesh has now)."""
     numbers = exact_numbers(edge)
     spans = numbers.get("flat_spans", [])
     return csvio.EdgeRow(
@@ -553,6 +554,7 @@ def edge_row(obj, edge, *, units: str) -> csvio.EdgeRow:
         flat_spans="; ".join(f"{a!r}-{b!r}" for a, b in spans),
         units=units,
         coordinates=numbers.get("space", WORLD),
+        stale=stale,
         extension_version=extension_version(),
         blender_version=bpy.app.version_string,
     )

@@ -225,10 +225,16 @@ def export_rows(objects, scene, *, depsgraph=None) -> list:
     return rows
 
 
-def export_edge_rows(objects, scene) -> list:
-    """Edge summary CSV rows of every edge profile of ``objects``, in list order."""
-    return [
-        records.edge_row(obj, edge, units=records.units_label(scene, obj))
-        for obj in objects
-        for edge in obj.vg.edges
-    ]
+def export_edge_rows(objects, scene, *, depsgraph=None) -> list:
+    """Edge summary CSV rows of every edge profile of ``objects``, in list order; an edge with a
+    stale station is flagged stale."""
+    rows = []
+    for obj in objects:
+        stale = measuring.stale_numbers(obj, depsgraph=depsgraph)
+        stale_edges = {item.edge_number for item in obj.vg.measurements if item.number in stale}
+        units = records.units_label(scene, obj)
+        rows.extend(
+            records.edge_row(obj, edge, units=units, stale=edge.number in stale_edges)
+            for edge in obj.vg.edges
+        )
+    return rows

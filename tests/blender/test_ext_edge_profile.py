@@ -598,3 +598,23 @@ def test_an_export_of_all_objects_imported_on_one_keeps_each_objects_edges_apart
         assert edge.n_stations == original.n_stations
         keys = ("arc_lengths", "angles", "spacing")
         assert [exact(edge)[k] for k in keys] == [exact(original)[k] for k in keys]
+
+
+def test_the_edge_file_says_which_edges_have_stale_stations(vg, tmp_path):
+    """After the mesh changed under one edge's stations, their rows say Stale and so does that
+    edge's row of the edge file (before: the edge row looked as before); an edge file of an
+    earlier version, without the column, reads "not known"."""
+    obj, _ = ramp_object()
+    measure_edge()
+    measure_edge(points=[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]], spacing=0.4, radius=0.25)
+    path = tmp_path / "m.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    assert [e.stale for e in csvio.read_edges_csv(csvio.edges_path_for(path))] == [False, False]
+    obj.data.vertices[0].co.z += 0.5  # a far corner: every record's geometry changed
+    obj.data.update()
+    bpy.ops.vg.export_csv(filepath=str(path))
+    rows = csvio.read_measurements_csv(path)
+    edges = csvio.read_edges_csv(csvio.edges_path_for(path))
+    assert all(r.stale for r in rows) and [e.stale for e in edges] == [True, True]
+    older = edited_csv(csvio.edges_path_for(path), tmp_path / "old_edges.csv", drop=["Stale"])
+    assert [e.stale for e in csvio.read_edges_csv(older)] == [None, None]

@@ -56,6 +56,7 @@ EDGE_SCHEMA = (
     ("flat_spans", "text", ("Flat Spans",)),
     ("units", "text", ("Units",)),
     ("coordinates", "space", ("Coordinates",)),
+    ("stale", "flag", ("Stale",)),
     ("extension_version", "text", ("Extension Version",)),
     ("blender_version", "text", ("Blender Version",)),
     ("error", "text", ("error",)),
@@ -71,7 +72,7 @@ STUDY_COLUMNS = ("Median Angle", "Angle Range", "Arc Length", "Chord Length", "A
 
 #: Columns added to the edge summary file after its first version: files without them read,
 #: their cells blank.
-LATER_EDGE_COLUMNS = ("Coordinates", "Rule", *STUDY_COLUMNS)
+LATER_EDGE_COLUMNS = ("Coordinates", "Rule", "Stale", *STUDY_COLUMNS)
 
 
 @dataclass
@@ -112,6 +113,9 @@ class EdgeRow:
         ``"world"``: in Blender world space (files written before this column existed).
     flat_spans : str
         Arc-length intervals where the path crossed no ridge, ``"a-b; ..."``; empty if none.
+    stale : bool or None
+        Some of the edge's stations were measured on other geometry than the mesh has now (the
+        mesh changed since); None (not known) in files written before the column.
     """
 
     mesh_name: str = ""
@@ -142,6 +146,7 @@ class EdgeRow:
     flat_spans: str = ""
     units: str = ""
     coordinates: str = MESH_COORDINATES
+    stale: bool | None = False
     extension_version: str = ""
     blender_version: str = ""
     error: str = ""
