@@ -94,10 +94,10 @@ def _kind(out: str) -> str:
         raise UsageError(f"--out {out}: {error}") from None
 
 
-def _given(args, option: str) -> bool:
-    """Whether the command line gave ``option`` (``--find-edges``: ``args.find_edges``)."""
-    name = {"--edges": "edges_csv"}.get(option, option.removeprefix("--").replace("-", "_"))
-    return bool(getattr(args, name, None))
+def _is_stream(out) -> bool:
+    """Whether ``--out`` is standard output or a stream (a pipe, a terminal, a device), which
+    nothing can be written beside."""
+    return out == files.STDOUT or (os.path.exists(out) and _kind(out) == "stream")
 
 
 def sweep_paths(out) -> tuple[Path, Path]:
@@ -116,19 +116,17 @@ def check_outputs(args) -> None:
     """
     outputs = [("--out", args.out), ("--save-blend", args.save_blend)]
     outputs = [(option, path) for option, path in outputs if path and path != files.STDOUT]
-    stream = bool(args.out) and (
-        args.out == files.STDOUT or (os.path.exists(args.out) and _kind(args.out) == "stream")
-    )
-    edges = [name for name in ("--edge", "--edges", "--find-edges") if _given(args, name)]
+    edge_options = (("--edge", "edge"), ("--edges", "edges_csv"), ("--find-edges", "find_edges"))
+    edges = [option for option, name in edge_options if getattr(args, name, None)]
     if args.out and edges:
-        if stream:
+        if _is_stream(args.out):
             raise UsageError(
                 f"{edges[0]} writes the edge summary <out>_edges.csv and a plot per edge beside "
                 f"--out, so --out {args.out} must be a file name, not standard output or a stream."
             )
         outputs.append(("--out's edge summary", str(csvio.edges_path_for(args.out))))
     if args.sweep:
-        if stream:
+        if _is_stream(args.out):
             raise UsageError(
                 f"--sweep writes <out>_sweep.csv and a plot folder beside --out, so --out "
                 f"{args.out} must be a file name, not standard output or a stream."

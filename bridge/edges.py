@@ -383,10 +383,11 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
 def redraw_plots(obj) -> None:
     """Draw every edge's plot of ``obj`` again (after its Scan Units changed: the axis names
     them), each replacing the image it had."""
-    for edge in obj.vg.edges:
-        if plot_image(edge) is None:
-            continue  # a batch run's object that is never saved has none
-        remove_plots([edge])  # first: the new image takes its name (kept if a duplicate shows it)
+    # A batch run's object that is never saved has none. The old images go first, so the new
+    # ones take their names (kept where a duplicate shows them); one look over every edge.
+    drawn = [edge for edge in obj.vg.edges if plot_image(edge) is not None]
+    remove_plots(drawn)
+    for edge in drawn:
         edge.plot = make_plot(obj, edge).name
 
 

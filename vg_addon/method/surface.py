@@ -245,8 +245,9 @@ class Surface:
             )
         # The canonical order (see algorithm.canonical_order), from the ranks sorted at build.
         indices = self._by_rank[np.sort(self.ranks[indices])].astype(np.int64)
+        patch_points = np.take(self.points, indices, axis=0)
         fields = measure_patch(
-            np.take(self.points, indices, axis=0),
+            patch_points,
             np.take(self.normals, indices, axis=0),
             self.points[center_index],
             radius,
@@ -254,7 +255,7 @@ class Surface:
             rule,
         )
         if self.estimated_orientation and sides_contradict_normals(
-            np.take(self.points, indices, axis=0),
+            patch_points,
             fields["labels"],
             fields["normal_plus"],
             fields["normal_minus"],
