@@ -261,8 +261,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--units",
         choices=tuple(UNITS),
         help="what one coordinate unit of the meshes is, recorded in the CSV's Units column and "
-        "the .blend's scene units (default: none, i.e. the file's own units, unnamed; a .blend "
-        "input keeps its scene's units)",
+        "the .blend's scene units (default: the unit a replayed CSV's Units cells all name, "
+        "else none, i.e. the file's own units, unnamed; a .blend input keeps its scene's units)",
     )
     how.add_argument(
         "--ignore-mesh-names",

@@ -87,6 +87,7 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
             # untransformed: the same numbers).
             "space": "world" if row.coordinates == csvio.WORLD_COORDINATES else "mesh",
             "given": f"{Path(args.edges_csv).name} row {number}",
+            "units": row.units,
         }
         add_checked(specs, problems, spec, f"row {number}")
     if problems:

@@ -152,6 +152,16 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
         return fail_all(str(error))
     result.n_vertices = int(geometry.points.shape[0])
     result.prepare_seconds = time.perf_counter() - start
+    if not options.get("units_given"):
+        # A replayed export's rows say what unit the scan is in, as Blender's import takes it.
+        named = [task.units for task in tasks if task.units]
+        named += [
+            spec["units"]
+            for spec in options.get("edges", ())
+            if spec.get("units") and spec_applies(spec, source)
+        ]
+        if named:
+            records.adopt_file_units(obj, named)
     units = records.units_label(bpy.context.scene, obj)  # a .blend object may be scaled
     result.winding = surface.winding
     measuring.note_winding(obj, surface)

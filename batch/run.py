@@ -429,6 +429,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "quiet": bool(args.quiet),
         "save_blend": bool(args.save_blend),
         "units": units,
+        "units_given": bool(args.units),  # else each mesh takes the unit its CSV rows name
         "stability": bool(args.stability),
         "rule": args.rule,  # of the edge stations; the points' rule is each task's own
         "sweep": [*args.sweep[:2], int(args.sweep[2])] if args.sweep else None,

@@ -299,6 +299,20 @@ def unit_symbol(obj, scene) -> str:
     return units.scene_symbol(settings.system, settings.scale_length)
 
 
+def adopt_file_units(obj, texts) -> str | None:
+    """Take the unit that the Units cells ``texts`` of a file of this extension all name as
+    ``obj``'s Scan Units, unless the user chose them; returns the key taken, or None where
+    nothing changed (no cells, cells that disagree or name no unit, a unit already set)."""
+    found = {units.unit_of_text(text) for text in texts}
+    if len(found) != 1 or None in found or obj.vg.unit_chosen:
+        return None
+    (key,) = found
+    if obj.vg.unit == key:
+        return None
+    set_unit(obj.vg, key, guessed=False)
+    return key
+
+
 def guess_unit(obj, scene) -> None:
     """Guess ``obj``'s Scan Units from its size, once, before its first measurement: only when
     nobody chose them and the scene's units are Blender's default (a scene set up with its own

@@ -12,7 +12,6 @@ from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from ..bridge import edges, measuring, records, replication
 from ..bridge.mesh_data import check_measurable
-from ..properties import set_unit
 from ..vg_addon import GoniometerError, units
 from ..vg_addon.formats import csvio
 from .common import poll_measurable, typed_value
@@ -340,16 +339,11 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
 
 
 def adopt_units(obj, texts) -> str:
-    """Take the unit the Units cells ``texts`` of a file of this extension all name as ``obj``'s
-    Scan Units, unless the user chose them, and redraw its edges' plots (their axes name the
+    """:func:`records.adopt_file_units`, then redraw ``obj``'s edges' plots (their axes name the
     unit); returns what to add to the report ("" where nothing changed)."""
-    found = {units.unit_of_text(text) for text in texts}
-    if len(found) != 1 or None in found or obj.vg.unit_chosen:
+    key = records.adopt_file_units(obj, texts)
+    if key is None:
         return ""
-    (key,) = found
-    if obj.vg.unit == key:
-        return ""
-    set_unit(obj.vg, key, guessed=False)
     edges.redraw_plots(obj)
     return f"; Scan Units {units.SYMBOLS[key]}, as the file says"
 

@@ -172,3 +172,39 @@ def test_an_edges_csv_row_is_measured_on_the_mesh_it_names_most_closely(tmp_path
     assert result.returncode == 0, result.stdout + result.stderr
     rows = csvio.read_measurements_csv(replay)
     assert [(r.mesh_name, r.angle) for r in rows] == [(" lead", r.angle) for r in stations]
+
+
+def test_a_replay_without_units_takes_the_unit_its_files_name(tmp_path):
+    """An export of a scan in mm (Units "mm", as Blender's export of an object with Scan Units
+    mm writes) replayed by a run without --units: its rows and its edges' rows say mm, as the
+    file did (before: "BU"), with the same numbers. --units given is the user's choice and
+    wins; rows that disagree name no unit, and the run's own label stays."""
+    mesh = run(tmp_path)
+    out = tmp_path / "out.csv"
+    in_mm = edited_csv(out, tmp_path / "mm.csv", lambda row: row.update(Units="mm"))
+    edges_in_mm = edited_csv(
+        csvio.edges_path_for(out), tmp_path / "mm_edges.csv", lambda row: row.update(Units="mm")
+    )
+    first = csvio.read_measurements_csv(out)
+
+    def replay(name, *extra, points=in_mm):
+        target = tmp_path / name
+        result = batch(mesh, "--points", points, "--edges", edges_in_mm, "--out", target, *extra)
+        assert result.returncode == 0, result.stdout + result.stderr
+        return csvio.read_measurements_csv(target), csvio.read_edges_csv(
+            csvio.edges_path_for(target)
+        )
+
+    rows, edge_rows = replay("again.csv")
+    assert rows and all(row.units == "mm" for row in rows)
+    assert len(edge_rows) == 3 and all(row.units == "mm" for row in edge_rows)
+    single = [(r.x, r.y, r.z, r.angle) for r in first if r.edge_number is None]
+    assert single and single == [(r.x, r.y, r.z, r.angle) for r in rows[: len(single)]]
+
+    rows, edge_rows = replay("chosen.csv", "--units", "cm")
+    assert all(row.units.startswith("BU (1 BU = 0.01 m") for row in [*rows, *edge_rows])
+
+    marks = iter(["cm"] + ["mm"] * len(first))
+    mixed = edited_csv(out, tmp_path / "mixed.csv", lambda row: row.update(Units=next(marks)))
+    rows, _ = replay("mixed_again.csv", points=mixed)
+    assert all(row.units == "BU" for row in rows)

@@ -61,6 +61,9 @@ class Task:
     rule : str
         ``"refined"``, ``"oriented"`` or ``"paper"``: a CSV row's own rule (MeshLab and earlier add-on rows
         carry the paper's), else the run's.
+    units : str
+        A CSV row's ``Units`` cell ("" where it has none): a run without ``--units`` takes the
+        unit its rows name as the mesh's.
     """
 
     index: int
@@ -77,6 +80,7 @@ class Task:
     error: str = ""
     coordinates: str = "mesh"
     rule: str = DEFAULT_RULE
+    units: str = ""
 
 
 # --------------------------------------------------------------------------- command line values
@@ -303,6 +307,7 @@ def plan_rows(
                 error=error,
                 coordinates=row.coordinates,
                 rule=row.rule or rule,
+                units=row.units or "",
             )
         )
     return tasks

@@ -85,6 +85,9 @@ class ReplicationRow:
         earlier add-on files and for exports written before the ``Rule`` column existed (they
         were all measured with the paper's rule); a points file's ``rule`` column, else ``None``
         (the current default).
+    units : str or None
+        The ``Units`` cell of an export (what one coordinate unit is, e.g. ``"mm"``); ``None``
+        when absent or blank.
     """
 
     row_number: int
@@ -105,6 +108,7 @@ class ReplicationRow:
     source_format: str = "points"
     coordinates: str = MESH_COORDINATES
     rule: str | None = None
+    units: str | None = None
 
 
 # Header aliases of the replication reader, normalised (case-folded, "_" as space, whitespace
@@ -125,6 +129,7 @@ _REPLICATION_ALIASES = {
     "spacing": ("spacing",),
     "edge_closed": ("edge closed",),
     "error": ("error",),
+    "units": ("units",),
 }
 
 
@@ -297,6 +302,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 source_format=fmt,
                 coordinates=coordinates,
                 rule=rule,
+                units=optional_text(cell("units")),
             )
         )
     if problems:
