@@ -301,6 +301,23 @@ def check_measurable(obj) -> None:
             f"'{obj.name}' is in Edit Mode: switch to Object Mode (Tab) before measuring, so the "
             "measurement and its colours see the edited mesh."
         )
+    others = _sharing_objects(obj)
+    if others:
+        names = ", ".join(f"'{name}'" for name in others[:3]) + (", ..." if len(others) > 3 else "")
+        raise GoniometerError(
+            f"'{obj.name}' shares its mesh '{obj.data.name}' with {names} (a linked duplicate, "
+            "Alt+D): the sides' colours are kept on the mesh, so one object's would paint over "
+            "the other's. Give it a mesh of its own first (Object > Relations > Make Single User "
+            "> Object & Data); its measurements are kept."
+        )
+
+
+def _sharing_objects(obj) -> list[str]:
+    """The names of the other objects whose data is ``obj``'s mesh (sorted)."""
+    mesh = obj.data
+    if mesh.users - int(mesh.use_fake_user) <= 1:  # the usual case, without a look at every object
+        return []
+    return sorted(other.name for other in bpy.data.objects if other.data == mesh and other != obj)
 
 
 def evaluated_geometry(obj, depsgraph=None) -> Geometry:

@@ -240,3 +240,29 @@ def test_every_operator_refuses_negative_values_as_given(vg, tmp_path, operator,
     assert "Traceback" not in str(error.value)
     assert snapshot(obj) == before
     assert not list(tmp_path.iterdir())
+
+
+def test_a_mesh_shared_by_two_objects_is_refused_until_each_has_its_own(vg):
+    """A linked duplicate (Alt+D) shares its mesh, and the sides' colours live on the mesh: a
+    measurement on either object would paint over the other's colours (before: accepted, and
+    the other object showed this one's sides). Refused, naming the other object, with nothing
+    changed; once the copy has its own mesh, measuring one leaves the other's colours alone."""
+    obj = measured_wedge()
+    copy = bpy.data.objects.new("Copy", obj.data)
+    bpy.context.scene.collection.objects.link(copy)
+    before = snapshot(obj)
+    for target, other in ((obj, "Copy"), (copy, obj.name)):
+        bpy.context.view_layer.objects.active = target
+        assert_refused(
+            f"shares its mesh '{obj.data.name}' with '{other}'", location=(0, 0, 0), radius=0.5
+        )
+        assert not bpy.ops.vg.delete_measurement.poll()
+    assert snapshot(obj) == before and not len(copy.vg.measurements)
+
+    copy.data = obj.data.copy()  # Make Single User > Object & Data
+    copy_colours = colours(copy).copy()
+    bpy.context.view_layer.objects.active = obj
+    bpy.ops.vg.measure_xyz(location=(0.1, 0, 0), radius=0.4)
+    assert len(obj.vg.measurements) == 2
+    assert np.array_equal(colours(copy), copy_colours)
+    assert not np.array_equal(colours(obj), copy_colours)
