@@ -215,6 +215,7 @@ def oracle_ply_binary(data, pos, elements, wanted, order):
 
 
 def oracle_obj(data: bytes):
+    data = data.removeprefix(b"\xef\xbb\xbf")  # a UTF-8 byte-order mark is not a word
     points, faces, vn_lines = [], [], []
     vertex_refs, normal_refs, n_f_lines, vn_before = [], [], 0, []
     for line in data.split(b"\n"):

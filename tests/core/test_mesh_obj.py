@@ -119,3 +119,19 @@ def test_obj_vertex_lines_with_w_or_colours_are_read(tmp_path, columns):
 )
 def test_obj_wrong_counts_and_indices_name_the_line(tmp_path, text, fragments):
     expect_error(write_text(tmp_path / "bad.obj", text), *fragments)
+
+
+@pytest.mark.parametrize("faces", ["", "f 1 2 3\nf 1 3 4\n"], ids=["cloud", "last vertex unused"])
+def test_an_obj_with_a_byte_order_mark_keeps_its_first_vertex(tmp_path, faces):
+    """A UTF-8 byte-order mark (as Windows editors write) hid the first 'v' keyword: the first
+    vertex was dropped and every face index shifted onto the next vertex, with no error."""
+    points = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 1.25]]
+    text = "".join(f"v {x} {y} {z}\n" for x, y, z in points) + faces
+    path = tmp_path / "bom.obj"
+    path.write_bytes(b"\xef\xbb\xbf" + text.encode())
+    mesh = read_mesh(path)
+    assert mesh.points.tolist() == points
+    if faces:
+        assert mesh.triangles.tolist() == [[0, 1, 2], [0, 2, 3]]
+    else:
+        assert mesh.triangles is None

@@ -551,3 +551,27 @@ def test_a_lone_sign_in_ascii_ply_faces_is_not_a_number(tmp_path, sign, where):
     path = tmp_path / "sign.ply"
     path.write_bytes(b"\n".join(lines))
     expect_error(path, f"line {at + 1}", repr(sign.decode()), "not a number")
+
+
+@pytest.mark.parametrize("short", ["vertex", "face"])
+def test_a_binary_ply_with_a_record_more_than_its_header_declares_is_refused(tmp_path, short):
+    """The header's count one short of the data: the last point or face was dropped with no
+    error (an ASCII PLY with the same fault was refused). A byte or two of padding is not a
+    record, and is still read."""
+    points = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 1.25]]
+    faces = [[0, 1, 2, 3], [0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]
+    vertex_header = "element vertex {}\nproperty float x\nproperty float y\nproperty float z\n"
+    face_header = "element face {}\nproperty list uchar int vertex_indices\n"
+    body = b"".join(struct.pack("<3f", *p) for p in points)
+    if short == "vertex":
+        header = vertex_header.format(4)
+    else:
+        header = vertex_header.format(5) + face_header.format(4)
+        body += b"".join(struct.pack(f"<B{len(f)}i", len(f), *f) for f in faces)
+    start = f"ply\nformat binary_little_endian 1.0\n{header}end_header\n".encode()
+    (tmp_path / "short.ply").write_bytes(start + body)
+    expect_error(tmp_path / "short.ply", "follow the last element", f"4 '{short}'")
+    if short == "face":
+        whole = start.replace(b"face 4", b"face 5")
+        (tmp_path / "padded.ply").write_bytes(whole + body + b"\n")
+        assert read_mesh(tmp_path / "padded.ply").triangles.shape == (6, 3)

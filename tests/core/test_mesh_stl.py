@@ -145,3 +145,22 @@ def test_binary_stl_trailing_bytes_are_ignored_only_short_of_a_record(tmp_path):
     for extra in (50, 51, 120):
         path.write_bytes(whole + b"\0" * extra)
         expect_error(path, "declares 12 triangles", f"implies {12 + extra // 50}")
+
+
+@pytest.mark.parametrize("cut", ["inside the last number", "after an endfacet"])
+def test_a_truncated_ascii_stl_is_refused(tmp_path, cut):
+    """An ASCII STL cut short was read as a smaller or different mesh: cut inside the last
+    vertex's z (1.25 → 1.2) it gave a wrong corner; cut after an 'endfacet', fewer facets."""
+    corners = CUBE_CORNERS[np.array(CUBE_TRIANGLES)].copy()
+    corners[-1, -1, 2] = 1.25
+    data = stl_ascii(corners)
+    if cut == "inside the last number":
+        keep = data.rindex(b"1.25") + 3
+        expected = "has no 'endfacet'"
+    else:
+        keep = data.index(b"endfacet", data.index(b"endfacet") + 1) + len(b"endfacet\n")
+        expected = "no 'endsolid'"
+    (tmp_path / "cut.stl").write_bytes(data[:keep])
+    expect_error(tmp_path / "cut.stl", "truncated ASCII STL", expected)
+    (tmp_path / "whole.stl").write_bytes(data)
+    assert read_mesh(tmp_path / "whole.stl").triangles.shape == (12, 3)

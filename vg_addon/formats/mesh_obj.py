@@ -44,7 +44,9 @@ def read_obj(path: str | os.PathLike) -> MeshData:
         with its line number.
     """
     path = _as_path(path)
-    text = _Text(_read_bytes(path), path)
+    data = _read_bytes(path)
+    # A byte-order mark (as Windows editors write) would hide the first line's keyword.
+    text = _Text(data[3:] if data.startswith(b"\xef\xbb\xbf") else data, path)
     v_lines = text.keyword(b"v")
     values, counts = text.floats(v_lines, 1, "'v'")
     # x y z, then w (the official format) or r g b (the colour extension that MeshLab, Blender

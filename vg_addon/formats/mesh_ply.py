@@ -1,4 +1,4 @@
-"""PLY files (ASCII and binary, either byte order): the reader and the writer."""
+"""PLY files (ASCII and binary, either byte order): the reader; the writer is in mesh_ply_write."""
 
 from __future__ import annotations
 
@@ -232,9 +232,11 @@ def _ply_binary_body(data, pos, elements, wanted, order, path) -> dict:
     """Read the needed properties of each element from binary data starting at ``pos``."""
     found: dict[str, dict] = {}
     buffer = np.frombuffer(data, np.uint8)
+    start = pos
     for element in elements:
         if all(name in found for name in wanted):
             break  # later elements are not needed, so they need not even be complete
+        start = pos
         need = wanted.get(element.name, set()) if element.name not in found else set()
         if not element.has_lists:
             dtype = np.dtype(
@@ -257,7 +259,26 @@ def _ply_binary_body(data, pos, elements, wanted, order, path) -> dict:
             values, pos = _binary_mixed_lists(data, buffer, pos, element, order, need, path)
         if need:
             found[element.name] = values
+    else:  # every element read: bytes for another record mean the header's count is short
+        last = elements[-1] if elements else None
+        if last is not None and last.count and len(data) - pos >= _record_floor(last, pos - start):
+            raise GoniometerError(
+                f"'{path}': {len(data) - pos} bytes follow the last element the header declares "
+                f"({last.count} '{last.name}'), at least as much as another record. The header's "
+                "counts are wrong or the file has data too many; re-export it."
+            )
     return found
+
+
+def _record_floor(element: _PlyElement, size: int) -> float:
+    """Fewer bytes than this after an ``element`` whose ``count`` records took ``size`` bytes
+    cannot hold another record: the smaller of their mean size and the size of one with each
+    list three long (a polygon's least)."""
+    least = sum(
+        p.dtype.itemsize if p.count_dtype is None else p.count_dtype.itemsize + 3 * p.dtype.itemsize
+        for p in element.properties
+    )
+    return min(size / element.count, least)
 
 
 def _binary_uniform_lists(data, pos, element, order, need):
@@ -600,101 +621,3 @@ def _ascii_cast(values, dtype, element, line_of, path) -> np.ndarray:
                 "corrupt."
             )
     return values.astype(dtype)
-
-
-# ------------------------------------------------------------------------------------------ write
-
-
-def write_ply(
-    path: str | os.PathLike,
-    points,
-    triangles=None,
-    normals=None,
-    binary: bool = True,
-) -> Path:
-    """Write a PLY file with float64 ("double") coordinates, exactly readable by :func:`read_ply`.
-
-    Parameters
-    ----------
-    path : str or path-like
-        The file to write (overwritten).
-    points : array_like
-        ``(n, 3)`` finite coordinates.
-    triangles : array_like, optional
-        ``(m, 3)`` vertex indices; omitted for a point cloud.
-    normals : array_like, optional
-        ``(n, 3)`` per-vertex normals, written as ``nx ny nz``.
-    binary : bool
-        ``True`` for binary little-endian, ``False`` for ASCII (17 significant digits, so the
-        values round-trip exactly).
-
-    Returns
-    -------
-    pathlib.Path
-        The written path.
-
-    Raises
-    ------
-    GoniometerError
-        If the arrays have the wrong shape, are not finite, indices are out of range, or the
-        file cannot be written.
-    """
-    path = _as_path(path)
-    points = np.asarray(points, dtype=np.float64)
-    if points.ndim != 2 or points.shape[1] != 3 or points.shape[0] == 0:
-        raise GoniometerError(f"write_ply needs (n, 3) points with n > 0, got {points.shape}.")
-    if not np.isfinite(points).all():
-        raise GoniometerError("write_ply: some point coordinates are not finite.")
-    n = points.shape[0]
-    columns = [points]
-    names = ["x", "y", "z"]
-    if normals is not None:
-        normals = np.asarray(normals, dtype=np.float64)
-        if normals.shape != points.shape:
-            raise GoniometerError(
-                f"write_ply: normals must have the points' shape {points.shape}, "
-                f"got {normals.shape}."
-            )
-        columns.append(normals)
-        names += ["nx", "ny", "nz"]
-    if triangles is not None:
-        triangles = np.asarray(triangles)
-        if triangles.ndim != 2 or triangles.shape[1] != 3 or triangles.dtype.kind not in "iu":
-            raise GoniometerError(
-                f"write_ply needs (m, 3) integer triangles, got {triangles.shape} "
-                f"{triangles.dtype}."
-            )
-        if triangles.size and (triangles.min() < 0 or triangles.max() >= n):
-            raise GoniometerError(
-                f"write_ply: a triangle index is outside 0..{n - 1} (the points' range)."
-            )
-    header = [
-        "ply",
-        f"format {'binary_little_endian' if binary else 'ascii'} 1.0",
-        "comment written by the Virtual Goniometer",
-        f"element vertex {n}",
-    ]
-    header += [f"property double {name}" for name in names]
-    if triangles is not None:
-        header += [f"element face {len(triangles)}", "property list uchar int vertex_indices"]
-    header.append("end_header")
-    vertices = np.hstack(columns)
-    try:
-        with open(path, "wb") as file:
-            file.write(("\n".join(header) + "\n").encode("ascii"))
-            if binary:
-                file.write(vertices.astype("<f8").tobytes())
-                if triangles is not None:
-                    faces = np.empty(len(triangles), [("n", "u1"), ("v", "<i4", (3,))])
-                    faces["n"] = 3
-                    faces["v"] = triangles
-                    file.write(faces.tobytes())
-            else:
-                np.savetxt(file, vertices, fmt="%.17g")
-                if triangles is not None:
-                    np.savetxt(
-                        file, np.column_stack([np.full(len(triangles), 3), triangles]), fmt="%d"
-                    )
-    except OSError as error:
-        raise GoniometerError(f"Could not write '{path}': {error.strerror or error}.") from None
-    return path

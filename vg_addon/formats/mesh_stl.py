@@ -129,6 +129,27 @@ def _stl_ascii_corners(data: bytes, path: Path) -> np.ndarray:
             f"'{path}', line {facet_lines[k] + 1}: this facet has {per_facet[k]} vertex lines, "
             "not 3 (an STL facet is one triangle). The file is corrupt; re-export it."
         )
+    closing = text.keyword(b"endfacet")
+    closed = np.zeros(facet_lines.size, dtype=bool)  # each facet's own endfacet, after its vertices
+    if closing.size:
+        owner = np.searchsorted(facet_lines, closing) - 1
+        last_vertex = np.full(facet_lines.size, -1)
+        if vertex_lines.size:
+            last_vertex[facet - 1] = vertex_lines  # in order: the last one written stays
+        ok = owner >= 0
+        closed[owner[ok][closing[ok] > last_vertex[owner[ok]]]] = True
+    ends = text.keyword(b"endsolid")
+    if not closed.all() or not ends.size or (facet_lines.size and ends[-1] < facet_lines[-1]):
+        k = int(np.argmin(closed)) if not closed.all() else facet_lines.size - 1
+        where = (
+            f"the facet at line {facet_lines[k] + 1} has no 'endfacet'"
+            if not closed.all()
+            else "no 'endsolid' line ends it"
+        )
+        raise GoniometerError(
+            f"'{path}' is a truncated ASCII STL: {where}. The file was not written completely; "
+            "re-export or copy it again."
+        )
     return values.reshape(-1, 3)
 
 

@@ -22,7 +22,8 @@ import os
 from ..errors import GoniometerError
 from .mesh_common import MeshData, _as_path
 from .mesh_obj import read_obj
-from .mesh_ply import read_ply, write_ply
+from .mesh_ply import read_ply
+from .mesh_ply_write import write_ply
 from .mesh_stl import read_stl
 
 __all__ = [
