@@ -66,7 +66,11 @@ def run_report(args) -> int:
         f"{outcome.readings} of {outcome.rows} rows used, {len(outcome.figures)} figures)",
         flush=True,
     )
-    for what, lines in (("left out", outcome.left_out), ("not computed", outcome.not_computed)):
+    for what, lines in (
+        ("left out", outcome.left_out),
+        ("not computed", outcome.not_computed),
+        ("to check", outcome.to_check),
+    ):
         if lines:
             print(
                 f"vg_batch: {what} ({len(lines)}):\n{bounded_list(lines, lines=True)}",

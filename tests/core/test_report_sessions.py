@@ -110,8 +110,9 @@ def test_stations_on_one_break_match_by_nearest_centre_and_ambiguity_is_reported
 
 
 def test_bad_input_is_named_not_dropped(tmp_path):
-    good = write(tmp_path, "obs1_drag_1.csv", "Mesh,Break #,Angle\nm,1,90\nm,2,91\nm,3,92\n")
-    same = write(tmp_path, "copy_drag.csv", "Mesh,Break #,Angle\nm,1,90\nm,2,91\nm,3,92\n")
+    dated = "Mesh,Break #,Angle,Date\nm,1,90,2026-01-05\nm,2,91,2026-01-05\nm,3,92,2026-01-05\n"
+    good = write(tmp_path, "obs1_drag_1.csv", dated)
+    same = write(tmp_path, "copy_drag.csv", dated)
     cells = write(
         tmp_path,
         "obs1_drag_2.csv",
@@ -210,3 +211,32 @@ def test_analysis_imports_without_scipy_and_says_what_to_install():
     assert "python vg_batch.py --report DIR" in run.stdout
     assert not (ROOT / "out").exists()
     assert missing_message() == ""  # here they are installed (requirements/report.txt)
+
+
+def test_manual_repetitions_that_read_the_same_are_kept_and_angles_are_checked(tmp_path):
+    """Three manual repetitions of three breaks, the second reading as the first (whole degrees:
+    chance, not a copy, since nothing dates them): kept, with a note to check, and the IOV is
+    the paper's equation 4.1 over all three (break 1: 40, 40, 42 -> (0 + 2 + 2) / 3; before: the
+    second left out as "the same session given twice", IOV 2.0). An angle outside 0 to 180
+    degrees is left out with its reason (before: -5 and 400 used, 1e308 a traceback)."""
+    rows = ["m,1,40\nm,2,50\nm,3,60", "m,1,40\nm,2,50\nm,3,60", "m,1,42\nm,2,50\nm,3,61"]
+    paths = [
+        write(tmp_path, f"obs1_manual_{n}.csv", "Mesh,Break #,Angle\n" + text + "\n")
+        for n, text in enumerate(rows, start=1)
+    ]
+    odd = write(tmp_path, "obs2_manual_1.csv", "Mesh,Break #,Angle\nm,1,-5\nm,2,400\nm,3,1e308\n")
+    loaded = load_sessions([*paths, odd])
+    assert [s.name for s in loaded.sessions][:3] == [p.name for p in paths]
+    assert loaded.notes == [
+        "obs1_manual_2.csv: kept, though its readings are those of obs1_manual_1.csv: without "
+        "dates or centres a repetition that read the same cannot be told from a copy; leave the "
+        "file out if it is one"
+    ]
+    assert loaded.sessions[3].readings == []
+    assert loaded.sessions[3].left_out == [
+        f"row {row}: Angle {value} is not an angle between two faces (0° to 180°)"
+        for row, value in ((2, "-5"), (3, "400"), (4, "1e+308"))
+    ]
+    matched = match_sessions(loaded.sessions[:3])
+    angles = {unit.label: sorted(r.angle for r in unit.readings.values()) for unit in matched.units}
+    assert iov.mean_abs_difference(angles["m break 1"]) == pytest.approx(4 / 3)

@@ -4,6 +4,7 @@ NIST's certified Longley results, Bland-Altman and the CIs against arithmetic do
 
 from __future__ import annotations
 
+import itertools
 import math
 import statistics
 import subprocess
@@ -57,10 +58,55 @@ def test_icc_of_raters_who_agree_exactly_is_one_and_undefined_without_variation(
     agreeing = [[1, 1], [5, 5], [9, 9]]
     single, mean = icc.icc_absolute(agreeing)
     assert single.value == 1.0 and mean.value == 1.0
-    with pytest.raises(ValueError, match="do not vary"):
+    with pytest.raises(ValueError, match="every rating is the same"):
         icc.icc_absolute([[3, 3], [3, 3], [3, 3]])
     with pytest.raises(ValueError, match="at least 2"):
         icc.icc_absolute([[1, 2, 3]])
+
+
+def test_the_icc_of_every_small_table_is_a_number_or_a_reason():
+    """Every 2x2, 3x2 and 2x3 table of whole degrees 40 to 42 (1,539 tables, as small pilot
+    data are): ICC(A,1) either refused with a reason or given; each figure a finite number or
+    None with a note saying why; each interval in order and at most 1. Before: 0/0 and x/0 raised
+    ZeroDivisionError (the report crashed), NaN limits, ICC(A,k) lower limits above 1."""
+    count = 0
+    for n, k in ((2, 2), (3, 2), (2, 3)):
+        for cells in itertools.product((40, 41, 42), repeat=n * k):
+            table = [list(cells[r * k : (r + 1) * k]) for r in range(n)]
+            try:
+                results = icc.icc_absolute(table)
+            except ValueError as error:
+                assert "undefined" in str(error), table
+                continue
+            count += 1
+            for result in results:
+                figures = [result.value, result.lower, result.upper]
+                assert all(v is None or math.isfinite(v) for v in figures), (table, result)
+                assert (None in figures) == bool(result.note), (table, result)
+                if result.lower is not None and result.upper is not None:
+                    assert result.lower <= result.upper + 1e-12 <= 1.0 + 1e-12, (table, result)
+                assert result.value is None or result.value <= 1.0
+    assert count > 1000
+
+
+def test_an_icc_a_k_limit_past_the_spearman_brown_pole_is_unbounded_not_a_number():
+    """Five breaks, two observers: ICC(A,1)'s lower limit is below -1/(k-1) = -1, where the
+    Spearman-Brown step k r / (1 + (k-1) r) jumps past its pole; the mean's lower limit is then
+    unbounded below (before: 18.5, above its upper limit 0.92)."""
+    single, mean = icc.icc_absolute([[89, 92], [91, 90], [90, 88], [92, 92], [89, 91]])
+    assert single.lower < -1.0 < single.upper
+    assert mean.lower is None and "unbounded below" in mean.note
+    assert mean.upper == pytest.approx(2 * single.upper / (1 + single.upper), rel=1e-12)
+
+
+def test_observers_a_constant_apart_have_an_icc_of_zero_and_no_f():
+    """Each break read 5 by one observer and 7 by the other: MSR = MSE = 0, MSC = 6, so McGraw &
+    Wong's ICC(A,1) = (0 - 0) / (0 + 0 + 2 * 6 / 3) = 0 (before: refused as "the ratings do
+    not vary", which they do). F = MSR / MSE is 0/0: no F, no p."""
+    single, _ = icc.icc_absolute([[5, 7], [5, 7], [5, 7]])
+    assert single.value == 0.0 and single.f is None and single.p is None
+    with pytest.raises(ValueError, match="not positive"):
+        icc.icc_absolute([[40, 50], [50, 40]])  # the two observers swapped: no estimate
 
 
 # R's PlantGrowth data set (Dobson 1983), 10 plants per group.

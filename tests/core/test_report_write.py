@@ -72,3 +72,22 @@ def test_an_iov_of_exactly_zero_is_drawn_without_an_axis_below_zero():
     ci = figures.ci_plot(summaries, "°")
     drag, xyz = ci.axes
     assert xyz.get_ylim()[0] == 0.0 and drag.get_ylim()[0] > 0.0
+
+
+def test_a_compare_name_that_several_sessions_share_is_refused_with_its_reason(tmp_path):
+    """Two folders each with a drag_1.csv (two observers): --compare other.csv drag_1.csv took
+    the first one silently. It is now not computed, saying the name is shared and by whom."""
+    paths = []
+    for folder, observer, shift in (("a", "obs1", 0), ("b", "obs2", 2), ("c", "obs3", 1)):
+        (tmp_path / folder).mkdir()
+        name = "other_drag.csv" if folder == "c" else "drag_1.csv"
+        text = "Mesh,Break #,Angle,Observer\n" + "".join(
+            f"m,{b},{90 + b + shift},{observer}\n" for b in range(1, 5)
+        )
+        (tmp_path / folder / name).write_text(text, encoding="utf-8")
+        paths.append(tmp_path / folder / name)
+    outcome = write_report(paths, tmp_path / "out", compare=[("other_drag.csv", "drag_1.csv")])
+    assert (
+        "Bland–Altman other_drag.csv against drag_1.csv: not computed, 'drag_1.csv' names 2 "
+        "sessions (of observers obs1, obs2): give the files names of their own"
+    ) in outcome.not_computed

@@ -28,16 +28,22 @@ class TwoWay:
 
 @dataclass
 class ICC:
-    """One ICC with its 95% confidence interval and F test (``value > 0``)."""
+    """One ICC with its 95% confidence interval and F test.
+
+    ``value``, ``lower``, ``upper``, ``f`` and ``p`` are None where the table leaves them
+    undefined (a zero denominator, a limit beyond the Spearman-Brown step's pole); ``note``
+    then says why, for the report.
+    """
 
     kind: str
-    value: float
-    lower: float
-    upper: float
-    f: float
+    value: float | None
+    lower: float | None
+    upper: float | None
+    f: float | None
     df1: int
     df2: int
-    p: float
+    p: float | None
+    note: str = ""
 
 
 def _fsum(values) -> float:
@@ -83,7 +89,9 @@ def icc_absolute(table, confidence: float = 0.95) -> tuple[ICC, ICC]:
     Raises
     ------
     ValueError
-        Fewer than 2 targets or raters, or no variation at all (the ICC is undefined).
+        Fewer than 2 targets or raters, a cell that is not finite, every rating the same, or a
+        table whose variance estimate is not positive: ICC(A,1) is undefined. Figures the table
+        leaves undefined beyond that are None, with the reason in :attr:`ICC.note`.
     """
     from scipy import stats
 
@@ -95,34 +103,92 @@ def icc_absolute(table, confidence: float = 0.95) -> tuple[ICC, ICC]:
     a = two_way(x)
     n, k = a.n, a.k
     msr, msc, mse = a.ms_rows, a.ms_columns, a.ms_error
+    if msr == 0 and msc == 0 and mse == 0:
+        raise ValueError("every rating is the same, so the ICC is undefined")
     denominator = msr + (k - 1) * mse + k * (msc - mse) / n
-    if not denominator > 0 or (mse == 0 and msr == 0):
-        raise ValueError("the ratings do not vary, so the ICC is undefined")
-    single = (msr - mse) / denominator
-    mean = (msr - mse) / (msr + (msc - mse) / n)
-    f = msr / mse if mse > 0 else math.inf
-    df1, df2 = n - 1, (n - 1) * (k - 1)
-    p = float(stats.f.sf(f, df1, df2)) if math.isfinite(f) else 0.0
-    alpha = 1 - confidence
-    # McGraw & Wong (1996), Table 7, case 2A: Satterthwaite's degrees of freedom for the
-    # denominator's mix of the rater and error mean squares.
-    ca = k * single / (n * (1 - single)) if single < 1 else math.inf
-    cb = 1 + k * single * (n - 1) / (n * (1 - single)) if single < 1 else math.inf
-    if math.isfinite(ca):
-        v = (ca * msc + cb * mse) ** 2 / (
-            (ca * msc) ** 2 / (k - 1) + (cb * mse) ** 2 / ((n - 1) * (k - 1))
+    if not denominator > 0:
+        raise ValueError(
+            "the ICC is undefined for this table: its variance estimate "
+            "MSR + (k-1) MSE + k (MSC - MSE) / n is not positive (too few breaks for the ANOVA "
+            "to tell breaks, observers and error apart)"
         )
-        f_upper = float(stats.f.ppf(1 - alpha / 2, n - 1, v))
-        f_lower = float(stats.f.ppf(1 - alpha / 2, v, n - 1))
-        spread = k * msc + (k * n - k - n) * mse
-        lower = n * (msr - f_upper * mse) / (f_upper * spread + n * msr)
-        upper = n * (f_lower * msr - mse) / (spread + n * f_lower * msr)
-    else:
-        lower = upper = 1.0
-    # The mean of k raters: the Spearman-Brown step of each limit.
-    lower_k = k * lower / (1 + (k - 1) * lower)
-    upper_k = k * upper / (1 + (k - 1) * upper)
-    return (
-        ICC("ICC(A,1)", single, lower, upper, f, df1, df2, p),
-        ICC(f"ICC(A,{k})", mean, lower_k, upper_k, f, df1, df2, p),
+    single = (msr - mse) / denominator
+    df1, df2 = n - 1, (n - 1) * (k - 1)
+    if mse > 0:
+        f = msr / mse
+        p = float(stats.f.sf(f, df1, df2))
+    else:  # no error variance: F is infinite where the breaks differ, undefined where not
+        f = math.inf if msr > 0 else None
+        p = 0.0 if msr > 0 else None
+    lower, upper, why = _single_limits(a, single, 1 - confidence, stats)
+    single_icc = ICC("ICC(A,1)", single, lower, upper, f, df1, df2, p, why)
+    mean_denominator = msr + (msc - mse) / n
+    if not mean_denominator > 0:
+        note = f"ICC(A,{k}) is undefined for this table: MSR + (MSC - MSE) / n is not positive"
+        return single_icc, ICC(f"ICC(A,{k})", None, None, None, f, df1, df2, p, note)
+    mean = (msr - mse) / mean_denominator
+    lower_k, upper_k, why_k = _spearman_brown(lower, upper, k, why)
+    return single_icc, ICC(f"ICC(A,{k})", mean, lower_k, upper_k, f, df1, df2, p, why_k)
+
+
+def _single_limits(a: TwoWay, single: float, alpha: float, stats) -> tuple:
+    """ICC(A,1)'s confidence limits (McGraw & Wong 1996, Table 7, case 2A: Satterthwaite's
+    degrees of freedom for the denominator's mix of the rater and error mean squares), as
+    ``(lower, upper, "")``, or ``(None, None, why)`` where the table leaves them undefined."""
+    n, k = a.n, a.k
+    msr, msc, mse = a.ms_rows, a.ms_columns, a.ms_error
+    if single >= 1:
+        return 1.0, 1.0, ""
+    ca = k * single / (n * (1 - single))
+    cb = 1 + k * single * (n - 1) / (n * (1 - single))
+    spread_of_mix = (ca * msc) ** 2 / (k - 1) + (cb * mse) ** 2 / ((n - 1) * (k - 1))
+    undefined = (
+        None,
+        None,
+        "the ICC's confidence interval is undefined for this table: Satterthwaite's degrees of "
+        "freedom for it are 0 or cannot be formed (too few breaks, or no error variance)",
     )
+    if not spread_of_mix > 0:
+        return undefined
+    v = (ca * msc + cb * mse) ** 2 / spread_of_mix
+    f_upper = float(stats.f.ppf(1 - alpha / 2, n - 1, v))
+    f_lower = float(stats.f.ppf(1 - alpha / 2, v, n - 1))
+    spread = k * msc + (k * n - k - n) * mse
+    lower_denominator = f_upper * spread + n * msr
+    upper_denominator = spread + n * f_lower * msr
+    if not (
+        v > 0 and math.isfinite(v) and math.isfinite(f_upper) and math.isfinite(f_lower)
+    ) or not (lower_denominator != 0 and upper_denominator != 0):
+        return undefined
+    lower = n * (msr - f_upper * mse) / lower_denominator
+    upper = n * (f_lower * msr - mse) / upper_denominator
+    return lower, upper, ""
+
+
+def _spearman_brown(lower, upper, k: int, why: str) -> tuple:
+    """The mean of ``k`` raters' limits from a single rater's, by the Spearman-Brown step
+    ``k r / (1 + (k-1) r)``. The step has a pole at ``r = -1/(k-1)``: a single-rater limit at or
+    below it leaves the mean's limit unbounded below (not the number past the pole)."""
+    if lower is None:
+        return None, None, why
+    pole = -1.0 / (k - 1)
+    if upper <= pole:
+        return (
+            None,
+            None,
+            (
+                f"ICC(A,{k})'s confidence interval is undefined: the single-rater interval "
+                f"[{lower:.3g}, {upper:.3g}] lies below -1/(k-1) = {pole:.3g}"
+            ),
+        )
+    upper_k = k * upper / (1 + (k - 1) * upper)
+    if lower <= pole:
+        return (
+            None,
+            upper_k,
+            (
+                f"ICC(A,{k})'s lower limit is unbounded below: the single-rater lower limit "
+                f"{lower:.3g} is at or below -1/(k-1) = {pole:.3g}"
+            ),
+        )
+    return k * lower / (1 + (k - 1) * lower), upper_k, ""

@@ -232,6 +232,9 @@ def write_report(
         paths, folder, loaded.sessions, stats, methods_of(loaded.sessions), outcome, Page(title)
     )
     _sessions_section(c, loaded.refused, matched.unmatched)
+    for line in loaded.notes:
+        c.page.paragraph(line, note=True)
+    outcome.to_check.extend(loaded.notes)
     _breaks_csv(c)
     angle_iov_section(c)
     virtual_section(c)

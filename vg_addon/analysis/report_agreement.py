@@ -38,8 +38,11 @@ def agreement_section(c: Context) -> None:
         row = [m, len(observers), s.n, s.mean, s.median, s.sd, len(complete)]
         for value in (single, mean):
             row += [None] * 3 if value is None else [value.value, value.lower, value.upper]
+            if value is not None and value.note:
+                c.skip(f"the {value.kind} of {m}, in part", value.note)
         # F is infinite where the observers agree exactly (no error variance): no number.
-        f = single.f if single is not None and math.isfinite(single.f) else None
+        f = single.f if single is not None and single.f is not None else math.inf
+        f = f if math.isfinite(f) else None
         row += [None] * 4 if single is None else [f, single.df1, single.df2, single.p]
         rows.append(row)
     if not rows:
@@ -91,8 +94,18 @@ def _pairs_to_compare(c: Context, compare) -> list[tuple[str, str, dict, dict]]:
     for a, b in compare:
         values = []
         for name in (a, b):
+            sharing = [s for s in c.sessions if s.name == name]
             if name in c.methods:
                 values.append(method_means(name))
+            elif len(sharing) > 1:
+                values = None
+                c.skip(
+                    f"Bland–Altman {a} against {b}",
+                    f"{name!r} names {len(sharing)} sessions (of observers "
+                    f"{', '.join(sorted({s.observer or '?' for s in sharing}))}): give the "
+                    "files names of their own",
+                )
+                break
             elif name in names:
                 values.append(session_values(name))
             else:

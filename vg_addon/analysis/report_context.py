@@ -29,6 +29,8 @@ class Outcome:
         One line per file, session, row or break left out, with its reason.
     not_computed : list of str
         One line per table or figure that could not be computed, with its reason.
+    to_check : list of str
+        One line per session used that the reader should check (one that may be a copy).
     figures : list of str
         The figures' names (each written as ``figures/NAME.png`` and ``.svg``).
     """
@@ -39,6 +41,7 @@ class Outcome:
     rows: int = 0
     left_out: list[str] = field(default_factory=list)
     not_computed: list[str] = field(default_factory=list)
+    to_check: list[str] = field(default_factory=list)
     figures: list[str] = field(default_factory=list)
 
     @property

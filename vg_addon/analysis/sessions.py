@@ -119,10 +119,12 @@ class Session:
 
 @dataclass
 class Loaded:
-    """What :func:`load_sessions` read: the sessions used and one line per file left out."""
+    """What :func:`load_sessions` read: the sessions used, one line per file left out, and one
+    per session kept that may be a copy of another."""
 
     sessions: list[Session] = field(default_factory=list)
     refused: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # sessions kept that a reader should check
 
 
 def method_word(text: str) -> str | None:
@@ -180,6 +182,8 @@ def _reading(number: int, cells, columns) -> tuple[Reading | None, str]:
     angle = _number(cells, columns, "angle", number, problems)
     if angle is None and not problems:
         problems.append("no Angle")
+    elif angle is not None and not 0.0 <= angle <= 180.0:
+        problems.append(f"Angle {angle:g} is not an angle between two faces (0° to 180°)")
     parts = [_number(cells, columns, axis, number, problems) for axis in "xyz"]
     if any(p is not None for p in parts) and any(p is None for p in parts):
         problems.append("x, y, z must be all filled or all empty")
@@ -260,6 +264,12 @@ def _fingerprint(session: Session) -> tuple:
     return (session.method, readings)
 
 
+def _identifies(session: Session) -> bool:
+    """Whether equal readings make two sessions one given twice: only with a date or a centre.
+    A manual table's same angles twice can be chance (whole-degree readings of a few breaks)."""
+    return any(r.date or r.centre is not None for r in session.readings)
+
+
 def load_sessions(paths, methods=None, observers=None) -> Loaded:
     """Read each CSV as one session (or several, where its Method, Observer or Repetition
     columns hold several values).
@@ -302,13 +312,19 @@ def load_sessions(paths, methods=None, observers=None) -> Loaded:
             loaded.refused.append(refused)
         for session in sessions:
             fingerprint = _fingerprint(session)
-            if session.readings and fingerprint in seen:
+            if session.readings and fingerprint in seen and not _identifies(session):
+                loaded.notes.append(
+                    f"{session.name}: kept, though its readings are those of "
+                    f"{seen[fingerprint]}: without dates or centres a repetition that read the "
+                    "same cannot be told from a copy; leave the file out if it is one"
+                )
+            elif session.readings and fingerprint in seen:
                 loaded.refused.append(
                     f"{session.name}: left out, its rows (numbers and dates) are those of "
                     f"{seen[fingerprint]}: the same session given twice"
                 )
                 continue
-            seen[fingerprint] = session.name
+            seen.setdefault(fingerprint, session.name)
             loaded.sessions.append(session)
     return loaded
 
