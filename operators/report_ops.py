@@ -145,6 +145,12 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
             f"Wrote {os.path.join(folder, 'report.html')}: {outcome.sessions} sessions, "
             f"{outcome.readings} of {outcome.rows} rows used" + (left if outcome.left_out else ""),
         )
+        if outcome.to_check:
+            self.report(
+                {"WARNING"},
+                f"{len(outcome.to_check)} session(s) to check:\n"
+                + bounded_list(outcome.to_check, lines=True),
+            )
         return {"FINISHED"}
 
 

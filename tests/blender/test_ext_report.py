@@ -59,12 +59,13 @@ def test_report_operator_without_sessions_says_what_to_choose(vg, tmp_path):
 
 def test_report_operator_names_what_it_left_out(vg, tmp_path, capfd):
     # Bad input from the file browser: a non-numeric cell, a break in one session only, a file
-    # without a Break # column, the same session twice. The report is written; the operator's
-    # warning names each one, as the batch's exit message does.
-    for rep, rows in enumerate(("1,98\nm,2,n/a", "1,101\nm,2,99\nm,3,90"), start=1):
-        (tmp_path / f"obs1_manual_{rep}.csv").write_text(
-            f"Mesh,Break #,Angle\nm,{rows}\n", encoding="utf-8"
-        )
+    # without a Break # column, the same (dated) session twice. The report is written; the
+    # operator's warning names each one, as the batch's exit message does.
+    dated = "Mesh,Break #,Angle,Date\nm,1,98,2026-01-05\nm,2,n/a,2026-01-05\n"
+    (tmp_path / "obs1_manual_1.csv").write_text(dated, encoding="utf-8")
+    (tmp_path / "obs1_manual_2.csv").write_text(
+        "Mesh,Break #,Angle\nm,1,101\nm,2,99\nm,3,90\n", encoding="utf-8"
+    )
     (tmp_path / "obs1_manual_3.csv").write_text("Mesh,Angle\nm,90\n", encoding="utf-8")
     (tmp_path / "copy_manual.csv").write_bytes((tmp_path / "obs1_manual_1.csv").read_bytes())
     settings = bpy.context.scene.vg_settings
@@ -87,3 +88,15 @@ def test_report_operator_names_what_it_left_out(vg, tmp_path, capfd):
     ):
         assert line in said, said
     assert (tmp_path / "report" / "report.html").is_file()
+
+    # Two undated manual tables that read the same: both used, and the operator says to check.
+    (tmp_path / "obs1_manual_4.csv").write_bytes((tmp_path / "obs1_manual_2.csv").read_bytes())
+    settings.report_folder = str(tmp_path / "again")
+    names = ("obs1_manual_2.csv", "obs1_manual_4.csv")
+    result = bpy.ops.vg.report(directory=str(tmp_path), files=[{"name": n} for n in names])
+    assert result == {"FINISHED"}
+    out = capfd.readouterr()
+    said = out.out + out.err
+    assert "2 sessions, 6 of 6 rows used" in said
+    assert "1 session(s) to check:" in said
+    assert "obs1_manual_4.csv: kept, though its readings are those of obs1_manual_2.csv" in said
