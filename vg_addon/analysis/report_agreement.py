@@ -41,8 +41,8 @@ def agreement_section(c: Context) -> None:
             if value is not None and value.note:
                 c.skip(f"the {value.kind} of {m}, in part", value.note)
         # F is infinite where the observers agree exactly (no error variance): no number.
-        f = single.f if single is not None and single.f is not None else math.inf
-        f = f if math.isfinite(f) else None
+        finite = single is not None and single.f is not None and math.isfinite(single.f)
+        f = single.f if finite else None
         row += [None] * 4 if single is None else [f, single.df1, single.df2, single.p]
         rows.append(row)
     if not rows:
@@ -90,7 +90,6 @@ def _pairs_to_compare(c: Context, compare) -> list[tuple[str, str, dict, dict]]:
         observers = sorted({s.observer for s in c.sessions if s.method == m})
         for a, b in itertools.combinations(observers, 2):
             pairs.append((f"{m} {a}", f"{m} {b}", observer_means(m, a), observer_means(m, b)))
-    names = {s.name for s in c.sessions}
     for a, b in compare:
         values = []
         for name in (a, b):
@@ -106,7 +105,7 @@ def _pairs_to_compare(c: Context, compare) -> list[tuple[str, str, dict, dict]]:
                     "files names of their own",
                 )
                 break
-            elif name in names:
+            elif sharing:
                 values.append(session_values(name))
             else:
                 values = None

@@ -232,7 +232,6 @@ def _ply_binary_body(data, pos, elements, wanted, order, path) -> dict:
     """Read the needed properties of each element from binary data starting at ``pos``."""
     found: dict[str, dict] = {}
     buffer = np.frombuffer(data, np.uint8)
-    start = pos
     for element in elements:
         if all(name in found for name in wanted):
             break  # later elements are not needed, so they need not even be complete
