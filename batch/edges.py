@@ -253,23 +253,30 @@ def not_found_row(options: dict, mesh_name: str, message: str, units):
     return dataclasses.replace(row, error=f"edges not found: {message}")
 
 
+def _failure_fields(spec: dict, mesh_name: str, message: str, units) -> dict:
+    """What the station row and the edges CSV row of an edge that failed have in common."""
+    return {
+        "mesh_name": mesh_name,
+        "date": csvio.now_iso(),
+        "user_data": spec.get("note", ""),
+        "radius": spec["radius"],
+        "lam": spec["lam"],
+        "patch": spec["patch"],
+        "spacing": spec["spacing"],
+        "units": units,
+        "extension_version": records.extension_version(),
+        "blender_version": bpy.app.version_string,
+        "error": f"edge not measured: {message}",
+    }
+
+
 def failed_edge_row(number: int | None, spec: dict, mesh_name: str, message: str, units):
     """The output row of an edge that could not be measured."""
     first = spec["points"][0]
     return csvio.MeasurementRow(
-        mesh_name=mesh_name,
-        date=csvio.now_iso(),
-        user_data=spec.get("note", ""),
-        radius=spec["radius"],
-        lam=spec["lam"],
-        patch=spec["patch"],
+        **_failure_fields(spec, mesh_name, message, units),
         requested=None if first is None else tuple(float(v) for v in first),
         edge_number=number,
-        spacing=spec["spacing"],
-        units=units,
-        extension_version=records.extension_version(),
-        blender_version=bpy.app.version_string,
-        error=f"edge not measured: {message}",
     )
 
 
@@ -277,23 +284,13 @@ def failed_edge_summary(number: int, spec: dict, mesh_name: str, message: str, u
     """The edges CSV row of an edge that could not be measured: its points and settings, so the
     edge can be looked at or measured again, and why it failed; no figures."""
     return csvio.EdgeRow(
-        mesh_name=mesh_name,
-        date=csvio.now_iso(),
+        **_failure_fields(spec, mesh_name, message, units),
         edge_number=number,
-        user_data=spec.get("note", ""),
-        spacing=spec["spacing"],
-        radius=spec["radius"],
-        lam=spec["lam"],
-        patch=spec["patch"],
         rule=rule,
         points=csvio.format_points(spec["points"]),
-        units=units,
         coordinates=(
             csvio.WORLD_COORDINATES if spec.get("space") == "world" else csvio.MESH_COORDINATES
         ),
-        extension_version=records.extension_version(),
-        blender_version=bpy.app.version_string,
-        error=f"edge not measured: {message}",
     )
 
 

@@ -207,7 +207,17 @@ def import_csv(obj, path, *, depsgraph=None, **options) -> list[int]:
 
 def export_rows(objects, scene, *, depsgraph=None) -> list:
     """CSV rows of every measurement of ``objects`` (stale ones flagged), in list order."""
-    rows = []
+    return export_tables(objects, scene, depsgraph=depsgraph)[0]
+
+
+def export_tables(objects, scene, *, depsgraph=None) -> tuple[list, list]:
+    """The measurement rows and the edge summary rows of ``objects``, in list order.
+
+    Stale measurements are flagged, and so is an edge with a stale station. Whether a record is
+    stale needs the object's current geometry hashed, so it is worked out once per object for
+    both tables.
+    """
+    rows, edge_rows = [], []
     for obj in objects:
         units = records.units_label(scene, obj)
         stale = measuring.stale_numbers(obj, depsgraph=depsgraph)
@@ -222,19 +232,9 @@ def export_rows(objects, scene, *, depsgraph=None) -> list:
             )
             for item in obj.vg.measurements
         )
-    return rows
-
-
-def export_edge_rows(objects, scene, *, depsgraph=None) -> list:
-    """Edge summary CSV rows of every edge profile of ``objects``, in list order; an edge with a
-    stale station is flagged stale."""
-    rows = []
-    for obj in objects:
-        stale = measuring.stale_numbers(obj, depsgraph=depsgraph)
         stale_edges = {item.edge_number for item in obj.vg.measurements if item.number in stale}
-        units = records.units_label(scene, obj)
-        rows.extend(
+        edge_rows.extend(
             records.edge_row(obj, edge, units=units, stale=edge.number in stale_edges)
             for edge in obj.vg.edges
         )
-    return rows
+    return rows, edge_rows

@@ -115,13 +115,10 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
                 return {"CANCELLED"}
             objects = [obj]
         try:
-            rows = replication.export_rows(
+            rows, edge_rows = replication.export_tables(
                 objects, context.scene, depsgraph=context.evaluated_depsgraph_get()
             )
             csvio.write_measurements_csv(path, rows)
-            edge_rows = replication.export_edge_rows(
-                objects, context.scene, depsgraph=context.evaluated_depsgraph_get()
-            )
             if edge_rows:
                 csvio.write_edges_csv(csvio.edges_path_for(path), edge_rows)
         except OSError as error:
