@@ -530,8 +530,9 @@ def test_the_station_csv_says_which_edge_is_a_loop_and_the_import_rebuilds_it_so
     rows = csvio.read_measurements_csv(stations_csv)
     assert len(rows) == len(centres) > 30 and {row.edge_closed for row in rows} == {closed}
     loop = [*centres, centres[0]]
-    # The case the judging got wrong: this open edge's ends are closer than a spacing.
-    assert station_points(centres, rows[0].arc_length, rows[0].spacing) == loop
+    if not closed:
+        # The case the judging got wrong: this open edge's ends are closer than a spacing.
+        assert station_points(centres, rows[0].arc_length, rows[0].spacing) == loop
 
     mesh_object("Lens.stations", shape.points, shape.triangles)
     assert bpy.ops.vg.import_csv(filepath=str(stations_csv), ignore_mesh_names=True) == {"FINISHED"}

@@ -361,3 +361,33 @@ def test_stations_carry_the_stability_figure_when_asked(concave):
         assert station.stability is not None
         assert station.stability == single.stability
         assert station.angle == single.angle
+
+
+@pytest.mark.parametrize("stations", [1, 2, 3, 10, 40, 41, 109])
+def test_a_loop_is_measured_once_round_at_each_place(stations):
+    # The rim of two intersecting spheres traced from a point back to it: a loop. Before, a
+    # spacing of length / k put a station at each end, on the same vertex, so that place was
+    # counted twice in the mean, median and SD, and the chord length read 0.
+    shape = lens(70.53, radius=1.0, n_around=240)
+    surface = Surface(shape.points, shape.triangles)
+    start, a, b = (shape.points[shape.edge[i]] for i in (0, 80, 160))
+    path = surface.trace_edge(start, start, via=[a, b])
+    assert path.vertices[0] == path.vertices[-1]
+    profile = surface.measure_along(path, path.length / stations, radius=0.05)
+    centres = np.array([m.center for m in profile.stations])
+    assert profile.n_stations == stations
+    assert len(np.unique(centres, axis=0)) == stations
+    # Evenly round the loop, the seam included: each gap, the one from the last station back
+    # to the first too, within one path segment of length / stations.
+    gaps = np.diff(np.append(profile.arc_lengths, path.length + profile.arc_lengths[0]))
+    segment = float(np.diff(path.arc_lengths).max())
+    assert np.abs(gaps - path.length / stations).max() <= segment
+    assert profile.mean == pytest.approx(np.mean([m.angle for m in profile.stations]), abs=1e-12)
+
+
+def test_a_path_that_turns_back_is_not_measured_twice_at_one_vertex(ramp):
+    _, surface = ramp
+    there_and_back = surface.trace_edge([-3, 0, 0], [-2, 0, 0], via=[[3, 0, 0]])
+    assert np.unique(there_and_back.vertices).size < there_and_back.vertices.size
+    with pytest.raises(GoniometerError, match="same vertex twice"):
+        surface.measure_along(there_and_back, spacing=0.5, radius=0.3)

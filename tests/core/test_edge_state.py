@@ -49,6 +49,7 @@ def test_refusals_leave_the_machine_as_it_was():
     machine.click([1.0, 0.0, 0.0])
     assert machine.confirm(0.5, 0.001) is None  # too small a radius: refused, still picking
     assert machine.phase is EdgePhase.PICKING and "could not be measured" in machine.message
+    assert "radius" in machine.message.splitlines()[0]  # why, on the line the header shows
     assert machine.confirm(0.5, 0.3) is not None
 
 

@@ -213,6 +213,20 @@ def test_a_click_off_the_trimmed_candidate_and_esc_leave_it_whole(surface):
     assert machine.candidates[0] is whole
 
 
+def test_keys_that_decide_during_a_trim_say_to_finish_it_first(surface):
+    # Before, Enter, A, X and Shift+A during a trim did nothing and said nothing.
+    machine = found(surface)
+    machine.start_trim()
+    for press in (machine.accept, machine.reject, machine.accept_pending):
+        machine.message = ""
+        assert not press() and "trim" in machine.message
+    machine.message = ""
+    assert not machine.finish(SPACING, 1.0) and "trim" in machine.message
+    assert machine.phase is FindPhase.TRIMMING and machine.count(Decision.PENDING) == len(
+        machine.candidates
+    )
+
+
 def test_a_candidate_that_cannot_be_measured_sends_the_review_back_naming_it(surface):
     machine = found(surface)
     machine.accept()
@@ -223,6 +237,8 @@ def test_a_candidate_that_cannot_be_measured_sends_the_review_back_naming_it(sur
         pass
     assert machine.phase is FindPhase.REVIEW and machine.profiles == []
     assert machine.message.startswith("Candidate 1 cannot be measured")
+    # The header shows the message's first line: it says why, not only that it failed.
+    assert "radius" in machine.message.splitlines()[0]
     assert machine.selected == 0
     assert machine.accepted == [0, 1]  # the decisions are kept
 

@@ -491,17 +491,26 @@ def check_station_count(length: float, spacing: float) -> None:
         )
 
 
+def is_loop(path: EdgePath) -> bool:
+    """Whether ``path`` ends on the vertex it starts from (a closed edge)."""
+    return path.vertices.size > 1 and bool(path.vertices[0] == path.vertices[-1])
+
+
 def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
     """Positions in ``path.vertices`` of the stations ``spacing`` apart.
 
-    Stations are spaced evenly in arc length and centred on the path (the leftover length is
-    split between both ends); each snaps to the path vertex nearest its arc length.
+    On an open path, :func:`station_count` stations ``spacing`` apart in arc length, centred on
+    the path (the leftover length is split between both ends). On a loop, whose last vertex is
+    its first, the stations go evenly round it from its start, as many as come nearest to
+    ``spacing`` apart (at least one): a station at each end would measure one place twice.
+    Each station snaps to the path vertex nearest its arc length.
 
     Raises
     ------
     GoniometerError
         A spacing not positive, one that would make more than :data:`MAX_STATIONS` stations,
-        or so fine that two stations snap to one vertex.
+        one so fine that two stations snap to one vertex, or a path that passes a station's
+        vertex twice.
     """
     try:
         spacing = as_radius(spacing)
@@ -511,19 +520,32 @@ def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
         ) from None
     check_station_count(path.length, spacing)
     arc = path.arc_lengths
-    count = station_count(path.length, spacing)
-    targets = (path.length - (count - 1) * spacing) / 2.0 + spacing * np.arange(count)
+    loop = is_loop(path)
+    if loop:
+        count = max(1, int(np.floor(path.length / spacing + 0.5)))
+        targets = path.length * np.arange(count) / count
+    else:
+        count = station_count(path.length, spacing)
+        targets = (path.length - (count - 1) * spacing) / 2.0 + spacing * np.arange(count)
     right = np.clip(np.searchsorted(arc, targets), 1, arc.size - 1)
     left = right - 1
     positions = np.where(targets - arc[left] <= arc[right] - targets, left, right)
-    if count > 1 and (np.diff(positions) == 0).any():
+    vertices = path.vertices[positions]
+    if np.unique(vertices).size == count:
+        return positions
+    neighbours = vertices[1:] == vertices[:-1]
+    if (loop and count > 1 and vertices[0] == vertices[-1]) or neighbours.any():
         longest = float(np.diff(arc).max())
         raise GoniometerError(
             f"The spacing {spacing:g} is finer than the mesh along this edge (its segments are up "
             f"to {longest:.4g} long), so two stations would share a vertex: use a spacing of at "
             f"least {longest:.4g}."
         )
-    return positions
+    raise GoniometerError(
+        "The traced edge passes through the same vertex twice (it doubles back or crosses "
+        "itself), and two stations fall on it: one place would be measured twice. Trace the edge "
+        "again with points that do not turn back along it."
+    )
 
 
 def measure_along(
@@ -571,9 +593,12 @@ def measure_along(
             failures.append(f"station at arc length {path.arc_lengths[position]:.6g}: {error}")
     if failures:
         hint = f"\n{path.warning}" if path.warning else ""
+        first = failures[0].splitlines()[0]
         raise GoniometerError(
             f"{len(failures)} of {positions.size} stations along the edge could not be "
-            f"measured; nothing was measured.\n" + bounded_list(failures, lines=True) + hint
+            f"measured (the first, {first}); nothing was measured.\n"
+            + bounded_list(failures, lines=True)
+            + hint
         )
     first = stations[0]
     return EdgeProfile(

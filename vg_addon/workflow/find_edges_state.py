@@ -179,8 +179,8 @@ class FindEdgesMachine:
             self.profiles = []
             first = str(error).splitlines()[0]
             self.message = (
-                f"Candidate {self.candidates[index].number} cannot be measured ({first}): "
-                "trim or reject it, or change the settings."
+                f"Candidate {self.candidates[index].number} cannot be measured: {first} "
+                "Trim or reject it, or change the settings."
             )
             return False
         self.profiles.append((points, profile))
@@ -244,8 +244,15 @@ class FindEdgesMachine:
             return False
         return self.select(best)
 
+    def _deciding(self) -> bool:
+        """Whether decisions can be made now; during a trim the message says to end it first
+        (a key that did nothing and said nothing looked like a lost decision)."""
+        if self.phase is FindPhase.TRIMMING:
+            self.message = "Finish the trim first (click on the candidate), or Esc back."
+        return self.reviewing
+
     def _decide(self, decision: Decision) -> bool:
-        if not self.reviewing:
+        if not self._deciding():
             return False
         if self.selected is None:
             self.message = "Select a candidate first: click on it."
@@ -265,7 +272,7 @@ class FindEdgesMachine:
 
     def accept_pending(self) -> int:
         """Accept every undecided candidate; returns how many."""
-        if not self.reviewing:
+        if not self._deciding():
             return 0
         pending = [i for i, d in enumerate(self.decisions) if d is Decision.PENDING]
         for index in pending:
@@ -344,7 +351,7 @@ class FindEdgesMachine:
         ``spacing``, ``radius`` and the further ``settings`` (``lam``, ``patch``, ``rule``,
         ``stability``, by position or name) are those of :func:`~.edge_profile.measure_along`.
         """
-        if not self.reviewing:
+        if not self._deciding():
             return False
         self._settings = ((spacing, radius, *settings), options)
         self._queue = self.accepted
