@@ -252,6 +252,8 @@ class FindEdgesSession(ViewSession):
                 "accept_all": machine.accept_pending,
                 "trim": machine.start_trim,
             }[action]()
+        elif action == "finish" and self.not_active(context):
+            machine.message = self.not_active(context)
         elif action == "finish":
             settings = context.scene.vg_settings
             machine.finish(

@@ -46,6 +46,20 @@ class ViewSession:
         inside = 0 <= x < self._region.width and 0 <= y < self._region.height
         return (x, y) if inside else None
 
+    def not_active(self, context) -> str:
+        """Why the session cannot record now: its object is no longer the active one (a click
+        in the Outliner passes through to Blender); ``""`` when it is.
+
+        What is recorded goes to the active object, and so does the redo of the last operation:
+        recording clicks taken on one object while another is active would put them on it.
+        """
+        if context.active_object is self.obj:
+            return ""
+        return (
+            f"The clicks are on '{self.obj.name}', which is no longer the active object: make it "
+            "active again to record, or Esc."
+        )
+
     def finish(self) -> None:
         """Remove the drawing and the texts; safe to call more than once."""
         self.overlay.stop()

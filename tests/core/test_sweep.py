@@ -159,3 +159,22 @@ def test_matplotlib_sweep_images_are_exactly_the_size_asked_for(surface):
             assert mpl_plots.rgba(figure).shape == (height, width, 4)
             data = mpl_plots.png(figure)
             assert struct.unpack(">II", data[16:24]) == (width, height)
+
+
+@pytest.mark.parametrize("fits", [[0.0, 1e-6, 1e-4], [0.0, 0.0, 0.0]], ids=["one", "all"])
+def test_the_numpy_drawing_marks_an_exact_fit_at_the_foot_not_as_the_smallest(fits):
+    # Before, a fit of exactly 0 was drawn as a point where the smallest positive fit is, on
+    # the panel's floor (with all fits 0, on an axis of 1E-300 to 1E-299); matplotlib's drawing
+    # marks it at the panel's foot, with no point.
+    radii = [0.1, 0.2, 0.3]
+    image = sweep_plot.draw_sweep(radii, [90.0, 91.0, 92.0], fits)
+    span = sweep_plot.WIDTH - sweep_plot._RIGHT - sweep_plot._LEFT
+    top, bottom = sweep_plot._FIT_PANEL
+    fit_coloured = (image == sweep_plot._FIT_COLOUR).all(axis=2)
+    for radius, fit in zip(radii, fits, strict=True):
+        x = int(np.rint(sweep_plot._LEFT + (radius - 0.1) / 0.2 * span))
+        if fit > 0:
+            assert fit_coloured[top : bottom + 4, x - 3 : x + 4].sum() >= 20  # its point
+        else:
+            assert not fit_coloured[bottom - 2 : bottom + 4, x - 3 : x + 4].any()  # no point
+            assert fit_coloured[bottom - 20 : bottom - 2, x - 6 : x + 7].any()  # its mark

@@ -11,8 +11,8 @@ looking, read-only, at the live ``DragSession`` objects), the running Find Break
 regions of an open file browser and what it offers (folder, file name, filter), the screen
 positions of the 3D points listed in ``$VG_GUI_POINTS``, each mesh's edge profiles and active
 list rows, the scenes and every "VG Map" data-block in the file, the window's running modal
-operators and the .blend's path; on request, the Info log's reports (as copied text), and the
-replication report's libraries put on ``sys.path``.
+operators and the .blend's path; on request, the Info log's reports (as copied text), the
+replication report's libraries put on ``sys.path``, and another object made active.
 """
 
 from __future__ import annotations
@@ -271,6 +271,22 @@ def _add_report_libraries() -> None:
     _status["report_libs"] = True
 
 
+def _activate(window) -> None:
+    """On the test's request (the file ``$VG_GUI_STATE.activate``, naming an object), make that
+    object the active one, as a click on it in the Outliner does; a name not in the file is
+    made first, a copy of the scene's mesh object with a mesh of its own."""
+    with open(STATE + ".activate") as handle:
+        name = handle.read().strip()
+    os.remove(STATE + ".activate")
+    obj = bpy.data.objects.get(name)
+    if obj is None:
+        original = bpy.data.objects[scene.OBJECT_NAME]
+        obj = bpy.data.objects.new(name, original.data.copy())  # none of its measurements
+        obj.matrix_world = original.matrix_world
+        window.scene.collection.objects.link(obj)
+    window.view_layer.objects.active = obj
+
+
 def _tick():
     try:
         window = bpy.context.window_manager.windows[0]
@@ -282,6 +298,8 @@ def _tick():
             _copy_reports(window)
         if os.path.exists(STATE + ".report_libs"):
             _add_report_libraries()
+        if os.path.exists(STATE + ".activate"):
+            _activate(window)
         if wm.clipboard:
             _status["clipboard"].append([_status["seq"], wm.clipboard])
             wm.clipboard = ""

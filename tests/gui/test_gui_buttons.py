@@ -272,6 +272,35 @@ def test_edge_profiles_list_shows_each_edge_and_picks_by_click(gui, places):
         pytest.fail(f"the Edge Profiles panel does not draw down to the edge's note ({figures})")
 
 
+def test_an_edge_profile_is_recorded_only_on_the_object_its_clicks_are_on(gui, places):
+    """Clicks outside the viewport reach Blender during an Edge Profile session, so another
+    object can become active (a click in the Outliner). Before, Enter then recorded the clicks
+    on that object: the stations of one scan on another, with no error."""
+    count = len(gui.state()["objects"][OBJ]["edges"])
+    gui.click(gui.find_button("UI", "vg.measure_edge", upward=True))
+    start, end = EDGES[0]
+    gui.click(point(gui, start))
+    gui.click(point(gui, end))
+    other = f"{OBJ}.other"
+    Path(f"{gui.state_path}.activate").write_text(other)
+    gui.wait_for(lambda s: s["active"] == other, 20, "the other object made active")
+    gui.key("Return")
+    state = gui.settle(5)
+    assert any("measure_edge" in op.lower() for op in state["modal_operators"]), (
+        "refused, the session goes on with its clicks"
+    )
+    assert len(state["objects"][OBJ]["edges"]) == count
+    assert not state["objects"][other]["edges"] and not state["objects"][other]["measurements"]
+    Path(f"{gui.state_path}.activate").write_text(OBJ)
+    gui.wait_for(lambda s: s["active"] == OBJ, 20, "the clicked object active again")
+    gui.key("Return")
+    state = gui.wait_for(
+        lambda s: len(s["objects"][OBJ]["edges"]) == count + 1, 60, "the edge on its object"
+    )
+    assert not state["objects"][other]["edges"]
+    assert abs(state["objects"][OBJ]["edges"][-1]["mean"] - WEDGE_ANGLE) < 1e-6
+
+
 def test_render_map_cancelled_with_escape_keeps_nothing(gui, places):
     """Issue 20, item 2: Esc while the map renders: no picture, no folder it made, no "VG Map"
     scene or data-block left in the file, the operator ended."""

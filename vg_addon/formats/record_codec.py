@@ -107,7 +107,9 @@ def study_texts(numbers: dict, unit: str) -> list[tuple[str, str]]:
         ("Arc, chord", f"{numbers['arc_length']:.4g}, {numbers['chord_length']:.4g} {unit}"),
         (
             "Arc angle",
-            "undefined (one station, or a ring)" if arc_angle is None else f"{arc_angle:.2f}°",
+            "undefined (one station, a ring or no long axis)"
+            if arc_angle is None
+            else f"{arc_angle:.2f}°",
         ),
     ]
 

@@ -177,10 +177,13 @@ def draw_sweep(radii, angles, fit_errors) -> np.ndarray:
         [_label(t) for t in ticks],
     )
 
-    positive = fits[measured & (fits > 0)]
-    floor = positive.min() if positive.size else 1e-300
-    logs = np.where(measured, np.log10(np.maximum(fits, floor)), np.nan)
-    low, high = math.floor(np.nanmin(logs)), math.ceil(np.nanmax(logs))
+    # 0 has no place on a log axis: an exact fit is a mark at the panel's foot, as matplotlib's
+    # drawing has it (before, it was drawn as the smallest positive fit).
+    positive = measured & (fits > 0)
+    logs = np.where(positive, np.log10(np.where(positive, fits, 1.0)), np.nan)
+    low, high = (
+        (math.floor(np.nanmin(logs)), math.ceil(np.nanmax(logs))) if positive.any() else (0, 1)
+    )
     high = max(high, low + 1)
     step = max(1, math.ceil((high - low) / 4))
     ticks = np.arange(low, high + 1, step, dtype=np.float64)
@@ -206,6 +209,9 @@ def draw_sweep(radii, angles, fit_errors) -> np.ndarray:
     for r in radii[~measured]:  # refused radii: a mark under the angle panel
         x = _pixel(x_of(r))
         _text(image, x, _ANGLE_PANEL[1] + 4, "X", _REFUSED_COLOUR, align="centre")
+    for r in radii[measured & ~positive]:  # exact fits: a mark at the fit panel's foot
+        x = _pixel(x_of(r))
+        _text(image, x, _FIT_PANEL[1] - 16, "0", _FIT_COLOUR, align="centre")
     return image
 
 
