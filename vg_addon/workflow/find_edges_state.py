@@ -248,7 +248,7 @@ class FindEdgesMachine:
         """Whether decisions can be made now; during a trim the message says to end it first
         (a key that did nothing and said nothing looked like a lost decision)."""
         if self.phase is FindPhase.TRIMMING:
-            self.message = "Finish the trim first (click on the candidate), or Esc back."
+            self.message = "Finish the trim first: click on the candidate."
         return self.reviewing
 
     def _decide(self, decision: Decision) -> bool:
