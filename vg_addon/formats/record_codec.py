@@ -107,9 +107,9 @@ def study_texts(numbers: dict, unit: str) -> list[tuple[str, str]]:
         ("Arc, chord", f"{numbers['arc_length']:.4g}, {numbers['chord_length']:.4g} {unit}"),
         (
             "Arc angle",
-            "undefined (one station, a ring or no long axis)"
-            if arc_angle is None
-            else f"{arc_angle:.2f}°",
+            # Short enough for the sidebar: the cases (one station, a ring, a fragment as wide
+            # as long) are in docs/EDGE_PROFILES.md.
+            "undefined (no single direction)" if arc_angle is None else f"{arc_angle:.2f}°",
         ),
     ]
 
