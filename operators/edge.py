@@ -127,8 +127,8 @@ class EdgeSession(ViewSession):
             machine.click(hit)
         elif action == "undo":
             machine.undo()
-        elif action == "confirm" and self.not_active(context):
-            machine.message = self.not_active(context)
+        elif action == "confirm" and (refusal := self.not_active(context)):
+            machine.message = refusal
         elif action == "confirm":
             settings = context.scene.vg_settings
             machine.confirm(

@@ -252,8 +252,8 @@ class FindEdgesSession(ViewSession):
                 "accept_all": machine.accept_pending,
                 "trim": machine.start_trim,
             }[action]()
-        elif action == "finish" and self.not_active(context):
-            machine.message = self.not_active(context)
+        elif action == "finish" and (refusal := self.not_active(context)):
+            machine.message = refusal
         elif action == "finish":
             settings = context.scene.vg_settings
             machine.finish(

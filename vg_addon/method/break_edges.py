@@ -40,7 +40,7 @@ from .edge_pieces import (
     smooth_regions,
     trace_piece,
 )
-from .edge_profile import EdgePath, assemble_path, has_ridge_graph, ridge_graph
+from .edge_profile import EdgePath, assemble_path, has_ridge_graph, is_loop, ridge_graph
 from .fixed_order import rows_dot, total
 from .mesh_edges import MeshEdges
 from .mesh_regions import dilate, flood_labels
@@ -658,4 +658,4 @@ def trim(candidate: BreakEdgeCandidate, start_arc: float, end_arc: float) -> Bre
     stops = [0, *inside, vertices.size - 1]
     legs = retraced_legs(surface, vertices, stops)
     part = assemble_path(surface, legs)
-    return rated(candidate, part, bend_deg, closed=bool(part.vertices[0] == part.vertices[-1]))
+    return rated(candidate, part, bend_deg, closed=is_loop(part))
