@@ -95,6 +95,24 @@ def test_the_harder_cases_that_docs_claim_pass_do(name):
         assert np.array_equal(again.vertices, candidate.path.vertices), candidate.number
 
 
+def test_no_candidate_passes_a_place_twice():
+    """A via point a little off the crest sent the marched flake's candidate 3 out to it and
+    back over the same 4 vertices (arc lengths 31.6 to 33.5): stations there measured one place
+    twice, or were refused. Oracle: the path's vertex indices, a loop's closing one left out, are
+    all different; and the candidate still retraces from its waypoints."""
+    for make in (fragments.marched_flake, fragments.marched_bevelled_cube, flake, bevelled_cube):
+        fragment = make()
+        surface = Surface(fragment.points, fragment.triangles)
+        for candidate in surface.find_break_edges().candidates:
+            vertices = candidate.path.vertices.tolist()
+            once = vertices[:-1] if candidate.closed else vertices
+            assert len(set(once)) == len(once), (make.__name__, candidate.number)
+            assert candidate.path.revisited_spans == ()
+            points = candidate.waypoint_points
+            again = surface.trace_edge(points[0], points[-1], via=points[1:-1])
+            assert np.array_equal(again.vertices, candidate.path.vertices)
+
+
 @pytest.mark.parametrize("seed", [2, 3])
 def test_the_bevelled_cube_at_noise_0_3_passes_with_other_noise_seeds(seed):
     """The seeds on which its fillets' paths wandered most and noise ridges inside its faces

@@ -373,6 +373,7 @@ def test_a_loop_is_measured_once_round_at_each_place(stations):
     start, a, b = (shape.points[shape.edge[i]] for i in (0, 80, 160))
     path = surface.trace_edge(start, start, via=[a, b])
     assert path.vertices[0] == path.vertices[-1]
+    assert path.revisited_spans == () and path.warning == ""  # closing on its start is no revisit
     profile = surface.measure_along(path, path.length / stations, radius=0.05)
     centres = np.array([m.center for m in profile.stations])
     assert profile.n_stations == stations

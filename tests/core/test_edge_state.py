@@ -69,6 +69,24 @@ def test_a_click_off_the_ridge_shows_the_flat_warning_while_picking():
     assert machine.path.flat_spans and "no ridge" in machine.message
 
 
+def test_a_click_that_turns_back_along_the_edge_is_flagged_while_picking():
+    # Before, nothing said so until Enter refused the path (or, where no two stations met on a
+    # vertex, measured the stretch twice). Oracle: the crease is the x axis with 20 vertices per
+    # unit; out from -1.5 to 1.5 and back to -0.5, the path passes x from -0.5 to 1.45 twice:
+    # arc lengths 1 to 2.95 going out and 3.05 to 5 coming back.
+    machine = EdgeMachine(SURFACE)
+    for x in (-1.5, 1.5):
+        machine.click([x, 0.0, 0.0])
+    assert machine.message == ""
+    assert machine.click([-0.5, 0.0, 0.0])  # a warning, not a refusal: the user may mean it
+    spans = np.array(machine.path.revisited_spans)
+    assert np.allclose(spans, [[1.0, 2.95], [3.05, 5.0]], atol=1e-9), spans
+    assert machine.message.startswith("The traced path passes the same vertices twice")
+    assert "1 to 2.95" in machine.message and "3.05 to 5 of 5" in machine.message
+    machine.undo()
+    assert machine.message == "" and machine.path.revisited_spans == ()
+
+
 def test_confirm_measures_every_station_with_the_rule_given():
     machine = EdgeMachine(SURFACE)
     for x in (-1.5, 1.5):

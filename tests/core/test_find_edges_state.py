@@ -8,9 +8,13 @@ the original path's own vertices and arc lengths for a trim."""
 
 from __future__ import annotations
 
+import collections
+
 import numpy as np
 import pytest
+from edge_truth import mean_edge_length
 
+from vg_addon.fragments import bone_shaft, with_noise
 from vg_addon.method.break_edges import BreakEdgeFinder, find_break_edges
 from vg_addon.method.surface import Surface
 from vg_addon.synthetic_meshes import bone_fragment
@@ -275,3 +279,26 @@ def test_accepted_candidates_are_measured_with_the_rule_and_stability_given(surf
         alone = surface.measure(station.center, RADIUS, rule="paper", stability=True)
         assert station.rule == "paper"
         assert (station.angle, station.stability) == (alone.angle, alone.stability)
+
+
+def test_selecting_a_candidate_that_passes_a_place_twice_says_so():
+    # On the shaft with noise of 0.3 mean edge lengths, candidate 4's path goes out to one vertex
+    # and back (a spur the finder could not untie without a shortcut off the crest). Its
+    # stations there would be refused; the review says so when it is selected, and says nothing
+    # for the others. Oracle: the path's repeated vertex indices, counted in plain Python.
+    shaft = bone_shaft(0.3)
+    noisy = with_noise(shaft, 0.3 * mean_edge_length(shaft.points, shaft.triangles), seed=1)
+    machine = found(Surface(noisy.points, noisy.triangles))
+    for index, candidate in enumerate(machine.candidates):
+        vertices = candidate.path.vertices.tolist()[:-1]  # every candidate here is a loop
+        counts = collections.Counter(vertices)
+        twice = [k for k, v in enumerate(vertices) if counts[v] > 1]
+        machine.select(index)
+        if not twice:
+            assert machine.message == ""
+            continue
+        arcs = candidate.path.arc_lengths
+        assert machine.message.startswith(f"Candidate {candidate.number} passes the same vertices")
+        assert f"{arcs[twice[0]]:.4g} to" in machine.message and "trim" in machine.message
+        assert f"{arcs[twice[-1]]:.4g})" in machine.message
+    assert any(machine.candidates[i].path.revisited_spans for i in range(4))

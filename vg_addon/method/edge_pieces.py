@@ -223,11 +223,10 @@ def follow(
             via = int(crest_ids[np.argmax(np.minimum(to_a, to_b))])
             pending += [(via, b, depth + 1), (a, via, depth + 1)]
             continue
-        off = ~near[leg]
-        run = _longest_run(off)
-        if run is None or run[1] - run[0] < MIN_OFF_RUN or depth >= MAX_VIA_DEPTH:
+        if not _strays(leg, near) or depth >= MAX_VIA_DEPTH:
             legs.append(leg)
             continue
+        run = _longest_run(~near[leg])
         middle = surface.points[leg[(run[0] + run[1]) // 2]]
         if ahead:
             via = _via(surface.points, a, b, middle, crest_points, crest_ids)
@@ -238,6 +237,12 @@ def follow(
             continue
         pending += [(via, b, depth + 1), (a, via, depth + 1)]
     return legs
+
+
+def _strays(leg: np.ndarray, near: np.ndarray) -> bool:
+    """Whether ``leg`` leaves the crest (``near``) for :data:`MIN_OFF_RUN` vertices in a row."""
+    run = _longest_run(~near[leg])
+    return run is not None and run[1] - run[0] >= MIN_OFF_RUN
 
 
 def _via(points, a: int, b: int, middle, crest_points, crest_ids) -> int:
@@ -296,7 +301,72 @@ def trace_piece(surface, graph, piece: Piece, sharp=None) -> tuple[EdgePath, boo
         return None
     if not closed:
         legs = _without_loops(surface, legs)
-    return assemble_path(surface, legs), closed
+    return assemble_path(surface, _untied(surface, graph, legs)), closed
+
+
+def _knot(vertices: np.ndarray, after: int = -1) -> tuple[int, int] | None:
+    """(first, last) positions of the first stretch of ``vertices`` after position ``after``
+    that the path passes twice (out and back over the same vertices, or round a little loop),
+    or None."""
+    _, inverse, counts = np.unique(vertices, return_inverse=True, return_counts=True)
+    twice = np.flatnonzero(counts[inverse] > 1)
+    twice = twice[twice > after]
+    if twice.size == 0:
+        return None
+    last_at = np.zeros(counts.size, dtype=np.int64)
+    np.maximum.at(last_at, inverse, np.arange(vertices.size))
+    first = last = int(twice[0])
+    reach = int(last_at[inverse[first]])
+    while reach > last:  # widen until no vertex inside comes back after the stretch
+        last, reach = reach, int(last_at[inverse[first : reach + 1]].max())
+    return first, last
+
+
+def _untied(surface, graph, legs: list[np.ndarray]) -> list[np.ndarray]:
+    """``legs`` with each knot traced again in one leg between the waypoints either side of it.
+
+    A via point a little off the crest can leave the path going out and back over the same
+    vertices: measured there, one place would count twice. The legs that take part in a knot
+    are replaced by the cheapest leg between the waypoint before it and the one after, which
+    retraces by construction. Where that leg goes farther than one ring of neighbours from the
+    stretch it replaces (a shortcut across the surface), or still passes a vertex twice, or no
+    leg joins them (or the knot takes in a whole loop), the knot is left as it was, and the
+    path's :attr:`~.edge_profile.EdgePath.warning` says so."""
+    closing = len(legs) > 1 and bool(legs[0][0] == legs[-1][-1])
+    after = -1
+    while True:
+        vertices = np.concatenate([legs[0], *(leg[1:] for leg in legs[1:])])
+        knot = _knot(vertices[:-1] if closing else vertices, after)
+        if knot is None:
+            return legs
+        ends = np.cumsum([0, *(leg.size - 1 for leg in legs)])
+        # The legs from the last waypoint before the knot to the first one after it.
+        k0 = max(int(np.searchsorted(ends, knot[0], side="left")) - 1, 0)
+        k1 = min(int(np.searchsorted(ends, knot[1], side="right")), len(legs))
+        leg = _knot_free_leg(surface, graph, legs[k0:k1])
+        if leg is None:
+            after = knot[1]
+        else:
+            legs = [*legs[:k0], leg, *legs[k1:]]
+            after = int(ends[k0]) + leg.size - 1
+
+
+def _knot_free_leg(surface, graph, legs: list[np.ndarray]) -> np.ndarray | None:
+    """The cheapest leg from the start of ``legs`` to their end if it passes no vertex twice
+    and keeps within one ring of neighbours of their vertices; otherwise None."""
+    start, end = int(legs[0][0]), int(legs[-1][-1])
+    if start == end:
+        return None
+    try:
+        leg = trace_leg(surface, start, end)
+    except GoniometerError:
+        return None
+    stretch = np.concatenate(legs)
+    counts = graph.starts[stretch + 1] - graph.starts[stretch]
+    beside = np.concatenate([stretch, graph.target[expand_ranges(graph.starts[stretch], counts)]])
+    if _knot(leg) is not None or not np.isin(leg, beside).all():
+        return None
+    return leg
 
 
 def _without_loops(surface, legs: list[np.ndarray]) -> list[np.ndarray]:

@@ -169,17 +169,35 @@ class EdgePath:
         return float(np.mean(self.vertex_bend_deg >= self.ridge_min_deg))
 
     @property
+    def revisited_spans(self) -> tuple:
+        """Arc-length intervals of the runs of path vertices the path passes more than once
+        (it doubles back or crosses itself there; a loop's closing vertex does not count)."""
+        vertices = self.vertices[:-1] if is_loop(self) else self.vertices
+        _, inverse, counts = np.unique(vertices, return_inverse=True, return_counts=True)
+        return _spans(counts[inverse] > 1, self.arc_lengths, 1)
+
+    @property
     def warning(self) -> str:
-        """A sentence naming the flat spans, or ``""`` when the whole path follows a ridge."""
-        if not self.flat_spans:
-            return ""
-        spans = bounded_list(f"{a:.4g} to {b:.4g}" for a, b in self.flat_spans)
-        return (
-            f"The traced path crosses surface with no ridge (every mesh edge there bends less "
-            f"than {self.ridge_min_deg:.3g}°) at arc lengths {spans} of {self.length:.4g}: there it is "
-            "a plain shortest route, not a break edge. Check the clicks or add a via point on "
-            "the edge."
-        )
+        """Sentences naming the stretches the path passes twice and the flat spans, or ``""``
+        when the path follows a ridge and never turns back."""
+        sentences = []
+        if revisited := self.revisited_spans:
+            spans = bounded_list(f"{a:.4g} to {b:.4g}" for a, b in revisited)
+            sentences.append(
+                f"The traced path passes the same vertices twice at arc lengths {spans} of "
+                f"{self.length:.4g} (it doubles back or crosses itself): a station there would "
+                "measure one place twice. Undo the click that turned back, or click farther "
+                "along the edge."
+            )
+        if self.flat_spans:
+            spans = bounded_list(f"{a:.4g} to {b:.4g}" for a, b in self.flat_spans)
+            sentences.append(
+                f"The traced path crosses surface with no ridge (every mesh edge there bends less "
+                f"than {self.ridge_min_deg:.3g}°) at arc lengths {spans} of {self.length:.4g}: "
+                "there it is a plain shortest route, not a break edge. Check the clicks or add a "
+                "via point on the edge."
+            )
+        return " ".join(sentences)
 
 
 _BATCH = 512
@@ -300,13 +318,18 @@ def _search(surface, graph: RidgeGraph, start: int, end: int, arrays, touched: l
 
 def _flat_spans(on_ridge: np.ndarray, arc: np.ndarray) -> tuple:
     """Arc-length intervals of the runs of at least MIN_FLAT_RUN path vertices off any ridge."""
-    steps = np.diff(np.concatenate([[0], (~on_ridge).astype(np.int8), [0]]))
+    return _spans(~on_ridge, arc, MIN_FLAT_RUN)
+
+
+def _spans(marked: np.ndarray, arc: np.ndarray, shortest: int) -> tuple:
+    """Arc-length intervals of the runs of at least ``shortest`` consecutive marked vertices."""
+    steps = np.diff(np.concatenate([[0], marked.astype(np.int8), [0]]))
     begins = np.flatnonzero(steps == 1)
     ends = np.flatnonzero(steps == -1) - 1
     return tuple(
         (float(arc[i]), float(arc[j]))
         for i, j in zip(begins, ends, strict=True)
-        if j - i + 1 >= MIN_FLAT_RUN
+        if j - i + 1 >= shortest
     )
 
 

@@ -24,7 +24,7 @@ from enum import StrEnum
 
 import numpy as np
 
-from ..errors import GoniometerError
+from ..errors import GoniometerError, bounded_list
 from ..method.break_edges import BreakEdgeCandidate, trim
 from ..method.edge_profile import measure_along
 
@@ -213,7 +213,7 @@ class FindEdgesMachine:
         if index is not None and not 0 <= index < len(self.candidates):
             return False
         self.selected = index
-        self.message = ""
+        self.message = "" if index is None else _revisit_hint(self.candidates[index])
         return True
 
     def select_next(self, step: int = 1) -> bool:
@@ -372,3 +372,16 @@ class FindEdgesMachine:
             self.profiles = []
             self.message = message
             self._work = iter(())
+
+
+def _revisit_hint(candidate) -> str:
+    """What to do with a candidate whose path passes the same vertices twice (the finder could
+    not untie it), or ``""``: a station there would measure one place twice, or be refused."""
+    spans = candidate.path.revisited_spans
+    if not spans:
+        return ""
+    where = bounded_list(f"{a:.4g} to {b:.4g}" for a, b in spans)
+    return (
+        f"Candidate {candidate.number} passes the same vertices twice (arc lengths {where}): "
+        "trim that stretch off, or reject it."
+    )
