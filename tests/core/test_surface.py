@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from vg_addon import GoniometerError, GridIndex, Surface
 from vg_addon.method.normals import vertex_normals
+from vg_addon.method.spatial import estimate_spacing
 from vg_addon.synthetic_meshes import wedge
 
 
@@ -280,3 +281,30 @@ def test_a_centre_as_far_as_a_double_reaches_is_refused_not_a_traceback(far):
     grid = GridIndex(shape.points, 0.1)
     assert grid.ball([far, 0.0, 0.0], 0.3)[0].size == 0
     assert grid.nearest([far, 0.0, 0.0], 1.0) == (-1, float("inf"))
+
+
+@pytest.mark.parametrize("far", [1e2, 1e4])
+def test_a_stray_point_far_from_a_point_cloud_changes_no_other_normal(far):
+    # Before, a stray point set the extent the spacing estimate's grid starts from: 1,000 object
+    # sizes away it made the estimate 5 times too large, the normals pooled whole regions (25 s
+    # for a 45,000-point cloud) and 100,000 away the memory ran out. Oracle: the same cloud
+    # without the stray point, and a brute-force nearest-neighbour distance.
+    mesh = wedge(100, n=60, irregular=True, seed=1)
+    clean = Surface(mesh.points)
+    stray = Surface(np.vstack([mesh.points, [[far, -far, far]]]))
+    # The same up to rounding: the grid's cells start elsewhere, so sums run in another order.
+    assert np.abs(stray.normals[:-1] - clean.normals).max() < 1e-12 and not stray.valid[-1]
+    angle = stray.measure([0, 0, 0], 0.5).angle
+    assert angle == pytest.approx(clean.measure([0, 0, 0], 0.5).angle, abs=1e-9)
+    some = mesh.points[:: mesh.points.shape[0] // 400]
+    gaps = np.linalg.norm(some[:, None] - mesh.points[None], axis=2)
+    gaps[gaps == 0.0] = np.inf  # each point's distance to itself
+    nearest = float(np.median(gaps.min(axis=1)))
+    estimate = estimate_spacing(np.vstack([mesh.points, [[far, -far, far]]]))
+    assert nearest / 2 < estimate < 2 * nearest, (estimate, nearest)
+
+
+def test_a_point_cloud_too_wide_for_its_grid_is_refused_not_left_to_exhaust_memory():
+    mesh = wedge(100, n=60, irregular=True, seed=1)
+    with pytest.raises(GoniometerError, match="far from the rest"):
+        Surface(np.vstack([mesh.points, [[1e9, 0.0, 0.0]]]))

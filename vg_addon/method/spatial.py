@@ -37,6 +37,7 @@ def estimate_spacing(points: np.ndarray) -> float:
     if points.shape[0] > 200_000:  # a subsample estimates the same density faster
         stride = points.shape[0] // 100_000
         return estimate_spacing(points[_sample_by_position(points, stride)]) / np.sqrt(stride)
+    points = bulk(points)
     n = points.shape[0]
     origin, top = bounds(points)
     extent = float((top - origin).max())
@@ -52,6 +53,26 @@ def estimate_spacing(points: np.ndarray) -> float:
         if occupied <= n / 4 or cell >= extent:
             return cell * float(np.sqrt(occupied / n))
         cell *= 2.0
+
+
+BULK_QUANTILE = 0.01
+"""The bulk of a point set lies between this quantile of each coordinate and its complement."""
+
+
+def bulk(points: np.ndarray) -> np.ndarray:
+    """``points`` without those far outside their bulk: the box between the 1% and 99% quantile
+    of each coordinate, widened on every side by its longest side. The same array where no
+    point lies outside (a scan without stray points), and at least the box's own points.
+
+    A stray point far from the rest (a speck of debris, a coordinate gone wrong) once set the
+    extent that the spacing estimate's grid starts from: 1,000 times the object's size away it
+    made the estimate 5 times too large, and a point cloud's normals then pooled whole regions
+    (a 45,000-point cloud took 25 s, and with the point 100,000 away ran out of memory)."""
+    low = np.quantile(points, BULK_QUANTILE, axis=0, method="lower")
+    high = np.quantile(points, 1.0 - BULK_QUANTILE, axis=0, method="higher")
+    pad = float((high - low).max())
+    inside = ((points >= low - pad) & (points <= high + pad)).all(axis=1)
+    return points if inside.all() else points[inside]
 
 
 def _sample_by_position(points: np.ndarray, stride: int) -> np.ndarray:

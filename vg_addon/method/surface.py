@@ -23,7 +23,7 @@ from .normals import pca_normals, vertex_normals
 from .ordering import canonical_ranks
 from .planes import sides_contradict_normals
 from .result import Measurement
-from .spatial import GridIndex
+from .spatial import GridIndex, estimate_spacing
 from .stability import SMALL_PATCH_VERTICES, estimate_stability
 from .winding import mesh_winding
 
@@ -115,7 +115,7 @@ class Surface:
         elif self.triangles is not None:
             self.normals, self.valid = vertex_normals(self.points, self.triangles)
         else:
-            full_index = GridIndex(self.points)
+            full_index = _cloud_index(self.points)
             self.normals, self.valid = pca_normals(self.points, full_index)
         self.valid_ids = np.flatnonzero(self.valid)
         if self.valid_ids.size == 0:
@@ -324,3 +324,22 @@ def check_patch_mode(patch) -> str:
     if mode not in PATCH_MODES:
         raise GoniometerError(f"Unknown patch mode {patch!r}: use one of {', '.join(PATCH_MODES)}.")
     return mode
+
+
+def _cloud_index(points: np.ndarray) -> GridIndex:
+    """The index a point cloud's normals are estimated over: cells twice the point spacing.
+
+    Refused where the grid cannot make cells that small (its cells per axis are capped, so a
+    cloud that spans more than about four million spacings: a point far from the rest, or a
+    coordinate gone wrong): each point's neighbourhood would then pool whole cells of points,
+    enough to exhaust the memory."""
+    spacing = estimate_spacing(points)
+    index = GridIndex(points, 2.0 * spacing)
+    if index.cell_size > 4.0 * spacing:
+        extent = float(np.ptp(points, axis=0).max())
+        raise GoniometerError(
+            f"This point cloud spans {extent:.6g}, {extent / spacing:,.0f} times its point "
+            f"spacing ({spacing:.3g}): some points lie far from the rest (stray points, or a "
+            "coordinate gone wrong). Remove them and measure again."
+        )
+    return index
