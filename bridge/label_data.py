@@ -4,10 +4,11 @@ in world space, read from the records (for the viewport labels and the measureme
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
-from ..vg_addon.formats.record_codec import exact_numbers
+from ..vg_addon.formats.record_codec import decode, exact_numbers
 from ..vg_addon.method.result import stored_stability_undetermined
 from ..vg_addon.workflow.labels import label_text
 from . import records
@@ -46,13 +47,32 @@ class Label:
     unstable: bool = False
 
 
-def stability_flag(item) -> str:
+@lru_cache(maxsize=4096)
+def _label_numbers(exact: str):
+    """``(centre, normal sum, angle, radius, stability parts)`` of a record's exact numbers in
+    mesh coordinates, or None (a world-space record of an earlier version, or no centre).
+
+    Kept per exact text: the viewport labels are drawn on every redraw, and decoding every
+    record each time cost 45 ms a redraw at 600 measurements."""
+    numbers = decode(exact)
+    if numbers.get("space") != records.MESH or "center" not in numbers:
+        return None
+    centre = np.asarray(numbers["center"], dtype=np.float64)
+    normals = np.asarray(numbers["normal_plus"]) + np.asarray(numbers["normal_minus"])
+    centre.flags.writeable = normals.flags.writeable = False  # shared by every caller
+    parts = numbers.get("stability") or {}
+    return centre, normals, numbers["angle"], float(numbers["radius"]), parts
+
+
+def stability_flag(item, parts: dict | None = None) -> str:
     """The stability figure an unstable reading is flagged with (``"±78°"``; ``"±?"`` where the
     figure is undetermined), or ``""`` for a reading that is not flagged (see
-    ``vg_addon.method.result.stability_warning``)."""
+    ``vg_addon.method.result.stability_warning``). ``parts``: the record's stability numbers,
+    where the caller has them."""
     if not item.stability_warning:
         return ""
-    parts = exact_numbers(item).get("stability") or {}
+    if parts is None:
+        parts = exact_numbers(item).get("stability") or {}
     if stored_stability_undetermined(parts):
         return "±?"  # the figure itself may be far too small: no number that looks steady
     return f"±{float(parts.get('spread', 0.0)):.0f}°"
@@ -73,27 +93,32 @@ def labels_of(obj, *, active_break_only: bool = False) -> list[Label]:
     except np.linalg.LinAlgError:
         return []
     scale = float(np.cbrt(abs(np.linalg.det(linear))))
-    labels = []
+    kept = []
     for index, item in enumerate(data.measurements):
         if item.stale or (active_break_only and item.break_number != data.break_number):
             continue
-        numbers = exact_numbers(item)
-        if numbers.get("space") != records.MESH or "center" not in numbers:
-            continue
-        outward = normal_matrix @ (
-            np.asarray(numbers["normal_plus"]) + np.asarray(numbers["normal_minus"])
-        )
-        length = np.linalg.norm(outward)
-        flag = stability_flag(item)
-        text = label_text(item.number, numbers["angle"])
+        numbers = _label_numbers(item.exact)
+        if numbers is not None:
+            kept.append((index, item, numbers))
+    if not kept:
+        return []
+    positions = world_points(np.array([numbers[0] for _, _, numbers in kept]), matrix)
+    outwards = np.array([numbers[1] for _, _, numbers in kept]) @ normal_matrix.T
+    lengths = np.linalg.norm(outwards, axis=1)
+    outwards[lengths > 0] /= lengths[lengths > 0, None]
+    labels = []
+    for (index, item, numbers), position, outward in zip(kept, positions, outwards, strict=True):
+        _, _, angle, radius, parts = numbers
+        flag = stability_flag(item, parts)
+        text = label_text(item.number, angle)
         labels.append(
             Label(
                 number=item.number,
                 break_number=item.break_number,
                 text=f"{text} {flag}" if flag else text,
-                position=world_points(np.asarray(numbers["center"])[None, :], matrix)[0],
-                outward=outward / length if length > 0 else outward,
-                radius=float(numbers["radius"]) * scale,
+                position=position,
+                outward=outward,
+                radius=radius * scale,
                 active=index == data.active_index,
                 unstable=bool(flag),
             )

@@ -38,15 +38,22 @@ LINE_COLOUR = (0.9, 0.0, 0.9, 1.0)
 """Magenta: in no side colour pair (Okabe-Ito), so it stands out on every side and the sky."""
 
 
-def edge_paths(obj) -> list[tuple[np.ndarray, bool]]:
-    """Each edge record's traced path, ``(points, in_mesh_coordinates)``, skipping records
-    without one (damaged outside the extension)."""
+def edge_paths(obj) -> list[tuple[int, np.ndarray, bool]]:
+    """``(edge number, points, in_mesh_coordinates)`` of each edge record's traced path, for
+    the edges with a current station: an edge whose stations are all stale (the mesh was
+    edited under it) is no longer where the line would show it, and its stations get no label.
+    Records without a path (damaged outside the extension) are skipped."""
+    current = {
+        item.edge_number for item in obj.vg.measurements if item.edge_number > 0 and not item.stale
+    }
     paths = []
     for edge in obj.vg.edges:
+        if edge.number not in current:
+            continue
         numbers = record_codec.exact_numbers(edge)
         points = np.asarray(numbers.get("path", []), dtype=np.float64)
         if points.ndim == 2 and points.shape[0] >= 2 and points.shape[1] == 3:
-            paths.append((points, numbers.get("space") == record_codec.MESH))
+            paths.append((edge.number, points, numbers.get("space") == record_codec.MESH))
     return paths
 
 
@@ -69,7 +76,8 @@ def stations_without_views(obj, edge_ends: int = EDGE_ENDS) -> set[int]:
 
 
 def add_edge_lines(scene, obj, material, size: float, keep) -> int:
-    """Draw every edge of ``obj`` into ``scene`` as a tube of radius ``LINE_WIDTH * size``.
+    """Draw each edge of ``obj`` with a current station (see :func:`edge_paths`) into ``scene``
+    as a tube of radius ``LINE_WIDTH * size``, named by its number.
 
     Parameters
     ----------
@@ -90,7 +98,7 @@ def add_edge_lines(scene, obj, material, size: float, keep) -> int:
         How many edges were drawn.
     """
     paths = edge_paths(obj)
-    for number, (points, in_mesh) in enumerate(paths, start=1):
+    for number, points, in_mesh in paths:
         curve = keep(bpy.data.curves.new(f"VG Map edge {number}", type="CURVE"))
         curve.dimensions = "3D"
         curve.bevel_depth = LINE_WIDTH * size

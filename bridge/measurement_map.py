@@ -40,7 +40,7 @@ from mathutils import Matrix, Vector
 
 from ..vg_addon import GoniometerError
 from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, looks_at, place_labels, view_up
-from .colors import new_sides_material
+from .colors import ATTRIBUTE_NAME, has_attribute, new_sides_material
 from .label_data import labels_of
 from .map_edges import EDGE_ENDS, LINE_COLOUR, add_edge_lines, stations_without_views
 from .mesh_data import read_positions, world_points
@@ -105,6 +105,12 @@ class MapJob:
     ):
         if obj is None or obj.type != "MESH":
             raise GoniometerError("Select the measured mesh object to make its map.")
+        if len(obj.vg.measurements) and not has_attribute(obj.data):
+            # The map copies the mesh with its colours: without them its sides would be blank.
+            raise GoniometerError(
+                f"'{obj.name}' has lost its '{ATTRIBUTE_NAME}' colour attribute, so the "
+                "map would show no sides: press Update Colours, then make the map."
+            )
         if isinstance(edge_ends, bool) or not isinstance(edge_ends, int) or edge_ends < 0:
             raise GoniometerError(
                 f"The edges whose ends get views of their own must be a whole number, 0 or more "
@@ -188,6 +194,7 @@ class MapJob:
 
         camera_data = self._keep(bpy.data.cameras.new("VG Map camera"))
         camera_data.type = "ORTHO"
+        camera_data.sensor_fit = "HORIZONTAL"  # the scale spans the width, as _frame assumes
         self._camera = self._keep(bpy.data.objects.new("VG Map camera", camera_data))
         scene.collection.objects.link(self._camera)
         scene.camera = self._camera

@@ -84,6 +84,42 @@ def test_six_view_map_and_its_contact_sheet(vg, tmp_path):
     assert colourful(tiles) > 200  # the sides are painted
 
 
+@pytest.mark.parametrize("size", [(150, 300), (300, 150)], ids=["portrait", "landscape"])
+def test_a_map_of_any_shape_frames_the_object_and_draws_each_label_inside(vg, tmp_path, size):
+    """A picture taller than wide once cut the object off at both sides: Blender fitted the
+    orthographic scale to the height, the map's framing to the width. A label the plan counted
+    as drawn then fell outside the picture, so no close-up or "not shown" line made up for it.
+    Oracle: Blender's own projection of the object's corners and of each label drawn."""
+    width, height = size
+    obj = measured_annulus(vg)
+    corners = [obj.matrix_world @ Vector(c) for c in obj.bound_box]
+    job = vg.bridge.measurement_map.MapJob(obj, tmp_path, size=size, samples=1)
+    drawn = set()
+    try:
+        while not job.done:
+            step = len(job.written)
+            path = job.render_next()
+            if step >= 6:
+                continue  # close-ups frame a part of the object on purpose
+            scene, camera = job._scene, job._camera
+            uv = np.array([world_to_camera_view(scene, camera, c)[:2] for c in corners])
+            assert uv.min() >= 0.0 and uv.max() <= 1.0, (path.name, uv.min(), uv.max())
+            rgba = pixels_of(path)
+            for index, _side in job.placements[step]:
+                label = job.labels[index]
+                u, v, _ = world_to_camera_view(scene, camera, Vector(label.position))
+                assert 0.0 <= u < 1.0 and 0.0 <= v < 1.0, (path.name, label.text, u, v)
+                x, y = int(u * width), int((1.0 - v) * height)
+                assert (rgba[y, x, :3] > 0.9).all(), (path.name, label.text)
+                drawn.add(label.number)
+    finally:
+        job.abort()
+        job.close()
+    assert drawn | {label.number for label in job.not_shown} == {
+        item.number for item in obj.vg.measurements
+    }
+
+
 def test_an_unmeasured_side_shows_no_colour(vg, tmp_path):
     obj = wedge_object(90.0)
     bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.3)
@@ -179,6 +215,23 @@ def test_the_operator_writes_the_map(vg, tmp_path):
         f"{obj.name}_map_face_B.png",
     ]
     assert pixels_of(folder / f"{obj.name}_map.png").shape == (90, 360, 4)
+
+
+def test_a_map_of_an_object_whose_colours_were_removed_is_refused_until_they_are_back(vg, tmp_path):
+    """The map copies the mesh with its "VG Sides" colours. With the attribute removed (the
+    Color Attributes list's minus button), it once rendered every view with no sides and
+    reported success. Oracle: the pixels with clear colour in the written sheet."""
+    obj = measured_annulus(vg)
+    obj.data.color_attributes.remove(obj.data.color_attributes["VG Sides"])
+    folder = tmp_path / "maps"
+    with pytest.raises(RuntimeError, match="Update Colours"):
+        bpy.ops.vg.render_map(directory=str(folder), width=120, height=90, samples=1)
+    assert not folder.exists()  # nothing written, no folder left
+    assert bpy.ops.vg.repaint() == {"FINISHED"}
+    assert bpy.ops.vg.render_map(directory=str(folder), width=120, height=90, samples=1) == {
+        "FINISHED"
+    }
+    assert colourful(pixels_of(folder / f"{obj.name}_map.png")) > 100
 
 
 def _frame_to(direction):
@@ -406,3 +459,34 @@ def test_only_the_first_edges_ends_get_views_of_their_own(vg, tmp_path):
     for bad in (-1, True, 2.0):
         with pytest.raises(vg.vg_addon.GoniometerError, match="0 or more"):
             vg.bridge.measurement_map.MapJob(obj, tmp_path / "bad", edge_ends=bad)
+
+
+def test_an_edge_whose_stations_are_all_stale_draws_no_line(vg, tmp_path):
+    """After the mesh is edited, the stations are stale and get no label; the edges' lines once
+    stayed on the map where the edges used to be. Oracle: the curve objects in the map's scene,
+    named by the edge numbers, before and after the edit."""
+    obj = wedge_object(100.0, "Edge", n=40)
+    first = vg.bridge.edges.measure_edge_on_object(
+        obj, [(-0.6, 0.0, 0.0), (0.0, 0.0, 0.0)], 0.1, 0.2
+    )
+    second = vg.bridge.edges.measure_edge_on_object(
+        obj, [(0.3, 0.0, 0.0), (0.8, 0.0, 0.0)], 0.1, 0.2
+    )
+
+    def lines():
+        job = vg.bridge.measurement_map.MapJob(obj, tmp_path, size=(64, 48), samples=1)
+        try:
+            return sorted(o.name for o in job._scene.objects if o.type == "CURVE")
+        finally:
+            job.close()
+
+    assert lines() == [f"VG Map edge {first.number}", f"VG Map edge {second.number}"]
+    positions = np.empty(len(obj.data.vertices) * 3)
+    obj.data.vertices.foreach_get("co", positions)
+    positions = positions.reshape(-1, 3)
+    positions[positions[:, 0] < -0.5, 2] += 0.5  # an edit: every record's geometry is gone
+    obj.data.vertices.foreach_set("co", positions.ravel())
+    obj.data.update()
+    vg.bridge.measuring.repaint(obj)
+    assert all(item.stale for item in obj.vg.measurements)
+    assert lines() == []
