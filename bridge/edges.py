@@ -23,6 +23,7 @@ from .mesh_data import (
     check_measurable,
     evaluated_geometry,
     mesh_points,
+    names_of,
     surface_for,
     uniform_scale,
 )
@@ -246,7 +247,7 @@ def import_edges_csv(
             f"{source} has no measured edges: the run that wrote it could not measure any of its "
             f"{len(rows)} edge(s) (their error column says why); clear a row's error to try it."
         )
-    names = (obj.name, obj.data.name)
+    names = names_of(obj)
     failures, jobs = [], []
     for number, row in enumerate(rows, start=2):
         if row.error:

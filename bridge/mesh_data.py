@@ -279,6 +279,29 @@ def read_triangles(mesh, corners: np.ndarray | None = None, faces=0) -> np.ndarr
     return triangles.reshape(-1, 3)
 
 
+def names_of(obj) -> tuple[str, ...]:
+    """The names a CSV row or picked-points file may call ``obj`` by: its own and its mesh's,
+    unless another object is named like its mesh (an object renamed after import keeps its
+    mesh's old name, which may be another object's): a row naming that is the other object's."""
+    other = bpy.data.objects.get(obj.data.name)
+    if other is not None and other != obj:
+        return (obj.name,)
+    return (obj.name, obj.data.name)
+
+
+def other_names(obj) -> tuple[str, ...]:
+    """The names of every other mesh object of the file and of their meshes, less ``obj``'s own
+    (:func:`names_of`): a file named after one of them belongs to it, not to ``obj``."""
+    own = set(names_of(obj))
+    names = {
+        name
+        for other in bpy.data.objects
+        if other.type == "MESH" and other != obj
+        for name in (other.name, other.data.name)
+    }
+    return tuple(sorted(names - own))
+
+
 def check_measurable(obj) -> None:
     """Raise a :class:`GoniometerError` saying why ``obj`` cannot be measured, if it cannot."""
     if obj is None:

@@ -120,7 +120,8 @@ def stamp(item) -> None:
 def next_free_break(obj) -> int:
     """The break after the current one: one past the highest the object uses or is on."""
     data = obj.vg
-    return max([data.break_number, *(item.break_number for item in data.measurements)]) + 1
+    highest = max([data.break_number, *(item.break_number for item in data.measurements)])
+    return min(highest + 1, csvio.MAX_BREAK_NUMBER)  # at the largest a break can be: that one
 
 
 def continue_after_recorded_breaks(obj) -> None:
@@ -129,7 +130,8 @@ def continue_after_recorded_breaks(obj) -> None:
     joining a recorded one (and its colours)."""
     data = obj.vg
     highest = max((item.break_number for item in data.measurements), default=0)
-    data.break_number = max(data.break_number, highest + 1)
+    # An imported Break # may be the largest a break can be (2**31 - 1): none can follow it.
+    data.break_number = max(data.break_number, min(highest + 1, csvio.MAX_BREAK_NUMBER))
 
 
 def station_colours(break_number: int, plus_left: bool = True) -> tuple[str, str]:

@@ -11,7 +11,7 @@ from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
 from ..vg_addon.method.algorithm import DEFAULT_RULE
 from . import colors, edges, measuring, records
-from .mesh_data import check_measurable, evaluated_geometry, surface_for
+from .mesh_data import check_measurable, evaluated_geometry, names_of, surface_for
 
 
 def replicate_rows(
@@ -113,7 +113,7 @@ def replicate_steps(
     if not rows:
         raise GoniometerError(f"{source} has no measurement rows: nothing to import.")
     if not ignore_mesh_names:
-        csvio.check_mesh_names(rows, (obj.name, obj.data.name), source=source)
+        csvio.check_mesh_names(rows, names_of(obj), source=source)
     geometry = evaluated_geometry(obj, depsgraph)
     surface = surface_for(obj, geometry)
     measuring.note_winding(obj, surface)

@@ -15,7 +15,13 @@ import bpy
 from bpy.props import BoolProperty, CollectionProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 
-from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
+from ..bridge.mesh_data import (
+    check_measurable,
+    evaluated_geometry,
+    names_of,
+    other_names,
+    surface_for,
+)
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import picked_points
@@ -25,10 +31,11 @@ from .csv_ops import _path
 from .find_edges import measure_all, record_all
 
 
-def picked_edges(paths, names, *, ignore_mesh_names=False) -> list:
+def picked_edges(paths, names, *, ignore_mesh_names=False, others=()) -> list:
     """``(path, points)`` of every file of ``paths``, its points in mesh coordinates; each file
     must be named after one of ``names`` (the object's and its mesh's) unless
-    ``ignore_mesh_names``.
+    ``ignore_mesh_names``, and not after one of ``others`` (the file's other objects) that fits
+    it better: ``bone_12_picked_points.pp`` is ``bone_12``'s, not ``bone``'s, as in the batch.
 
     Raises
     ------
@@ -39,9 +46,11 @@ def picked_edges(paths, names, *, ignore_mesh_names=False) -> list:
     for path in paths:
         try:
             picked = picked_points.read_picked_points(path)
-            if not ignore_mesh_names and picked_points.mesh_for_file(path, names) is None:
+            owner = picked_points.mesh_for_file(path, [*names, *others])
+            if not ignore_mesh_names and owner not in names:
+                whose = f", but after the object '{owner}'" if owner is not None else ""
                 raise GoniometerError(
-                    f"'{Path(path).name}' is not named after '{names[0]}' (NAME.pp or "
+                    f"'{Path(path).name}' is not named after '{names[0]}'{whose} (NAME.pp or "
                     "NAME_*.pp; tick Ignore Names to measure it here)"
                 )
             found.append((path, picked_points.edge_points(picked)))
@@ -114,8 +123,9 @@ class VG_OT_import_picked_points(bpy.types.Operator, ImportHelper):
             check_measurable(obj)
             found = picked_edges(
                 self.paths(),
-                (obj.name, obj.data.name),
+                names_of(obj),
                 ignore_mesh_names=self.ignore_mesh_names,
+                others=other_names(obj),
             )
             geometry = evaluated_geometry(obj, context.evaluated_depsgraph_get())
             surface = surface_for(obj, geometry)

@@ -370,3 +370,42 @@ def test_export_through_a_symbolic_link_updates_its_target_and_keeps_the_link(vg
     bpy.ops.vg.export_csv(filepath=str(link))
     assert link.is_symlink() and os.readlink(link) == str(target)
     assert len(read_rows(target)) == 1 + len(obj.vg.measurements)
+
+
+def test_rows_of_another_object_are_not_taken_by_this_ones_mesh_name(vg, tmp_path):
+    """An object keeps its mesh's name when renamed: 'bone_left', imported as bone.ply, has the
+    mesh 'bone', and another object is called 'bone'. A CSV row of that object was once
+    re-measured on 'bone_left' with no word (its 100° came back as 60°). Oracle: the wedges'
+    true angles and the refusal naming the other mesh."""
+    bone = wedge_object(100.0, "bone")
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    left = wedge_object(60.0, "bone_left")
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    bone.data.name, left.data.name = "bone_mesh", "bone"
+    path = tmp_path / "all.csv"
+    bpy.ops.vg.export_csv(filepath=str(path), all_objects=True)
+    bpy.context.view_layer.objects.active = left
+    before = snapshot(left)
+    with pytest.raises(RuntimeError, match="name another mesh"):
+        bpy.ops.vg.import_csv(filepath=str(path))
+    assert snapshot(left) == before
+    own = tmp_path / "left.csv"
+    bpy.ops.vg.export_csv(filepath=str(own))
+    bpy.ops.vg.import_csv(filepath=str(own))  # its own rows still come back, by either name
+    first, again = (exact(m)["angle"] for m in left.vg.measurements)
+    assert again == first == pytest.approx(60.0, abs=0.01)
+
+
+def test_an_imported_break_at_the_largest_number_leaves_the_next_break_there(vg, tmp_path):
+    """Break # 2147483647 (the largest a CSV may give) was read, recorded, and then the next
+    break, one past it, overflowed Blender's integer: a traceback, with the row already
+    recorded and nothing repainted. Oracle: the limit itself and the recorded rows."""
+    obj = measured_wedge()
+    x, y, z = exact(obj.vg.measurements[0])["center"]
+    last = csvio.MAX_BREAK_NUMBER
+    path = write(
+        tmp_path / "max.csv", f"Mesh Name,Radius,x,y,z,Break #\nWedge,0.5,{x},{y},{z},{last}\n"
+    )
+    assert bpy.ops.vg.import_csv(filepath=path) == {"FINISHED"}
+    assert obj.vg.measurements[-1].break_number == last and obj.vg.break_number == last
+    assert bpy.ops.vg.next_break() == {"FINISHED"} and obj.vg.break_number == last

@@ -12,7 +12,7 @@ import json
 import bpy
 import numpy as np
 import pytest
-from bpy_helpers import exact, mesh_object
+from bpy_helpers import exact, mesh_object, wedge_object
 from conftest import MODULE
 from test_ext_measure import core_surface
 
@@ -268,3 +268,25 @@ def test_stations_take_the_panels_rule_and_stability(vg):
         alone = surface.measure(numbers["center"], RADIUS, rule="paper", stability=True)
         assert numbers["rule"] == "paper" and numbers["angle"] == alone.angle
         assert numbers["stability"]["spread"] == alone.stability.spread
+
+
+def test_a_picked_points_file_named_after_another_object_is_not_measured_on_the_active_one(
+    vg, tmp_path
+):
+    """MeshLab names a file NAME_picked_points.pp. ``bone_12_picked_points.pp`` once fitted the
+    active object ``bone`` ("bone" + "_...") and was measured there, though the file belongs to
+    ``bone_12`` (the batch, choosing among both, sends it there). Oracle: the edges recorded on
+    each object, and the angle of the one made on the right object."""
+    bone_12 = wedge_object(60.0, "bone_12", n=40)
+    bone = wedge_object(100.0, "bone", n=40)
+    bpy.context.view_layer.objects.active = bone
+    path = write_pp(tmp_path / "bone_12_picked_points.pp", [[-0.3, 0.0, 0.0], [0.3, 0.0, 0.0]])
+    settings = bpy.context.scene.vg_settings
+    settings.edge_spacing, settings.radius = 0.1, 0.15
+    with pytest.raises(RuntimeError, match="but after the object 'bone_12'"):
+        bpy.ops.vg.import_picked_points(filepath=str(path))
+    assert len(bone.vg.edges) == 0
+    bpy.context.view_layer.objects.active = bone_12
+    assert bpy.ops.vg.import_picked_points(filepath=str(path)) == {"FINISHED"}
+    (edge,) = bone_12.vg.edges
+    assert edge.mean == pytest.approx(60.0, abs=0.01)
