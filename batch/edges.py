@@ -331,11 +331,14 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         number = obj.vg.next_edge_number
         rule = spec.get("rule") or options.get("rule", DEFAULT_RULE)
         try:
+            spacing, radius = spec["spacing"], spec["radius"]
+            if spec.get("space") == "world":  # an edge file of an earlier version
+                spacing, radius = edges.mesh_lengths(obj, spacing, radius)
             profile, geometry, clicks = edges.measure_edge(
                 obj,
                 spec["points"],
-                spec["spacing"],
-                spec["radius"],
+                spacing,
+                radius,
                 spec["lam"],
                 spec["patch"],
                 space=spec.get("space", "mesh"),

@@ -263,14 +263,8 @@ def import_edges_csv(
             points = csvio.parse_points(row.points)
             spacing, radius = row.spacing, row.radius
             if row.coordinates == csvio.WORLD_COORDINATES:  # a file of an earlier version
-                scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
-                if scale is None:
-                    raise GoniometerError(
-                        "its points are in world space and the object's scale is not uniform, "
-                        "so its lengths have no single size on the mesh"
-                    )
+                spacing, radius = mesh_lengths(obj, spacing, radius)
                 points = mesh_points(points, np.array(obj.matrix_world, dtype=np.float64))
-                spacing, radius = spacing / scale, radius / scale
             settings = (
                 spacing,
                 radius,
@@ -302,6 +296,24 @@ def import_edges_csv(
         ).number
         for points, settings, edge_rule, note in jobs
     ]
+
+
+def mesh_lengths(obj, *lengths: float) -> tuple[float, ...]:
+    """World-space ``lengths`` (an edge file's spacing and radius from an earlier version) in
+    ``obj``'s mesh units: divided by its uniform scale.
+
+    Raises
+    ------
+    GoniometerError
+        The object's scale is not uniform: a world length has no single size on the mesh.
+    """
+    scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
+    if scale is None:
+        raise GoniometerError(
+            "its points are in world space and the object's scale is not uniform, so its "
+            "lengths have no single size on the mesh"
+        )
+    return tuple(length / scale for length in lengths)
 
 
 def station_points(centers: list, first_arc: float, spacing: float, closed=None) -> list:

@@ -208,3 +208,34 @@ def test_a_replay_without_units_takes_the_unit_its_files_name(tmp_path):
     mixed = edited_csv(out, tmp_path / "mixed.csv", lambda row: row.update(Units=next(marks)))
     rows, _ = replay("mixed_again.csv", points=mixed)
     assert all(row.units == "BU" for row in rows)
+
+
+def test_an_old_world_space_edge_file_replays_in_mesh_units_on_a_scaled_blend_object(vg, tmp_path):
+    """An edge file of an earlier version (no Coordinates column: points, spacing and radius in
+    world units) replayed by the batch on a .blend object scaled by 2. The points were brought
+    into mesh coordinates but the spacing and radius were not: 7 stations every 0.2 with radius
+    0.6 where Blender's import measures 13 every 0.1 with radius 0.3. Oracle: Blender's import
+    of the same file on the same object, and the wedge's angle."""
+    shape = wedge(70.0, n=40, irregular=True, seed=5)
+    obj = mesh_object("Bone", shape.points, shape.triangles, location=(1.0, 2.0, 3.0),
+                      rotation=(0.2, 0.5, 0.9), scale=(2.0, 2.0, 2.0))  # fmt: skip
+    source = tmp_path / "study.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(source))
+    matrix = np.array(obj.matrix_world, dtype=np.float64)
+    ends = np.array([[-0.6, 0.0, 0.0], [0.6, 0.0, 0.0]])
+    world = ends @ matrix[:3, :3].T + matrix[:3, 3]
+    header = [c for c in csvio.EDGE_COLUMNS if c != "Coordinates"]
+    values = {"Mesh Name": "Bone", "Edge #": "1", "Spacing": "0.2", "Radius": "0.6",
+              "SegParam": "2.0", "Patch Mode": "euclidean",
+              "Points": "; ".join(" ".join(repr(float(v)) for v in p) for p in world)}  # fmt: skip
+    old = tmp_path / "old_edges.csv"
+    old.write_text(",".join(header) + "\n" + ",".join(values.get(c, "") for c in header) + "\n")
+    out = tmp_path / "out.csv"
+    result = batch(source, "--object", "Bone", "--edges", old, "--out", out)
+    assert result.returncode == 0, result.stdout + result.stderr
+    (row,) = csvio.read_edges_csv(csvio.edges_path_for(out))
+    vg.bridge.edges.import_edges_csv(obj, old)  # Blender's import of the same file
+    (edge,) = obj.vg.edges
+    assert (row.spacing, row.radius) == (0.1, 0.3) and edge.n_stations == 13
+    assert row.n_stations == edge.n_stations
+    assert abs(row.mean - edge.mean) < 1e-6 and abs(row.mean - 70.0) < 1e-6
