@@ -230,13 +230,16 @@ def _break_sides(data, break_number: int) -> list:
     :data:`BREAK_NEIGHBOURS` measurements of ``break_number`` among the last
     :data:`BREAK_WINDOW` of ``data.measurements``."""
     items = data.measurements
-    latest = []
-    for index in range(len(items) - 1, max(len(items) - BREAK_WINDOW, 0) - 1, -1):
-        if items[index].break_number == break_number:
-            latest.append(items[index].exact)
-            if len(latest) == BREAK_NEIGHBOURS:
-                break
-    sides = (_painted_normals(exact) for exact in reversed(latest))
+    count = len(items)
+    if count == 0:
+        return []
+    # One read of every break number: indexing a Blender collection walks it from the start,
+    # so reading the window item by item cost time growing with the records held, per record.
+    breaks = np.empty(count, dtype=np.int32)
+    items.foreach_get("break_number", breaks)
+    start = max(count - BREAK_WINDOW, 0)
+    latest = np.flatnonzero(breaks[start:] == break_number)[-BREAK_NEIGHBOURS:] + start
+    sides = (_painted_normals(items[int(index)].exact) for index in latest)
     return [entry for entry in sides if entry is not None]
 
 
