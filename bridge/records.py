@@ -121,7 +121,7 @@ def next_free_break(obj) -> int:
     """The break after the current one: one past the highest the object uses or is on."""
     data = obj.vg
     highest = max([data.break_number, *(item.break_number for item in data.measurements)])
-    return min(highest + 1, csvio.MAX_BREAK_NUMBER)  # at the largest a break can be: that one
+    return _break_after(highest)
 
 
 def continue_after_recorded_breaks(obj) -> None:
@@ -130,8 +130,13 @@ def continue_after_recorded_breaks(obj) -> None:
     joining a recorded one (and its colours)."""
     data = obj.vg
     highest = max((item.break_number for item in data.measurements), default=0)
-    # An imported Break # may be the largest a break can be (2**31 - 1): none can follow it.
-    data.break_number = max(data.break_number, min(highest + 1, csvio.MAX_BREAK_NUMBER))
+    data.break_number = max(data.break_number, _break_after(highest))
+
+
+def _break_after(highest: int) -> int:
+    """The break after ``highest``; at the largest a break can be (an imported ``Break #`` of
+    2**31 - 1, the most Blender's integer holds), that one: none can follow it."""
+    return min(highest + 1, csvio.MAX_BREAK_NUMBER)
 
 
 def station_colours(break_number: int, plus_left: bool = True) -> tuple[str, str]:

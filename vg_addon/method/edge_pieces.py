@@ -223,10 +223,11 @@ def follow(
             via = int(crest_ids[np.argmax(np.minimum(to_a, to_b))])
             pending += [(via, b, depth + 1), (a, via, depth + 1)]
             continue
-        if not _strays(leg, near) or depth >= MAX_VIA_DEPTH:
+        off = ~near[leg]
+        run = _longest_run(off)
+        if run is None or run[1] - run[0] < MIN_OFF_RUN or depth >= MAX_VIA_DEPTH:
             legs.append(leg)
             continue
-        run = _longest_run(~near[leg])
         middle = surface.points[leg[(run[0] + run[1]) // 2]]
         if ahead:
             via = _via(surface.points, a, b, middle, crest_points, crest_ids)
@@ -237,12 +238,6 @@ def follow(
             continue
         pending += [(via, b, depth + 1), (a, via, depth + 1)]
     return legs
-
-
-def _strays(leg: np.ndarray, near: np.ndarray) -> bool:
-    """Whether ``leg`` leaves the crest (``near``) for :data:`MIN_OFF_RUN` vertices in a row."""
-    run = _longest_run(~near[leg])
-    return run is not None and run[1] - run[0] >= MIN_OFF_RUN
 
 
 def _via(points, a: int, b: int, middle, crest_points, crest_ids) -> int:
