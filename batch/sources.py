@@ -81,7 +81,8 @@ def blend_objects(names: list[str], blend: str) -> list[MeshSource]:
         except GoniometerError as error:
             problems.append(str(error))
             continue
-        sources.append(MeshSource(obj.name, "", (obj.data.name,)))
+        # its mesh's name too, unless another object carries it (as Blender's imports read)
+        sources.append(MeshSource(obj.name, "", mesh_data.names_of(obj)[1:]))
     if problems:
         raise UsageError("\n  ".join(["cannot measure these objects:", *problems]))
     return sources

@@ -346,3 +346,31 @@ def test_a_run_killed_while_its_map_renders_keeps_the_meshs_rows(tmp_path):
     rows = csvio.read_measurements_csv(out)
     assert len(rows) == 1 and abs(rows[0].angle - 90.0) < 0.01
     assert not list(maps.glob("*.png"))  # no picture of the stopped map was kept in place
+
+
+def test_a_row_of_another_object_is_not_taken_by_a_blend_objects_mesh_name(vg, tmp_path):
+    """An object keeps its mesh's name when renamed: 'bone_left' has the mesh 'bone', and
+    another object of the .blend is called 'bone'. With only 'bone_left' given, a row of 'bone'
+    was once measured on 'bone_left' (its 100° read as 60°), as Blender's import once did.
+    Oracle: the wedges' true angles."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    for name, angle in (("bone", 100.0), ("bone_left", 60.0)):
+        shape = wedge(angle, n=30)
+        mesh_object(name, shape.points, shape.triangles)
+    bpy.data.objects["bone"].data.name = "bone_mesh"
+    bpy.data.objects["bone_left"].data.name = "bone"
+    source = tmp_path / "study.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(source))
+    rows = tmp_path / "rows.csv"
+    rows.write_text("Mesh Name,x,y,z,Radius\nbone,0.05,0,0,0.3\nbone_left,0.05,0,0,0.3\n")
+    out = tmp_path / "out.csv"
+    ok(batch(source, "--object", "bone_left", "--points", rows, "--out", out), 1)
+    refused, measured = csvio.read_measurements_csv(out)
+    assert refused.angle is None
+    assert "names mesh 'bone', which is not among the meshes given" in refused.error
+    assert (measured.mesh_name, round(measured.angle, 2)) == ("bone_left", 60.0)
+    ok(batch(source, "--object", "bone_left", "--object", "bone", "--points", rows, "--out", out))
+    assert sorted((r.mesh_name, round(r.angle, 2)) for r in csvio.read_measurements_csv(out)) == [
+        ("bone", 100.0),
+        ("bone_left", 60.0),
+    ]
