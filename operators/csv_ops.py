@@ -14,6 +14,7 @@ from ..bridge import edges, measuring, records, replication
 from ..bridge.mesh_data import check_measurable
 from ..vg_addon import GoniometerError, units
 from ..vg_addon.formats import csvio
+from ..vg_addon.workflow import agreement
 from .common import poll_measurable, typed_value
 from .progress import Progress, own_timer_tick
 
@@ -276,9 +277,9 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        extra = follow_export(self._obj, self._full_path, numbers)
+        extra, differing = follow_export(self._obj, self._full_path, numbers)
         self.report(
-            {"INFO"},
+            {"WARNING" if differing else "INFO"},
             f"Re-measured {len(numbers)} row(s) of {self._path_name} on '{self._obj.name}' "
             f"(measurements {numbers[0]}–{numbers[-1]}){extra}",
         )
@@ -345,29 +346,33 @@ def adopt_units(obj, texts) -> str:
     return f"; Scan Units {units.SYMBOLS[key]}, as the file says"
 
 
-def follow_export(obj, path, numbers) -> str:
+def follow_export(obj, path, numbers) -> tuple[str, bool]:
     """After re-measuring an export of this extension: take its Units as ``obj``'s Scan Units
-    (unless the user chose them) and paint each new measurement's sides the way round its
-    Colors cell says; returns what to add to the report ("" for a file of another kind)."""
+    (unless the user chose them), paint each new measurement's sides the way round its Colors
+    cell says, and compare the new angles with the file's; returns what to add to the report
+    ("" for a file of another kind) and whether an angle came back different."""
     try:
         rows = csvio.read_measurements_csv(path)
     except (GoniometerError, OSError, ValueError):
-        return ""  # MeshLab's, the earlier add-on's or a points file: no Units, no Colors
+        return "", False  # MeshLab's, the earlier add-on's or a points file: no Units, no Colors
     # A batch run's failed rows (an error and no coordinates) were not replicated.
     rows = [row for row in rows if not (row.error and (row.x, row.y, row.z) == (None,) * 3)]
     if len(rows) != len(numbers):
-        return ""
+        return "", False
     extra = adopt_units(obj, [row.units for row in rows])
     by_number = {item.number: item for item in obj.vg.measurements}
-    turned = sum(
-        records.honour_colours(by_number[number], row.colors)
-        for number, row in zip(numbers, rows, strict=True)
-        if number in by_number
+    found = [(by_number[n], row) for n, row in zip(numbers, rows, strict=True) if n in by_number]
+    agreed = agreement.agreement(
+        [row.angle for _, row in found],
+        [records.numbers_of(item)["angle"] for item, _ in found],
+        [row.precision for _, row in found],
+        [row.stale for _, row in found],
     )
+    turned = sum(records.honour_colours(item, row.colors) for item, row in found)
     if turned:
         measuring.repaint(obj)
         extra += f"; {turned} painted the other way round, as its Colors say"
-    return extra
+    return extra + agreed.text, agreed.differing > 0
 
 
 classes = (VG_OT_export_csv, VG_OT_import_csv)

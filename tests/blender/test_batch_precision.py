@@ -3,9 +3,10 @@ mesh would round them), and the CSV's Precision column says which coordinates we
 
 from __future__ import annotations
 
+import bpy
 import numpy as np
 import pytest
-from bpy_helpers import batch
+from bpy_helpers import batch, exact, mesh_object
 
 from vg_addon import Surface
 from vg_addon.formats import csvio, meshio
@@ -69,3 +70,34 @@ def test_edge_stations_of_a_float64_file_are_measured_at_its_precision(tmp_path,
     )
     assert [row.angle for row in stations] == profile.angles.tolist()
     assert max(abs(row.angle - 60.0) for row in stations) < 1e-6
+
+
+def test_blenders_import_of_float64_rows_says_they_differ_and_why(vg, tmp_path, capfd):
+    """Blender holds vertices as float32, so a batch row measured at a file's float64 precision
+    comes back a little different when the CSV is imported there. It once did so in silence.
+    Oracle: the core on the float32-rounded coordinates, and the file's own angle."""
+    shape = wedge(90.0, n=24, irregular=True, seed=3)
+    points = shape.points + np.array([1000.0, 2000.0, 50.0])
+    path = meshio.write_ply(tmp_path / "far.ply", points, shape.triangles)
+    at = [repr(float(v)) for v in np.add((1000.0, 2000.0, 50.0), (0.05, 0.0, 0.0))]
+    out = tmp_path / "out.csv"
+    assert batch(path, "--at", *at, "--radius", "0.3", "--out", out).returncode == 0
+    (row,) = csvio.read_measurements_csv(out)
+    rounded = points.astype(np.float32).astype(np.float64)
+    in_float32 = Surface(rounded, shape.triangles).measure([row.x, row.y, row.z], 0.3).angle
+    assert row.precision == "float64" and in_float32 != row.angle
+    bpy.ops.wm.read_homefile(use_empty=True)
+    obj = mesh_object("far", points, shape.triangles)
+    capfd.readouterr()
+    bpy.ops.vg.import_csv(filepath=str(out))
+    assert exact(obj.vg.measurements[0])["angle"] == in_float32
+    said = capfd.readouterr()
+    assert (
+        f"1 of 1 angles differ from the file's, by up to {abs(in_float32 - row.angle):.2g}° "
+        "(1 measured by a batch run at the mesh file's float64 precision"
+    ) in said.out + said.err
+    again = tmp_path / "again.csv"
+    bpy.ops.vg.export_csv(filepath=str(again))
+    bpy.ops.vg.import_csv(filepath=str(again))
+    said = capfd.readouterr()
+    assert "all 1 angles equal the file's exactly" in said.out + said.err
