@@ -6,6 +6,7 @@ Each raises :class:`GoniometerError` for bad input before changing anything.
 
 from __future__ import annotations
 
+import contextlib
 import math
 from pathlib import Path
 
@@ -41,6 +42,12 @@ def free_break(obj) -> int:
     number = obj.vg.break_number
     while number in used:
         number += 1
+    if number > csvio.MAX_BREAK_NUMBER:
+        raise GoniometerError(
+            f"'{obj.name}' has no Break # left for a new edge: its breaks reach "
+            f"{csvio.MAX_BREAK_NUMBER}, the largest Blender can hold (an imported Break #). "
+            "Nothing was recorded."
+        )
     return number
 
 
@@ -154,8 +161,7 @@ def measure_edge_on_object(
         rule=rule,
         stability=stability,
     )
-    edge = record_profile(obj, profile, geometry, clicks, note=note)
-    measuring.repaint(obj, depsgraph=depsgraph, geometry=geometry)
+    (edge,) = record_profiles(obj, [(clicks, profile)], geometry, note)
     return edge
 
 
@@ -199,10 +205,68 @@ def record_profile(obj, profile, geometry, clicks, *, note="", plot=True):
     edge = records.add_edge(
         obj, profile, clicks, geometry.fingerprint, break_number=break_number, note=note
     )
-    obj.vg.break_number = break_number + 1  # the next measurement starts a new break
+    # the next measurement starts a new break (none follows the largest: free_break says so)
+    obj.vg.break_number = min(break_number + 1, csvio.MAX_BREAK_NUMBER)
     if plot:
         edge.plot = make_plot(obj, edge).name
     return edge
+
+
+def record_profiles(obj, measured, geometry, notes) -> list:
+    """Record measured edges on ``obj``, all of them or none, and repaint once.
+
+    Parameters
+    ----------
+    measured : list of (clicks, EdgeProfile)
+        Each edge's start, via points and end in mesh coordinates, and its profile measured on
+        ``geometry``'s surface through them (see :func:`record_profile`).
+    geometry : Geometry
+    notes : str or list of str
+        One text for every edge, or one per edge.
+
+    Returns
+    -------
+    list
+        The new ``VG_EdgeProfile`` items.
+
+    Raises
+    ------
+    GoniometerError
+        An edge that cannot be recorded (no break number left); nothing is recorded then.
+    """
+    notes = [notes] * len(measured) if isinstance(notes, str) else list(notes)
+    with recorded_whole(obj):
+        numbers = [
+            record_profile(obj, profile, geometry, clicks, note=note).number
+            for (clicks, profile), note in zip(measured, notes, strict=True)
+        ]
+    measuring.repaint(obj, geometry=geometry)
+    by_number = {edge.number: edge for edge in obj.vg.edges}
+    return [by_number[number] for number in numbers]
+
+
+@contextlib.contextmanager
+def recorded_whole(obj):
+    """Record on ``obj`` inside this block as one: where the block raises, every measurement,
+    edge and plot it added is removed and the object's counters are put back before the error
+    goes on."""
+    data = obj.vg
+    measurements, edge_count = len(data.measurements), len(data.edges)
+    counters = ("break_number", "next_number", "next_edge_number")
+    kept = {name: getattr(data, name) for name in counters}
+    active = (data.active_index, data.active_edge_index)
+    try:
+        yield
+    except BaseException:
+        remove_plots([data.edges[i] for i in range(edge_count, len(data.edges))])
+        for position in reversed(range(edge_count, len(data.edges))):
+            data.edges.remove(position)
+        for position in reversed(range(measurements, len(data.measurements))):
+            data.measurements.remove(position)
+        for name, value in kept.items():
+            setattr(data, name, value)
+        data.active_index, data.active_edge_index = active
+        raise
 
 
 def import_edges_csv(
@@ -248,7 +312,7 @@ def import_edges_csv(
             f"{len(rows)} edge(s) (their error column says why); clear a row's error to try it."
         )
     names = names_of(obj)
-    failures, jobs = [], []
+    failures, measured, notes = [], [], []
     for number, row in enumerate(rows, start=2):
         if row.error:
             continue  # an edge the run that wrote the file could not measure: nothing to repeat
@@ -271,31 +335,28 @@ def import_edges_csv(
                 lam if row.lam is None else row.lam,
                 row.patch or patch,
             )
-            # A row without a Rule (a file of an earlier version) takes the panel's. Each edge is
-            # checked before anything is recorded: points picked on another mesh are refused.
-            edge_rule = row.rule.strip().lower() or rule
-            measure_edge(obj, points, *settings, depsgraph=depsgraph, rule=edge_rule, given=source)
+            # A row without a Rule (a file of an earlier version) takes the panel's. Every edge
+            # is measured before anything is recorded: points picked on another mesh are refused.
+            profile, geometry, clicks = measure_edge(
+                obj,
+                points,
+                *settings,
+                depsgraph=depsgraph,
+                rule=row.rule.strip().lower() or rule,
+                stability=stability,
+                given=source,
+            )
         except GoniometerError as error:
             failures.append(f"row {number}: {error}")
             continue
-        jobs.append((points, settings, edge_rule, row.user_data))
+        measured.append((clicks, profile))
+        notes.append(row.user_data)
     if failures:
         raise GoniometerError(
             f"{len(failures)} of {len(rows)} edges of {source} could not be measured on "
             f"'{obj.name}'; nothing was imported.\n" + bounded_list(failures, lines=True)
         )
-    return [
-        measure_edge_on_object(
-            obj,
-            points,
-            *settings,
-            depsgraph=depsgraph,
-            note=note,
-            rule=edge_rule,
-            stability=stability,
-        ).number
-        for points, settings, edge_rule, note in jobs
-    ]
+    return [edge.number for edge in record_profiles(obj, measured, geometry, notes)]
 
 
 def mesh_lengths(obj, *lengths: float) -> tuple[float, ...]:

@@ -157,36 +157,37 @@ def replicate_steps(
         raise GoniometerError(
             f"'{obj.name}' changed while {source} was being measured; nothing was imported."
         )
-    numbers = []
-    stations: dict[tuple[str, int], list] = {}  # by mesh and edge: files may hold several
-    for row, m in results:
-        station = None
-        if row.edge_number is not None:  # numbered and oriented when its edge is rebuilt
-            station = (0, row.arc_length or 0.0, row.spacing or 0.0, True)
-        item = measuring.record(
-            obj,
-            m,
-            geometry,
-            note=row.label or "",
-            break_number=row.break_number,
-            station=station,
-            paint=False,
-        )
-        numbers.append(item.number)
-        if station is not None:
-            stations.setdefault((row.mesh_name or "", row.edge_number), []).append(
-                (item.number, m, station[1], station[2], row.edge_closed)
+    with edges.recorded_whole(obj):  # a failure part way records no row
+        numbers = []
+        stations: dict[tuple[str, int], list] = {}  # by mesh and edge: files may hold several
+        for row, m in results:
+            station = None
+            if row.edge_number is not None:  # numbered and oriented when its edge is rebuilt
+                station = (0, row.arc_length or 0.0, row.spacing or 0.0, True)
+            item = measuring.record(
+                obj,
+                m,
+                geometry,
+                note=row.label or "",
+                break_number=row.break_number,
+                station=station,
+                paint=False,
             )
-    if stations:
-        by_number = {item.number: item for item in obj.vg.measurements}
-        edges.edges_from_stations(
-            obj,
-            {
-                key: [(by_number[entry[0]], *entry[1:]) for entry in group]
-                for key, group in stations.items()
-            },
-            geometry,
-        )
+            numbers.append(item.number)
+            if station is not None:
+                stations.setdefault((row.mesh_name or "", row.edge_number), []).append(
+                    (item.number, m, station[1], station[2], row.edge_closed)
+                )
+        if stations:
+            by_number = {item.number: item for item in obj.vg.measurements}
+            edges.edges_from_stations(
+                obj,
+                {
+                    key: [(by_number[entry[0]], *entry[1:]) for entry in group]
+                    for key, group in stations.items()
+                },
+                geometry,
+            )
     records.continue_after_recorded_breaks(obj)
     measuring.repaint(obj, depsgraph=depsgraph, geometry=geometry)
     colors.show_sides_once(obj)

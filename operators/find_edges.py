@@ -24,7 +24,7 @@ import bpy
 import numpy as np
 from bpy.props import FloatProperty, StringProperty
 
-from ..bridge import edges, measuring
+from ..bridge import edges
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
@@ -167,18 +167,6 @@ def measure_all(surface, found, settings, names=None) -> list:
             + bounded_list(failures, lines=True)
         )
     return measured
-
-
-def record_all(obj, measured, geometry, note="") -> list:
-    """Record measured edges (``(points, EdgeProfile)`` pairs) on ``obj`` and repaint once;
-    returns the new edge items. ``note``: one text for every edge, or one per edge."""
-    notes = [note] * len(measured) if isinstance(note, str) else list(note)
-    made = [
-        edges.record_profile(obj, profile, geometry, points, note=text)
-        for (points, profile), text in zip(measured, notes, strict=True)
-    ]
-    measuring.repaint(obj, geometry=geometry)
-    return made
 
 
 class FindEdgesSession(ViewSession):
@@ -416,7 +404,7 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
             return {"CANCELLED"}
         # Edges found by Accept are not written back: a redo with another Accept, Scale, Min
         # Length or Min Bend finds them again.
-        return self.recorded(obj, record_all(obj, measured, geometry, self.note))
+        return self.recorded(obj, edges.record_profiles(obj, measured, geometry, self.note))
 
     def find(self, surface) -> list[np.ndarray]:
         """Run the detector to the end; the points of the candidates ``accept`` names."""
@@ -507,7 +495,7 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
         self.seg_param, self.patch = settings.seg_param, settings.patch
         self.rule, self.stability = settings.rule, settings.stability
         self.edges = format_edges_json([points for points, _ in machine.profiles])  # for redo
-        return self.recorded(obj, record_all(obj, machine.profiles, geometry, self.note))
+        return self.recorded(obj, edges.record_profiles(obj, machine.profiles, geometry, self.note))
 
     def _end(self, context) -> None:
         timer, self._timer = getattr(self, "_timer", None), None

@@ -15,6 +15,7 @@ import bpy
 from bpy.props import BoolProperty, CollectionProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 
+from ..bridge import edges
 from ..bridge.mesh_data import (
     check_measurable,
     evaluated_geometry,
@@ -28,7 +29,7 @@ from ..vg_addon.formats import picked_points
 from ..vg_addon.method.given_points import check_given_points
 from .common import poll_measurable, typed_value
 from .csv_ops import _path
-from .find_edges import measure_all, record_all
+from .find_edges import measure_all
 
 
 def picked_edges(paths, names, *, ignore_mesh_names=False, others=()) -> list:
@@ -139,7 +140,9 @@ class VG_OT_import_picked_points(bpy.types.Operator, ImportHelper):
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        made = record_all(obj, measured, geometry, note=[Path(path).name for path, _ in found])
+        made = edges.record_profiles(
+            obj, measured, geometry, [Path(path).name for path, _ in found]
+        )
         self.report(
             {"INFO"},
             f"Made {len(made)} edge profile(s) on '{obj.name}' from picked points: "

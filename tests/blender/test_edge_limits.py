@@ -7,8 +7,9 @@ import tracemalloc
 
 import bpy
 import pytest
-from bpy_helpers import mesh_object
+from bpy_helpers import exact, mesh_object
 
+from vg_addon.formats import csvio
 from vg_addon.method.edge_profile import MAX_STATIONS
 from vg_addon.synthetic_meshes import varying_wedge
 
@@ -35,3 +36,34 @@ def test_a_spacing_making_too_many_stations_is_refused_naming_the_limit(vg, spac
     assert bpy.ops.vg.measure_edge(
         points=json.dumps(POINTS), space="MESH", spacing=0.5, radius=0.3
     ) == {"FINISHED"}
+
+
+def test_an_edge_file_whose_edges_run_out_of_break_numbers_records_none_of_them(vg, tmp_path):
+    """Every edge takes a break number of its own. An object whose breaks reach the largest
+    number Blender's integer holds (an imported Break #) has room for one more edge: importing a
+    file of three once recorded one or two of them and then failed (a traceback, as the next
+    break overflowed). Oracle: the records before the import, and the limit."""
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+    obj = mesh_object("Ramp", shape.points, shape.triangles)
+    for offset in (-0.2, 0.0, 0.2):
+        points = [[-1.5, offset, 0.0], [1.5, offset, 0.0]]
+        bpy.ops.vg.measure_edge(points=json.dumps(points), spacing=0.5, radius=0.3, space="MESH")
+    bpy.ops.vg.export_csv(filepath=str(tmp_path / "ramp.csv"))
+    edges_file = csvio.edges_path_for(tmp_path / "ramp.csv")
+    assert len(csvio.read_edges_csv(edges_file)) == 3
+    x, y, z = exact(obj.vg.measurements[0])["center"]
+    near_last = tmp_path / "near_last.csv"
+    near_last.write_text(
+        f"Mesh Name,Radius,x,y,z,Break #\nRamp,0.3,{x},{y},{z},{csvio.MAX_BREAK_NUMBER - 2}\n"
+    )
+    bpy.ops.vg.import_csv(filepath=str(near_last))
+    before = [(m.number, m.break_number, m.exact) for m in obj.vg.measurements]
+    counters = (obj.vg.break_number, obj.vg.next_number, obj.vg.next_edge_number)
+    edges = [(edge.number, edge.plot) for edge in obj.vg.edges]
+    images = len(bpy.data.images)
+    with pytest.raises(RuntimeError, match="no Break # left for a new edge"):
+        bpy.ops.vg.import_csv(filepath=str(edges_file))
+    assert [(m.number, m.break_number, m.exact) for m in obj.vg.measurements] == before
+    assert [(edge.number, edge.plot) for edge in obj.vg.edges] == edges
+    assert len(bpy.data.images) == images  # no plot of an edge not kept
+    assert (obj.vg.break_number, obj.vg.next_number, obj.vg.next_edge_number) == counters
