@@ -252,7 +252,9 @@ def _measure_task(surface, geometry, task, options):
     try:
         center, radius = task.center, task.radius
         if task.coordinates == records.WORLD:  # a row of an export of earlier versions
-            center, radius = measuring.from_world(center, radius, geometry.matrix)
+            center, radius = measuring.from_world(
+                center, radius, geometry.matrix, scale_radius=not task.default_radius
+            )
         return surface.measure(
             center,
             radius,

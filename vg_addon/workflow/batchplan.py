@@ -58,6 +58,9 @@ class Task:
         ``"mesh"``: ``center`` and ``radius`` are in the mesh's own coordinates (every input
         but a world-space row, see :attr:`ReplicationRow.coordinates`); ``"world"``: in Blender
         world space, to be converted by the object's transform.
+    default_radius : bool
+        ``radius`` is the run's default (``--radius``), in mesh units whatever ``coordinates``
+        says: a world-space row without its own radius keeps it as it is.
     rule : str
         ``"refined"``, ``"oriented"`` or ``"paper"``: a CSV row's own rule (MeshLab and earlier add-on rows
         carry the paper's), else the run's.
@@ -81,6 +84,7 @@ class Task:
     coordinates: str = "mesh"
     rule: str = DEFAULT_RULE
     units: str = ""
+    default_radius: bool = False
 
 
 # --------------------------------------------------------------------------- command line values
@@ -297,6 +301,7 @@ def plan_rows(
                 mesh=mesh,
                 center=(row.x, row.y, row.z),
                 radius=row.radius if row.radius is not None else radius,
+                default_radius=row.radius is None,
                 lam=row.lam if row.lam is not None else lam,
                 patch=row.patch or patch,
                 label=row.label or "",
