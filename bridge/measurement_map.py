@@ -39,6 +39,7 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from ..vg_addon import GoniometerError
+from ..vg_addon.formats.png import write_png
 from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, looks_at, place_labels, view_up
 from .colors import ATTRIBUTE_NAME, has_attribute, new_sides_material
 from .label_data import labels_of
@@ -600,33 +601,31 @@ class MapJob:
 def write_contact_sheet(paths, out: Path, *, columns: int = 3) -> Path:
     """Tile the PNGs ``paths`` (all the same size) into one PNG, ``columns`` wide, row by row
     from the top left."""
-    images = []
-    try:
-        for path in paths:
-            images.append(bpy.data.images.load(str(path), check_existing=False))
-        width, height = images[0].size
-        rows = -(-len(images) // columns)
-        sheet = np.ones((rows * height, columns * width, 4), dtype=np.float32)
-        for index, image in enumerate(images):
-            if tuple(image.size) != (width, height):
-                raise GoniometerError("The map's pictures differ in size: cannot tile them.")
+    if not paths:
+        raise GoniometerError("The map has no pictures to tile.")
+    # Eight bits a channel, as the views are, and one view loaded at a time: the memory is the
+    # sheet's bytes and one view's, where Blender's float pixels took 17 MB a view.
+    sheet = None
+    for index, path in enumerate(paths):
+        image = bpy.data.images.load(str(path), check_existing=False)
+        try:
+            width, height = image.size
             pixels = np.empty(width * height * 4, dtype=np.float32)
             image.pixels.foreach_get(pixels)
-            row, column = divmod(index, columns)
-            top = (rows - 1 - row) * height  # Blender's pixels start at the bottom row
-            sheet[top : top + height, column * width : (column + 1) * width] = pixels.reshape(
-                height, width, 4
-            )
-        result = bpy.data.images.new("VG Map sheet", columns * width, rows * height, alpha=False)
-        images.append(result)
-        result.pixels.foreach_set(sheet.ravel())
-        result.filepath_raw = str(out)
-        result.file_format = "PNG"
-        result.save()
-    finally:
-        for image in images:
-            with contextlib.suppress(ReferenceError, RuntimeError):
-                bpy.data.images.remove(image)
+        finally:
+            bpy.data.images.remove(image)
+        if sheet is None:
+            tile = (height, width)
+            rows = -(-len(paths) // columns)
+            sheet = np.full((rows * height, columns * width, 3), 255, dtype=np.uint8)
+        if (height, width) != tile:
+            raise GoniometerError("The map's pictures differ in size: cannot tile them.")
+        row, column = divmod(index, columns)
+        view = pixels.reshape(height, width, 4)[::-1, :, :3]  # Blender's rows start at the bottom
+        sheet[row * height : (row + 1) * height, column * width : (column + 1) * width] = np.rint(
+            np.clip(view, 0.0, 1.0) * 255.0
+        )
+    write_png(out, sheet)
     return out
 
 
