@@ -11,9 +11,8 @@ import bpy
 import numpy as np
 
 from ..bridge import colors, measuring, mesh_data, records
-from ..bridge.measurement_map import safe_file_name
 from ..vg_addon import GoniometerError, Surface
-from ..vg_addon.formats import csvio, sweep_plot
+from ..vg_addon.formats import csvio, files, sweep_plot
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
 from .edges import failed_edge_row, measure_edges, not_found_row, spec_applies
@@ -229,7 +228,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
 def picture_stem(index: int, source: MeshSource, options) -> str:
     """The file-name stem of this mesh's pictures, unique within the run."""
     stems = options.get("picture_names") or []
-    return stems[index] if index < len(stems) else safe_file_name(source.name)
+    return stems[index] if index < len(stems) else files.safe_file_name(source.name)
 
 
 def draw_pictures(result: MeshResult, obj, options, stem: str, plots, name: str) -> None:

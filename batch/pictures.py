@@ -11,7 +11,6 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..bridge.measurement_map import safe_file_name
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import files
 from .outputs import refuse_input
@@ -19,31 +18,6 @@ from .outputs import refuse_input
 # Below this much free space a failed picture is reported as a full disk (Blender's own errors
 # on a full disk name other symptoms, e.g. an empty pixel buffer).
 NEARLY_FULL_BYTES = 1 << 20
-
-
-def picture_names(names: list[str]) -> tuple[list[str], list[str]]:
-    """A file-name stem per mesh, unique within the run (also ignoring case, for file systems
-    that do), and a note for each mesh whose stem had to be changed.
-
-    ``safe_file_name`` maps "bone 1" and "bone_1" to the same "bone_1": the second gets
-    "bone_1-2", so its pictures never replace the first's.
-    """
-    taken: set[str] = set()
-    stems, notes = [], []
-    for name in names:
-        base = stem = safe_file_name(name)
-        suffix = 1
-        while stem.casefold() in taken:
-            suffix += 1
-            stem = f"{base}-{suffix}"
-        taken.add(stem.casefold())
-        stems.append(stem)
-        if stem != base:
-            notes.append(
-                f"the pictures of {name!r} are named {stem!r}: another mesh of this run "
-                f"already has the file name {base!r}"
-            )
-    return stems, notes
 
 
 def disk_full(folder) -> bool:

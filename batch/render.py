@@ -10,6 +10,7 @@ import bpy
 
 from ..bridge import colors, measurement_map
 from ..bridge.map_edges import EDGE_ENDS
+from ..vg_addon.formats import files
 from .outputs import refuse_input
 from .stdio import quiet_stdout
 
@@ -27,14 +28,14 @@ def add_sides_material(obj):
 
 class NamedMap(measurement_map.MapJob):
     """The extension's measurement map with the batch's file names: ``stem`` unique within the
-    run (see ``pictures.picture_names``) and never an input's path."""
+    run (see ``files.picture_names``) and never an input's path."""
 
     def __init__(self, obj, directory, *, stem: str, inputs, **settings):
         self.stem, self.inputs = stem, inputs
         super().__init__(obj, directory, **settings)
 
     def picture_path(self, view_name: str) -> Path:
-        view = measurement_map.safe_file_name(view_name)
+        view = files.safe_file_name(view_name)
         path = self.directory / f"{self.stem}_map_{view}.png"
         refuse_input(path, self.inputs)
         return path

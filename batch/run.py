@@ -27,7 +27,7 @@ from .edges import edge_specs, profiled, spec_applies
 from .find_edges import find_options
 from .measure import MeshResult, error_row, safe_measure_mesh, set_units
 from .outputs import check_outputs, input_files, make_folders, sweep_paths
-from .pictures import picture_names, reason
+from .pictures import reason
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
 from .workers import run_workers
@@ -416,7 +416,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             or args.find_edges
             or any(spec_applies(spec, sources[mesh]) for spec in edges)
         }
-    stems, renamed = picture_names([source.name for source in sources])
+    stems, renamed = files.picture_names([source.name for source in sources])
     units = args.units or ("none" if not blend else None)
     set_units(bpy.context.scene, units)
     make_folders(args)

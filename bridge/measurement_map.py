@@ -39,6 +39,7 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from ..vg_addon import GoniometerError
+from ..vg_addon.formats.files import picture_names, safe_file_name
 from ..vg_addon.formats.png import write_png
 from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, looks_at, place_labels, view_up
 from .colors import ATTRIBUTE_NAME, has_attribute, new_sides_material
@@ -59,9 +60,16 @@ CLOSE_UPS = (
 )  # how much nearer a close-up looks, for labels crowded out of a view  # the name of the picture listing measurements no view can show
 
 
-def safe_file_name(name: str) -> str:
-    """``name`` with every character that is not safe in a file name replaced by ``_``."""
-    return "".join(c if c.isalnum() or c in "-_.+" else "_" for c in name) or "mesh"
+def map_stem(obj) -> str:
+    """The file-name stem of ``obj``'s map: its name made safe for a file, unique among the
+    file's objects (ignoring case), so that the maps of "A 1" and "A_1" never replace each
+    other's pictures. An object whose name is already safe keeps it; the others, in name order,
+    take "-2", "-3", … after it."""
+    names = sorted(
+        (other.name for other in bpy.data.objects),
+        key=lambda name: (safe_file_name(name) != name, name),
+    )
+    return picture_names(names)[0][names.index(obj.name)]
 
 
 def view_list(obj, views: str, depsgraph) -> tuple:
@@ -158,13 +166,11 @@ class MapJob:
 
     def picture_path(self, view_name: str) -> Path:
         """Where the picture of a view ends up."""
-        return (
-            self.directory / f"{safe_file_name(self.obj.name)}_map_{safe_file_name(view_name)}.png"
-        )
+        return self.directory / f"{map_stem(self.obj)}_map_{safe_file_name(view_name)}.png"
 
     def sheet_path(self) -> Path:
         """Where the contact sheet ends up."""
-        return self.directory / f"{safe_file_name(self.obj.name)}_map.png"
+        return self.directory / f"{map_stem(self.obj)}_map.png"
 
     def _staged(self, path: Path) -> Path:
         return self._staging / path.name

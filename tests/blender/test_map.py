@@ -490,3 +490,23 @@ def test_an_edge_whose_stations_are_all_stale_draws_no_line(vg, tmp_path):
     vg.bridge.measuring.repaint(obj)
     assert all(item.stale for item in obj.vg.measurements)
     assert lines() == []
+
+
+def test_the_maps_of_two_objects_whose_names_make_one_file_name_keep_apart(vg, tmp_path):
+    """ "A 1" and "A_1" both made the file name "A_1", so one object's map replaced the
+    other's pictures in a shared folder. The object whose name is already a file name keeps
+    it; the other takes "A_1-2". Oracle: the files written and their pixels."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    maps = {}
+    for name in ("A 1", "A_1"):
+        obj = wedge_object(90.0, name, n=20)
+        vg.bridge.measuring.measure_on_object(obj, (0.0, 0.0, 0.0), 0.3)
+    for name in ("A_1", "A 1"):
+        _, sheet = vg.bridge.measurement_map.render_map(
+            bpy.data.objects[name], tmp_path, size=SIZE, samples=1
+        )
+        maps[name] = (sheet.name, sheet.read_bytes())
+    assert maps["A_1"][0] == "A_1_map.png" and maps["A 1"][0] == "A_1-2_map.png"
+    for name, (file_name, data) in maps.items():
+        assert (tmp_path / file_name).read_bytes() == data, name  # neither replaced
+    assert len(list(tmp_path.glob("A_1_map_*.png"))) == len(list(tmp_path.glob("A_1-2_map_*.png")))

@@ -1,6 +1,7 @@
 """How every output file of the project is written: a regular file replaced in one step
 (never half-written, its old content kept on any failure), a stream (standard output, a pipe,
-a device) written into, and which targets are refused before anything is written."""
+a device) written into, which targets are refused before anything is written, and the names of
+picture files (safe on every file system, one per mesh)."""
 
 from __future__ import annotations
 
@@ -155,3 +156,33 @@ def replace_atomically(path, data: bytes) -> None:
         _write_into(path, data)
     else:
         _replace_atomically(os.path.realpath(path), data)
+
+
+def safe_file_name(name: str) -> str:
+    """``name`` with every character that is not safe in a file name replaced by ``_``."""
+    return "".join(c if c.isalnum() or c in "-_.+" else "_" for c in name) or "mesh"
+
+
+def picture_names(names: list[str]) -> tuple[list[str], list[str]]:
+    """A file-name stem per mesh, unique within the run (also ignoring case, for file systems
+    that do), and a note for each mesh whose stem had to be changed.
+
+    ``safe_file_name`` maps "bone 1" and "bone_1" to the same "bone_1": the second gets
+    "bone_1-2", so its pictures never replace the first's.
+    """
+    taken: set[str] = set()
+    stems, notes = [], []
+    for name in names:
+        base = stem = safe_file_name(name)
+        suffix = 1
+        while stem.casefold() in taken:
+            suffix += 1
+            stem = f"{base}-{suffix}"
+        taken.add(stem.casefold())
+        stems.append(stem)
+        if stem != base:
+            notes.append(
+                f"the pictures of {name!r} are named {stem!r}: another mesh of this run "
+                f"already has the file name {base!r}"
+            )
+    return stems, notes
