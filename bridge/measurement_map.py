@@ -557,7 +557,31 @@ class MapJob:
             os.replace(self._staged(path), path)
         self.sheet = sheet
         self._remove_staging()
+        for path in self._outdated_pictures():
+            with contextlib.suppress(OSError):
+                path.unlink()
         return sheet
+
+    def _outdated_pictures(self) -> list:
+        """Pictures an earlier map of this object left in the folder that this map does not
+        make again: a close-up of a measurement since deleted or now seen in a view, or the
+        "not shown" list. Left there, they would read as part of this map."""
+        prefix = self.picture_path("measurement 0").name[: -len("0.png")]
+        not_shown = self.picture_path(NOT_SHOWN).name
+        written = {path.name for path in self.written}
+
+        def outdated(name: str) -> bool:
+            number = name[len(prefix) : -len(".png")]
+            close_up = name.startswith(prefix) and name.endswith(".png")
+            return name not in written and (
+                name == not_shown or (close_up and number.isascii() and number.isdigit())
+            )
+
+        try:
+            names = [entry.name for entry in os.scandir(self.directory) if entry.is_file()]
+        except OSError:
+            return []
+        return [self.directory / name for name in names if outdated(name)]
 
     def abort(self) -> None:
         """Remove the pictures of a map not finished (a cancelled map leaves nothing half-done,

@@ -510,3 +510,24 @@ def test_the_maps_of_two_objects_whose_names_make_one_file_name_keep_apart(vg, t
     for name, (file_name, data) in maps.items():
         assert (tmp_path / file_name).read_bytes() == data, name  # neither replaced
     assert len(list(tmp_path.glob("A_1_map_*.png"))) == len(list(tmp_path.glob("A_1-2_map_*.png")))
+
+
+def test_a_map_made_again_leaves_no_close_up_of_the_map_before(vg, tmp_path):
+    """A close-up (and the "not shown" list) of an earlier map stayed in the folder beside a
+    new map that no longer had them, reading as part of it. Oracle: the files of each map."""
+    points, triangles = hidden_measurements_mesh()
+    obj = mesh_object("Hidden", points, triangles)
+    for at in (OPEN, PIT, SHUT):
+        vg.bridge.measuring.measure_on_object(obj, at, 0.2)
+    other = tmp_path / "Hidden_map_measurement_2.png.keep"  # not a picture of this map
+    other.write_bytes(b"mine")
+    first, _ = vg.bridge.measurement_map.render_map(obj, tmp_path, size=SIZE, samples=1)
+    assert len(first) == 8
+    obj.vg.active_index = len(obj.vg.measurements) - 1
+    while len(obj.vg.measurements) > 1:  # keep the one the six views see
+        bpy.ops.vg.delete_measurement()
+    again, sheet = vg.bridge.measurement_map.render_map(obj, tmp_path, size=SIZE, samples=1)
+    assert len(again) == 6
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [sheet.name, other.name, *(p.name for p in again)]
+    )
