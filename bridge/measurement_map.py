@@ -136,6 +136,12 @@ class MapJob:
         self.size = (width, height)
         self.samples = int(samples)
         self.depsgraph = bpy.context.evaluated_depsgraph_get()
+        if not obj.evaluated_get(self.depsgraph).is_evaluated:
+            raise GoniometerError(
+                f"'{obj.name}' is disabled in the viewports or left out of this view layer (the "
+                "monitor icon or the checkbox in the Outliner, its own or its collection's), so "
+                "Blender has no evaluated mesh to render: enable it, then make the map."
+            )
         self.views = list(view_list(obj, views, self.depsgraph))
         self.labels = labels_of(obj)
         unviewed = stations_without_views(obj, edge_ends)

@@ -531,3 +531,29 @@ def test_a_map_made_again_leaves_no_close_up_of_the_map_before(vg, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         [sheet.name, other.name, *(p.name for p in again)]
     )
+
+
+@pytest.mark.parametrize("how", ["object", "collection"])
+def test_a_map_of_an_object_disabled_in_the_viewports_says_so(vg, tmp_path, how):
+    """An object disabled in the viewports (its own monitor icon, or its collection's) has no
+    evaluated mesh: the map failed with Blender's "has no evaluated mesh data". Oracle: the
+    object's Outliner state and the folder left empty."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    obj = wedge_object(90.0, "Hidden", n=20)
+    vg.bridge.measuring.measure_on_object(obj, (0.0, 0.0, 0.0), 0.3)
+    if how == "object":
+        obj.hide_viewport = True
+    else:
+        shelf = bpy.data.collections.new("Shelf")
+        bpy.context.scene.collection.children.link(shelf)
+        shelf.objects.link(obj)
+        bpy.context.scene.collection.objects.unlink(obj)
+        bpy.context.view_layer.layer_collection.children["Shelf"].exclude = True
+    with pytest.raises(vg.vg_addon.GoniometerError, match="disabled in the viewports"):
+        vg.bridge.measurement_map.render_map(obj, tmp_path / "map", size=SIZE, samples=1)
+    assert not (tmp_path / "map").exists()
+    obj.hide_viewport = False
+    if how == "collection":
+        bpy.context.view_layer.layer_collection.children["Shelf"].exclude = False
+    views, _ = vg.bridge.measurement_map.render_map(obj, tmp_path / "map", size=SIZE, samples=1)
+    assert len(views) == 6
