@@ -19,7 +19,7 @@ from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, files
 from ..vg_addon.method.result import stability_text, stability_warning
 from ..vg_addon.method.winding import winding_message
-from ..vg_addon.workflow import batchplan
+from ..vg_addon.workflow import agreement, batchplan
 from . import extension
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
@@ -48,6 +48,7 @@ class Run:
         self.results: list[MeshResult] = []
         self.bad_files: list[str] = []
         self.passed_over: list[str] = []  # lines naming .pp files that name no mesh given
+        self.replayed = 0  # how many rows of a --points file the tasks were planned from
         self.lock = threading.Lock()
         self.started = time.perf_counter()
         self.last_progress = 0.0
@@ -87,6 +88,28 @@ class Run:
 
     def say(self, text: str) -> None:
         say(text)
+
+    def say_agreement(self) -> None:
+        """After re-measuring an export (this extension's or a batch run's): a line saying how
+        the angles agree with the file's (``workflow.agreement``)."""
+        if not self.args.points or not self.replayed:
+            return
+        try:
+            file_rows = csvio.replayed_rows(csvio.read_measurements_csv(Path(self.args.points)))
+        except (GoniometerError, OSError, ValueError):
+            return  # MeshLab's, the earlier add-on's or a plain points file: no angles of ours
+        if len(file_rows) != self.replayed:
+            return
+        pairs = [(file_rows[index], row) for index, row in sorted(self.rows.items())]
+        agreed = agreement.agreement(
+            [old.angle for old, _ in pairs],
+            [new.angle for _, new in pairs],
+            [old.precision for old, _ in pairs],
+            [new.precision for _, new in pairs],
+            [old.stale for old, _ in pairs],
+        )
+        if agreed.text:
+            self.say(f"re-measured {Path(self.args.points).name}: " + agreed.text[2:])
 
     def say_flagged(self, by_index: dict) -> None:
         """The summary's lines for unstable readings (points, then edge stations): how many,
@@ -285,6 +308,7 @@ class Run:
         self.say(f"mesh import {load:.1f} s, surface preparation {prepare:.1f} s{speed}")
         by_index = {t.index: t for t in self.tasks}
         self.say_flagged(by_index)
+        self.say_agreement()
         for index, row in failed[:10]:
             task = by_index[index]
             where = f"row {task.source_row}" if task.source_row else f"point {task.number}"
@@ -373,6 +397,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         if source.name in seen:
             raise UsageError(f"two inputs are both named {source.name!r}: rename one.")
         seen[source.name] = source
+    replayed = 0  # rows of a --points file, in order: task i is its row i
     try:
         if args.at:
             tasks = bp.plan_points(
@@ -390,6 +415,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                 rows = csvio.read_replication_csv(Path(args.points))  # a path, whatever it holds
             except OSError as error:
                 raise UsageError(f"{args.points}: {error.strerror or error}") from None
+            replayed = len(rows)
             tasks = bp.plan_rows(
                 [s.names for s in sources],
                 rows,
@@ -446,6 +472,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         sweep_paths(args.out)[1].mkdir(parents=True, exist_ok=True)
     run = Run(args, sources, tasks, len(groups))
     run.passed_over = passed_over
+    run.replayed = replayed
     for note in renamed:
         run.say(f"note: {note}")
     if args.shard and not args.quiet:

@@ -355,8 +355,7 @@ def follow_export(obj, path, numbers) -> tuple[str, bool]:
         rows = csvio.read_measurements_csv(path)
     except (GoniometerError, OSError, ValueError):
         return "", False  # MeshLab's, the earlier add-on's or a points file: no Units, no Colors
-    # A batch run's failed rows (an error and no coordinates) were not replicated.
-    rows = [row for row in rows if not (row.error and (row.x, row.y, row.z) == (None,) * 3)]
+    rows = csvio.replayed_rows(rows)
     if len(rows) != len(numbers):
         return "", False
     extra = adopt_units(obj, [row.units for row in rows])
@@ -366,6 +365,7 @@ def follow_export(obj, path, numbers) -> tuple[str, bool]:
         [row.angle for _, row in found],
         [records.numbers_of(item)["angle"] for item, _ in found],
         [row.precision for _, row in found],
+        ["float32"] * len(found),  # Blender's vertices
         [row.stale for _, row in found],
     )
     turned = sum(records.honour_colours(item, row.colors) for item, row in found)

@@ -72,7 +72,7 @@ def test_edge_stations_of_a_float64_file_are_measured_at_its_precision(tmp_path,
     assert max(abs(row.angle - 60.0) for row in stations) < 1e-6
 
 
-def test_blenders_import_of_float64_rows_says_they_differ_and_why(vg, tmp_path, capfd):
+def test_a_replication_at_another_precision_says_its_angles_differ_and_why(vg, tmp_path, capfd):
     """Blender holds vertices as float32, so a batch row measured at a file's float64 precision
     comes back a little different when the CSV is imported there. It once did so in silence.
     Oracle: the core on the float32-rounded coordinates, and the file's own angle."""
@@ -94,10 +94,20 @@ def test_blenders_import_of_float64_rows_says_they_differ_and_why(vg, tmp_path, 
     said = capfd.readouterr()
     assert (
         f"1 of 1 angles differ from the file's, by up to {abs(in_float32 - row.angle):.2g}° "
-        "(1 measured by a batch run at the mesh file's float64 precision"
+        "(1 measured at another precision than the file's"
     ) in said.out + said.err
     again = tmp_path / "again.csv"
     bpy.ops.vg.export_csv(filepath=str(again))
     bpy.ops.vg.import_csv(filepath=str(again))
     said = capfd.readouterr()
     assert "all 1 angles equal the file's exactly" in said.out + said.err
+    # The batch says the same of its own CSV, and of Blender's float32 rows on the float64 file.
+    replay = tmp_path / "replay.csv"
+    result = batch(path, "--points", out, "--out", replay)
+    assert "re-measured out.csv: all 1 angles equal the file's exactly" in result.stderr
+    result = batch(path, "--points", again, "--out", replay)
+    assert result.returncode == 0, result.stderr
+    assert (
+        f"re-measured again.csv: 1 of 1 angles differ from the file's, by up to "
+        f"{abs(in_float32 - row.angle):.2g}° (1 measured at another precision"
+    ) in result.stderr

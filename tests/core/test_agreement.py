@@ -6,29 +6,32 @@ from vg_addon.workflow.agreement import agreement
 
 
 def test_angles_that_come_back_exactly_say_so():
-    agreed = agreement([90.0, 60.000000001], [90.0, 60.000000001], ["float32", ""], [False] * 2)
+    agreed = agreement(
+        [90.0, 60.000000001], [90.0, 60.000000001], ["float32", ""], ["float32"] * 2, [False] * 2
+    )
     assert (agreed.compared, agreed.differing, agreed.largest) == (2, 0, 0.0)
     assert agreed.text == "; all 2 angles equal the file's exactly"
 
 
-def test_one_ulp_off_is_a_difference_and_float64_rows_are_named_as_the_reason():
+def test_one_ulp_off_is_a_difference_and_another_precision_is_named_as_the_reason():
     off = math.nextafter(90.0, 91.0)
     agreed = agreement(
-        [90.0, 60.0, 45.0, 30.0],
-        [off, 60.0008, 45.0, 30.5],
-        ["float64", "float64", "float32", "float32"],
-        [False] * 4,
+        [90.0, 60.0, 45.0, 30.0, 20.0],
+        [off, 60.0008, 45.0, 30.5, 20.1],
+        ["float64", "float32", "float32", "float32", ""],
+        ["float32", "float64", "float32", "float32", "float32"],
+        [False] * 5,
     )
-    assert (agreed.compared, agreed.differing, agreed.float64) == (4, 3, 2)
+    assert (agreed.compared, agreed.differing, agreed.other_precision) == (5, 4, 2)
     assert agreed.largest == abs(30.5 - 30.0)
-    assert agreed.text.startswith("; 3 of 4 angles differ from the file's, by up to 0.5° (")
-    assert "2 measured by a batch run at the mesh file's float64 precision" in agreed.text
-    assert "1 on a mesh or with a version other than the file's" in agreed.text
+    assert agreed.text.startswith("; 4 of 5 angles differ from the file's, by up to 0.5° (")
+    assert "2 measured at another precision than the file's" in agreed.text
+    assert "2 on a mesh or with a version other than the file's" in agreed.text
 
 
 def test_rows_without_an_angle_are_not_compared_and_stale_rows_are_counted_apart():
-    agreed = agreement([None, 50.0, 70.0], [10.0, 51.0, 70.0], ["", "float32", "float32"],
-                       [False, True, False])  # fmt: skip
+    agreed = agreement([None, 50.0, 70.0, 80.0], [10.0, 51.0, 70.0, None], ["", "float32",
+                       "float32", "float32"], ["float32"] * 4, [False, True, False, False])  # fmt: skip
     assert (agreed.compared, agreed.differing, agreed.stale) == (1, 0, 1)
     assert agreed.text == (
         "; all 1 angles equal the file's exactly; 1 row(s) marked Stale (measured before the "
@@ -37,5 +40,5 @@ def test_rows_without_an_angle_are_not_compared_and_stale_rows_are_counted_apart
 
 
 def test_nothing_to_compare_adds_nothing():
-    assert agreement([None], [10.0], [""], [False]).text == ""
-    assert agreement([], [], [], []).text == ""
+    assert agreement([None], [10.0], [""], [""], [False]).text == ""
+    assert agreement([], [], [], [], []).text == ""

@@ -1,10 +1,12 @@
 """How the angles of a re-measured CSV agree with the angles the file holds: the words an import
-adds to its report, so that a replication that did not come back exactly never passes unnoticed.
+(Blender's) or a batch run adds to its report, so that a replication that did not come back
+exactly never passes unnoticed.
 
 A re-measurement with the same coordinates, settings and NumPy gives the same bits. Where it
-does not, the usual reason is one the file states: a batch run measured a mesh file at its
-float64 precision (``Precision`` ``float64``), and Blender holds the vertices as float32; or the
-row was ``Stale`` (recorded before the mesh was edited), so today's mesh is another surface.
+does not, the usual reason is one the file states: the row was measured at another precision
+(``Precision``: a batch run measures a mesh file at its float64 coordinates where float32 would
+round them, and Blender holds every mesh as float32), or the row was ``Stale`` (recorded
+before the mesh was edited), so today's mesh is another surface.
 """
 
 from __future__ import annotations
@@ -26,8 +28,8 @@ class Agreement:
         Of those, rows whose angles are not the same float64.
     largest : float
         The largest absolute difference in degrees (0.0 when none differ).
-    float64 : int
-        Differing rows that the file says were measured at float64 precision.
+    other_precision : int
+        Differing rows re-measured at another precision than the file says they were.
     stale : int
         Rows not compared: the file marks them Stale.
     """
@@ -35,28 +37,28 @@ class Agreement:
     compared: int
     differing: int
     largest: float
-    float64: int
+    other_precision: int
     stale: int
 
     @property
     def text(self) -> str:
-        """What an import's report adds ("" with nothing compared or passed over), starting
+        """What a report adds ("" with nothing compared or passed over), each part starting
         with "; "."""
         parts = []
         if self.compared and not self.differing:
             parts.append(f"all {self.compared} angles equal the file's exactly")
         elif self.differing:
             why = []
-            if self.float64:
+            if self.other_precision:
                 why.append(
-                    f"{self.float64} measured by a batch run at the mesh file's float64 "
-                    "precision, which Blender's float32 vertices round: re-measure those with "
-                    "the batch to replicate them exactly"
+                    f"{self.other_precision} measured at another precision than the file's "
+                    "(a batch run measures a mesh file's float64 coordinates, Blender its "
+                    "float32 vertices): only the same precision replicates them exactly"
                 )
-            if self.differing > self.float64:
+            if self.differing > self.other_precision:
                 why.append(
-                    f"{self.differing - self.float64} on a mesh or with a version other than "
-                    "the file's"
+                    f"{self.differing - self.other_precision} on a mesh or with a version "
+                    "other than the file's"
                 )
             parts.append(
                 f"{self.differing} of {self.compared} angles differ from the file's, by up to "
@@ -72,7 +74,8 @@ class Agreement:
 
 def agreement(
     recorded: Sequence[float | None],
-    remeasured: Sequence[float],
+    remeasured: Sequence[float | None],
+    file_precisions: Sequence[str],
     precisions: Sequence[str],
     stale: Sequence[bool],
 ) -> Agreement:
@@ -82,21 +85,23 @@ def agreement(
     ----------
     recorded : sequence of float or None
         Each row's angle as the file holds it (None: the file gives none; not compared).
-    remeasured : sequence of float
-        The angle measured again for each row.
-    precisions : sequence of str
-        Each row's ``Precision`` cell (``"float32"``, ``"float64"`` or empty).
+    remeasured : sequence of float or None
+        The angle measured again for each row (None: it could not be; not compared).
+    file_precisions, precisions : sequence of str
+        Each row's ``Precision`` in the file and in the re-measurement (``"float32"``,
+        ``"float64"``, or empty where not known).
     stale : sequence of bool
-        Each row's ``Stale`` cell.
+        Each row's ``Stale`` cell in the file.
 
     Returns
     -------
     Agreement
     """
-    compared = differing = in_float64 = passed_over = 0
+    compared = differing = other_precision = passed_over = 0
     largest = 0.0
-    for old, new, precision, was_stale in zip(recorded, remeasured, precisions, stale, strict=True):
-        if old is None or not math.isfinite(old):
+    rows = zip(recorded, remeasured, file_precisions, precisions, stale, strict=True)
+    for old, new, old_precision, new_precision, was_stale in rows:
+        if old is None or new is None or not math.isfinite(old):
             continue
         if was_stale:
             passed_over += 1
@@ -104,6 +109,6 @@ def agreement(
         compared += 1
         if old != new:
             differing += 1
-            in_float64 += precision == "float64"
+            other_precision += bool(old_precision and new_precision != old_precision)
             largest = max(largest, abs(new - old))
-    return Agreement(compared, differing, largest, in_float64, passed_over)
+    return Agreement(compared, differing, largest, other_precision, passed_over)

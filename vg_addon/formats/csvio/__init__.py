@@ -44,6 +44,7 @@ from .measurements import (
     now_iso,
     parse_measurements_csv,
     read_measurements_csv,
+    replayed_rows,
     writable_row,
     write_measurements_csv,
 )
@@ -119,6 +120,7 @@ __all__ = [
     "read_measurements_csv",
     "read_replication_csv",
     "read_table",
+    "replayed_rows",
     "rows_for_mesh",
     "rows_for_other_meshes",
     "sweep_cells",

@@ -472,6 +472,12 @@ def parse_measurements_csv(text: str, source: str = "The CSV text") -> list[Meas
     return parse_table(text, source, SCHEMA, MeasurementRow, LATER_COLUMNS, "an export")
 
 
+def replayed_rows(rows: Iterable[MeasurementRow]) -> list[MeasurementRow]:
+    """The rows of an export that a replication re-measures, in order: all but a batch run's
+    failed rows (an ``error`` and no coordinates), which the replication reader passes over."""
+    return [row for row in rows if not (row.error and (row.x, row.y, row.z) == (None,) * 3)]
+
+
 def read_measurements_csv(path_or_text) -> list[MeasurementRow]:
     """Read a complete export of this extension back into :class:`MeasurementRow` objects.
 
