@@ -113,6 +113,7 @@ def measure_edge_on_object(
     surface=None,
     rule=DEFAULT_RULE,
     stability=False,
+    given="",
 ):
     """Measure the edge through ``points`` and record every station as a measurement of one new
     break (its own colour pair), plus the edge's record with its summary and plot.
@@ -137,6 +138,9 @@ def measure_edge_on_object(
         The rule every station is measured with (default ``"refined"``).
     stability : bool
         Also compute every station's stability figure.
+    given : str
+        Where the points came from, if not clicked on the surface: points far from the mesh
+        are then refused naming it (see :func:`measure_edge`).
 
     Returns
     -------
@@ -160,6 +164,7 @@ def measure_edge_on_object(
         surface=surface,
         rule=rule,
         stability=stability,
+        given=given,
     )
     (edge,) = record_profiles(obj, [(clicks, profile)], geometry, note)
     return edge

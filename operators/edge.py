@@ -225,6 +225,7 @@ class VG_OT_measure_edge(PatchProperties, RuleProperties, bpy.types.Operator):
                 space=self.space.lower(),
                 rule=self.rule,
                 stability=self.stability,
+                given="Edge Profile",  # typed points, or clicks: those are on the surface
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))

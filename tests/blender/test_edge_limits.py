@@ -67,3 +67,22 @@ def test_an_edge_file_whose_edges_run_out_of_break_numbers_records_none_of_them(
     assert [(edge.number, edge.plot) for edge in obj.vg.edges] == edges
     assert len(bpy.data.images) == images  # no plot of an edge not kept
     assert (obj.vg.break_number, obj.vg.next_number, obj.vg.next_edge_number) == counters
+
+
+def test_typed_points_off_the_mesh_are_refused_as_in_a_file(vg, tmp_path):
+    """A typed point 0.37 off the mesh snapped to the nearest vertex and the edge was measured,
+    but its own export was then refused on re-import as "farther than the radius". Typed
+    points now meet the file's rule. Oracle: the ramp's geometry (its crease is its top, so a
+    point above it is that far from every vertex) and the records."""
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+    obj = mesh_object("Ramp", shape.points, shape.triangles)
+    above = [[-1.5, 0.0, 0.5], [1.5, 0.0, 0.0]]
+    with pytest.raises(RuntimeError, match=r"Edge Profile: point 1 \(-1.5, 0, 0.5\) is 0.5 from"):
+        bpy.ops.vg.measure_edge(points=json.dumps(above), spacing=0.5, radius=0.3, space="MESH")
+    assert len(obj.vg.measurements) == 0 and len(obj.vg.edges) == 0
+    on = [[-1.5, 0.0, 0.0], [1.5, 0.0, 0.0]]
+    bpy.ops.vg.measure_edge(points=json.dumps(on), spacing=0.5, radius=0.3, space="MESH")
+    path = tmp_path / "ramp.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    bpy.ops.vg.import_csv(filepath=str(csvio.edges_path_for(path)))  # its own file reads back
+    assert len(obj.vg.edges) == 2

@@ -65,7 +65,7 @@ def test_stations_are_the_core_profile_bit_for_bit_and_one_break(vg):
 
 def test_stations_replay_with_measure_xyz(vg):
     obj, _ = ramp_object(location=(0.5, 0.25, -1.0), rotation=(0.0, 0.4, 0.1))
-    measure_edge(spacing=0.75, radius=0.35, seg_param=1.5)
+    measure_edge(spacing=0.75, radius=0.35, seg_param=1.5, space="MESH")
     stations = [exact(item) for item in obj.vg.measurements]
     for numbers in stations:
         bpy.ops.vg.measure_xyz(

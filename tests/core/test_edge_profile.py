@@ -392,3 +392,25 @@ def test_a_path_that_turns_back_is_not_measured_twice_at_one_vertex(ramp):
     assert np.unique(there_and_back.vertices).size < there_and_back.vertices.size
     with pytest.raises(GoniometerError, match="same vertex twice"):
         surface.measure_along(there_and_back, spacing=0.5, radius=0.3)
+
+
+def test_a_point_on_a_large_face_is_on_the_mesh_however_far_its_vertices():
+    """A click recorded on a face much larger than the mesh's mean (a decimated flat region)
+    lay farther than three mean edge lengths from every vertex, so the edge's own export was
+    refused on re-import. Any point on a face is within its longest edge of one of its
+    vertices: that is the limit's floor. A point off the mesh is still refused."""
+    xs, ys = np.meshgrid(np.linspace(0.0, 1.0, 51), np.linspace(0.0, 1.0, 51))
+    fine = np.column_stack([xs.ravel(), ys.ravel(), np.zeros(xs.size)])
+    quads = [(j * 51 + i, j * 51 + i + 1, (j + 1) * 51 + i) for j in range(50) for i in range(50)]
+    quads += [(j * 51 + i + 1, (j + 1) * 51 + i + 1, (j + 1) * 51 + i) for j in range(50)
+              for i in range(50)]  # fmt: skip
+    big = np.array([[2.0, 0.0, 0.0], [4.0, 0.0, 0.0], [3.0, 2.0, 0.0]])
+    points = np.vstack([fine, big])
+    triangles = np.array([*quads, (len(fine), len(fine) + 1, len(fine) + 2)])
+    surface = Surface(points, triangles)
+    centroid = big.mean(axis=0)
+    nearest = np.linalg.norm(points - centroid, axis=1).min()
+    assert nearest > 3 * mean_edge_length(points, triangles) and nearest > 0.1
+    check_given_points(surface, [fine[0], centroid], 0.1, "clicked.csv")
+    with pytest.raises(GoniometerError, match=r"point 2 .* from the mesh"):
+        check_given_points(surface, [fine[0], centroid + np.array([0.0, 0.0, 2.5])], 0.1, "off.csv")

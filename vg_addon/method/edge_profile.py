@@ -83,7 +83,7 @@ class RidgeGraph:
     ridge_min : float
         The bend (radians) a path vertex needs to count as on a ridge: :data:`RIDGE_MIN_DEG`, or
         :data:`NOISE_FACTOR` times the median vertex bend if that is more.
-    mean_edge_length : float
+    mean_edge_length, longest_edge_length : float
     """
 
     def __init__(self, points: np.ndarray, triangles: np.ndarray, valid: np.ndarray, edges=None):
@@ -99,6 +99,7 @@ class RidgeGraph:
         noise = float(np.median(self.vertex_bend[used])) if used.any() else 0.0
         self.ridge_min = max(np.radians(RIDGE_MIN_DEG), NOISE_FACTOR * noise)
         self.mean_edge_length = float(lengths.mean()) if lengths.size else 0.0
+        self.longest_edge_length = float(lengths.max()) if lengths.size else 0.0
 
 
 def ridge_graph(surface, edges=None) -> RidgeGraph:

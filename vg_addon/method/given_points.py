@@ -13,8 +13,10 @@ from .edge_profile import ridge_graph
 
 def check_given_points(surface, points, radius: float, where: str) -> None:
     """Refuse points given in a file or typed (not clicked on the surface) that lie farther than
-    ``max(radius, 3 × mean edge length)`` from every vertex: a point picked on another copy of
-    the mesh, or in other units, would otherwise snap to some vertex and be measured.
+    ``max(radius, 3 × mean edge length, longest edge length)`` from every vertex: a point picked
+    on another copy of the mesh, or in other units, would otherwise snap to some vertex and be
+    measured. Any point on a face is within its longest edge of a vertex, so a point clicked on
+    the surface (and recorded, exported and read back) always passes, however large its face.
 
     Parameters
     ----------
@@ -30,16 +32,22 @@ def check_given_points(surface, points, radius: float, where: str) -> None:
     GoniometerError
         Naming every point too far, its distance and the limit.
     """
-    limit = max(as_radius(radius), 3.0 * ridge_graph(surface).mean_edge_length)
+    graph = ridge_graph(surface)
+    limit = max(as_radius(radius), 3.0 * graph.mean_edge_length, graph.longest_edge_length)
     far = []
     for number, point in enumerate(np.asarray(points, dtype=np.float64), 1):
         _, distance = surface.index.nearest(point, limit)
         if not distance <= limit:
             _, distance = surface.index.nearest(point, math.inf)
             x, y, z = point
-            far.append(f"point {number} ({x:g}, {y:g}, {z:g}) is {distance:.6g} from the mesh")
+            how_far = (
+                f"{distance:.6g} from the mesh"
+                if math.isfinite(distance)
+                else ("far from every vertex (beyond what a double holds)")
+            )
+            far.append(f"point {number} ({x:g}, {y:g}, {z:g}) is {how_far}")
     if far:
         raise GoniometerError(
-            f"{where}: {'; '.join(far)}, farther than {limit:.6g} (the radius or three mean edge "
-            "lengths): check that the points were picked on this mesh, in its units and frame."
+            f"{where}: {'; '.join(far)}, farther than {limit:.6g} (the radius, three mean edge "
+            "lengths or the longest edge): check that the points were picked on this mesh, in its units and frame."
         )
