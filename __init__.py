@@ -31,6 +31,8 @@ if numpy_import_error is None:
         ui.labels.register()
 
     def unregister():
+        # Blender frees a running modal operator without its cancel(): end its session here.
+        operators.view_session.end_all()
         ui.labels.unregister()
         operators.drag.unregister_tool()
         watch.unregister()

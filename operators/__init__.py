@@ -16,6 +16,7 @@ from . import (
     picked_points_ops,
     report_ops,
     sweep,
+    view_session,
 )
 
 classes = (

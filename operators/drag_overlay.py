@@ -196,8 +196,16 @@ class DragOverlay(ViewOverlay):
         region = bpy.context.region
         if region_data is None or region is None or self.center is None:
             return
+        blend, depth = gpu.state.blend_get(), gpu.state.depth_test_get()
         gpu.state.blend_set("ALPHA")
         gpu.state.depth_test_set("NONE")  # the whole patch is measured, hidden side included
+        try:
+            self._draw_patch(region, region_data)
+        finally:  # what later drawing (other add-ons') expects
+            gpu.state.blend_set(blend)
+            gpu.state.depth_test_set(depth)
+
+    def _draw_patch(self, region, region_data) -> None:
         with gpu.matrix.push_pop(), point_shader() as points:
             gpu.matrix.multiply_matrix(Matrix(self.matrix.tolist()))
             if self._batches is None:
@@ -220,4 +228,3 @@ class DragOverlay(ViewOverlay):
                 lines.uniform_float("lineWidth", LINE_WIDTH)
                 lines.uniform_float("color", CIRCLE_COLOR)
                 batch_for_shader(lines, "LINE_STRIP", {"pos": ring}).draw(lines)
-        gpu.state.blend_set("NONE")

@@ -33,9 +33,9 @@ from .common import (
     status_hints,
     typed_value,
 )
-from .drag import NAVIGATION_EVENTS, format_length, object_alive, ray_cast_object
+from .drag import NAVIGATION_EVENTS, format_length, ray_cast_object
 from .edge_overlay import EdgeOverlay
-from .view_session import ViewSession
+from .view_session import ViewSession, modifiers
 
 # The drag tool's view navigation, and plain mouse moves (a click session has no drag).
 _NAVIGATION = NAVIGATION_EVENTS | {"MOUSEMOVE"}
@@ -49,20 +49,21 @@ HINTS = (
 )
 
 
-def translate_edge_event(event_type: str, value: str, *, ctrl=False, alt=False):
+def translate_edge_event(
+    event_type: str, value: str, *, ctrl=False, alt=False, shift=False, repeat=False
+):
     """What a Blender event means to the edge session: ``"click"``, ``"confirm"``, ``"undo"``,
-    ``"cancel"``, ``"pass"`` (navigation, let Blender have it) or ``"ignore"``."""
-    if event_type in _NAVIGATION:
+    ``"cancel"``, ``"pass"`` (navigation, and the window losing focus: Blender's) or
+    ``"ignore"`` (a key held down repeating: each step is one deliberate press)."""
+    if event_type in _NAVIGATION or event_type == "WINDOW_DEACTIVATE":
         return "pass"
-    if event_type == "WINDOW_DEACTIVATE":
-        return "cancel"
-    if value != "PRESS":
+    if value != "PRESS" or repeat:
         return "ignore"
     if event_type == "LEFTMOUSE" and not (ctrl or alt):
         return "click"
     if event_type in ("RET", "NUMPAD_ENTER", "SPACE"):
         return "confirm"
-    if event_type == "BACK_SPACE" or (event_type == "Z" and ctrl):
+    if event_type == "BACK_SPACE" or (event_type == "Z" and ctrl and not shift):
         return "undo"
     if event_type in ("ESC", "RIGHTMOUSE"):
         return "cancel"
@@ -99,8 +100,9 @@ class EdgeSession(ViewSession):
 
     def __init__(self, context, obj):
         super().__init__(context, obj, EdgeOverlay(), "Edge profiles are picked in a 3D viewport.")
-        depsgraph = context.evaluated_depsgraph_get()
-        self.machine = EdgeMachine(surface_for(obj, evaluated_geometry(obj, depsgraph)))
+        geometry = evaluated_geometry(obj, context.evaluated_depsgraph_get())
+        self.fingerprint = geometry.fingerprint
+        self.machine = EdgeMachine(surface_for(obj, geometry))
         self.overlay.start()
         self.refresh(context)
 
@@ -108,26 +110,24 @@ class EdgeSession(ViewSession):
         """Apply one translated event (``mouse``: window pixel coordinates); returns
         ``"running"``, ``"pass"`` or ``"done"``."""
         machine = self.machine
-        if not object_alive(context, self.obj):
+        if self.deleted():
             machine.cancel("The object was deleted: nothing was recorded.")
             return "done"
         if action == "pass":
             return "pass"
         if action == "click":
-            coord = self.region_coord(mouse)
-            if coord is None:  # on the sidebar or a header: let Blender have it
+            view = self.view_at(mouse)
+            if view is None:  # on the toolbar, sidebar or a header: let Blender have it
                 return "pass"
-            hit = ray_cast_object(
-                self.obj,
-                context.evaluated_depsgraph_get(),
-                self._region,
-                self._region_data,
-                coord,
-            )
-            machine.click(hit)
+            if refusal := self.absent(context):
+                machine.message = refusal
+            else:
+                region, region_data, coord = view
+                depsgraph = context.evaluated_depsgraph_get()
+                machine.click(ray_cast_object(self.obj, depsgraph, region, region_data, coord))
         elif action == "undo":
             machine.undo()
-        elif action == "confirm" and (refusal := self.not_active(context)):
+        elif action == "confirm" and (refusal := self.unrecordable(context)):
             machine.message = refusal
         elif action == "confirm":
             settings = context.scene.vg_settings
@@ -265,7 +265,7 @@ class VG_OT_measure_edge(PatchProperties, RuleProperties, bpy.types.Operator):
     def modal(self, context, event):
         session = self._session
         try:
-            action = translate_edge_event(event.type, event.value, ctrl=event.ctrl, alt=event.alt)
+            action = translate_edge_event(event.type, event.value, **modifiers(event))
             status = session.handle(context, action, (event.mouse_x, event.mouse_y))
         except BaseException:
             session.finish()

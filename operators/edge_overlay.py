@@ -89,8 +89,17 @@ def draw_batches(overlay) -> None:
     # Line width and point size as shader uniforms (Metal and Vulkan ignore line_width_set);
     # the points' shader falls back on 4.2 (drag_overlay.PointShader).
     lines = gpu.shader.from_builtin("POLYLINE_UNIFORM_COLOR")
+    blend, depth = gpu.state.blend_get(), gpu.state.depth_test_get()
     gpu.state.blend_set("ALPHA")
     gpu.state.depth_test_set("NONE")
+    try:
+        _draw_each(overlay, lines, region)
+    finally:  # what later drawing (other add-ons') expects
+        gpu.state.blend_set(blend)
+        gpu.state.depth_test_set(depth)
+
+
+def _draw_each(overlay, lines, region) -> None:
     with point_shader() as points:
         if overlay._batches is None:
             overlay._batches = overlay._build(lines, points.shader)
@@ -103,4 +112,3 @@ def draw_batches(overlay) -> None:
             lines.uniform_float("lineWidth", size)
             lines.uniform_float("color", color)
             batch.draw(lines)
-    gpu.state.blend_set("NONE")

@@ -47,10 +47,10 @@ from .common import (
     status_hints,
     typed_value,
 )
-from .drag import NAVIGATION_EVENTS, format_length, object_alive
+from .drag import NAVIGATION_EVENTS, format_length
 from .find_edges_overlay import FindEdgesOverlay
 from .progress import Progress, own_timer_tick
-from .view_session import ViewSession
+from .view_session import ViewSession, modifiers
 
 # Work done per timer tick before the review gets the events again (seconds).
 TICK_BUDGET = 0.08
@@ -82,13 +82,16 @@ _KEYS = {
 }
 
 
-def translate_find_event(event_type: str, value: str, *, shift=False, ctrl=False, alt=False):
+def translate_find_event(
+    event_type: str, value: str, *, shift=False, ctrl=False, alt=False, repeat=False
+):
     """What a Blender event means to the review: ``"click"``, ``"accept"``, ``"accept_all"``,
     ``"reject"``, ``"trim"``, ``"next"``, ``"previous"``, ``"finish"``, ``"cancel"``,
-    ``"pass"`` (navigation: Blender's) or ``"ignore"``."""
+    ``"pass"`` (navigation: Blender's) or ``"ignore"`` (a key held down repeating: each
+    decision is one deliberate press, so holding A never accepts candidates not looked at)."""
     if event_type in _NAVIGATION:
         return "pass"
-    if value != "PRESS" or ctrl or alt:
+    if value != "PRESS" or ctrl or alt or repeat:
         return "ignore"
     if event_type == "LEFTMOUSE":
         return "click"
@@ -177,6 +180,7 @@ class FindEdgesSession(ViewSession):
             context, obj, FindEdgesOverlay(), "Break edges are reviewed in a 3D viewport."
         )
         self.geometry = evaluated_geometry(obj, context.evaluated_depsgraph_get())
+        self.fingerprint = self.geometry.fingerprint
         surface = surface_for(obj, self.geometry)
         self.machine = FindEdgesMachine(surface, BreakEdgeFinder(surface, parameters))
         self.progress: Progress | None = None
@@ -205,32 +209,38 @@ class FindEdgesSession(ViewSession):
         if progress is not None:
             progress.__exit__(None, None, None)
 
-    def projected(self) -> list[np.ndarray]:
-        """Each candidate's path in region pixels (NaN behind the viewer)."""
-        to_clip = np.array(self._region_data.perspective_matrix, dtype=np.float64) @ np.array(
+    def projected(self, region, region_data) -> list[np.ndarray]:
+        """Each candidate's path in ``region``'s pixels (NaN behind the viewer)."""
+        to_clip = np.array(region_data.perspective_matrix, dtype=np.float64) @ np.array(
             self.obj.matrix_world, dtype=np.float64
         )
-        width, height = self._region.width, self._region.height
+        width, height = region.width, region.height
         return [project(c.path.points, to_clip, width, height) for c in self.machine.candidates]
 
     def handle(self, context, action: str, mouse=None) -> str:
         """Apply one translated event; returns ``"running"``, ``"pass"`` or ``"done"``."""
         machine = self.machine
-        if not object_alive(context, self.obj):
+        if self.deleted():
             machine.cancel("The object was deleted: nothing was recorded.")
             return "done"
         if action == "pass":
             return "pass"
         if action == "cancel":
-            if not machine.back():
+            if machine.back():
+                self._end_progress()  # back to the review: the measuring's progress ends
+            else:
                 machine.cancel()
         elif machine.working:
             return "running"  # only Esc and navigation while the work runs
         elif action == "click":
-            coord = self.region_coord(mouse)
-            if coord is None:
+            view = self.view_at(mouse)
+            if view is None:  # on the toolbar, sidebar or a header: let Blender have it
                 return "pass"
-            machine.pick(self.projected(), coord)
+            region, region_data, coord = view
+            if refusal := self.absent(context):
+                machine.message = refusal
+            else:
+                machine.pick(self.projected(region, region_data), coord)
         elif action in ("accept", "reject", "next", "previous", "accept_all", "trim"):
             {
                 "accept": machine.accept,
@@ -240,7 +250,7 @@ class FindEdgesSession(ViewSession):
                 "accept_all": machine.accept_pending,
                 "trim": machine.start_trim,
             }[action]()
-        elif action == "finish" and (refusal := self.not_active(context)):
+        elif action == "finish" and (refusal := self.unrecordable(context)):
             machine.message = refusal
         elif action == "finish":
             settings = context.scene.vg_settings
@@ -446,6 +456,7 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
             return {"CANCELLED"}
         wm = context.window_manager
         self._timer = wm.event_timer_add(TIMER_INTERVAL, window=context.window)
+        self._session.timer = self._timer  # removed with the session if the extension goes
         wm.modal_handler_add(self)
         return {"RUNNING_MODAL"}
 
@@ -459,9 +470,7 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
                 if session.machine.phase is FindPhase.CANCELLED:
                     status = "done"
             else:
-                action = translate_find_event(
-                    event.type, event.value, shift=event.shift, ctrl=event.ctrl, alt=event.alt
-                )
+                action = translate_find_event(event.type, event.value, **modifiers(event))
                 status = session.handle(context, action, (event.mouse_x, event.mouse_y))
         except BaseException:
             self._end(context)
@@ -498,12 +507,10 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
         return self.recorded(obj, edges.record_profiles(obj, machine.profiles, geometry, self.note))
 
     def _end(self, context) -> None:
-        timer, self._timer = getattr(self, "_timer", None), None
-        if timer is not None:
-            context.window_manager.event_timer_remove(timer)
+        self._timer = None
         session = getattr(self, "_session", None)
         if session is not None:
-            session.finish()
+            session.finish()  # its timer too
 
     def cancel(self, context):
         """Blender ends the modal operator (file load, window closed, ...): clean up."""

@@ -4,8 +4,31 @@ status-bar texts, and their removal on every way out."""
 
 from __future__ import annotations
 
+import contextlib
+import weakref
+
+import bpy
+
+from ..bridge.mesh_data import check_measurable, evaluated_geometry
 from ..vg_addon import GoniometerError
 from .common import clear_texts
+from .drag import pointer_in_view
+
+# The sessions running now: ended by :func:`end_all` when the extension is disabled, as
+# Blender then frees their operators without calling ``cancel``.
+_LIVE: weakref.WeakSet = weakref.WeakSet()
+
+
+def modifiers(event) -> dict:
+    """The keyword arguments of an event the sessions' translators read: the modifier keys
+    held, and whether it is a held key's repeat."""
+    return {"ctrl": event.ctrl, "alt": event.alt, "shift": event.shift, "repeat": event.is_repeat}
+
+
+def end_all() -> None:
+    """End every running session (its drawing, texts and timer), as the extension goes away."""
+    for session in list(_LIVE):
+        session.finish()
 
 
 class ViewSession:
@@ -32,19 +55,64 @@ class ViewSession:
         self.obj = obj
         area = context.area
         # Started from the sidebar's button, the context's region is the sidebar: clicks are
-        # taken in the area's main (WINDOW) region, with its view.
-        self._region = next((r for r in area.regions if r.type == "WINDOW"), None)
-        self._region_data = getattr(area.spaces.active, "region_3d", None)
-        if self._region is None or self._region_data is None:
+        # taken in the area's main (WINDOW) regions, each with its own view (:meth:`view_at`).
+        region = next((r for r in area.regions if r.type == "WINDOW"), None)
+        if region is None or getattr(area.spaces.active, "region_3d", None) is None:
             raise GoniometerError(refusal)
         self.overlay = overlay
         self._area, self._workspace = area, context.workspace
+        self.timer = None  # a window-manager timer the operator runs the session with
+        self.fingerprint = None  # the geometry the session's clicks were taken on
+        _LIVE.add(self)
 
-    def region_coord(self, mouse) -> tuple | None:
-        """Window-pixel ``mouse`` relative to the viewport's main region, or None if outside."""
-        x, y = mouse[0] - self._region.x, mouse[1] - self._region.y
-        inside = 0 <= x < self._region.width and 0 <= y < self._region.height
-        return (x, y) if inside else None
+    def view_at(self, mouse) -> tuple | None:
+        """The view under window-pixel ``mouse``: ``(region, region_3d, region pixel)`` of the
+        area's main region it is in (each quadrant of Quad View is one, with its own view), or
+        None where the pointer is off the view (another area, or the toolbar, header or
+        sidebar drawn over it)."""
+        for region in self._area.regions if self._area is not None else ():
+            if region.type != "WINDOW":
+                continue
+            coord = (mouse[0] - region.x, mouse[1] - region.y)
+            if pointer_in_view(self._area, region, coord):
+                # region.data: the view of this quadrant (unset in a background Blender)
+                view = region.data or self._area.spaces.active.region_3d
+                return region, view, coord
+        return None
+
+    def absent(self, context) -> str:
+        """Why the session's object cannot be clicked on now: it is not in this scene (another
+        scene is shown); ``""`` when it is."""
+        if context.scene.objects.get(self.obj.name) == self.obj:
+            return ""
+        return f"'{self.obj.name}' is not in this scene: go back to its scene to go on, or Esc."
+
+    def deleted(self) -> bool:
+        """Whether the session's object is gone from the file."""
+        try:
+            name = self.obj.name
+        except ReferenceError:
+            return True
+        return bpy.data.objects.get(name) != self.obj
+
+    def unrecordable(self, context) -> str:
+        """Why what the session holds cannot be recorded now (``""`` when it can): the object
+        is not the active one or not in this scene, cannot be measured (Edit Mode, ...), or its
+        mesh changed since the session began. The session goes on, so nothing is lost."""
+        reason = self.absent(context) or self.not_active(context)
+        if reason:
+            return reason
+        try:
+            check_measurable(self.obj)
+            geometry = evaluated_geometry(self.obj, context.evaluated_depsgraph_get())
+        except GoniometerError as error:
+            return f"{error} Then press Enter again, or Esc."
+        if self.fingerprint is not None and geometry.fingerprint != self.fingerprint:
+            return (
+                f"'{self.obj.name}' changed since this began (an edit, a modifier): what is "
+                "shown is on the old mesh; Esc and start again."
+            )
+        return ""
 
     def not_active(self, context) -> str:
         """Why the session cannot record now: its object is no longer the active one (a click
@@ -61,7 +129,12 @@ class ViewSession:
         )
 
     def finish(self) -> None:
-        """Remove the drawing and the texts; safe to call more than once."""
+        """Remove the drawing, the texts and the timer; safe to call more than once."""
+        _LIVE.discard(self)
+        timer, self.timer = self.timer, None
+        if timer is not None:
+            with contextlib.suppress(ReferenceError, RuntimeError, ValueError):
+                bpy.context.window_manager.event_timer_remove(timer)
         self.overlay.stop()
         area, self._area = self._area, None
         workspace, self._workspace = self._workspace, None

@@ -134,12 +134,17 @@ def test_only_accepted_candidates_are_measured_each_station_as_alone(surface):
         assert (alone.angle, alone.fit_error) == (station.angle, station.fit_error)
 
 
-def test_finishing_with_nothing_accepted_records_nothing(surface):
+def test_enter_with_nothing_accepted_keeps_the_review_and_its_decisions(surface):
+    """Enter pressed before any candidate was accepted once ended the review, losing every
+    decision and trim made so far."""
     machine = found(surface)
     machine.reject()
-    assert machine.finish(SPACING, RADIUS)
-    assert machine.phase is FindPhase.DONE and machine.profiles == []
-    assert "nothing was recorded" in machine.message
+    assert not machine.finish(SPACING, RADIUS)
+    assert machine.phase is FindPhase.REVIEW and machine.profiles == []
+    assert "No candidate is accepted yet" in machine.message
+    assert machine.decisions[0] is Decision.REJECTED
+    assert machine.accept()  # the review goes on: candidate 2
+    assert machine.finish(SPACING, RADIUS) and machine.phase is FindPhase.MEASURING
 
 
 @pytest.mark.parametrize("steps", [0, 1, None])

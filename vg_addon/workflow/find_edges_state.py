@@ -346,20 +346,20 @@ class FindEdgesMachine:
     # -- the end ----------------------------------------------------------------------------
     def finish(self, spacing: float, radius: float, *settings, **options) -> bool:
         """Start measuring the accepted candidates (one per :meth:`step`). With none accepted
-        the review ends at once with nothing measured.
+        the review goes on, saying so (Enter pressed early must not lose the decisions made);
+        Esc leaves it with nothing recorded.
 
         ``spacing``, ``radius`` and the further ``settings`` (``lam``, ``patch``, ``rule``,
         ``stability``, by position or name) are those of :func:`~.edge_profile.measure_along`.
         """
         if not self._deciding():
             return False
+        if not self.accepted:
+            self.message = "No candidate is accepted yet: accept one (A) to record it, or Esc."
+            return False
         self._settings = ((spacing, radius, *settings), options)
         self._queue = self.accepted
         self.profiles = []
-        if not self._queue:
-            self.phase = FindPhase.DONE
-            self.message = "No candidate was accepted: nothing was recorded."
-            return True
         self.phase = FindPhase.MEASURING
         self.progress = 0.0
         self.message = ""

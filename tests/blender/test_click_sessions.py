@@ -1,0 +1,99 @@
+"""The Edge Profile and Find Break Edges sessions in the startup screen's 3D viewport (headless
+bpy): what they hold survives what a user does around them, keys held down decide nothing, and
+the extension going away ends them. From a review of the modal tools; each test failed before."""
+
+from __future__ import annotations
+
+import importlib
+
+import bpy
+import numpy as np
+import pytest
+from test_drag import N, drag, pixel, ridge_vertex, view  # noqa: F401  (fixtures)
+
+
+@pytest.fixture
+def edge(vg):
+    """The Edge Profile operator's module, with its session and translator."""
+    return importlib.import_module(f"{vg.__name__}.operators.edge")
+
+
+def window_pixel(view, point):  # noqa: F811
+    x, y = pixel(view, point)
+    return (view.region.x + x, view.region.y + y)
+
+
+def two_clicks(edge, view):  # noqa: F811
+    session = edge.EdgeSession(bpy.context, view.obj)
+    for k in (10, N - 10):
+        point = view.points[ridge_vertex(view, k)]
+        assert session.handle(bpy.context, "click", window_pixel(view, point)) == "running"
+    assert len(session.machine.clicks) == 2, session.machine.message
+    return session
+
+
+def test_keys_held_down_decide_nothing_and_focus_lost_cancels_nothing(vg, edge):
+    find = importlib.import_module(f"{vg.__name__}.operators.find_edges")
+    t = edge.translate_edge_event
+    assert t("BACK_SPACE", "PRESS") == "undo" and t("BACK_SPACE", "PRESS", repeat=True) == "ignore"
+    assert t("Z", "PRESS", ctrl=True) == "undo"
+    assert t("Z", "PRESS", ctrl=True, shift=True) == "ignore"  # redo drops no click
+    assert t("WINDOW_DEACTIVATE", "NOTHING") == "pass"  # Alt+Tab keeps the clicks
+    f = find.translate_find_event
+    assert f("A", "PRESS") == "accept" and f("A", "PRESS", repeat=True) == "ignore"
+    assert f("X", "PRESS", repeat=True) == "ignore" and f("RET", "PRESS", repeat=True) == "ignore"
+
+
+def test_another_scene_shown_keeps_the_clicks(edge, view):  # noqa: F811
+    """Switching the window to another scene ended the session at the next mouse move, as "The
+    object was deleted", with every click lost."""
+    session = two_clicks(edge, view)
+    home, other = view.window.scene, bpy.data.scenes.new("Other")
+    try:
+        view.window.scene = other
+        assert session.handle(bpy.context, "pass", (0, 0)) == "pass"
+        assert session.handle(bpy.context, "confirm") == "running"
+        assert "not in this scene" in session.machine.message
+        assert len(session.machine.clicks) == 2
+    finally:
+        view.window.scene = home
+        bpy.data.scenes.remove(other)
+    assert session.handle(bpy.context, "confirm") == "done"
+    assert session.machine.phase is edge.EdgePhase.CONFIRMED
+    session.finish()
+
+
+def test_enter_on_an_object_in_edit_mode_keeps_the_clicks(edge, view):  # noqa: F811
+    """Enter with the object in Edit Mode ended the session, and then the record was refused:
+    every click lost. Now Enter says why and the session goes on."""
+    session = two_clicks(edge, view)
+    bpy.ops.object.mode_set(mode="EDIT")
+    try:
+        assert session.handle(bpy.context, "confirm") == "running"
+        assert "Edit Mode" in session.machine.message and len(session.machine.clicks) == 2
+    finally:
+        bpy.ops.object.mode_set(mode="OBJECT")
+    assert session.handle(bpy.context, "confirm") == "done"
+    session.finish()
+
+
+def test_a_click_on_the_toolbar_is_not_a_click_on_the_mesh(edge, view):  # noqa: F811
+    session = edge.EdgeSession(bpy.context, view.obj)
+    tools = next(r for r in view.area.regions if r.type == "TOOLS" and r.width > 1)
+    inside = (tools.x + tools.width // 2, tools.y + tools.height // 2)
+    assert session.handle(bpy.context, "click", inside) == "pass"
+    assert len(session.machine.clicks) == 0
+    session.finish()
+
+
+def test_the_extension_disabled_mid_session_takes_its_drawing_with_it(vg, edge, view):  # noqa: F811
+    """Blender frees a running modal operator on unregister without calling its cancel(): the
+    overlay's draw handler stayed installed until Blender quit."""
+    session = two_clicks(edge, view)
+    assert session.overlay.active
+    vg.unregister()
+    try:
+        assert not session.overlay.active
+    finally:
+        vg.register()
+    assert np.isfinite(view.points).all()
