@@ -110,8 +110,8 @@ class EdgeSession(ViewSession):
         """Apply one translated event (``mouse``: window pixel coordinates); returns
         ``"running"``, ``"pass"`` or ``"done"``."""
         machine = self.machine
-        if self.deleted():
-            machine.cancel("The object was deleted: nothing was recorded.")
+        if ending := self.closed():
+            machine.cancel(ending)
             return "done"
         if action == "pass":
             return "pass"
@@ -151,9 +151,9 @@ class EdgeSession(ViewSession):
         """Hand the clicks and path to the overlay; update header and status bar."""
         matrix = np.array(self.obj.matrix_world, dtype=np.float64)
         self.overlay.update(self.machine.clicks, self.machine.path, matrix)
-        if self._area is not None:
-            self._area.header_text_set(self.header_text(context.scene))
-            self._area.tag_redraw()
+        if (area := self.area) is not None:
+            area.header_text_set(self.header_text(context.scene))
+            area.tag_redraw()
         if self._workspace is not None:
             self._workspace.status_text_set(status_hints(HINTS))
 

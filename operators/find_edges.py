@@ -220,8 +220,8 @@ class FindEdgesSession(ViewSession):
     def handle(self, context, action: str, mouse=None) -> str:
         """Apply one translated event; returns ``"running"``, ``"pass"`` or ``"done"``."""
         machine = self.machine
-        if self.deleted():
-            machine.cancel("The object was deleted: nothing was recorded.")
+        if ending := self.closed():
+            machine.cancel(ending)
             return "done"
         if action == "pass":
             return "pass"
@@ -284,9 +284,9 @@ class FindEdgesSession(ViewSession):
             np.array(self.obj.matrix_world, dtype=np.float64),
             trim_points,
         )
-        if self._area is not None:
-            self._area.header_text_set(self.header_text(context.scene))
-            self._area.tag_redraw()
+        if (area := self.area) is not None:
+            area.header_text_set(self.header_text(context.scene))
+            area.tag_redraw()
         if self._workspace is not None and not machine.working:
             self._workspace.status_text_set(status_hints(HINTS))
 
@@ -464,7 +464,9 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
         session = self._session
         try:
             if own_timer_tick(self, event):
-                if session.machine.working:
+                if ending := session.closed():
+                    session.machine.cancel(ending)
+                elif session.machine.working:
                     session.work(context)
                 status = "done" if session.machine.phase is FindPhase.DONE else "running"
                 if session.machine.phase is FindPhase.CANCELLED:

@@ -61,22 +61,36 @@ class ViewSession:
             raise GoniometerError(refusal)
         self.overlay = overlay
         self._area, self._workspace = area, context.workspace
+        self._area_pointer = area.as_pointer()
         self.timer = None  # a window-manager timer the operator runs the session with
         self.fingerprint = None  # the geometry the session's clicks were taken on
         _LIVE.add(self)
+
+    @property
+    def area(self):
+        """The session's 3D viewport, or None once it is closed (or joined into another):
+        Blender frees a closed area, and touching it then may crash Blender."""
+        if self._area is None:
+            return None
+        # Every screen's (another workspace shown keeps its areas: the session waits for it).
+        screens = bpy.data.screens
+        if any(a.as_pointer() == self._area_pointer for s in screens for a in s.areas):
+            return self._area
+        return None
 
     def view_at(self, mouse) -> tuple | None:
         """The view under window-pixel ``mouse``: ``(region, region_3d, region pixel)`` of the
         area's main region it is in (each quadrant of Quad View is one, with its own view), or
         None where the pointer is off the view (another area, or the toolbar, header or
         sidebar drawn over it)."""
-        for region in self._area.regions if self._area is not None else ():
+        area = self.area
+        for region in area.regions if area is not None else ():
             if region.type != "WINDOW":
                 continue
             coord = (mouse[0] - region.x, mouse[1] - region.y)
-            if pointer_in_view(self._area, region, coord):
+            if pointer_in_view(area, region, coord):
                 # region.data: the view of this quadrant (unset in a background Blender)
-                view = region.data or self._area.spaces.active.region_3d
+                view = region.data or area.spaces.active.region_3d
                 return region, view, coord
         return None
 
@@ -86,6 +100,15 @@ class ViewSession:
         if context.scene.objects.get(self.obj.name) == self.obj:
             return ""
         return f"'{self.obj.name}' is not in this scene: go back to its scene to go on, or Esc."
+
+    def closed(self) -> str:
+        """Why the session must end though the user did not end it (``""`` while it can go
+        on): its object was deleted, or its viewport closed."""
+        if self.deleted():
+            return "The object was deleted: nothing was recorded."
+        if self.area is None:
+            return "The viewport was closed: nothing was recorded."
+        return ""
 
     def deleted(self) -> bool:
         """Whether the session's object is gone from the file."""
@@ -136,6 +159,6 @@ class ViewSession:
             with contextlib.suppress(ReferenceError, RuntimeError, ValueError):
                 bpy.context.window_manager.event_timer_remove(timer)
         self.overlay.stop()
-        area, self._area = self._area, None
+        area, self._area = self.area, None
         workspace, self._workspace = self._workspace, None
         clear_texts(area, workspace)

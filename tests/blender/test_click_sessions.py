@@ -97,3 +97,20 @@ def test_the_extension_disabled_mid_session_takes_its_drawing_with_it(vg, edge, 
     finally:
         vg.register()
     assert np.isfinite(view.points).all()
+
+
+def test_another_workspace_shown_keeps_the_session(edge, view):  # noqa: F811
+    """A session waits while another workspace is shown (its viewport still exists), and ends
+    only when its viewport is closed; Enter records once back."""
+    session = two_clicks(edge, view)
+    home = view.window.workspace
+    other = next(w for w in bpy.data.workspaces if w != home)
+    view.window.workspace = other
+    try:
+        assert session.area is not None  # the viewport kept, in the other workspace's screen
+        assert session.handle(bpy.context, "pass", (0, 0)) == "pass"
+    finally:
+        view.window.workspace = home
+    assert session.handle(bpy.context, "confirm") == "done"
+    assert session.machine.phase is edge.EdgePhase.CONFIRMED
+    session.finish()
