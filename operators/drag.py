@@ -10,6 +10,8 @@ records the measurement it took (not a second one) through the bridge's one reco
 
 from __future__ import annotations
 
+import math
+
 import bpy
 import numpy as np
 from bpy_extras import view3d_utils
@@ -125,6 +127,16 @@ def format_length(scene, value: float, obj=None) -> str:
         split_unit=units.use_separate,
         compatible_unit=False,
     )
+
+
+def mesh_length_text(scene, value: float, obj) -> str:
+    """A length in ``obj``'s mesh units as a header shows it: in its Scan Units, or the
+    scene's length units where those measure it (an unscaled object); on a scaled object
+    without Scan Units, "N mesh units" (the scene's units measure world lengths)."""
+    scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
+    if obj.vg.unit != "SCENE" or (scale is not None and math.isclose(scale, 1.0, rel_tol=1e-6)):
+        return format_length(scene, value, obj)
+    return f"{value:.5g} mesh units"
 
 
 def ray_cast_object(obj, depsgraph, region, region_data, coord):
@@ -339,11 +351,7 @@ class DragSession:
     def header_text(self, scene) -> str:
         """The header line: radius, vertex count, λ, the angle after a λ change, and any hint."""
         machine = self.machine
-        if self.obj.vg.unit != "SCENE" or uniform_scale(self.matrix) == 1.0:
-            radius = format_length(scene, machine.radius, self.obj)
-        else:  # the scene's units measure world lengths, not the scaled mesh's
-            radius = f"{machine.radius:.5g} mesh units"
-        parts = [f"Goniometer radius {radius}"]
+        parts = [f"Goniometer radius {mesh_length_text(scene, machine.radius, self.obj)}"]
         if machine.typed:
             parts[0] += f" (typed {machine.typed})"
         parts.append(f"{machine.n_vertices} vertices")

@@ -33,7 +33,7 @@ from .common import (
     status_hints,
     typed_value,
 )
-from .drag import NAVIGATION_EVENTS, format_length, ray_cast_object
+from .drag import NAVIGATION_EVENTS, mesh_length_text, ray_cast_object
 from .edge_overlay import EdgeOverlay
 from .view_session import ViewSession, modifiers
 
@@ -163,11 +163,11 @@ class EdgeSession(ViewSession):
         machine = self.machine
         parts = [f"Edge Profile: {len(machine.clicks)} point(s)"]
         if machine.path is not None:
-            parts.append(f"path {format_length(scene, machine.path.length, self.obj)}")
+            parts.append(f"path {mesh_length_text(scene, machine.path.length, self.obj)}")
         settings = scene.vg_settings
         parts.append(
-            f"every {format_length(scene, settings.edge_spacing, self.obj)}, r "
-            f"{format_length(scene, settings.radius, self.obj)}"
+            f"every {mesh_length_text(scene, settings.edge_spacing, self.obj)}, r "
+            f"{mesh_length_text(scene, settings.radius, self.obj)}"
         )
         if machine.message:
             parts.append(machine.message.splitlines()[0])

@@ -47,7 +47,7 @@ from .common import (
     status_hints,
     typed_value,
 )
-from .drag import NAVIGATION_EVENTS, format_length
+from .drag import NAVIGATION_EVENTS, mesh_length_text
 from .find_edges_overlay import FindEdgesOverlay
 from .progress import Progress, own_timer_tick
 from .view_session import ViewSession, modifiers
@@ -305,7 +305,7 @@ class FindEdgesSession(ViewSession):
         if machine.selected is not None:
             c = machine.candidates[machine.selected]
             parts.append(
-                f"#{c.number} {c.confidence:.0%} {format_length(scene, c.length, self.obj)} "
+                f"#{c.number} {c.confidence:.0%} {mesh_length_text(scene, c.length, self.obj)} "
                 f"bend {c.mean_bend_deg:.0f}°"
             )
         message = machine.message.splitlines()[0] if machine.message else ""

@@ -114,3 +114,21 @@ def test_another_workspace_shown_keeps_the_session(edge, view):  # noqa: F811
     assert session.handle(bpy.context, "confirm") == "done"
     assert session.machine.phase is edge.EdgePhase.CONFIRMED
     session.finish()
+
+
+def test_headers_give_a_scaled_objects_lengths_in_mesh_units(edge, view):  # noqa: F811
+    """On an object scaled by 0.001 the Edge Profile header showed its path and spacing in the
+    scene's units as if they were world lengths ("path 3.3 km" for a 3.3 m path); the drag's
+    header already said "mesh units". Oracle: the lengths the panel holds."""
+    session = two_clicks(edge, view)
+    settings = bpy.context.scene.vg_settings
+    plain = session.header_text(bpy.context.scene)
+    view.obj.scale = (0.001, 0.001, 0.001)
+    bpy.context.view_layer.update()
+    try:
+        header = session.header_text(bpy.context.scene)
+        assert f"every {settings.edge_spacing:.5g} mesh units" in header
+        assert f"r {settings.radius:.5g} mesh units" in header and "mesh units" not in plain
+    finally:
+        view.obj.scale = (1.0, 1.0, 1.0)
+        session.finish()
