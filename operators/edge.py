@@ -113,6 +113,8 @@ class EdgeSession(ViewSession):
         if ending := self.closed():
             machine.cancel(ending)
             return "done"
+        if self.moved():
+            self.refresh(context)
         if action == "pass":
             return "pass"
         if action == "click":
@@ -149,8 +151,7 @@ class EdgeSession(ViewSession):
 
     def refresh(self, context) -> None:
         """Hand the clicks and path to the overlay; update header and status bar."""
-        matrix = np.array(self.obj.matrix_world, dtype=np.float64)
-        self.overlay.update(self.machine.clicks, self.machine.path, matrix)
+        self.overlay.update(self.machine.clicks, self.machine.path, self.drawn_at())
         if (area := self.area) is not None:
             area.header_text_set(self.header_text(context.scene))
             area.tag_redraw()

@@ -223,6 +223,8 @@ class FindEdgesSession(ViewSession):
         if ending := self.closed():
             machine.cancel(ending)
             return "done"
+        if self.moved():
+            self.refresh(context)
         if action == "pass":
             return "pass"
         if action == "cancel":
@@ -281,7 +283,7 @@ class FindEdgesSession(ViewSession):
             machine.candidates,
             [str(d) for d in machine.decisions],
             machine.selected,
-            np.array(self.obj.matrix_world, dtype=np.float64),
+            self.drawn_at(),
             trim_points,
         )
         if (area := self.area) is not None:

@@ -8,6 +8,7 @@ import contextlib
 import weakref
 
 import bpy
+import numpy as np
 
 from ..bridge.mesh_data import check_measurable, evaluated_geometry
 from ..vg_addon import GoniometerError
@@ -109,6 +110,19 @@ class ViewSession:
         if self.area is None:
             return "The viewport was closed: nothing was recorded."
         return ""
+
+    def drawn_at(self) -> np.ndarray:
+        """The object's ``matrix_world`` now, remembered as the one the overlay draws with."""
+        self._drawn_matrix = np.array(self.obj.matrix_world, dtype=np.float64)
+        return self._drawn_matrix
+
+    def moved(self) -> bool:
+        """Whether the object moved since the overlay was drawn (the Properties editor, a
+        driver, playback): the drawing must follow it, as the next click's ray cast does."""
+        drawn = getattr(self, "_drawn_matrix", None)
+        return drawn is not None and not np.array_equal(
+            drawn, np.array(self.obj.matrix_world, dtype=np.float64)
+        )
 
     def deleted(self) -> bool:
         """Whether the session's object is gone from the file."""

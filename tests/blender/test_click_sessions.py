@@ -132,3 +132,18 @@ def test_headers_give_a_scaled_objects_lengths_in_mesh_units(edge, view):  # noq
     finally:
         view.obj.scale = (1.0, 1.0, 1.0)
         session.finish()
+
+
+def test_the_drawing_follows_the_object_moved_mid_session(edge, view):  # noqa: F811
+    """The overlay kept the object's place at the last click: moved in the Properties editor,
+    the clicks were drawn where it had been while the next click's ray cast used the new place.
+    Oracle: the clicks (mesh coordinates) placed by the new matrix."""
+    session = two_clicks(edge, view)
+    view.obj.location = view.obj.location + view.obj.matrix_world.col[2].xyz * 0.5
+    bpy.context.view_layer.update()
+    assert session.handle(bpy.context, "pass", (0, 0)) == "pass"  # a mouse move anywhere
+    matrix = np.array(view.obj.matrix_world, dtype=np.float64)
+    clicks = np.array(session.machine.clicks)
+    expected = clicks @ matrix[:3, :3].T + matrix[:3, 3]
+    np.testing.assert_allclose(session.overlay._clicks, expected, atol=1e-5)
+    session.finish()
