@@ -23,6 +23,7 @@ from vg_addon.workflow.find_edges_state import (
     FindEdgesMachine,
     FindPhase,
     edge_points,
+    nearest_on_path,
     nearest_on_screen,
     project,
 )
@@ -307,3 +308,17 @@ def test_selecting_a_candidate_that_passes_a_place_twice_says_so():
         assert f"{arcs[twice[0]]:.4g} to" in machine.message and "trim" in machine.message
         assert f"{arcs[twice[-1]]:.4g})" in machine.message
     assert any(machine.candidates[i].path.revisited_spans for i in range(4))
+
+
+def test_a_click_on_the_drawn_line_between_far_vertices_picks_it(surface):
+    """Zoomed in, a candidate's vertices lie far apart on screen: a click on its line, 100 px
+    from either vertex, said "No candidate there". Oracle: the line's pixels by hand."""
+    assert nearest_on_path([[100.0, 100.0], [300.0, 100.0]], (180.0, 103.0)) == (0, 3.0)
+    assert nearest_on_path([[100.0, 100.0], [300.0, 100.0]], (240.0, 96.0)) == (1, 4.0)
+    assert nearest_on_path([[np.nan, np.nan], [300.0, 100.0]], (240.0, 100.0)) == (1, 60.0)
+    machine = found(surface)
+    far = [np.array([[5000.0 + i, 5000.0]]) for i in range(len(machine.candidates))]
+    target = len(machine.candidates) - 1
+    far[target] = np.array([[100.0, 100.0], [300.0, 100.0]])
+    assert machine.pick(far, (200.0, 105.0)) and machine.selected == target
+    assert not machine.pick(far, (200.0, 150.0))  # 50 px off the line: no candidate

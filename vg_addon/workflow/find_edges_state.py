@@ -81,6 +81,29 @@ def nearest_on_screen(pixels: np.ndarray, mouse) -> tuple[int, float]:
     return index, float(distance[index])
 
 
+def nearest_on_path(pixels: np.ndarray, mouse) -> tuple[int, float]:
+    """``(index, distance)`` for a path drawn through ``pixels`` (``(k, 2)``, NaN: not on
+    screen): the distance from ``mouse`` to the drawn line (its segments, and any point on
+    screen alone), and the vertex nearest the spot on it; ``(-1, inf)`` when none is on
+    screen. Zoomed in, a click on the line can be far from every vertex of it."""
+    pixels = np.asarray(pixels, dtype=np.float64).reshape(-1, 2)
+    index, distance = nearest_on_screen(pixels, mouse)
+    if len(pixels) < 2:
+        return index, distance
+    start, step = pixels[:-1], np.diff(pixels, axis=0)
+    length2 = np.einsum("ij,ij->i", step, step)
+    offset = np.asarray(mouse, dtype=np.float64) - start
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = np.clip(np.einsum("ij,ij->i", offset, step) / length2, 0.0, 1.0)
+    t = np.where(length2 > 0.0, t, 0.0)
+    gaps = np.hypot(*(offset - t[:, None] * step).T)
+    gaps = np.where(np.isnan(gaps), np.inf, gaps)
+    segment = int(np.argmin(gaps))
+    if gaps[segment] < distance:
+        return segment + int(t[segment] > 0.5), float(gaps[segment])
+    return index, distance
+
+
 def edge_points(candidate: BreakEdgeCandidate) -> np.ndarray:
     """The points an accepted candidate is recorded with: its path's waypoints (start, via
     points, end), which ``trace_edge`` follows back to its path; float64 mesh coordinates."""
@@ -236,7 +259,7 @@ class FindEdgesMachine:
             return False
         best, best_distance = None, tolerance
         for index, pixels in enumerate(pixels_per_candidate):
-            _, distance = nearest_on_screen(pixels, mouse)
+            _, distance = nearest_on_path(pixels, mouse)
             if distance <= best_distance:
                 best, best_distance = index, distance
         if best is None:
@@ -295,7 +318,7 @@ class FindEdgesMachine:
         return True
 
     def _trim_click(self, pixels, mouse, tolerance: float) -> bool:
-        index, distance = nearest_on_screen(pixels, mouse)
+        index, distance = nearest_on_path(pixels, mouse)
         if distance > tolerance:
             self.message = "Click on the candidate being trimmed, where the kept part ends."
             return False
