@@ -356,6 +356,13 @@ class VG_ObjectData(PropertyGroup):
     next_number: IntProperty(
         name="Next measurement #", description="Number the next measurement gets", default=1, min=1
     )
+    map_pictures: StringProperty(
+        name="Map pictures",
+        description="The pictures this object's last measurement map wrote (JSON paths): a map "
+        "made again removes those it does not make again, and no other file",
+        default="[]",
+        options={"HIDDEN"},
+    )
     sides_shown: BoolProperty(
         name="Sides shown",
         description="The viewports were switched to show the sides, on the first measurement",

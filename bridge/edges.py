@@ -10,6 +10,7 @@ import contextlib
 import math
 from pathlib import Path
 
+import bpy
 import numpy as np
 
 from ..vg_addon import GoniometerError
@@ -263,7 +264,11 @@ def recorded_whole(obj):
     try:
         yield
     except BaseException:
-        remove_plots([data.edges[i] for i in range(edge_count, len(data.edges))])
+        # The records first (nothing here can fail); the new edges' plot images last, as
+        # finding them looks at every image.
+        images = []
+        with contextlib.suppress(Exception):
+            images = [plot_image(data.edges[i]) for i in range(edge_count, len(data.edges))]
         for position in reversed(range(edge_count, len(data.edges))):
             data.edges.remove(position)
         for position in reversed(range(measurements, len(data.measurements))):
@@ -271,6 +276,10 @@ def recorded_whole(obj):
         for name, value in kept.items():
             setattr(data, name, value)
         data.active_index, data.active_edge_index = active
+        for image in images:
+            with contextlib.suppress(Exception):
+                if image is not None:
+                    bpy.data.images.remove(image)
         raise
 
 

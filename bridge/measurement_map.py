@@ -29,6 +29,7 @@ for the render is removed afterwards, whatever happens.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import shutil
 import tempfile
@@ -566,28 +567,29 @@ class MapJob:
         for path in self._outdated_pictures():
             with contextlib.suppress(OSError):
                 path.unlink()
+        with contextlib.suppress(AttributeError, TypeError, RuntimeError):  # linked: none kept
+            self.obj.vg.map_pictures = json.dumps(
+                [str(path.resolve()) for path in [*self.written, sheet]]
+            )
         return sheet
 
     def _outdated_pictures(self) -> list:
-        """Pictures an earlier map of this object left in the folder that this map does not
-        make again: a close-up of a measurement since deleted or now seen in a view, or the
-        "not shown" list. Left there, they would read as part of this map."""
-        prefix = self.picture_path("measurement 0").name[: -len("0.png")]
-        not_shown = self.picture_path(NOT_SHOWN).name
-        written = {path.name for path in self.written}
-
-        def outdated(name: str) -> bool:
-            number = name[len(prefix) : -len(".png")]
-            close_up = name.startswith(prefix) and name.endswith(".png")
-            return name not in written and (
-                name == not_shown or (close_up and number.isascii() and number.isdigit())
-            )
-
+        """Pictures this object's earlier map wrote into this folder (its record,
+        ``obj.vg.map_pictures``) that this map does not make again: a close-up of a measurement
+        since deleted or now seen in a view, or the "not shown" list. Left there, they would
+        read as part of this map. Files the record does not name (another object's pictures,
+        the user's) are never touched."""
         try:
-            names = [entry.name for entry in os.scandir(self.directory) if entry.is_file()]
-        except OSError:
-            return []
-        return [self.directory / name for name in names if outdated(name)]
+            earlier = [Path(p) for p in json.loads(self.obj.vg.map_pictures or "[]")]
+        except (ValueError, TypeError):
+            earlier = []
+        written = {path.resolve() for path in [*self.written, self.sheet]}
+        folder = self.directory.resolve()
+        return [
+            path
+            for path in earlier
+            if path.parent == folder and path not in written and path.is_file()
+        ]
 
     def abort(self) -> None:
         """Remove the pictures of a map not finished (a cancelled map leaves nothing half-done,

@@ -388,7 +388,7 @@ def from_world(location, radius, matrix, *, scale_radius=True):
     """A world-space centre and radius in mesh coordinates: ``(location, radius)``.
 
     The radius is divided by the object's scale (when ``scale_radius``; a default radius given
-    in mesh units is kept).
+    in mesh units is kept, and then any invertible transform will do).
 
     Raises
     ------
@@ -397,14 +397,15 @@ def from_world(location, radius, matrix, *, scale_radius=True):
         mesh.
     """
     scale = uniform_scale(matrix)
-    if scale is None:
+    scaled = scale_radius and radius is not None
+    if scaled and scale is None:
         raise GoniometerError(
             "its coordinates are in world space and the object's scale is not uniform, so its "
             "radius has no single length on the mesh: re-export the CSV in mesh coordinates, or "
             "set a uniform scale"
         )
     location = mesh_points(np.asarray(location, dtype=np.float64), matrix)
-    return location, (radius / scale if scale_radius and radius is not None else radius)
+    return location, (radius / scale if scaled else radius)
 
 
 def forget_paint() -> None:

@@ -411,12 +411,13 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
             surface = surface_for(obj, geometry)
             found = parse_edges_json(self.edges) if self.edges else self.find(surface)
             measured = measure_all(surface, found, self.settings())
+            made = edges.record_profiles(obj, measured, geometry, self.note)
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         # Edges found by Accept are not written back: a redo with another Accept, Scale, Min
         # Length or Min Bend finds them again.
-        return self.recorded(obj, edges.record_profiles(obj, measured, geometry, self.note))
+        return self.recorded(obj, made)
 
     def find(self, surface) -> list[np.ndarray]:
         """Run the detector to the end; the points of the candidates ``accept`` names."""
@@ -508,7 +509,12 @@ class VG_OT_find_break_edges(PatchProperties, RuleProperties, bpy.types.Operator
         self.seg_param, self.patch = settings.seg_param, settings.patch
         self.rule, self.stability = settings.rule, settings.stability
         self.edges = format_edges_json([points for points, _ in machine.profiles])  # for redo
-        return self.recorded(obj, edges.record_profiles(obj, machine.profiles, geometry, self.note))
+        try:
+            made = edges.record_profiles(obj, machine.profiles, geometry, self.note)
+        except GoniometerError as error:  # recorded none (no break number left)
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        return self.recorded(obj, made)
 
     def _end(self, context) -> None:
         self._timer = None

@@ -137,12 +137,12 @@ class VG_OT_import_picked_points(bpy.types.Operator, ImportHelper):
                 (spacing, radius, lam, patch, settings.rule, settings.stability),
                 [f"'{Path(path).name}'" for path, _ in found],
             )
+            made = edges.record_profiles(
+                obj, measured, geometry, [Path(path).name for path, _ in found]
+            )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        made = edges.record_profiles(
-            obj, measured, geometry, [Path(path).name for path, _ in found]
-        )
         self.report(
             {"INFO"},
             f"Made {len(made)} edge profile(s) on '{obj.name}' from picked points: "

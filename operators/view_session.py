@@ -83,9 +83,18 @@ class ViewSession:
         """The view under window-pixel ``mouse``: ``(region, region_3d, region pixel)`` of the
         area's main region it is in (each quadrant of Quad View is one, with its own view), or
         None where the pointer is off the view (another area, or the toolbar, header or
-        sidebar drawn over it)."""
-        area = self.area
-        for region in area.regions if area is not None else ():
+        sidebar drawn over it), or the view is not shown (another workspace) or no longer a 3D
+        view (the area switched to another editor)."""
+        area, window = self.area, bpy.context.window
+        if (
+            area is None
+            or window is None
+            or window.workspace != self._workspace  # another workspace shown
+            or area not in list(window.screen.areas)
+            or area.type != "VIEW_3D"  # the area made another editor
+        ):
+            return None
+        for region in area.regions:
             if region.type != "WINDOW":
                 continue
             coord = (mouse[0] - region.x, mouse[1] - region.y)

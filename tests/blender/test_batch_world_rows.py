@@ -37,3 +37,25 @@ def test_a_world_row_without_a_radius_takes_the_default_in_mesh_units(vg, tmp_pa
     item = exact(obj.vg.measurements[0])
     assert row.radius == item["radius"] == 0.6
     assert row.angle == item["angle"]
+
+
+def test_a_world_row_without_a_radius_on_a_stretched_object_is_measured(vg, tmp_path):
+    """A default radius needs no scaling, so a world row without one was refused on an object
+    scaled (1, 1, 2) for a radius "with no single length on the mesh". Oracle: measure_xyz at
+    the same mesh point with the panel's radius."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    shape = wedge(75.0, n=30, irregular=True, seed=5)
+    obj = mesh_object("Bone", shape.points, shape.triangles, scale=(1.0, 1.0, 2.0))
+    matrix = np.array(obj.matrix_world, dtype=np.float64)
+    local = np.array([0.1, 0.0, 0.0])
+    centre = matrix[:3, :3] @ local + matrix[:3, 3]
+    header = [c for c in csvio.EXPORT_COLUMNS if c != "Coordinates"]
+    values = {"Mesh Name": "Bone", "SegParam": "2.0", "Patch Mode": "euclidean"}
+    values.update({axis: repr(float(v)) for axis, v in zip("xyz", centre, strict=True)})
+    old = tmp_path / "old.csv"
+    old.write_text(",".join(header) + "\n" + ",".join(values.get(c, "") for c in header) + "\n")
+    bpy.context.scene.vg_settings.radius = 0.3
+    bpy.ops.vg.import_csv(filepath=str(old))
+    bpy.ops.vg.measure_xyz(location=tuple(local), space="MESH", radius=0.3)
+    imported, direct = (exact(m) for m in obj.vg.measurements)
+    assert imported["radius"] == 0.3 and imported["angle"] == direct["angle"]

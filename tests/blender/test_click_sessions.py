@@ -96,7 +96,6 @@ def test_the_extension_disabled_mid_session_takes_its_drawing_with_it(vg, edge, 
         assert not session.overlay.active
     finally:
         vg.register()
-    assert np.isfinite(view.points).all()
 
 
 def test_another_workspace_shown_keeps_the_session(edge, view):  # noqa: F811

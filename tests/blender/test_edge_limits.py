@@ -86,3 +86,19 @@ def test_typed_points_off_the_mesh_are_refused_as_in_a_file(vg, tmp_path):
     bpy.ops.vg.export_csv(filepath=str(path))
     bpy.ops.vg.import_csv(filepath=str(csvio.edges_path_for(path)))  # its own file reads back
     assert len(obj.vg.edges) == 2
+
+
+def test_find_break_edges_on_an_object_out_of_break_numbers_says_so(vg, tmp_path):
+    """The recording of Find Break Edges (and of .pp files) raised the "no Break # left"
+    refusal as a traceback. Oracle: the records before and after."""
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+    obj = mesh_object("Ramp", shape.points, shape.triangles)
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.3, space="MESH")
+    obj.vg.measurements[0].break_number = obj.vg.break_number = csvio.MAX_BREAK_NUMBER
+    before = [(m.number, m.exact) for m in obj.vg.measurements]
+    edges = json.dumps([[[-1.5, 0.0, 0.0], [1.5, 0.0, 0.0]]])
+    with pytest.raises(RuntimeError, match="no Break # left") as error:
+        bpy.ops.vg.find_break_edges(edges=edges, spacing=0.5, radius=0.3)
+    assert "Traceback" not in str(error.value)
+    assert [(m.number, m.exact) for m in obj.vg.measurements] == before
+    assert len(obj.vg.edges) == 0

@@ -521,6 +521,10 @@ def test_a_map_made_again_leaves_no_close_up_of_the_map_before(vg, tmp_path):
         vg.bridge.measuring.measure_on_object(obj, at, 0.2)
     other = tmp_path / "Hidden_map_measurement_2.png.keep"  # not a picture of this map
     other.write_bytes(b"mine")
+    # Named like a close-up of this object, but not written by its map (another object's of the
+    # same file name, made before a rename): kept.
+    alike = tmp_path / "Hidden_map_measurement_99.png"
+    alike.write_bytes(b"another object's")
     first, _ = vg.bridge.measurement_map.render_map(obj, tmp_path, size=SIZE, samples=1)
     assert len(first) == 8
     obj.vg.active_index = len(obj.vg.measurements) - 1
@@ -529,7 +533,7 @@ def test_a_map_made_again_leaves_no_close_up_of_the_map_before(vg, tmp_path):
     again, sheet = vg.bridge.measurement_map.render_map(obj, tmp_path, size=SIZE, samples=1)
     assert len(again) == 6
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        [sheet.name, other.name, *(p.name for p in again)]
+        [sheet.name, other.name, alike.name, *(p.name for p in again)]
     )
 
 

@@ -42,3 +42,10 @@ def test_rows_without_an_angle_are_not_compared_and_stale_rows_are_counted_apart
 def test_nothing_to_compare_adds_nothing():
     assert agreement([None], [10.0], [""], [""], [False]).text == ""
     assert agreement([], [], [], [], []).text == ""
+
+
+def test_a_reading_that_is_not_a_number_is_not_compared():
+    agreed = agreement([90.0, 80.0], [float("nan"), 80.0], ["float32"] * 2, ["float32"] * 2,
+                       [False, False])  # fmt: skip
+    assert (agreed.compared, agreed.differing) == (1, 0)
+    assert agreement([None], [10.0], [""], [""], [True]).stale == 1  # stale, angle or not

@@ -27,7 +27,6 @@ WEDGE_ANGLE = 100.0
 VIEWS = ("front", "back", "right", "left", "top", "bottom")
 EXTRA_VIEWS = (f"{OBJ}_map_close-up_", f"{OBJ}_map_measurement_")  # see bridge.measurement_map
 # Three edge profiles along the crease (start, end: points of conftest.POINTS).
-EDGES = (("crease_-7", "crease_+5"), ("crease_-5", "crease_+1"), ("crease_+0", "crease_+7"))
 
 
 # -- helpers -------------------------------------------------------------------------------------
@@ -35,6 +34,21 @@ def point(gui, name: str) -> tuple[float, float]:
     xy = gui.state()["points"][name]
     assert xy is not None, f"{name} is not in view"
     return tuple(xy)
+
+
+def edges_in_view(gui) -> tuple:
+    """Three (start, end) pairs of crease points the viewer can click: on the view, left of the
+    sidebar drawn over it (a click there is the sidebar's, not the mesh's)."""
+    state = gui.state()
+    sidebar_left = state["regions"]["UI"][0]
+    names = sorted(
+        (n for n, xy in state["points"].items()
+         if n.startswith("crease_") and xy is not None and xy[0] < sidebar_left - 20),
+        key=lambda n: int(n.split("_")[1]),
+    )  # fmt: skip
+    assert len(names) >= 6, f"too few crease points left of the sidebar: {names}"
+    middle = len(names) // 2
+    return ((names[0], names[-2]), (names[1], names[middle]), (names[middle - 1], names[-1]))
 
 
 def measurements(gui) -> list[dict]:
@@ -224,7 +238,8 @@ def test_edge_profiles_list_shows_each_edge_and_picks_by_click(gui, places):
     """Issue 20, item 3: three edge profiles traced with the Edge Profile button (click start,
     click end, Enter); their list draws a row for each, and clicking a row selects that edge."""
     button = gui.find_button("UI", "vg.measure_edge", upward=True)
-    for start, end in EDGES:
+    pairs = edges_in_view(gui)
+    for start, end in pairs:
         count = len(gui.state()["objects"][OBJ]["edges"])
         # The Selected panel above changes once a station is selected (a row more, no
         # stability rows): find the button again.
@@ -236,7 +251,7 @@ def test_edge_profiles_list_shows_each_edge_and_picks_by_click(gui, places):
         gui.key("Return")
         gui.wait_for(lambda s, n=count: len(s["objects"][OBJ]["edges"]) == n + 1, 60, "an edge")
     edges = gui.settle()["objects"][OBJ]["edges"]
-    assert len(edges) == len(EDGES)
+    assert len(edges) == len(pairs)
     assert all(abs(edge["mean"] - WEDGE_ANGLE) < 1e-6 for edge in edges)
     # The list is below the button, its hint line, Find Break Edges and its folded settings:
     # where hovering copies its index property. Clicking down it selects each edge in turn.
@@ -249,8 +264,8 @@ def test_edge_profiles_list_shows_each_edge_and_picks_by_click(gui, places):
     for y in range(span[0] + 2, span[-1] - 1, 5):
         gui.click((left + width // 3, y))
         picked.setdefault(gui.settle()["objects"][OBJ]["active_edge_index"], []).append(y)
-    assert sorted(picked) == list(range(len(EDGES))), f"rows clicked: {picked} ({shot})"
-    middles = [float(np.mean(picked[index])) for index in range(len(EDGES))]
+    assert sorted(picked) == list(range(len(pairs))), f"rows clicked: {picked} ({shot})"
+    middles = [float(np.mean(picked[index])) for index in range(len(pairs))]
     assert middles == sorted(middles), "the edges are listed in order, one row each"
     # Each row shows its texts (number, mean angle, stations): bright pixels in every row.
     picture = gui.screenshot("edge_rows")
@@ -278,7 +293,7 @@ def test_an_edge_profile_is_recorded_only_on_the_object_its_clicks_are_on(gui, p
     on that object: the stations of one scan on another, with no error."""
     count = len(gui.state()["objects"][OBJ]["edges"])
     gui.click(gui.find_button("UI", "vg.measure_edge", upward=True))
-    start, end = EDGES[0]
+    start, end = edges_in_view(gui)[0]
     gui.click(point(gui, start))
     gui.click(point(gui, end))
     other = f"{OBJ}.other"

@@ -101,10 +101,10 @@ def agreement(
     largest = 0.0
     rows = zip(recorded, remeasured, file_precisions, precisions, stale, strict=True)
     for old, new, old_precision, new_precision, was_stale in rows:
-        if old is None or new is None or not math.isfinite(old):
-            continue
         if was_stale:
             passed_over += 1
+            continue
+        if old is None or new is None or not (math.isfinite(old) and math.isfinite(new)):
             continue
         compared += 1
         if old != new:
