@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import os
+import re
 import shutil
 from pathlib import Path
 
@@ -43,12 +44,12 @@ def edges_in_view(gui) -> tuple:
     sidebar_left = state["regions"]["UI"][0]
     names = sorted(
         (n for n, xy in state["points"].items()
-         if n.startswith("crease_") and xy is not None and xy[0] < sidebar_left - 20),
+         if re.fullmatch(r"crease_[+-]?\d+", n) and xy is not None and xy[0] < sidebar_left - 20),
         key=lambda n: int(n.split("_")[1]),
     )  # fmt: skip
-    assert len(names) >= 6, f"too few crease points left of the sidebar: {names}"
+    assert len(names) >= 5, f"too few crease points left of the sidebar: {names}"
     middle = len(names) // 2
-    return ((names[0], names[-2]), (names[1], names[middle]), (names[middle - 1], names[-1]))
+    return ((names[0], names[-1]), (names[1], names[middle + 1]), (names[middle], names[-1]))
 
 
 def measurements(gui) -> list[dict]:
