@@ -100,13 +100,11 @@ class Run:
             return  # MeshLab's, the earlier add-on's or a plain points file: no angles of ours
         if len(file_rows) != self.replayed:
             return
-        pairs = [(file_rows[index], row) for index, row in sorted(self.rows.items())]
-        agreed = agreement.agreement(
-            [old.angle for old, _ in pairs],
-            [new.angle for _, new in pairs],
-            [old.precision for old, _ in pairs],
-            [new.precision for _, new in pairs],
-            [old.stale for old, _ in pairs],
+        rows = [row for _, row in sorted(self.rows.items())]
+        agreed = agreement.agreement_of_rows(
+            [file_rows[index] for index in sorted(self.rows)],
+            [row.angle for row in rows],
+            [row.precision for row in rows],
         )
         if agreed.text:
             self.say(f"re-measured {Path(self.args.points).name}: " + agreed.text[2:])

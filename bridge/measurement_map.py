@@ -133,6 +133,7 @@ class MapJob:
                 f"{width} x {height}, {samples})."
             )
         self.obj = obj
+        self._stem = map_stem(obj)  # fixed for the job: a rename meanwhile splits no map
         self.directory = Path(directory)
         self.size = (width, height)
         self.samples = int(samples)
@@ -173,11 +174,11 @@ class MapJob:
 
     def picture_path(self, view_name: str) -> Path:
         """Where the picture of a view ends up."""
-        return self.directory / f"{map_stem(self.obj)}_map_{safe_file_name(view_name)}.png"
+        return self.directory / f"{self._stem}_map_{safe_file_name(view_name)}.png"
 
     def sheet_path(self) -> Path:
         """Where the contact sheet ends up."""
-        return self.directory / f"{map_stem(self.obj)}_map.png"
+        return self.directory / f"{self._stem}_map.png"
 
     def _staged(self, path: Path) -> Path:
         return self._staging / path.name

@@ -361,12 +361,10 @@ def follow_export(obj, path, numbers) -> tuple[str, bool]:
     extra = adopt_units(obj, [row.units for row in rows])
     by_number = {item.number: item for item in obj.vg.measurements}
     found = [(by_number[n], row) for n, row in zip(numbers, rows, strict=True) if n in by_number]
-    agreed = agreement.agreement(
-        [row.angle for _, row in found],
+    agreed = agreement.agreement_of_rows(
+        [row for _, row in found],
         [records.numbers_of(item)["angle"] for item, _ in found],
-        [row.precision for _, row in found],
         ["float32"] * len(found),  # Blender's vertices
-        [row.stale for _, row in found],
     )
     turned = sum(records.honour_colours(item, row.colors) for item, row in found)
     if turned:

@@ -17,6 +17,8 @@ to ``UNIFORM_COLOR`` with ``point_size_set`` there.
 
 from __future__ import annotations
 
+import contextlib
+
 import bpy
 import gpu
 import numpy as np
@@ -72,6 +74,20 @@ class PointShader:
     def __exit__(self, *exc) -> None:
         if not self.uniform_size:
             gpu.state.point_size_set(1.0)
+
+
+@contextlib.contextmanager
+def over_everything():
+    """Draw blended and with no depth test (a patch or path is drawn whole, hidden side
+    included), and leave the GPU state as it was for what draws next (other add-ons')."""
+    blend, depth = gpu.state.blend_get(), gpu.state.depth_test_get()
+    gpu.state.blend_set("ALPHA")
+    gpu.state.depth_test_set("NONE")
+    try:
+        yield
+    finally:
+        gpu.state.blend_set(blend)
+        gpu.state.depth_test_set(depth)
 
 
 def point_shader() -> PointShader:
@@ -196,17 +212,8 @@ class DragOverlay(ViewOverlay):
         region = bpy.context.region
         if region_data is None or region is None or self.center is None:
             return
-        blend, depth = gpu.state.blend_get(), gpu.state.depth_test_get()
-        gpu.state.blend_set("ALPHA")
-        gpu.state.depth_test_set("NONE")  # the whole patch is measured, hidden side included
-        try:
-            self._draw_patch(region, region_data)
-        finally:  # what later drawing (other add-ons') expects
-            gpu.state.blend_set(blend)
-            gpu.state.depth_test_set(depth)
-
-    def _draw_patch(self, region, region_data) -> None:
-        with gpu.matrix.push_pop(), point_shader() as points:
+        # the whole patch is measured, hidden side included
+        with over_everything(), gpu.matrix.push_pop(), point_shader() as points:
             gpu.matrix.multiply_matrix(Matrix(self.matrix.tolist()))
             if self._batches is None:
                 self._batches = self._build_batches(points.shader)

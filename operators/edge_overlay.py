@@ -13,7 +13,7 @@ import numpy as np
 from gpu_extras.batch import batch_for_shader
 
 from ..bridge.mesh_data import world_points
-from .drag_overlay import ViewOverlay, point_shader
+from .drag_overlay import ViewOverlay, over_everything, point_shader
 
 PATH_COLOR = (1.0, 0.85, 0.1, 1.0)
 CLICK_COLOR = (1.0, 1.0, 1.0, 1.0)
@@ -89,18 +89,7 @@ def draw_batches(overlay) -> None:
     # Line width and point size as shader uniforms (Metal and Vulkan ignore line_width_set);
     # the points' shader falls back on 4.2 (drag_overlay.PointShader).
     lines = gpu.shader.from_builtin("POLYLINE_UNIFORM_COLOR")
-    blend, depth = gpu.state.blend_get(), gpu.state.depth_test_get()
-    gpu.state.blend_set("ALPHA")
-    gpu.state.depth_test_set("NONE")
-    try:
-        _draw_each(overlay, lines, region)
-    finally:  # what later drawing (other add-ons') expects
-        gpu.state.blend_set(blend)
-        gpu.state.depth_test_set(depth)
-
-
-def _draw_each(overlay, lines, region) -> None:
-    with point_shader() as points:
+    with over_everything(), point_shader() as points:
         if overlay._batches is None:
             overlay._batches = overlay._build(lines, points.shader)
         for kind, batch, color, size in overlay._batches:

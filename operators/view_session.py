@@ -13,7 +13,7 @@ import numpy as np
 from ..bridge.mesh_data import check_measurable, evaluated_geometry
 from ..vg_addon import GoniometerError
 from .common import clear_texts
-from .drag import pointer_in_view
+from .drag import object_alive, pointer_in_view
 
 # The sessions running now: ended by :func:`end_all` when the extension is disabled, as
 # Blender then frees their operators without calling ``cancel``.
@@ -107,7 +107,7 @@ class ViewSession:
     def absent(self, context) -> str:
         """Why the session's object cannot be clicked on now: it is not in this scene (another
         scene is shown); ``""`` when it is."""
-        if context.scene.objects.get(self.obj.name) == self.obj:
+        if object_alive(context, self.obj):
             return ""
         return f"'{self.obj.name}' is not in this scene: go back to its scene to go on, or Esc."
 

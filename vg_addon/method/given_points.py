@@ -43,11 +43,12 @@ def check_given_points(surface, points, radius: float, where: str) -> None:
             how_far = (
                 f"{distance:.6g} from the mesh"
                 if math.isfinite(distance)
-                else ("far from every vertex (beyond what a double holds)")
+                else "far from every vertex (beyond what a double holds)"
             )
             far.append(f"point {number} ({x:g}, {y:g}, {z:g}) is {how_far}")
     if far:
         raise GoniometerError(
             f"{where}: {'; '.join(far)}, farther than {limit:.6g} (the radius, three mean edge "
-            "lengths or the longest edge): check that the points were picked on this mesh, in its units and frame."
+            "lengths or the longest edge): check that the points were picked on this mesh, in "
+            "its units and frame."
         )

@@ -112,3 +112,15 @@ def agreement(
             other_precision += bool(old_precision and new_precision != old_precision)
             largest = max(largest, abs(new - old))
     return Agreement(compared, differing, largest, other_precision, passed_over)
+
+
+def agreement_of_rows(file_rows: Sequence, remeasured: Sequence, precisions: Sequence[str]):
+    """:func:`agreement` of a file's rows (``csvio.MeasurementRow``: their angles, precisions
+    and Stale cells) with the angles and precisions of the same rows re-measured."""
+    return agreement(
+        [row.angle for row in file_rows],
+        remeasured,
+        [row.precision for row in file_rows],
+        precisions,
+        [row.stale for row in file_rows],
+    )
