@@ -363,6 +363,13 @@ class VG_ObjectData(PropertyGroup):
         default="[]",
         options={"HIDDEN"},
     )
+    map_stem: StringProperty(
+        name="Map file name",
+        description="The file-name stem this object's measurement maps are written under: kept "
+        "while it comes from the object's name, so another object never takes it",
+        default="",
+        options={"HIDDEN"},
+    )
     sides_shown: BoolProperty(
         name="Sides shown",
         description="The viewports were switched to show the sides, on the first measurement",

@@ -40,7 +40,7 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from ..vg_addon import GoniometerError
-from ..vg_addon.formats.files import picture_names, safe_file_name
+from ..vg_addon.formats.files import kept_picture_name, safe_file_name
 from ..vg_addon.formats.png import write_png
 from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, looks_at, place_labels, view_up
 from .colors import ATTRIBUTE_NAME, has_attribute, new_sides_material
@@ -62,15 +62,14 @@ CLOSE_UPS = (
 
 
 def map_stem(obj) -> str:
-    """The file-name stem of ``obj``'s map: its name made safe for a file, unique among the
-    file's objects (ignoring case), so that the maps of "A 1" and "A_1" never replace each
-    other's pictures. An object whose name is already safe keeps it; the others, in name order,
-    take "-2", "-3", … after it."""
-    names = sorted(
-        (other.name for other in bpy.data.objects),
-        key=lambda name: (safe_file_name(name) != name, name),
-    )
-    return picture_names(names)[0][names.index(obj.name)]
+    """The file-name stem of ``obj``'s map, unique among the file's objects: see
+    :func:`~vg_addon.formats.files.kept_picture_name`. Recorded at the map's end
+    (``obj.vg.map_stem``, saved in the .blend)."""
+    records = {
+        other.name: getattr(getattr(other, "vg", None), "map_stem", "")
+        for other in bpy.data.objects
+    }
+    return kept_picture_name(obj.name, records)
 
 
 def view_list(obj, views: str, depsgraph) -> tuple:
@@ -572,6 +571,7 @@ class MapJob:
             self.obj.vg.map_pictures = json.dumps(
                 [str(path.resolve()) for path in [*self.written, sheet]]
             )
+            self.obj.vg.map_stem = self._stem
         return sheet
 
     def _outdated_pictures(self) -> list:

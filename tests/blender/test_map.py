@@ -512,6 +512,30 @@ def test_the_maps_of_two_objects_whose_names_make_one_file_name_keep_apart(vg, t
     assert len(list(tmp_path.glob("A_1_map_*.png"))) == len(list(tmp_path.glob("A_1-2_map_*.png")))
 
 
+def test_an_object_named_later_like_a_mapped_one_never_writes_over_its_map(vg, tmp_path):
+    """ "A 1" made its map as "A_1"; an object "A_1" made later (after a save and reload)
+    took the same file name and wrote over "A 1"'s pictures. The stem a map was written under
+    is kept in the .blend and stays its object's. Oracle: the files and their bytes."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    first = wedge_object(90.0, "A 1", n=20)
+    vg.bridge.measuring.measure_on_object(first, (0.0, 0.0, 0.0), 0.3)
+    views, sheet = vg.bridge.measurement_map.render_map(first, tmp_path, size=SIZE, samples=1)
+    assert sheet.name == "A_1_map.png"
+    pictures = {path: path.read_bytes() for path in [*views, sheet]}
+    blend = tmp_path / "study.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend))
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    later = wedge_object(60.0, "A_1", n=20)
+    vg.bridge.measuring.measure_on_object(later, (0.0, 0.0, 0.0), 0.3)
+    _, sheet = vg.bridge.measurement_map.render_map(later, tmp_path, size=SIZE, samples=1)
+    assert sheet.name == "A_1-2_map.png"
+    assert {path: path.read_bytes() for path in pictures} == pictures
+    _, sheet = vg.bridge.measurement_map.render_map(
+        bpy.data.objects["A 1"], tmp_path, size=SIZE, samples=1
+    )
+    assert sheet.name == "A_1_map.png"
+
+
 def test_a_map_made_again_leaves_no_close_up_of_the_map_before(vg, tmp_path):
     """A close-up (and the "not shown" list) of an earlier map stayed in the folder beside a
     new map that no longer had them, reading as part of it. Oracle: the files of each map."""

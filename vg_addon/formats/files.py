@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import secrets
 import stat
 
@@ -163,14 +164,15 @@ def safe_file_name(name: str) -> str:
     return "".join(c if c.isalnum() or c in "-_.+" else "_" for c in name) or "mesh"
 
 
-def picture_names(names: list[str]) -> tuple[list[str], list[str]]:
+def picture_names(names: list[str], taken=()) -> tuple[list[str], list[str]]:
     """A file-name stem per mesh, unique within the run (also ignoring case, for file systems
     that do), and a note for each mesh whose stem had to be changed.
 
     ``safe_file_name`` maps "bone 1" and "bone_1" to the same "bone_1": the second gets
-    "bone_1-2", so its pictures never replace the first's.
+    "bone_1-2", so its pictures never replace the first's. Stems in ``taken`` (held by meshes
+    not named here) are never given.
     """
-    taken: set[str] = set()
+    taken = {stem.casefold() for stem in taken}
     stems, notes = [], []
     for name in names:
         base = stem = safe_file_name(name)
@@ -186,3 +188,28 @@ def picture_names(names: list[str]) -> tuple[list[str], list[str]]:
                 f"already has the file name {base!r}"
             )
     return stems, notes
+
+
+def kept_picture_name(name: str, records: dict) -> str:
+    """The file-name stem of the pictures of ``name`` among the meshes of ``records`` (each
+    mesh's name, ``name`` included, and the stem its pictures were last written under, or
+    ``""``), unique ignoring case.
+
+    A recorded stem stays its mesh's while it still comes from the mesh's name (its safe file
+    name, maybe with "-2", "-3", … after it): a mesh made or renamed later to the same file name
+    takes another stem, and never writes over the first one's pictures. Among meshes with no
+    such stem, one whose name is already safe keeps it; the others, in name order, take "-2",
+    "-3", … after it (:func:`picture_names`).
+    """
+    order = sorted(records, key=lambda other: (safe_file_name(other) != other, other))
+    held: dict[str, str] = {}  # casefolded stem -> the mesh that holds it
+    for other in order:
+        stem = records[other] or ""
+        if re.fullmatch(re.escape(safe_file_name(other)) + r"(-[0-9]+)?", stem):
+            held.setdefault(stem.casefold(), other)
+    recorded = records.get(name) or ""
+    if held.get(recorded.casefold()) == name:
+        return recorded
+    holders = set(held.values())
+    names = [other for other in order if other not in holders]
+    return picture_names(names, taken=held)[0][names.index(name)]
