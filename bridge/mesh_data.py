@@ -489,7 +489,11 @@ def surface_for(obj, geometry: Geometry) -> Surface:
     """The prepared :class:`Surface` of ``geometry``, built once per fingerprint (objects with
     equal meshes share it, wherever they are placed)."""
     triangles = geometry.triangles if geometry.triangles.size else None
-    return _kept(_surfaces, geometry.fingerprint, lambda: Surface(geometry.points, triangles))
+    return _kept(
+        _surfaces,
+        geometry.fingerprint,
+        lambda: Surface(geometry.points, triangles, precision="float32"),
+    )
 
 
 def ray_tree_for(obj, geometry: Geometry, depsgraph=None) -> BVHTree:

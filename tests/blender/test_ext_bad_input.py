@@ -9,12 +9,14 @@ from bpy_helpers import (
     expected_colours,
     linked_object,
     local_points,
+    mesh_object,
     snapshot,
     wedge_object,
     world,
 )
 
 from vg_addon import Surface
+from vg_addon.synthetic_meshes import wedge
 
 
 def measured_wedge():
@@ -266,3 +268,20 @@ def test_a_mesh_shared_by_two_objects_is_refused_until_each_has_its_own(vg):
     assert len(obj.vg.measurements) == 2
     assert np.array_equal(colours(copy), copy_colours)
     assert not np.array_equal(colours(obj), copy_colours)
+
+
+def test_a_mesh_stored_far_from_its_origin_is_refused_with_the_reason(vg):
+    """A scan imported in site coordinates, 1.13 million units from the origin: Blender holds
+    its vertices as float32, rounded to 0.125, more than the spacing of its vertices, and the
+    90° wedge read degrees off (Unstable, with no reason given). Now refused, naming float32
+    and the step. The same wedge kept near its mesh origin and placed that far away by the
+    object's location is measured: the oracle is the wedge's true angle."""
+    shape = wedge(90.0, n=40, irregular=True, seed=1)
+    centre = np.array([1.13, -0.71, 0.37]) * 1e6
+    far = mesh_object("Far", np.asarray(shape.points) + centre, shape.triangles)
+    before = snapshot(far)
+    assert_refused(r"stored as float32.*steps of 0\.12", location=centre, radius=0.5, space="MESH")
+    assert snapshot(far) == before
+    placed = mesh_object("Placed", shape.points, shape.triangles, location=centre)
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.5, space="MESH")
+    assert placed.vg.measurements[-1].angle == pytest.approx(90.0, abs=0.01)

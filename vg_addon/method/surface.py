@@ -22,6 +22,7 @@ from .geodesic import EdgeGraph
 from .normals import pca_normals, vertex_normals
 from .ordering import canonical_ranks
 from .planes import sides_contradict_normals
+from .precision import check_rounding, precision_of
 from .result import Measurement
 from .spatial import GridIndex, estimate_spacing
 from .stability import SMALL_PATCH_VERTICES, estimate_stability
@@ -88,6 +89,11 @@ class Surface:
         Each corner's edge id, aligned with ``triangles`` (Blender's ``.corner_edge`` of an
         all-triangle mesh): lets :attr:`winding` count edge uses instead of sorting the edges.
         See :func:`~vg_addon.method.winding.mesh_winding`.
+    precision : {"float32", "float64"}, optional
+        The precision the coordinates were stored at before they reached here (Blender keeps
+        every mesh as float32). Default: ``"float32"`` for a float32 array, else ``"float64"``.
+        A patch whose float32 rounding is too coarse for its vertex spacing is refused (see
+        :func:`~vg_addon.method.precision.check_rounding`).
 
     Notes
     -----
@@ -95,7 +101,8 @@ class Surface:
     of every patch; ``valid`` marks the vertices that take part.
     """
 
-    def __init__(self, points, triangles=None, normals=None, corner_edges=None):
+    def __init__(self, points, triangles=None, normals=None, corner_edges=None, precision=None):
+        self.precision = precision_of(points, precision)
         self.points = as_points("points", points)
         n = self.points.shape[0]
         self.triangles = None if triangles is None else _as_triangles(triangles, n)
@@ -224,7 +231,8 @@ class Surface:
         ------
         GoniometerError
             Centre farther than ``radius`` from the surface, bad radius or λ, unknown patch mode,
-            too few vertices, a flat patch, or a side that is a line.
+            too few vertices, float32 coordinates rounded too coarsely for the patch, a flat
+            patch, or a side that is a line.
         """
         requested = as_center(center)
         radius = as_radius(radius)
@@ -246,6 +254,7 @@ class Surface:
         # The canonical order (see algorithm.canonical_order), from the ranks sorted at build.
         indices = self._by_rank[np.sort(self.ranks[indices])].astype(np.int64)
         patch_points = np.take(self.points, indices, axis=0)
+        check_rounding(patch_points, radius, self.precision)
         fields = measure_patch(
             patch_points,
             np.take(self.normals, indices, axis=0),
