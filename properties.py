@@ -65,7 +65,8 @@ PATCH_ITEMS = (
 
 def _number(key):
     def get(self):
-        return float(exact_numbers(self).get(key, 0.0))
+        value = exact_numbers(self).get(key)
+        return 0.0 if value is None else float(value)  # shown undefined by the panels
 
     return get
 

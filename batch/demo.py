@@ -11,6 +11,7 @@ import numpy as np
 
 from ..vg_addon import synthetic_meshes
 from ..vg_addon.formats import meshio
+from ..vg_addon.method.edge_summary import sd_text
 from . import extension
 from .cli import build_parser
 from .run import run_batch
@@ -126,7 +127,7 @@ def print_edge(run) -> None:
     for edge in run.profiled_edges:
         print(
             f"  {edge.n_stations} stations over {edge.length:.1f} mm: mean {edge.mean:.2f}° "
-            f"(SD {edge.std:.2f}°), min {edge.min:.2f}°, max {edge.max:.2f}°, pooled "
+            f"(SD {sd_text(edge.std)}), min {edge.min:.2f}°, max {edge.max:.2f}°, pooled "
             f"{edge.pooled_angle:.2f}°"
         )
     if not stations:

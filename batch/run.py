@@ -17,6 +17,7 @@ from ..bridge import records
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, files
+from ..vg_addon.method.edge_summary import sd_text
 from ..vg_addon.method.result import stability_text, stability_warning
 from ..vg_addon.method.winding import winding_message
 from ..vg_addon.workflow import agreement, batchplan
@@ -317,7 +318,8 @@ class Run:
             self.say(
                 f"edge {edge.edge_number} on {edge.mesh_name!r}: {edge.n_stations} stations every "
                 f"{edge.spacing:g} over {edge.length:.4g}: mean {edge.mean:.2f}° "
-                f"(SD {edge.std:.2f}°, min {edge.min:.2f}°, max {edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°"
+                f"(SD {sd_text(edge.std)}, min {edge.min:.2f}°, max {edge.max:.2f}°), "
+                f"pooled {edge.pooled_angle:.2f}°"
                 + (
                     f"; the path crosses no ridge at arc lengths {edge.flat_spans}"
                     if edge.flat_spans

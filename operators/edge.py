@@ -21,6 +21,7 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 from ..bridge import edges
 from ..bridge.mesh_data import check_measurable, evaluated_geometry, surface_for
 from ..vg_addon import GoniometerError
+from ..vg_addon.method.edge_summary import sd_text
 from ..vg_addon.workflow.edge_state import EdgeMachine, EdgePhase
 from .common import (
     EDGE_SETTINGS,
@@ -234,7 +235,8 @@ class VG_OT_measure_edge(PatchProperties, RuleProperties, bpy.types.Operator):
         self.report(
             {"INFO"},
             f"Edge {edge.number} (break {edge.break_number}) on '{obj.name}': {edge.n_stations} "
-            f"stations, mean {edge.mean:.2f}° (SD {edge.std:.2f}°, min {edge.min:.2f}°, max "
+            f"stations, mean {edge.mean:.2f}° (SD {sd_text(json.loads(edge.exact).get('std'))}, min "
+            f"{edge.min:.2f}°, max "
             f"{edge.max:.2f}°), pooled {edge.pooled_angle:.2f}°",
         )
         warning = json.loads(edge.exact).get("flat_spans")

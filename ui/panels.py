@@ -6,6 +6,7 @@ from ..bridge.plots import plot_image
 from ..bridge.records import unit_symbol, units_label
 from ..operators.measure import non_uniform_scale_note
 from ..vg_addon.formats.record_codec import exact_numbers, study_texts
+from ..vg_addon.method.edge_summary import sd_text
 from ..vg_addon.method.winding import winding_message
 from .text import fits_beside, region_width, text_width, ui_scale, wrapped_label
 
@@ -306,7 +307,8 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
             f"{edge.n_stations} every {edge.spacing:.4g} over {edge.length:.4g} {unit}",
         )
         # "SD", never "±": in this extension "±" is a reading's stability figure.
-        _text_fitted(column, context, "Mean, SD", f"{edge.mean:.2f}°, {edge.std:.2f}°")
+        sd = sd_text(exact_numbers(edge).get("std"))
+        _text_fitted(column, context, "Mean, SD", f"{edge.mean:.2f}°, {sd}")
         _text_fitted(column, context, "Min, max", f"{edge.min:.2f}°, {edge.max:.2f}°")
         for label, text in study_texts(exact_numbers(edge), unit):
             _text_fitted(column, context, label, text)

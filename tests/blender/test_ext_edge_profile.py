@@ -619,3 +619,18 @@ def test_the_edge_file_says_which_edges_have_stale_stations(vg, tmp_path):
     assert all(r.stale for r in rows) and [e.stale for e in edges] == [True, True]
     older = edited_csv(csvio.edges_path_for(path), tmp_path / "old_edges.csv", drop=["Stale"])
     assert [e.stale for e in csvio.read_edges_csv(older)] == [None, None]
+
+
+def test_a_one_station_edge_records_no_sd_and_exports_a_blank_cell(vg, tmp_path):
+    """An edge shorter than its spacing has one station: its SD was exported and reported as
+    0°, as if the edge were known to be uniform. Now the record holds none and the edges CSV
+    cell is blank."""
+    obj, _ = ramp_object()
+    assert measure_edge(points=[[-0.3, 0.0, 0.0], [0.3, 0.0, 0.0]], spacing=2.0) == {"FINISHED"}
+    (edge,) = obj.vg.edges
+    assert edge.n_stations == 1 and exact(edge)["std"] is None
+    path = tmp_path / "m.csv"
+    assert bpy.ops.vg.export_csv(filepath=str(path)) == {"FINISHED"}
+    with open(csvio.edges_path_for(path), newline="") as handle:
+        (row,) = list(csv.DictReader(handle))
+    assert row["SD Angle"] == "" and float(row["Mean Angle"]) == exact(edge)["mean"]

@@ -414,3 +414,27 @@ def test_a_point_on_a_large_face_is_on_the_mesh_however_far_its_vertices():
     check_given_points(surface, [fine[0], centroid], 0.1, "clicked.csv")
     with pytest.raises(GoniometerError, match=r"point 2 .* from the mesh"):
         check_given_points(surface, [fine[0], centroid + np.array([0.0, 0.0, 2.5])], 0.1, "off.csv")
+
+
+def test_a_one_station_profile_has_no_sd_and_says_so(ramp):
+    """One station has no spread to speak of: its SD was given as 0°, as if the edge were
+    known to be uniform. The oracle: ``statistics.stdev`` refuses one value."""
+    import statistics
+
+    from vg_addon.formats import csvio
+    from vg_addon.formats.record_codec import figure_numbers
+
+    _, surface = ramp
+    profile = surface.measure_along([[-0.3, 0, 0], [0.3, 0, 0]], spacing=2.0, radius=0.3)
+    assert profile.n_stations == 1
+    with pytest.raises(statistics.StatisticsError):
+        statistics.stdev(profile.angles.tolist())
+    assert profile.std is None
+    assert "SD undefined (one station)" in profile.summary()
+    assert figure_numbers(profile.figures)["std"] is None
+    text = csvio.format_edges_csv([csvio.EdgeRow(mesh_name="Ramp", edge_number=1, std=None)])
+    header, row = text.splitlines()[:2]
+    cells = dict(zip(header.split(","), row.split(","), strict=True))
+    assert cells["SD Angle"] == ""
+    (back,) = csvio.parse_edges_csv(text)
+    assert back.std is None

@@ -117,10 +117,10 @@ def study_texts(numbers: dict, unit: str) -> list[tuple[str, str]]:
 def figure_numbers(figures) -> dict:
     """The summary numbers an edge record stores for ``figures`` (an ``EdgeSummary``):
     ``mean``, ``std``, ``min``, ``max``, ``pooled_angle``, ``pooled_fit`` and the
-    :data:`STUDY_FIGURES` (``arc_angle`` may be None: undefined)."""
+    :data:`STUDY_FIGURES` (``std`` and ``arc_angle`` may be None: undefined)."""
     return {
         "mean": float(figures.mean),
-        "std": float(figures.std),
+        "std": _optional(figures.std),
         "min": float(figures.min),
         "max": float(figures.max),
         "pooled_angle": float(figures.pooled_angle),

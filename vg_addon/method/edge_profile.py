@@ -34,7 +34,7 @@ import numpy as np
 
 from ..errors import GoniometerError, bounded_list
 from .algorithm import DEFAULT_RULE, as_center, as_radius
-from .edge_summary import EdgeSummary, summarize
+from .edge_summary import EdgeSummary, sd_text, summarize
 from .mesh_edges import MeshEdges
 from .ranges import expand_ranges
 
@@ -462,7 +462,10 @@ class EdgeProfile:
 
     n_stations = property(lambda self: self.figures.n_stations, doc="Number of stations.")
     mean = property(lambda self: self.figures.mean, doc="Mean station angle (degrees).")
-    std = property(lambda self: self.figures.std, doc="Sample standard deviation (degrees).")
+    std = property(
+        lambda self: self.figures.std,
+        doc="Sample standard deviation (degrees); None for one station.",
+    )
     min = property(lambda self: self.figures.min, doc="Smallest station angle (degrees).")
     max = property(lambda self: self.figures.max, doc="Largest station angle (degrees).")
     pooled_angle = property(lambda self: self.figures.pooled_angle, doc="Whole-edge angle.")
@@ -480,7 +483,7 @@ class EdgeProfile:
         f = self.figures
         return (
             f"{f.n_stations} stations every {self.spacing:g} over {self.path.length:.4g}: "
-            f"mean {f.mean:.2f}° (SD {f.std:.2f}°, min {f.min:.2f}°, max {f.max:.2f}°), "
+            f"mean {f.mean:.2f}° (SD {sd_text(f.std)}, min {f.min:.2f}°, max {f.max:.2f}°), "
             f"pooled {f.pooled_angle:.2f}° (r={self.radius:g}, λ={self.lam:g})"
         )
 

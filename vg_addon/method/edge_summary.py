@@ -20,9 +20,11 @@ class EdgeSummary:
     Attributes
     ----------
     n_stations : int
-    mean, std, min, max : float
-        Of the stations' angles (degrees); ``std`` is the sample standard deviation (0 for one
-        station).
+    mean, min, max : float
+        Of the stations' angles (degrees).
+    std : float or None
+        The sample standard deviation of the stations' angles (degrees); None (undefined) for
+        one station, whose spread is unknown, not 0 (see :func:`sd_text`).
     pooled_angle, pooled_fit_error : float
         The whole-edge mean angle: the angle between the mean plane normals of the edge's left
         and right sides, each station's two fitted normals expressed in its own frame (along the
@@ -44,7 +46,7 @@ class EdgeSummary:
 
     n_stations: int
     mean: float
-    std: float
+    std: float | None
     min: float
     max: float
     pooled_angle: float
@@ -120,7 +122,7 @@ def summarize(surface, stations) -> EdgeSummary:
     return EdgeSummary(
         n_stations=len(stations),
         mean=float(angles.mean()),
-        std=float(angles.std(ddof=1)) if angles.size > 1 else 0.0,
+        std=float(angles.std(ddof=1)) if angles.size > 1 else None,
         min=float(angles.min()),
         max=float(angles.max()),
         pooled_angle=pooled,
@@ -135,3 +137,9 @@ def summarize(surface, stations) -> EdgeSummary:
 
 
 __all__ = ["EdgeSummary", "summarize"]
+
+
+def sd_text(std) -> str:
+    """An edge's SD for a report or panel: ``"0.42°"``, or ``"undefined (one station)"`` where
+    ``std`` is None (the CSV leaves the cell blank)."""
+    return "undefined (one station)" if std is None else f"{std:.2f}°"
