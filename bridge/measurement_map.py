@@ -576,10 +576,13 @@ class MapJob:
 
     def _outdated_pictures(self) -> list:
         """Pictures this object's earlier map wrote into this folder (its record,
-        ``obj.vg.map_pictures``) that this map does not make again: a close-up of a measurement
-        since deleted or now seen in a view, or the "not shown" list. Left there, they would
-        read as part of this map. Files the record does not name (another object's pictures,
-        the user's) are never touched."""
+        ``obj.vg.map_pictures``) under this map's file name that this map does not make again:
+        a close-up of a measurement since deleted or now seen in a view, or the "not shown"
+        list. Left there, they would read as part of this map. Nothing else is touched: not
+        files the record does not name, nor those of a record made under another file name (a
+        copy of an object carries its original's record; a renamed object's earlier map)."""
+        if self.obj.vg.map_stem != self._stem:
+            return []
         try:
             earlier = [Path(p) for p in json.loads(self.obj.vg.map_pictures or "[]")]
         except (ValueError, TypeError):
@@ -589,7 +592,10 @@ class MapJob:
         return [
             path
             for path in earlier
-            if path.parent == folder and path not in written and path.is_file()
+            if path.parent == folder
+            and path.name.startswith(f"{self._stem}_map")
+            and path not in written
+            and path.is_file()
         ]
 
     def abort(self) -> None:

@@ -271,7 +271,7 @@ def test_a_mesh_shared_by_two_objects_is_refused_until_each_has_its_own(vg):
 
 
 def test_a_mesh_stored_far_from_its_origin_is_refused_with_the_reason(vg):
-    """A scan imported in site coordinates, 1.13 million units from the origin: Blender holds
+    """A scan imported in site coordinates, its coordinates up to 1.13 million: Blender holds
     its vertices as float32, rounded to 0.125, more than the spacing of its vertices, and the
     90° wedge read degrees off (Unstable, with no reason given). Now refused, naming float32
     and the step. The same wedge kept near its mesh origin and placed that far away by the

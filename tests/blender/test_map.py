@@ -536,6 +536,35 @@ def test_an_object_named_later_like_a_mapped_one_never_writes_over_its_map(vg, t
     assert sheet.name == "A_1_map.png"
 
 
+@pytest.mark.parametrize("how", ["renamed", "copied"])
+def test_a_renamed_or_copied_objects_map_leaves_the_others_pictures(vg, tmp_path, how):
+    """ "A" mapped, then renamed "B" and a new "A" made; or "A" mapped and copied (the copy
+    carries its record). The new "A" wrote over the pictures "B" made as "A", and "B"'s next
+    map deleted the new "A"'s; a copy's map deleted its original's. Oracle: the bytes of the
+    pictures each map wrote, read again after the other object's map."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    first = wedge_object(90.0, "A", n=20)
+    vg.bridge.measuring.measure_on_object(first, (0.0, 0.0, 0.0), 0.3)
+    views, sheet = vg.bridge.measurement_map.render_map(first, tmp_path, size=SIZE, samples=1)
+    kept = {path: path.read_bytes() for path in [*views, sheet]}
+    if how == "renamed":
+        first.name = "B"
+        other = wedge_object(60.0, "A", n=20)
+        vg.bridge.measuring.measure_on_object(other, (0.0, 0.0, 0.0), 0.3)
+    else:
+        other = first.copy()
+        other.data = first.data.copy()
+        bpy.context.scene.collection.objects.link(other)
+    views, sheet = vg.bridge.measurement_map.render_map(other, tmp_path, size=SIZE, samples=1)
+    assert sheet.name == ("A-2_map.png" if how == "renamed" else "A.001_map.png")
+    assert {path: path.read_bytes() for path in kept} == kept  # the first's, as they were
+    if how == "copied":
+        kept = {}  # the original's own map, made again next, may rewrite them
+    kept.update({path: path.read_bytes() for path in [*views, sheet]})
+    vg.bridge.measurement_map.render_map(first, tmp_path, size=SIZE, samples=1)
+    assert {path: path.read_bytes() if path.exists() else None for path in kept} == kept
+
+
 def test_a_map_made_again_leaves_no_close_up_of_the_map_before(vg, tmp_path):
     """A close-up (and the "not shown" list) of an earlier map stayed in the folder beside a
     new map that no longer had them, reading as part of it. Oracle: the files of each map."""

@@ -48,3 +48,11 @@ def test_two_records_of_one_stem_go_to_the_safe_name_first():
     records = {"A 1": "A_1", "A_1": "A_1"}
     assert kept_picture_name("A_1", records) == "A_1"
     assert kept_picture_name("A 1", records) == "A_1-2"
+
+
+def test_a_stem_recorded_by_a_renamed_object_is_not_given_to_its_old_name():
+    """ "A" mapped, renamed "B", then a new "A": the new one must not write over the
+    pictures "B" made as "A"."""
+    records = {"B": "A", "A": ""}
+    assert kept_picture_name("A", records) == "A-2"
+    assert kept_picture_name("B", records) == "B"

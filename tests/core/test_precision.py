@@ -20,14 +20,15 @@ def far_wedge(distance, seed=1):
 
 
 def test_a_float32_patch_rounded_past_its_vertex_spacing_is_refused_with_the_reason():
-    """1.13 million units out float32 keeps coordinates to 0.125, more than the wedge's vertex
+    """With coordinates up to 1.13 million, float32 keeps coordinates to 0.125, more than the wedge's vertex
     spacing: the rounded mesh, measured as if exact, reads degrees off the true 90°. The
     oracle is the true angle of the synthetic wedge."""
     _, rounded, triangles, centre = far_wedge(1e6)
     off = Surface(rounded, triangles, precision="float64").measure(centre, 0.5).angle
     assert abs(off - 90.0) > 1.0  # what the refusal keeps from the user
     with pytest.raises(
-        GoniometerError, match=r"float32.*1,130,000 units.*steps of 0\.12.*vg_batch"
+        GoniometerError,
+        match=r"float32.*coordinates up to 1,130,000 units.*steps of 0\.12.*vg_batch",
     ) as error:
         Surface(rounded, triangles).measure(centre, 0.5)
     assert "nan" not in str(error.value).lower()
@@ -54,7 +55,7 @@ def test_float32_values_given_as_float64_are_checked_when_said_to_be_float32():
     assert Surface(given, triangles).precision == "float64"
 
 
-def test_a_larger_radius_takes_more_vertices_and_may_measure_what_a_small_one_refuses():
+def test_every_radius_is_refused_where_the_step_is_past_the_limit():
     """The limit is the rounding against the spacing of the vertices, not against the radius:
     at 1e5 units (steps of 0.0078, about a fifth of the spacing) every radius is refused."""
     _, rounded, triangles, centre = far_wedge(1e5)

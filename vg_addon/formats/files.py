@@ -195,14 +195,16 @@ def kept_picture_name(name: str, records: dict) -> str:
     mesh's name, ``name`` included, and the stem its pictures were last written under, or
     ``""``), unique ignoring case.
 
-    A recorded stem stays its mesh's while it still comes from the mesh's name (its safe file
-    name, maybe with "-2", "-3", … after it): a mesh made or renamed later to the same file name
-    takes another stem, and never writes over the first one's pictures. Among meshes with no
-    such stem, one whose name is already safe keeps it; the others, in name order, take "-2",
+    Every recorded stem is held, so no other mesh is given it and writes over those pictures:
+    not one made later under the same file name, nor one named like a mesh since renamed. A mesh
+    keeps its own recorded stem while the stem still comes from its name (its safe file name,
+    maybe with "-2", "-3", … after it); where two meshes record one stem (a copy carries its
+    original's record), the one whose name it comes from keeps it. Any other mesh gets a stem
+    from its name as it is now: a safe name keeps it, the others, in name order, take "-2",
     "-3", … after it (:func:`picture_names`).
     """
     order = sorted(records, key=lambda other: (safe_file_name(other) != other, other))
-    held: dict[str, str] = {}  # casefolded stem -> the mesh that holds it
+    held: dict[str, str] = {}  # casefolded stem -> the mesh that keeps it
     for other in order:
         stem = records[other] or ""
         if re.fullmatch(re.escape(safe_file_name(other)) + r"(-[0-9]+)?", stem):
@@ -210,6 +212,6 @@ def kept_picture_name(name: str, records: dict) -> str:
     recorded = records.get(name) or ""
     if held.get(recorded.casefold()) == name:
         return recorded
-    holders = set(held.values())
-    names = [other for other in order if other not in holders]
-    return picture_names(names, taken=held)[0][names.index(name)]
+    taken = set(held) | {(records[other] or "").casefold() for other in records} - {""}
+    names = [other for other in order if other not in set(held.values())]
+    return picture_names(names, taken=taken)[0][names.index(name)]

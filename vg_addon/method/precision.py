@@ -35,8 +35,10 @@ def check_rounding(patch_points: np.ndarray, radius: float, precision: str) -> N
 
     Far from the mesh's origin, float32 keeps coordinates only to a coarse step (0.25 units at
     4 million units, 6e-5 at a thousand): each vertex is moved by up to half a step, which tilts
-    the normals the sides are split by and the planes fitted to them. Measured on wedges, the
-    angle moves by up to 0.07° at a step of a tenth of the spacing, and by degrees past it.
+    the normals the sides are split by and the planes fitted to them. Measured on wedges of
+    about 600 patch vertices, the angle moves by up to 0.08° at a step of a tenth of the
+    spacing, and by degrees past it; a patch of about 100 vertices moves by up to 0.4° below
+    the limit (see docs/METHOD.md).
 
     Parameters
     ----------
@@ -61,8 +63,8 @@ def check_rounding(patch_points: np.ndarray, radius: float, precision: str) -> N
         return
     distance = f"{largest:,.0f}" if largest >= 10.0 else f"{largest:.3g}"
     raise GoniometerError(
-        f"This mesh's coordinates are stored as float32 (as Blender keeps every mesh), which "
-        f"{distance} units from the mesh's origin rounds them to steps of {step:.2g}: "
+        f"This mesh's coordinates are stored as float32 (as Blender keeps every mesh), which at "
+        f"coordinates up to {distance} units rounds them to steps of {step:.2g}: "
         f"{step / spacing:.2g} of the spacing of the vertices here ({spacing:.2g}), more than "
         f"the {MAX_ROUNDING:g} at which the angle can move by several hundredths of a degree. "
         "The rounding happened when the mesh was stored: move the scan near the origin before "
