@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from vg_addon import GoniometerError, Surface
+from vg_addon.method.precision import check_rounding
 from vg_addon.synthetic_meshes import wedge
 
 OFFSET = np.array([1.13, -0.71, 0.37])  # not along any symmetry of the wedge's faces
@@ -69,3 +70,45 @@ def test_an_unknown_precision_is_refused():
     points, _, triangles, _ = far_wedge(0.0)
     with pytest.raises(GoniometerError, match="Unknown precision 'float16'"):
         Surface(points, triangles, precision="float16")
+
+
+def test_a_small_patch_takes_a_finer_step_than_a_large_one():
+    """8,000 units out, float32 keeps coordinates to steps of about 0.03 of the wedge's vertex
+    spacing. A patch of 26 vertices read as if exact is 0.13° off the true 90° (measured before
+    the limit depended on the vertex count); it is refused, pointing to a larger radius. A patch
+    of about 630 vertices at the same place reads within 0.05° of the true angle."""
+    _, rounded, triangles, centre = far_wedge(8e3)
+    small = Surface(rounded, triangles, precision="float64").measure(centre, 0.1)
+    assert small.n_vertices == 26
+    assert abs(small.angle - 90.0) > 0.1  # what the refusal keeps from the user
+    surface = Surface(rounded, triangles)
+    with pytest.raises(GoniometerError, match=r"patch of 26 vertices.*larger radius"):
+        surface.measure(centre, 0.1)
+    large = surface.measure(centre, 0.5)
+    assert large.n_vertices > 600
+    assert large.angle == pytest.approx(90.0, abs=0.05)
+
+
+# The limit docs/METHOD.md states: a step of 0.05° × n / 400 of the spacing, at most 0.1.
+DOCUMENTED_LIMITS = {13: 0.05 * 13 / 400, 40: 0.005, 400: 0.05, 800: 0.1, 5000: 0.1}
+
+
+@pytest.mark.parametrize("n_vertices", sorted(DOCUMENTED_LIMITS))
+def test_the_limit_is_the_documented_share_of_the_spacing(n_vertices):
+    """A patch of ``n`` vertices 1.5 million units out (float32 steps of 0.125), its radius
+    chosen so the step is 0.95 and 1.05 times the documented limit's share of the spacing:
+    measured just inside it, refused just past it."""
+    rng = np.random.default_rng(n_vertices)
+    points = 1.5e6 + rng.uniform(0.0, 1.0, (n_vertices, 3))
+    step = float(np.spacing(np.float32(points.max())))
+    assert step == 0.125
+    limit = DOCUMENTED_LIMITS[n_vertices]
+    for factor, refused in ((0.95, False), (1.05, True)):
+        spacing = step / (limit * factor)
+        radius = spacing / np.sqrt(np.pi / n_vertices)
+        if refused:
+            with pytest.raises(GoniometerError, match="stored as float32"):
+                check_rounding(points, radius, "float32")
+        else:
+            check_rounding(points, radius, "float32")
+        check_rounding(points, radius, "float64")  # float64 is never refused for this

@@ -10,7 +10,22 @@ from ..errors import GoniometerError
 PRECISIONS = ("float32", "float64")
 MAX_ROUNDING = 0.1
 """Largest float32 rounding step of a patch's coordinates, as a share of the spacing of its
-vertices, that is measured (see docs/METHOD.md, "Coordinates far from the origin")."""
+vertices, that is measured at any vertex count (see docs/METHOD.md, "Coordinates far from the
+origin")."""
+MAX_MOVE = 0.05
+"""Largest move of a reading, in degrees, that the rounding is let make."""
+ROUNDING_SENSITIVITY = 400.0
+"""The largest move of a reading, in degrees, times the patch's vertex count, per unit of the
+rounding step's share of the vertex spacing: measured 20 to 360 on wedges of 13 to 1,034 patch
+vertices (``scripts/float32_rounding_table.py``), so a patch of ``n`` vertices moves by up to
+about ``ROUNDING_SENSITIVITY * share / n`` degrees."""
+
+
+def rounding_limit(n_vertices: int) -> float:
+    """The largest rounding step, as a share of the vertex spacing, that a patch of
+    ``n_vertices`` is measured at: the share at which the rounding can move the reading by
+    :data:`MAX_MOVE`, and never more than :data:`MAX_ROUNDING`."""
+    return min(MAX_ROUNDING, MAX_MOVE * n_vertices / ROUNDING_SENSITIVITY)
 
 
 def precision_of(points, precision=None) -> str:
@@ -30,15 +45,15 @@ def precision_of(points, precision=None) -> str:
 
 
 def check_rounding(patch_points: np.ndarray, radius: float, precision: str) -> None:
-    """Refuse a patch whose float32 coordinates are rounded to more than :data:`MAX_ROUNDING`
-    of the spacing of its vertices.
+    """Refuse a patch whose float32 coordinates are rounded by more than
+    :func:`rounding_limit` of the spacing of its vertices.
 
     Far from the mesh's origin, float32 keeps coordinates only to a coarse step (0.25 units at
     4 million units, 6e-5 at a thousand): each vertex is moved by up to half a step, which tilts
-    the normals the sides are split by and the planes fitted to them. Measured on wedges of
-    about 600 patch vertices, the angle moves by up to 0.08° at a step of a tenth of the
-    spacing, and by degrees past it; a patch of about 100 vertices moves by up to 0.4° below
-    the limit (see docs/METHOD.md).
+    the normals the sides are split by and the planes fitted to them. The angle moves by about
+    the step's share of the spacing over the vertex count (times 20 to 360 degrees, measured;
+    by degrees once the step nears the spacing), so a small patch takes a finer step than a
+    large one (see docs/METHOD.md).
 
     Parameters
     ----------
@@ -58,16 +73,22 @@ def check_rounding(patch_points: np.ndarray, radius: float, precision: str) -> N
         return
     largest = float(np.abs(patch_points).max())
     step = float(np.spacing(np.float32(largest)))
-    spacing = radius * float(np.sqrt(np.pi / patch_points.shape[0]))
-    if step <= MAX_ROUNDING * spacing:
+    n_vertices = patch_points.shape[0]
+    spacing = radius * float(np.sqrt(np.pi / n_vertices))
+    limit = rounding_limit(n_vertices)
+    if step <= limit * spacing:
         return
+    larger = ""
+    if limit < MAX_ROUNDING:
+        larger = ", or use a larger radius (a patch of more vertices takes a coarser step)"
     distance = f"{largest:,.0f}" if largest >= 10.0 else f"{largest:.3g}"
     raise GoniometerError(
         f"This mesh's coordinates are stored as float32 (as Blender keeps every mesh), which at "
         f"coordinates up to {distance} units rounds them to steps of {step:.2g}: "
         f"{step / spacing:.2g} of the spacing of the vertices here ({spacing:.2g}), more than "
-        f"the {MAX_ROUNDING:g} at which the angle can move by several hundredths of a degree. "
-        "The rounding happened when the mesh was stored: move the scan near the origin before "
-        "it is imported (subtract an offset from its coordinates), or measure a float64 scan "
-        "file with vg_batch, which measures at the file's own coordinates."
+        f"the {limit:.2g} at which it can move the angle of a patch of {n_vertices} vertices "
+        f"by {MAX_MOVE:g}°. The rounding happened when the mesh was stored: move the scan near "
+        "the origin before it is imported (subtract an offset from its coordinates), or keep "
+        "its coordinates as float64 (vg_batch measures a float64 mesh file at the file's own "
+        f"coordinates){larger}."
     )
