@@ -20,7 +20,9 @@ The method, in four steps (docs/EDGE_DETECTION.md shows it at work):
    loops) with the cheapest ridge path of :mod:`.edge_profile`, so it is an
    :class:`~.edge_profile.EdgePath` whose waypoints retrace it exactly through ``trace_edge``:
    an accepted candidate is an ordinary Edge Profile. A candidate that does not stand out from
-   the noise of the regions round it (:data:`LOCAL_NOISE_FACTOR`) is dropped.
+   the noise of the regions round it (:data:`LOCAL_NOISE_FACTOR`) is dropped, and an end that
+   runs along a more confident candidate is cut back to where they part, so no stretch of ridge
+   is in two candidates (:func:`.candidate_parts.without_shared_ends`).
 """
 
 from __future__ import annotations
@@ -32,15 +34,15 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from ..errors import GoniometerError
+from .candidate_parts import rated, trim, without_shared_ends  # noqa: F401 (trim: public here)
 from .edge_pieces import (
     balanced_crest,
     outer_crest,
-    retraced_legs,
     ridge_pieces,
     smooth_regions,
     trace_piece,
 )
-from .edge_profile import EdgePath, assemble_path, has_ridge_graph, is_loop, ridge_graph
+from .edge_profile import EdgePath, has_ridge_graph, ridge_graph
 from .fixed_order import rows_dot, total
 from .mesh_edges import MeshEdges
 from .mesh_regions import dilate, flood_labels
@@ -229,6 +231,11 @@ def _median(values: np.ndarray) -> float:
     return float(np.median(values)) if values.size else 0.0
 
 
+def _rank(candidate) -> tuple:
+    """The order of candidates: most confident first, then longest, then by first vertex."""
+    return (-candidate.confidence, -candidate.length, int(candidate.path.vertices[0]))
+
+
 def _is_number(value) -> bool:
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
 
@@ -260,7 +267,11 @@ class BreakEdgeCandidate:
     min_bend_deg : float
         The ``min_bend_deg`` it was found with (the confidence of a trimmed part uses both).
     surface : Surface
-        The surface it lies on (:func:`trim` retraces parts on it).
+        The surface it lies on (:func:`.candidate_parts.trim` retraces parts on it).
+    bend_field : ndarray, shape (n_points,)
+        The field ``bend_deg`` was read from (anisotropy at ``scale``; see
+        :func:`.ridge_field.bend_of_anisotropy`), shared by every candidate of a run: a trimmed
+        part reads the bend of each of its vertices there.
     """
 
     number: int
@@ -273,6 +284,7 @@ class BreakEdgeCandidate:
     ridge_min_deg: float = field(default=30.0, repr=False)
     min_bend_deg: float = field(default=30.0, repr=False)
     surface: object = field(default=None, repr=False)
+    bend_field: np.ndarray = field(default=None, repr=False)
 
     @property
     def length(self) -> float:
@@ -310,27 +322,6 @@ class BreakEdgeResult:
     region_kind: np.ndarray
     parameters: BreakEdgeParameters
     ridge_min_deg: float = 0.0
-
-
-def confidence(ridge_fraction: float, mean_bend_deg: float, min_bend_deg: float) -> float:
-    """How sure a candidate is: ``ridge_fraction * (1 - exp(-2 (mean - min) / min))``, 0 when
-    the mean bend is below ``min_bend_deg``."""
-    clear = max(0.0, mean_bend_deg - min_bend_deg) / min_bend_deg
-    return float(ridge_fraction * (1.0 - math.exp(-2.0 * clear)))
-
-
-def rated(candidate: BreakEdgeCandidate, path: EdgePath, bend_deg: np.ndarray, **changes):
-    """``candidate`` with ``path`` and its bends, mean bend and confidence worked out anew."""
-    mean_bend = float(bend_deg.mean())
-    on_ridge = float(np.mean(bend_deg >= candidate.ridge_min_deg))
-    return replace(
-        candidate,
-        path=path,
-        bend_deg=bend_deg,
-        mean_bend_deg=mean_bend,
-        confidence=confidence(on_ridge, mean_bend, candidate.min_bend_deg),
-        **changes,
-    )
 
 
 def region_kinds(region: np.ndarray, sums: np.ndarray, n_regions: int) -> np.ndarray:
@@ -508,7 +499,9 @@ class BreakEdgeFinder:
             if float(spread[c.path.vertices].mean())
             >= LOCAL_NOISE_FACTOR * _local_noise(graph, c.path.vertices, region, isotropic, reach)
         ]
-        traced.sort(key=lambda c: (-c.confidence, -c.length, int(c.path.vertices[0])))
+        traced.sort(key=_rank)
+        traced = without_shared_ends(traced, graph.starts, graph.target, params.min_length)
+        traced.sort(key=_rank)  # a cut candidate's confidence is its part's
         numbered = tuple(
             replace(c, number=k + 1) for k, c in enumerate(traced[: params.max_candidates])
         )
@@ -561,6 +554,7 @@ class BreakEdgeFinder:
             ridge_min_deg=ridge_min_deg,
             min_bend_deg=params.min_bend_deg,
             surface=self.surface,
+            bend_field=spread,
         )
         return rated(blank, path, bend_of_anisotropy(spread[path.vertices]))
 
@@ -600,62 +594,3 @@ def find_break_edges(surface, parameters: BreakEdgeParameters | None = None, **o
             f"Unknown break-edge parameter {', '.join(unknown)}: use {', '.join(sorted(known))}."
         )
     return BreakEdgeFinder(surface, replace(parameters, **overrides)).run()
-
-
-def trim(candidate: BreakEdgeCandidate, start_arc: float, end_arc: float) -> BreakEdgeCandidate:
-    """The part of ``candidate`` between arc lengths ``start_arc`` and ``end_arc``.
-
-    Each end snaps to the path vertex nearest its arc length. On a loop (``candidate.closed``) a
-    ``start_arc`` beyond ``end_arc`` keeps the part that runs on from ``start_arc`` through the
-    loop's start to ``end_arc``. The part keeps the candidate's waypoints that fall inside it,
-    plus via points where the part would not otherwise retrace identically through
-    ``trace_edge``. Its confidence and mean bend are those of the part.
-
-    Raises
-    ------
-    GoniometerError
-        Arc lengths out of order on an open candidate or outside 0 to its length (not clamped:
-        a part the caller did not ask for is never kept), or leaving less than one mesh edge.
-    """
-    path = candidate.path
-    arc = path.arc_lengths
-    try:
-        start_arc, end_arc = float(start_arc), float(end_arc)
-    except (TypeError, ValueError):
-        raise GoniometerError("The trim's arc lengths must be numbers.") from None
-    wraps = candidate.closed and start_arc > end_arc
-    slack = 1e-9 * path.length  # a click's arc length computed in another order of sums
-    within = all(-slack <= value <= path.length + slack for value in (start_arc, end_arc))
-    if not (within and (start_arc < end_arc or wraps)):  # also refuses NaN and infinities
-        raise GoniometerError(
-            f"Trim from arc length {start_arc:g} to {end_arc:g}: the start must come before the "
-            f"end, both within 0 to {path.length:.6g}."
-        )
-    first = int(np.argmin(np.abs(arc - start_arc)))
-    last = int(np.argmin(np.abs(arc - end_arc)))
-    end = arc.size - 1
-    if wraps:
-        # The loop's start and end are one vertex: a part that reaches either does not wrap.
-        if first == end:
-            first, wraps = 0, False
-        elif last == 0:
-            last, wraps = end, False
-    if wraps:
-        vertices = np.concatenate([path.vertices[first:], path.vertices[1 : last + 1]])
-        bend_deg = np.concatenate([candidate.bend_deg[first:], candidate.bend_deg[1 : last + 1]])
-        inside = [int(w) - first for w in path.waypoints if first < w < end]
-        inside += [end - first] + [end - first + int(w) for w in path.waypoints if 0 < w < last]
-    elif last <= first:
-        raise GoniometerError(
-            f"Trimming from {start_arc:g} to {end_arc:g} leaves less than one mesh edge of this "
-            "candidate: keep a longer part."
-        )
-    else:
-        vertices = path.vertices[first : last + 1]
-        bend_deg = candidate.bend_deg[first : last + 1].copy()
-        inside = [int(w) - first for w in path.waypoints if first < w < last]
-    surface = candidate.surface
-    stops = [0, *inside, vertices.size - 1]
-    legs = retraced_legs(surface, vertices, stops)
-    part = assemble_path(surface, legs)
-    return rated(candidate, part, bend_deg, closed=is_loop(part))

@@ -25,7 +25,8 @@ from enum import StrEnum
 import numpy as np
 
 from ..errors import GoniometerError, bounded_list
-from ..method.break_edges import BreakEdgeCandidate, trim
+from ..method.break_edges import BreakEdgeCandidate
+from ..method.candidate_parts import trim
 from ..method.edge_profile import measure_along
 
 #: A click selects the candidate drawn nearest to it within this many pixels.
