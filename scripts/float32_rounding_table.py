@@ -43,6 +43,13 @@ SENSITIVITY_RATIOS = (0.01, 0.03, 0.1)
 SENSITIVITY_MOVES = 8
 
 
+def measured_patch_size(points, triangles, radius: float) -> int:
+    """The vertex count of the patch measured: the one round the vertex nearest the wedge's
+    centre (the origin), where each reading is taken."""
+    centre_vertex = int(np.argmin(np.linalg.norm(points, axis=1)))
+    return int(Surface(points, triangles).patch(centre_vertex, radius).size)
+
+
 def far_centre(ratio: float, size: float, rng) -> np.ndarray:
     """A random centre far enough from the origin that float32 keeps coordinates there to a
     step of at most ``ratio * size`` and at least half of it."""
@@ -57,7 +64,7 @@ def largest_move(angle: float, grid: int, radius: float, ratio: float, rng) -> t
     shape = wedge(angle, n=grid, irregular=True, seed=3)
     points = np.asarray(shape.points, dtype=np.float64)
     triangles = np.asarray(shape.triangles)
-    count = Surface(points, triangles).patch(0, radius).size
+    count = measured_patch_size(points, triangles, radius)
     size = radius * np.sqrt(np.pi / count)
     worst = 0.0
     for _ in range(SENSITIVITY_MOVES):
@@ -103,7 +110,7 @@ def largest_error(angle: float, n: int, radius: float, ratio: float, rng) -> flo
     shape = wedge(angle, n=n, irregular=True)
     points = np.asarray(shape.points, dtype=np.float64)
     triangles = np.asarray(shape.triangles)
-    size = radius * np.sqrt(np.pi / Surface(points, triangles).patch(0, radius).size)
+    size = radius * np.sqrt(np.pi / measured_patch_size(points, triangles, radius))
     worst = 0.0
     for _ in range(MOVES):
         centre = far_centre(ratio, size, rng)

@@ -317,7 +317,7 @@ def test_a_scale_below_the_mesh_spacing_is_refused_and_one_just_above_it_runs():
 def test_every_trim_of_a_marched_flakes_candidates_retraces():
     """On a mesh whose edges fall between vertices the cheapest ridge path between the two ends
     of one mesh edge can go round by a third vertex, which no via point can hold: 32 of these
-    326 trims kept the direct edge, so an edge file replayed the part one vertex apart from what
+    326 trims kept the direct edge (3 of 332 before the platform edge's ends were cut), so an edge file replayed the part one vertex apart from what
     was accepted. Oracle: ``trace_edge`` through each part's waypoints gives its vertices."""
     fragment = fragments.marched_flake()
     surface = Surface(fragment.points, fragment.triangles)

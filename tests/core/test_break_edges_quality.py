@@ -121,7 +121,7 @@ def test_no_candidate_passes_a_place_twice():
 )  # fmt: skip
 def test_no_stretch_of_ridge_is_in_two_candidates(make, noise):
     """Where two edges meet (a rounded cube corner, the flake's platform edge joining its
-    margin) both candidates ran round the same stretch: on the clean cube candidates 2 and 10
+    margin) both candidates ran round the same stretch: on the clean cube candidates 3 and 11
     shared 9 vertices (3.8 mm), so a batch profiling every edge measured it twice. Oracle: the
     vertex indices of any two candidates' paths have at most one in common (where they meet),
     and the bar still holds."""

@@ -89,8 +89,8 @@ def test_a_small_patch_takes_a_finer_step_than_a_large_one():
     assert large.angle == pytest.approx(90.0, abs=0.05)
 
 
-# The limit docs/METHOD.md states: a step of 0.05° × n / 400 of the spacing, at most 0.1.
-DOCUMENTED_LIMITS = {13: 0.05 * 13 / 400, 40: 0.005, 400: 0.05, 800: 0.1, 5000: 0.1}
+# The limit docs/METHOD.md states: a step of 0.05° × n / 1000 of the spacing, at most 0.1.
+DOCUMENTED_LIMITS = {13: 0.00065, 40: 0.002, 400: 0.02, 2000: 0.1, 5000: 0.1}
 
 
 @pytest.mark.parametrize("n_vertices", sorted(DOCUMENTED_LIMITS))

@@ -57,6 +57,10 @@ def trim(candidate: BreakEdgeCandidate, start_arc: float, end_arc: float) -> Bre
         Arc lengths out of order on an open candidate or outside 0 to its length (not clamped:
         a part the caller did not ask for is never kept), or leaving less than one mesh edge.
     """
+    if candidate.bend_field is None:
+        raise GoniometerError(
+            "Only a candidate the finder made can be trimmed: this one carries no bend field."
+        )
     path = candidate.path
     arc = path.arc_lengths
     try:

@@ -14,11 +14,12 @@ vertices, that is measured at any vertex count (see docs/METHOD.md, "Coordinates
 origin")."""
 MAX_MOVE = 0.05
 """Largest move of a reading, in degrees, that the rounding is let make."""
-ROUNDING_SENSITIVITY = 400.0
+ROUNDING_SENSITIVITY = 1000.0
 """The largest move of a reading, in degrees, times the patch's vertex count, per unit of the
-rounding step's share of the vertex spacing: measured 20 to 360 on wedges of 13 to 1,034 patch
-vertices (``scripts/float32_rounding_table.py``), so a patch of ``n`` vertices moves by up to
-about ``ROUNDING_SENSITIVITY * share / n`` degrees."""
+rounding step's share of the vertex spacing: 130 to 400 in the table of
+``scripts/float32_rounding_table.py`` (wedges of 22 to 2,015 patch vertices, eight moves a cell),
+up to about 880 over 300 moves of one patch, so a patch of ``n`` vertices moves by up to about
+``ROUNDING_SENSITIVITY * share / n`` degrees."""
 
 
 def rounding_limit(n_vertices: int) -> float:
@@ -51,7 +52,7 @@ def check_rounding(patch_points: np.ndarray, radius: float, precision: str) -> N
     Far from the mesh's origin, float32 keeps coordinates only to a coarse step (0.25 units at
     4 million units, 6e-5 at a thousand): each vertex is moved by up to half a step, which tilts
     the normals the sides are split by and the planes fitted to them. The angle moves by about
-    the step's share of the spacing over the vertex count (times 20 to 360 degrees, measured;
+    the step's share of the spacing over the vertex count (times up to about 900 degrees, measured;
     by degrees once the step nears the spacing), so a small patch takes a finer step than a
     large one (see docs/METHOD.md).
 
