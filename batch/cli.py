@@ -8,6 +8,7 @@ import math
 from ..bridge.map_edges import EDGE_ENDS
 from ..vg_addon import GoniometerError
 from ..vg_addon.method.algorithm import as_lambda
+from ..vg_addon.method.break_edges import BreakEdgeParameters
 from ..vg_addon.method.sweep import sweep_radii
 
 # --units: Blender's unit system, unit scale and length unit for what one coordinate unit is.
@@ -19,6 +20,14 @@ UNITS = {
     "um": ("METRIC", 1e-6, "MICROMETERS"),
     "in": ("IMPERIAL", 0.0254, "INCHES"),
 }
+
+FINDER_SETTINGS = (
+    ("--min-length", "L", "min_length"),
+    ("--find-scale", "S", "find_scale"),
+    ("--min-bend", "DEG", "min_bend"),
+)
+"""The finder's settings on the command line (flag, metavar, argument name); each needs
+--find-edges."""
 
 # --render-size and --render-samples: a map's cost grows with pixels times samples, and Cycles
 # cannot be stopped inside a view, so both are bounded before anything is rendered.
@@ -71,7 +80,9 @@ edges:
   docs/EDGE_DETECTION.md) and profiles each like an --edge, with --spacing D and --radius R:
   stations in --out, summaries in OUT_edges.csv (each row re-measures with --edges), a plot
   per edge, and with --render the map with the edges drawn. --min-length L drops edges
-  shorter than L (default: from the mesh's resolution). It works with --jobs (not --shard).
+  shorter than L, --find-scale S judges bends over S (rounded edges need S about their
+  size), --min-bend DEG keeps edges bending at least DEG (defaults: from the mesh's
+  resolution; 30°). It works with --jobs (not --shard).
 
 output:
   --out CSV gets one row per requested point, in input order, in the extension's export
@@ -136,7 +147,7 @@ def build_parser() -> argparse.ArgumentParser:
         "       python vg_batch.py ARGS\n\n"
         "ARGS:  MESH... [--object NAME] (--at X Y Z ... | --points CSV) [--radius R]\n"
         "       [--edge X1 Y1 Z1 X2 Y2 Z2 [--via X Y Z]... --spacing D]... [--edges CSV|PP]\n"
-        "       [--find-edges --spacing D [--min-length L]]\n"
+        "       [--find-edges --spacing D [--min-length L] [--find-scale S] [--min-bend DEG]]\n"
         "       [--lambda L] [--patch euclidean|geodesic] [--rule refined|oriented|paper]\n"
         "       [--stability] [--sweep R0 R1 N] --out CSV [--save-blend PATH]\n"
         "       [--render DIR] [--jobs N] [--shard K/N]\n"
@@ -208,6 +219,20 @@ def build_parser() -> argparse.ArgumentParser:
         type=float,
         metavar="L",
         help="with --find-edges: drop edges shorter than L (mesh units; default: from the mesh)",
+    )
+    edges.add_argument(
+        "--find-scale",
+        type=float,
+        metavar="S",
+        help="with --find-edges: the neighbourhood a bend is judged at (mesh units; default: "
+        "from the mesh); about the size of rounded edges to find",
+    )
+    edges.add_argument(
+        "--min-bend",
+        type=float,
+        metavar="DEG",
+        help="with --find-edges: an edge bends at least this much, 180° minus its angle "
+        f"(default {BreakEdgeParameters().min_bend_deg:g})",
     )
     edges.add_argument(
         "--spacing",
@@ -405,10 +430,12 @@ def check_edge_points(edges) -> None:
 
 
 def check_find_edges(args) -> None:
-    """Refuse ``--find-edges`` without a spacing and radius, with ``--shard``, and a
-    ``--min-length`` that is not a positive number or comes without ``--find-edges``."""
-    if args.min_length is not None and not args.find_edges:
-        raise UsageError("--min-length L is for --find-edges.")
+    """Refuse ``--find-edges`` without a spacing and radius, with ``--shard``, and finder
+    settings (``--min-length``, ``--find-scale``, ``--min-bend``) that are out of range or come
+    without ``--find-edges``."""
+    for flag, metavar, name in FINDER_SETTINGS:
+        if getattr(args, name) is not None and not args.find_edges:
+            raise UsageError(f"{flag} {metavar} is for --find-edges.")
     if not args.find_edges:
         return
     if args.spacing is None or args.radius is None:
@@ -419,6 +446,11 @@ def check_find_edges(args) -> None:
             "rows: drop --shard (--jobs N measures N meshes at a time)."
         )
     check_positive("--min-length", args.min_length)
+    check_positive("--find-scale", args.find_scale)
+    if args.min_bend is not None and not 0 < args.min_bend < 180:
+        raise UsageError(
+            f"--min-bend must be a number of degrees above 0 and below 180 (got {args.min_bend:g})."
+        )
 
 
 def check_positive(flag: str, value) -> None:

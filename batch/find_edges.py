@@ -23,10 +23,11 @@ def found_edge_specs(surface, options: dict, name: str) -> list[dict]:
     Raises
     ------
     GoniometerError
-        When the finder cannot run on this surface (a point cloud, a bad ``--min-length``).
+        When the finder cannot run on this surface (a point cloud, a ``--min-length`` or
+        ``--find-scale`` too large for the mesh).
     """
     found = options["find_edges"]
-    overrides = {} if found["min_length"] is None else {"min_length": found["min_length"]}
+    overrides = {name: value for name, value in found["parameters"].items() if value is not None}
     start = time.perf_counter()
     result = find_break_edges(surface, **overrides)
     seconds = time.perf_counter() - start
@@ -65,5 +66,9 @@ def find_options(args) -> dict | None:
         "radius": args.radius,
         "lam": args.lam,
         "patch": args.patch,
-        "min_length": args.min_length,
+        "parameters": {
+            "min_length": args.min_length,
+            "scale": args.find_scale,
+            "min_bend_deg": args.min_bend,
+        },
     }

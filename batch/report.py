@@ -20,6 +20,8 @@ MEASURING_OPTIONS = (
     ("--edges", "edges_csv"),
     ("--find-edges", "find_edges"),
     ("--min-length", "min_length"),
+    ("--find-scale", "find_scale"),
+    ("--min-bend", "min_bend"),
     ("--out", "out"),
     ("--save-blend", "save_blend"),
     ("--render", "render"),

@@ -101,7 +101,7 @@ def sensitivity_table(rng) -> None:
     print(
         f"\nHighest sensitivity {highest:.0f} (bounded by {ROUNDING_SENSITIVITY:g}); the limit "
         f"keeps the move under {MAX_MOVE:g}°: a step of "
-        + ", ".join(f"{rounding_limit(n):.3g} × at {n}" for n in (13, 50, 100, 300, 800))
+        + ", ".join(f"{rounding_limit(n):.3g} × at {n}" for n in (13, 100, 400, 1000, 2000))
         + " vertices."
     )
 

@@ -297,6 +297,29 @@ def test_a_min_length_longer_than_every_edge_finds_none(tmp_path):
     assert csvio.read_edges_csv(csvio.edges_path_for(out)) == []
 
 
+def test_the_finders_scale_and_bend_reach_the_finder(tmp_path):
+    # The oracle is the core finder with the same settings; the default finds other candidates
+    # on this cube, so settings dropped on the way would show.
+    shape = bevelled_cube()
+    mesh = tmp_path / "cube.ply"
+    meshio.write_ply(mesh, shape.points, shape.triangles)
+    surface = Surface(shape.points, shape.triangles)
+    default = find_break_edges(surface).candidates
+    wanted = find_break_edges(surface, scale=2.0, min_bend_deg=40.0).candidates
+    assert wanted and [c.waypoint_points.tolist() for c in wanted] != [
+        c.waypoint_points.tolist() for c in default
+    ]
+    out = tmp_path / "out.csv"
+    result = ok(batch(mesh, "--find-edges", "--spacing", SPACING, "--radius", RADIUS,
+                      "--find-scale", 2, "--min-bend", 40, "--out", out))  # fmt: skip
+    assert f"cube: found {len(wanted)} break edge(s)" in result.stderr
+    assert "(scale 2, bend at least 40°" in result.stderr
+    edges = csvio.read_edges_csv(csvio.edges_path_for(out))
+    assert [csvio.parse_points(e.points) for e in edges] == [
+        [tuple(p) for p in c.waypoint_points.tolist()] for c in wanted
+    ]
+
+
 def test_quiet_still_names_the_meshes_where_no_edge_was_found(tmp_path):
     # A smooth ball has no break edge (the finder finds none on it: the oracle is the core's
     # answer on the same mesh); the bone has some.
@@ -339,6 +362,19 @@ def test_a_point_cloud_is_one_failed_row_saying_why(tmp_path):
         (("--find-edges", "--spacing", 1, "--radius", 1, "--shard", "1/2"), "drop --shard"),
         (("--find-edges", "--spacing", 1, "--radius", 1, "--min-length", -1), "positive"),
         (("--at", 0, 0, 0, "--radius", 1, "--min-length", 2), "--min-length L is for"),
+        (("--at", 0, 0, 0, "--radius", 1, "--find-scale", 2), "--find-scale S is for"),
+        (("--at", 0, 0, 0, "--radius", 1, "--min-bend", 40), "--min-bend DEG is for"),
+        *[
+            (("--find-edges", "--spacing", 1, "--radius", 1, "--find-scale", scale), "positive")
+            for scale in ("0", "-1", "nan", "inf")
+        ],
+        *[
+            (
+                ("--find-edges", "--spacing", 1, "--radius", 1, "--min-bend", bend),
+                "--min-bend must be a number of degrees above 0 and below 180",
+            )
+            for bend in ("0", "180", "-5", "nan")
+        ],
         *[
             (
                 (*how, "--spacing", spacing, "--radius", 1),

@@ -74,9 +74,10 @@ def score(fragment, paths, tolerance: float | None = None) -> dict:
     }
 
 
-def found_on(make, noise: float = 0.0, tolerance: float | None = None):
-    """Run the finder (default parameters) on the fragment ``make()`` makes, with noise of
-    ``noise`` mean edge lengths (seed 1) if any, and score it.
+def found_on(make, noise: float = 0.0, tolerance: float | None = None, seed: int = 1, **parameters):
+    """Run the finder on the fragment ``make()`` makes, with noise of ``noise`` mean edge
+    lengths (noise seed ``seed``) if any, and score it. ``parameters``: break-edge parameters to
+    change from the defaults (e.g. ``scale=2.0``).
 
     Returns ``(fragment, surface, result, figures)``; ``figures`` as :func:`score` gives them.
     """
@@ -86,8 +87,8 @@ def found_on(make, noise: float = 0.0, tolerance: float | None = None):
     fragment = make()
     if noise:
         h = mean_edge_length(fragment.points, fragment.triangles)
-        fragment = with_noise(fragment, noise * h, seed=1)
+        fragment = with_noise(fragment, noise * h, seed=seed)
     surface = Surface(fragment.points, fragment.triangles)
-    result = surface.find_break_edges()
+    result = surface.find_break_edges(**parameters)
     figures = score(fragment, [c.path.points for c in result.candidates], tolerance)
     return fragment, surface, result, figures

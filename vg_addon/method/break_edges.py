@@ -270,9 +270,8 @@ class BreakEdgeCandidate:
         The surface it lies on (:func:`.candidate_parts.trim` retraces parts on it).
     bend_field : ndarray, shape (n_points,)
         The field ``bend_deg`` was read from (the larger of the anisotropy at ``scale`` and the
-        fine field's; see
-        :func:`.ridge_field.bend_of_anisotropy`), shared by every candidate of a run: a trimmed
-        part reads the bend of each of its vertices there.
+        fine field's; see :func:`.ridge_field.bend_of_anisotropy`), shared by every candidate of
+        a run: a trimmed part reads the bend of each of its vertices there.
     """
 
     number: int
