@@ -495,12 +495,16 @@ def delete_edge(obj, index: int, *, depsgraph=None) -> int:
     edge = data.edges[index]
     number = edge.number
     remove_plots([edge])
-    for position in reversed(range(len(data.measurements))):
-        if data.measurements[position].edge_number == number:
-            data.measurements.remove(position)
-    data.active_index = min(data.active_index, max(len(data.measurements) - 1, 0))
+    stations = [p for p, m in enumerate(data.measurements) if m.edge_number == number]
+    for position in reversed(stations):
+        data.measurements.remove(position)
+    data.active_index = records.position_after_removal(
+        data.active_index, stations, len(data.measurements)
+    )
     data.edges.remove(index)
-    data.active_edge_index = min(index, max(len(data.edges) - 1, 0))
+    data.active_edge_index = records.position_after_removal(
+        data.active_edge_index, [index], len(data.edges)
+    )
     if geometry is not None:
         measuring.repaint(obj, geometry=geometry)
     return number

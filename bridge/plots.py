@@ -82,3 +82,28 @@ def remove_plots(leaving) -> None:
                 images.pop(image.name, None)
     for image in images.values():
         bpy.data.images.remove(image)
+
+
+def remove_orphaned_plots() -> int:
+    """Remove the plot images no edge of any object shows any more and nothing else uses (their
+    object was deleted: the fake user that keeps a plot in the file kept them for good, out of
+    reach of Purge). Returns how many went.
+
+    Images of linked libraries and images of earlier versions (untagged) are left alone.
+    """
+    tagged = {
+        image.name: image
+        for image in bpy.data.images
+        if PLOT_KEY in image and image.library is None and image.users <= image.use_fake_user
+    }
+    if not tagged:
+        return 0
+    for obj in bpy.data.objects:
+        if obj.type != "MESH":
+            continue
+        for edge in obj.vg.edges:
+            if (image := plot_image(edge)) is not None:
+                tagged.pop(image.name, None)
+    for image in tagged.values():
+        bpy.data.images.remove(image)
+    return len(tagged)

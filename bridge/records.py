@@ -104,6 +104,16 @@ def add_measurement(
     return item
 
 
+def position_after_removal(active: int, removed, remaining: int) -> int:
+    """Where the selected list item stands once the items at positions ``removed`` are gone.
+
+    The same item stays selected; where it was removed, the one now in its place (the new last
+    one at the end of the list). ``remaining``: the list's length after the removal.
+    """
+    before = sum(1 for position in removed if position < active)
+    return max(min(active - before, remaining - 1), 0)
+
+
 def content_id(item) -> int:
     """A digest, from 1 to 2**31 - 1, of what painting ``item`` depends on besides its
     break: its exact numbers, patch mode and geometry fingerprint."""

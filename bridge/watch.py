@@ -18,7 +18,8 @@ brings the mesh back, and the next check brings the flags and colours back with 
 nothing of the timer's own for the user to undo. Its writes join the edit's undo step.
 
 On file load (``on_load``) the caches are emptied and measurements recorded in world space by
-earlier versions are brought into mesh coordinates (see ``legacy``).
+earlier versions are brought into mesh coordinates (see ``legacy``). Before a save
+(``on_save``) the plot images of deleted objects' edges are removed.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..vg_addon import GoniometerError
-from . import legacy, mesh_data, painting, records
+from . import legacy, mesh_data, painting, plots, records
 from .measuring import forget_paint, migrate_fingerprints, repaint
 from .mesh_data import check_measurable, evaluated_geometry
 
@@ -120,6 +121,13 @@ def on_load(*_args):
             records.update_changed_edges(obj)  # files saved before the flag was kept
 
 
+@persistent
+def on_save(*_args):
+    """Before the file is written: drop the plots of edges whose object is gone, so a deleted
+    object's plots do not stay packed in the file for good."""
+    plots.remove_orphaned_plots()
+
+
 def migrate(obj) -> list[int]:
     """Bring ``obj``'s world-space records into mesh coordinates where they still match, and
     repaint it if any were; returns their numbers. Objects that cannot be measured now are
@@ -143,6 +151,7 @@ _HANDLERS = (
     ("undo_post", on_undo_or_redo),
     ("redo_post", on_undo_or_redo),
     ("load_post", on_load),
+    ("save_pre", on_save),
 )
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 
+import bpy
 import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty
 
@@ -23,16 +24,31 @@ SPACE_ITEMS = (
 )
 
 
+def absolute_path(path: str) -> str:
+    """A file or folder path an operator was given, made absolute; ``""`` when none was given.
+
+    Raises
+    ------
+    GoniometerError
+        A path relative to the .blend file (``//``) while the file has never been saved: it
+        would silently mean the process's working folder.
+    """
+    if path.startswith("//") and not bpy.data.filepath:
+        raise GoniometerError(
+            f"{path!r} is relative to the .blend file ('//'), but this file has not been saved "
+            "yet: save the .blend file first, or choose a full path."
+        )
+    return bpy.path.abspath(path) if path else ""
+
+
 def length_property(name: str, description: str):
-    """A length in the mesh's units whose negative values are refused as given, not clamped."""
-    return FloatProperty(
-        name=name,
-        description=description,
-        soft_min=0.0,
-        precision=4,
-        subtype="DISTANCE",
-        unit="LENGTH",
-    )
+    """A length in the mesh's units whose negative values are refused as given, not clamped.
+
+    A plain number, as the panel's fields are: with Blender's length unit the Adjust Last
+    Operation panel showed a radius of 5 (mm, the panel's) as "5 m", and "5 mm" typed there was
+    stored as 0.005.
+    """
+    return FloatProperty(name=name, description=description, soft_min=0.0, precision=4)
 
 
 class LocationProperties:

@@ -15,7 +15,7 @@ from ..bridge.mesh_data import check_measurable
 from ..vg_addon import GoniometerError, units
 from ..vg_addon.formats import csvio
 from ..vg_addon.workflow import agreement
-from .common import poll_measurable, typed_value
+from .common import absolute_path, poll_measurable, typed_value
 from .progress import Progress, own_timer_tick
 
 # The CSV this session last exported or imported: what the Import dialog offers (Blender's
@@ -45,24 +45,6 @@ def offered_import_path(given: str = "") -> str:
     return ""
 
 
-def _path(operator) -> str:
-    """The operator's file path made absolute; ``""`` when none was given.
-
-    Raises
-    ------
-    GoniometerError
-        A path relative to the .blend file (``//``) while the file has never been saved: it
-        would silently mean the process's working folder.
-    """
-    path = operator.filepath
-    if path.startswith("//") and not bpy.data.filepath:
-        raise GoniometerError(
-            f"{path!r} is relative to the .blend file ('//'), but this file has not been saved "
-            "yet: save the .blend file first, or choose a full path."
-        )
-    return bpy.path.abspath(path) if path else ""
-
-
 class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
     """Write the measurements to a CSV file (MeshLab Virtual Goniometer columns first)"""
 
@@ -87,7 +69,7 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
 
     def execute(self, context):
         try:
-            path = _path(self)
+            path = absolute_path(self.filepath)
         except GoniometerError as error:
             self.report({"ERROR"}, f"{error} Nothing was written.")
             return {"CANCELLED"}
@@ -191,7 +173,7 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         path = self.filepath
         obj = context.active_object
         try:
-            path = _path(self)
+            path = absolute_path(self.filepath)
             check_measurable(obj)
             if not path:
                 raise GoniometerError("No file name given: choose the CSV to import.")

@@ -12,7 +12,7 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 from ..bridge import measurement_map
 from ..properties import BLEND_RELATIVE
 from ..vg_addon import GoniometerError
-from .common import poll_measured
+from .common import absolute_path, poll_measured
 from .progress import Progress, own_timer_tick
 
 VIEW_ITEMS = (
@@ -28,7 +28,7 @@ class VG_OT_render_map(bpy.types.Operator):
 
     bl_idname = "vg.render_map"
     bl_label = "Render Measurement Map"
-    bl_options = {"REGISTER"}  # noqa: RUF012 (Blender wants a set)
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender wants a set)
 
     views: EnumProperty(name="Views", items=VIEW_ITEMS, default="SIX")
     directory: StringProperty(
@@ -47,12 +47,7 @@ class VG_OT_render_map(bpy.types.Operator):
         return poll_measured(cls, context)
 
     def _folder(self) -> str:
-        if self.directory.startswith("//") and not bpy.data.filepath:
-            raise GoniometerError(
-                "The map folder is relative to the .blend file (//), which is not saved yet: "
-                "save the file or choose an absolute folder."
-            )
-        folder = bpy.path.abspath(self.directory)
+        folder = absolute_path(self.directory)
         if not folder:
             raise GoniometerError("No folder given: choose where to write the map.")
         return folder

@@ -195,7 +195,9 @@ class VG_OT_delete_measurement(bpy.types.Operator):
         data = obj.vg
         number = data.measurements[index].number
         data.measurements.remove(index)
-        data.active_index = min(index, max(len(data.measurements) - 1, 0))
+        data.active_index = records.position_after_removal(
+            data.active_index, [index], len(data.measurements)
+        )
         if geometry is not None:
             measuring.repaint(obj, geometry=geometry)
         self.report({"INFO"}, f"Deleted measurement {number} of '{obj.name}'")

@@ -27,8 +27,7 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import picked_points
 from ..vg_addon.method.given_points import check_given_points
-from .common import poll_measurable, typed_value
-from .csv_ops import _path
+from .common import absolute_path, poll_measurable, typed_value
 from .find_edges import measure_all
 
 
@@ -110,7 +109,7 @@ class VG_OT_import_picked_points(bpy.types.Operator, ImportHelper):
         names = [f.name for f in self.files if f.name]
         if names and self.directory:
             return [str(Path(bpy.path.abspath(self.directory)) / name) for name in names]
-        path = _path(self)
+        path = absolute_path(self.filepath)
         if not path:
             raise GoniometerError("No file name given: choose the .pp file(s) to import.")
         return [path]

@@ -21,6 +21,7 @@ from ..vg_addon.analysis import missing_message
 from ..vg_addon.analysis.report import write_report
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
+from .common import absolute_path
 from .csv_ops import offered_import_path
 
 SCENE_SESSION = "scene_measurements.csv"
@@ -68,7 +69,7 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
     def _folder(self, context, sessions: list[str]) -> str:
         folder = context.scene.vg_settings.report_folder
         if folder:
-            return bpy.path.abspath(folder)
+            return absolute_path(folder)
         if sessions:
             return os.path.join(os.path.dirname(sessions[0]), "vg_report")
         if bpy.data.filepath:
@@ -95,7 +96,11 @@ class VG_OT_report(bpy.types.Operator, ImportHelper):
     def execute(self, context):
         settings = context.scene.vg_settings
         sessions = self._sessions()
-        folder = self._folder(context, sessions)
+        try:
+            folder = self._folder(context, sessions)
+        except GoniometerError as error:
+            self.report({"ERROR"}, f"{error} Nothing was written.")
+            return {"CANCELLED"}
         missing = missing_message(batch_command(folder, sessions))
         if missing:
             self.report({"ERROR"}, missing)

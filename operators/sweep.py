@@ -17,6 +17,7 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.formats import csvio, mpl_plots, sweep_plot
 from .common import (
     LocationProperties,
+    absolute_path,
     defaults_from_panel,
     length_property,
     poll_measurable,
@@ -47,9 +48,9 @@ class VG_OT_radius_sweep(LocationProperties, bpy.types.Operator, ExportHelper):
         defaults_from_panel(
             self, context, {"start": "sweep_start", "stop": "sweep_stop", "count": "sweep_count"}
         )
-        path = bpy.path.abspath(self.filepath) if self.filepath else ""
         obj = context.active_object
         try:
+            path = absolute_path(self.filepath)
             if not path:
                 raise GoniometerError("No file name given: choose where to write the sweep CSV.")
             points = measuring.sweep(

@@ -100,3 +100,15 @@ def test_report_operator_names_what_it_left_out(vg, tmp_path, capfd):
     assert "2 sessions, 6 of 6 rows used" in said
     assert "1 session(s) to check:" in said
     assert "obs1_manual_4.csv: kept, though its readings are those of obs1_manual_2.csv" in said
+
+
+def test_a_report_folder_relative_to_an_unsaved_file_writes_nothing(vg, tmp_path, monkeypatch):
+    # '//' is the .blend file's folder; this file has none, so it would mean the working folder.
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "obs1_manual_1.csv").write_text("Mesh,Break #,Angle\nm,1,98\n", encoding="utf-8")
+    settings = bpy.context.scene.vg_settings
+    settings.report_include_scene = False
+    settings.report_folder = "//report"
+    with pytest.raises(RuntimeError, match="has not been saved yet"):
+        bpy.ops.vg.report(directory=str(tmp_path), files=[{"name": "obs1_manual_1.csv"}])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["obs1_manual_1.csv"]

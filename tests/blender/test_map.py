@@ -196,7 +196,7 @@ def test_a_map_cancelled_or_failed_half_way_keeps_an_earlier_map_as_it_was(vg, t
 
 def test_the_operator_refuses_a_relative_folder_of_an_unsaved_file(vg):
     measured_annulus(vg)
-    with pytest.raises(RuntimeError, match="not saved yet"):
+    with pytest.raises(RuntimeError, match="has not been saved yet"):
         bpy.ops.vg.render_map(directory="//maps")
 
 
