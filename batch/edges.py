@@ -56,7 +56,8 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
     except GoniometerError as error:
         raise UsageError(str(error)) from None
     problems, failed = [], []
-    for number, row in enumerate(rows, start=2):
+    for row in rows:
+        number = row.row_number
         if row.error:
             failed.append(number)  # a run could not measure it: nothing to replicate
             continue

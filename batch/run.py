@@ -241,13 +241,13 @@ class Run:
         )
 
     def write_csv(self, out=None) -> None:
-        """Write the rows to ``out`` (default ``--out``), and the edge summaries beside it."""
+        """Write the rows to ``out`` (default ``--out``), and the edge summaries beside it (emptied
+        where an earlier run left one and this one measures no edge)."""
         out = self.args.out if out is None else out
         start = time.perf_counter()
         rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
-        csvio.write_measurements_csv(out, rows, lines=self.csv_lines)
-        if any(getattr(self.args, name, None) for name in ("edge", "edges_csv", "find_edges")):
-            csvio.write_edges_csv(csvio.edges_path_for(out), self.edge_rows)
+        edges = any(getattr(self.args, name, None) for name in ("edge", "edges_csv", "find_edges"))
+        csvio.write_export(out, rows, self.edge_rows, lines=self.csv_lines, summary=edges)
         self.last_write = time.perf_counter()
         self.write_seconds = self.last_write - start
 

@@ -327,7 +327,8 @@ def import_edges_csv(
         )
     names = names_of(obj)
     failures, measured, notes = [], [], []
-    for number, row in enumerate(rows, start=2):
+    for row in rows:
+        number = row.row_number
         if row.error:
             continue  # an edge the run that wrote the file could not measure: nothing to repeat
         try:

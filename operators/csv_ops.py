@@ -101,11 +101,16 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
             rows, edge_rows = replication.export_tables(
                 objects, context.scene, depsgraph=context.evaluated_depsgraph_get()
             )
-            csvio.write_measurements_csv(path, rows)
-            if edge_rows:
-                csvio.write_edges_csv(csvio.edges_path_for(path), edge_rows)
+        except GoniometerError as error:
+            self.report({"ERROR"}, f"{error} ({path} was not written)")
+            return {"CANCELLED"}
+        try:
+            summary = csvio.write_export(path, rows, edge_rows)
         except OSError as error:
             self.report({"ERROR"}, f"Could not write {path}: {error}")
+            return {"CANCELLED"}
+        except csvio.SummaryWriteError as error:
+            self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         except GoniometerError as error:
             self.report({"ERROR"}, f"{error} ({path} was not written)")
@@ -113,11 +118,13 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
         _remember(path)
         stale = sum(row.stale for row in rows)
         note = f" ({stale} stale)" if stale else ""
-        edges = f" and {len(edge_rows)} edge profile(s) to {csvio.edges_path_for(path)}"
-        self.report(
-            {"INFO"},
-            f"Wrote {len(rows)} measurement(s){note} to {path}" + (edges if edge_rows else ""),
-        )
+        if edge_rows:
+            edges = f" and {len(edge_rows)} edge profile(s) to {summary}"
+        elif summary is not None:
+            edges = f"; {summary}, from an earlier export, now lists no edge"
+        else:
+            edges = ""
+        self.report({"INFO"}, f"Wrote {len(rows)} measurement(s){note} to {path}{edges}")
         return {"FINISHED"}
 
 

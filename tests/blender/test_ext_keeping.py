@@ -10,6 +10,7 @@ import pytest
 from bpy_helpers import wedge_object
 from test_map import measured_annulus
 
+from vg_addon.formats import csvio
 from vg_addon.synthetic_meshes import varying_wedge
 
 
@@ -124,3 +125,21 @@ def test_undo_after_a_map_keeps_its_record_of_the_pictures(vg, tmp_path):
     assert (
         bpy.data.objects[name].vg.map_pictures == recorded
     )  # before: the state before the map, no record
+
+
+def test_an_export_after_deleting_the_edges_leaves_no_summary_listing_them(vg, tmp_path, capfd):
+    # Before: the earlier site_edges.csv stayed beside the new CSV, listing the deleted edge,
+    # and importing it measured the edge again.
+    ramp("Ramp")
+    measure_edge([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.3)
+    out = tmp_path / "site.csv"
+    assert bpy.ops.vg.export_csv(filepath=str(out)) == {"FINISHED"}
+    summary = tmp_path / "site_edges.csv"
+    assert [e.edge_number for e in csvio.read_edges_csv(summary)] == [1]
+    assert bpy.ops.vg.delete_edge() == {"FINISHED"}
+    capfd.readouterr()
+    assert bpy.ops.vg.export_csv(filepath=str(out)) == {"FINISHED"}
+    assert "site_edges.csv, from an earlier export, now lists no edge" in capfd.readouterr().out
+    assert csvio.read_edges_csv(summary) == []
+    assert [r.edge_number for r in csvio.read_measurements_csv(out)] == [None]

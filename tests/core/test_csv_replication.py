@@ -91,6 +91,14 @@ def test_our_export_is_recognised():
     assert rows[0].coordinates == "mesh"
 
 
+@pytest.mark.parametrize("note", [" lead", "trail ", "two\nlines\n", "\x0bvt", "=1+1"])
+def test_a_note_is_read_back_as_written_to_be_recorded_again(note):
+    # Re-measuring records the note again; before, it lost its surrounding spaces and line ends.
+    text = csvio.format_measurements_csv([good_row(user_data=note)])
+    assert csvio.read_measurements_csv(text)[0].user_data == note  # the export reader's
+    assert csvio.read_replication_csv(text)[0].label == note
+
+
 def legacy_export(rows) -> str:
     """An export as versions before the Coordinates column wrote it (world coordinates)."""
     records = list(csv.reader(io.StringIO(csvio.format_measurements_csv(rows))))

@@ -30,6 +30,7 @@ from .edges import (
     read_edges_csv,
     write_edges_csv,
 )
+from .export_files import SummaryWriteError, write_export
 from .measurements import (
     CLOSED_COLUMNS,
     CREASE_COLUMNS,
@@ -96,6 +97,7 @@ __all__ = [
     "EdgeRow",
     "MeasurementRow",
     "ReplicationRow",
+    "SummaryWriteError",
     "break_number_cell",
     "check_mesh_names",
     "edges_path_for",
@@ -127,6 +129,7 @@ __all__ = [
     "text_cell",
     "writable_row",
     "write_edges_csv",
+    "write_export",
     "write_measurements_csv",
     "write_sweep_csv",
     "write_table",

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...errors import GoniometerError
@@ -116,6 +116,9 @@ class EdgeRow:
     stale : bool or None
         Some of the edge's stations were measured on other geometry than the mesh has now (the
         mesh changed since); None (not known) in files written before the column.
+    row_number : int or None
+        The spreadsheet row it was read from (the header is row 1, blank lines count), for
+        messages; None for a row not read from a file. Not written, not compared.
     """
 
     mesh_name: str = ""
@@ -150,6 +153,7 @@ class EdgeRow:
     extension_version: str = ""
     blender_version: str = ""
     error: str = ""
+    row_number: int | None = field(default=None, compare=False)
 
 
 def format_points(points) -> str:

@@ -161,8 +161,8 @@ def _lenient_number(raw: str) -> int | float | None:
 
 
 def _parse_name(raw: str) -> str | None:
-    """A mesh name as written, surrounding spaces kept (a file " lead.ply" is the mesh
-    " lead"); ``None`` when blank."""
+    """A mesh name or a note as written, surrounding spaces kept (a file " lead.ply" is the
+    mesh " lead"; a note is re-recorded as it was); ``None`` when blank."""
     return text_cell(raw) if raw.strip() else None
 
 
@@ -292,7 +292,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
                 radius=values["radius"],
                 lam=values["lam"],
                 patch=patch,
-                label=optional_text(cell("label")),
+                label=_parse_name(cell("label")),
                 number=_lenient_number(cell("number")),
                 break_number=break_number,
                 edge_number=edge_number if isinstance(edge_number, int) else None,

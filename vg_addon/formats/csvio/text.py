@@ -22,6 +22,7 @@ a quoted cell that spans lines stays one row.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import math
 import operator
@@ -415,6 +416,7 @@ def parse_table(text, source, schema, row_type, optional, what, check=None):
     existed lack; ``what`` names the file in that message. Text cells are kept as written (only
     the formula-guard apostrophe removed), numbers read back bit-identical, blank lines are
     skipped. ``check(values)``, if given, says what else is wrong with a row's values (or None).
+    A ``row_type`` with a ``row_number`` field gets each row's spreadsheet row number there.
 
     Raises
     ------
@@ -423,6 +425,7 @@ def parse_table(text, source, schema, row_type, optional, what, check=None):
     """
     records = read_records(text, source)
     header_at, header = header_of(records, source)
+    numbered = "row_number" in {f.name for f in dataclasses.fields(row_type)}
     problems: list[str] = []
     all_columns = [column for _, _, names in schema for column in names]
     aliases = {column: (normalise(column),) for column in all_columns}
@@ -488,6 +491,8 @@ def parse_table(text, source, schema, row_type, optional, what, check=None):
         why = check(values) if check is not None else None
         if why:
             problems.append(f"row {number}: {why}")
+        if numbered:
+            values["row_number"] = number
         rows.append(row_type(**values))
     if problems:
         raise problems_error(source, problems)

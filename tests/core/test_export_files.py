@@ -1,0 +1,69 @@
+"""An export's measurement CSV and the edge summary beside it are written as one record: never a
+summary listing edges the CSV no longer has, never a CSV replaced when its summary cannot be."""
+
+from pathlib import Path
+
+import pytest
+
+from vg_addon import GoniometerError
+from vg_addon.formats import csvio
+from vg_addon.formats.csvio import EdgeRow, MeasurementRow
+
+ROWS = [MeasurementRow(mesh_name="bone", number=1, break_number=1, angle=97.5, radius=2.0)]
+STATION = MeasurementRow(mesh_name="bone", number=2, break_number=1, angle=96.0, edge_number=1)
+EDGE = EdgeRow(mesh_name="bone", edge_number=1, break_number=1, n_stations=1, mean=96.0)
+
+
+def test_an_export_with_edges_writes_both(tmp_path):
+    out = tmp_path / "site.csv"
+    summary = csvio.write_export(out, [*ROWS, STATION], [EDGE])
+    assert summary == tmp_path / "site_edges.csv"
+    assert [r.edge_number for r in csvio.read_edges_csv(summary)] == [1]
+    assert len(csvio.read_measurements_csv(out)) == 2
+
+
+def test_an_export_without_edges_empties_an_earlier_summary(tmp_path):
+    # Before: the earlier summary stayed, listing edge 1, and importing it brought the edge back.
+    out = tmp_path / "site.csv"
+    csvio.write_export(out, [*ROWS, STATION], [EDGE])
+    summary = csvio.write_export(out, ROWS, [])
+    assert summary == tmp_path / "site_edges.csv"
+    assert summary.read_text(encoding="utf-8") == csvio.format_edges_csv([])
+    assert [r.edge_number for r in csvio.read_measurements_csv(out)] == [None]
+
+
+def test_an_export_without_edges_makes_no_summary_unless_asked(tmp_path):
+    out = tmp_path / "site.csv"
+    assert csvio.write_export(out, ROWS, []) is None
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["site.csv"]
+    assert csvio.write_export(out, ROWS, [], summary=True) == tmp_path / "site_edges.csv"
+    assert csvio.read_edges_csv(tmp_path / "site_edges.csv") == []
+
+
+def test_a_summary_that_cannot_be_written_leaves_the_csv_as_it_was(tmp_path):
+    # Before: the CSV was replaced first, then the summary failed, and the message said the CSV
+    # "was not written".
+    out = tmp_path / "site.csv"
+    out.write_text("the earlier export\n", encoding="utf-8")
+    (tmp_path / "site_edges.csv").mkdir()
+    with pytest.raises(GoniometerError, match="folder"):
+        csvio.write_export(out, [*ROWS, STATION], [EDGE])
+    assert out.read_text(encoding="utf-8") == "the earlier export\n"
+
+
+def test_a_folder_named_like_a_summary_is_no_reason_to_refuse_an_export_without_edges(tmp_path):
+    out = tmp_path / "site.csv"
+    Path(tmp_path / "site_edges.csv").mkdir()
+    assert csvio.write_export(out, ROWS, []) is None
+    assert len(csvio.read_measurements_csv(out)) == 1
+
+
+def test_edge_rows_read_back_carry_their_spreadsheet_rows_blank_lines_counted(tmp_path):
+    # Import messages name these rows; before, they counted the rows read (blank lines left out),
+    # so a fault on spreadsheet row 5 was reported on row 4.
+    text = csvio.format_edges_csv([EDGE, EDGE])
+    header, first, second = text.splitlines()
+    path = tmp_path / "site_edges.csv"
+    path.write_text(f"{header}\n{first}\n\n{second}\n", encoding="utf-8")
+    assert [row.row_number for row in csvio.read_edges_csv(path)] == [2, 4]
+    assert csvio.read_edges_csv(path) == [EDGE, EDGE]  # the number is not part of the row

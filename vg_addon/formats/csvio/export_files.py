@@ -1,0 +1,79 @@
+"""An export's two files together: the measurement CSV and the edge summary beside it.
+
+They are one record. The summary is written whenever there are edges, and also when there are
+none but an earlier summary lies beside the CSV (it is emptied to its header: otherwise it would
+list edges the new CSV no longer has, and importing it would bring them back). Both targets are
+checked before either is written, so a summary that cannot be written leaves the CSV as it was.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+from ...errors import GoniometerError
+from ..files import output_target, replace_atomically
+from .edges import EdgeRow, edges_path_for, format_edges_csv
+from .measurements import MeasurementRow, format_measurements_csv
+
+
+class SummaryWriteError(GoniometerError):
+    """The measurement CSV was written, its edge summary was not (the message names both)."""
+
+
+def write_export(
+    path,
+    rows: Sequence[MeasurementRow],
+    edge_rows: Sequence[EdgeRow],
+    *,
+    lines=None,
+    summary: bool = False,
+) -> Path | None:
+    """Write the measurement CSV ``path`` and its edge summary (:func:`edges_path_for`).
+
+    Parameters
+    ----------
+    path : str or PathLike
+        The measurement CSV.
+    rows, edge_rows
+        The station and measurement rows, and one row per edge profile (may be empty).
+    lines : dict, optional
+        As for :func:`write_measurements_csv`.
+    summary : bool
+        Write the edge summary even with no edges and none there before (a run that looked for
+        edges says so with an empty one).
+
+    Returns
+    -------
+    Path or None
+        The edge summary written: with ``edge_rows``, or emptied to its header where an earlier
+        one was there; None when there was none to write.
+
+    Raises
+    ------
+    SummaryWriteError
+        The summary failed after the CSV was written (a :class:`GoniometerError`).
+    GoniometerError
+        Either target cannot be written (checked before anything is written).
+    OSError
+        The CSV itself could not be written (nothing was).
+    """
+    edges_path = edges_path_for(path)
+    csv_text = format_measurements_csv(rows, lines=lines).encode("utf-8")
+    is_file = output_target(path) == "file"
+    with_edges = bool(edge_rows) or summary or (is_file and os.path.isfile(edges_path))
+    edges_text = format_edges_csv(edge_rows).encode("utf-8") if with_edges else b""
+    if with_edges:
+        output_target(edges_path)
+    replace_atomically(path, csv_text)
+    if not with_edges:
+        return None
+    try:
+        replace_atomically(edges_path, edges_text)
+    except (OSError, GoniometerError) as error:
+        raise SummaryWriteError(
+            f"{os.fspath(path)} was written, but its edge summary {edges_path} was not ({error}): "
+            "the two no longer match; write the export again once that file can be replaced."
+        ) from error
+    return edges_path
