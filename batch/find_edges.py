@@ -24,7 +24,7 @@ def found_edge_specs(surface, options: dict, name: str) -> list[dict]:
     ------
     GoniometerError
         When the finder cannot run on this surface (a point cloud, a ``--min-length`` or
-        ``--find-scale`` too large for the mesh).
+        ``--find-scale`` out of the mesh's range).
     """
     found = options["find_edges"]
     overrides = {name: value for name, value in found["parameters"].items() if value is not None}

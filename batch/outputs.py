@@ -125,6 +125,13 @@ def check_outputs(args) -> None:
                 f"--out, so --out {args.out} must be a file name, not standard output or a stream."
             )
         outputs.append(("--out's edge summary", str(csvio.edges_path_for(args.out))))
+    elif (
+        args.out
+        and not _is_stream(args.out)
+        and csvio.holds_edge_summary(csvio.edges_path_for(args.out))
+    ):
+        # An earlier run's summary there is emptied (csvio.write_export): never an input.
+        outputs.append(("--out's edge summary", str(csvio.edges_path_for(args.out))))
     if args.sweep:
         if _is_stream(args.out):
             raise UsageError(

@@ -68,6 +68,29 @@ def test_out_onto_the_points_csv_is_refused_and_its_columns_kept(scan, tmp_path)
     assert points.read_bytes() == before
 
 
+def test_a_points_csv_named_like_outs_edge_summary_is_left_alone(scan, tmp_path):
+    # A first version of the export emptied any site_edges.csv beside --out site.csv, this
+    # input too, before anything was measured.
+    points = tmp_path / "site_edges.csv"
+    points.write_text("x,y,z,site,notes\n0.05,0,0,A,keep me\n")
+    before = points.read_bytes()
+    out = tmp_path / "site.csv"
+    result = batch(scan, "--points", points, "--radius", "0.3", "--out", out)
+    assert result.returncode == 0, result.stderr
+    assert points.read_bytes() == before
+    assert len(csvio.read_measurements_csv(out)) == 1
+
+
+def test_an_earlier_edge_summary_given_as_points_is_refused_not_emptied(scan, tmp_path):
+    out = tmp_path / "site.csv"
+    summary = tmp_path / "site_edges.csv"
+    summary.write_text(csvio.format_edges_csv([csvio.EdgeRow(mesh_name="scan", edge_number=1)]))
+    before = summary.read_bytes()
+    refused(batch(scan, "--points", summary, "--radius", "0.3", "--out", out),
+            "--out's edge summary", "would destroy an input")  # fmt: skip
+    assert summary.read_bytes() == before
+
+
 def test_save_blend_onto_an_input_or_onto_the_out_csv_is_refused(scan, tmp_path):
     before = scan.read_bytes()
     refused(batch(scan, *AT, "--out", tmp_path / "o.csv", "--save-blend", scan),

@@ -67,3 +67,14 @@ def test_edge_rows_read_back_carry_their_spreadsheet_rows_blank_lines_counted(tm
     path.write_text(f"{header}\n{first}\n\n{second}\n", encoding="utf-8")
     assert [row.row_number for row in csvio.read_edges_csv(path)] == [2, 4]
     assert csvio.read_edges_csv(path) == [EDGE, EDGE]  # the number is not part of the row
+
+
+def test_a_file_named_like_a_summary_that_is_not_one_is_left_alone(tmp_path):
+    # A points list or the user's notes named site_edges.csv: not an earlier export's to empty
+    # (a first version of write_export emptied any file of that name, a --points input too).
+    out = tmp_path / "site.csv"
+    points = tmp_path / "site_edges.csv"
+    points.write_text("x,y,z,radius,label\n0,0,0,0.3,my point\n", encoding="utf-8")
+    assert csvio.write_export(out, ROWS, []) is None
+    assert points.read_text(encoding="utf-8") == "x,y,z,radius,label\n0,0,0,0.3,my point\n"
+    assert not csvio.holds_edge_summary(points)

@@ -30,7 +30,7 @@ from .edges import (
     read_edges_csv,
     write_edges_csv,
 )
-from .export_files import SummaryWriteError, write_export
+from .export_files import SummaryWriteError, holds_edge_summary, write_export
 from .measurements import (
     CLOSED_COLUMNS,
     CREASE_COLUMNS,
@@ -108,6 +108,7 @@ __all__ = [
     "format_sweep_rows",
     "format_table",
     "header_columns",
+    "holds_edge_summary",
     "is_edges_csv",
     "mesh_name_match",
     "mesh_name_matches",

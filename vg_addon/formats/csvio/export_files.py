@@ -1,7 +1,7 @@
 """An export's two files together: the measurement CSV and the edge summary beside it.
 
 They are one record. The summary is written whenever there are edges, and also when there are
-none but an earlier summary lies beside the CSV (it is emptied to its header: otherwise it would
+none but an earlier edge summary lies beside the CSV (it is emptied to its header: otherwise it would
 list edges the new CSV no longer has, and importing it would bring them back). Both targets are
 checked before either is written, so a summary that cannot be written leaves the CSV as it was.
 """
@@ -14,8 +14,19 @@ from pathlib import Path
 
 from ...errors import GoniometerError
 from ..files import output_target, replace_atomically
-from .edges import EdgeRow, edges_path_for, format_edges_csv
+from .edges import EdgeRow, edges_path_for, format_edges_csv, is_edges_csv
 from .measurements import MeasurementRow, format_measurements_csv
+
+
+def holds_edge_summary(path) -> bool:
+    """Whether ``path`` holds an edge summary an earlier export wrote. Any other file of that
+    name (a points list, the user's notes) is not this export's to empty."""
+    if not os.path.isfile(path):
+        return False
+    try:
+        return is_edges_csv(path)
+    except (OSError, GoniometerError):
+        return False
 
 
 class SummaryWriteError(GoniometerError):
@@ -62,7 +73,7 @@ def write_export(
     edges_path = edges_path_for(path)
     csv_text = format_measurements_csv(rows, lines=lines).encode("utf-8")
     is_file = output_target(path) == "file"
-    with_edges = bool(edge_rows) or summary or (is_file and os.path.isfile(edges_path))
+    with_edges = bool(edge_rows) or summary or (is_file and holds_edge_summary(edges_path))
     edges_text = format_edges_csv(edge_rows).encode("utf-8") if with_edges else b""
     if with_edges:
         output_target(edges_path)
