@@ -211,8 +211,8 @@ class Run:
         except (OSError, GoniometerError) as error:
             if not self.write_error:
                 self.say(
-                    f"could not write the CSV to {self.args.out}: {reason(error)}; measuring "
-                    "goes on, and the CSV is written again at the end"
+                    f"could not write {what_failed(error, self.args.out)}; measuring goes on, "
+                    "and the CSV is written again at the end"
                 )
             self.write_error = reason(error)
             self.last_write = time.perf_counter()
@@ -228,6 +228,12 @@ class Run:
         where = "standard output" if self.args.out == files.STDOUT else self.args.out
         try:
             self.write_csv(path)
+        except csvio.SummaryWriteError as second:
+            self.say(
+                f"could not write the CSV to {where}: {reason(error)}; the rows are in {path} "
+                f"(move it where it belongs), but not their edge summary: {reason(second.cause)}"
+            )
+            return
         except (OSError, GoniometerError) as second:
             Path(path).unlink(missing_ok=True)
             self.say(
@@ -237,6 +243,19 @@ class Run:
             return
         self.say(
             f"could not write the CSV to {where}: {reason(error)}; the rows are in {path} "
+            "(move it where it belongs)"
+        )
+
+    def recover_summary(self, error) -> None:
+        """The CSV was written at the end but not its edge summary: keep the summary in the
+        temporary folder and say where, so no edge row is lost."""
+        handle, path = tempfile.mkstemp(
+            prefix=f"vg_batch_{error.summary_path.stem}_", suffix=".csv"
+        )
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(error.summary_text)
+        self.say(
+            f"could not write {what_failed(error, self.args.out)}; the edge summary is in {path} "
             "(move it where it belongs)"
         )
 
@@ -272,6 +291,9 @@ class Run:
             )
         try:
             self.write_csv()
+        except csvio.SummaryWriteError as error:
+            self.recover_summary(error)
+            return 2
         except (OSError, GoniometerError) as error:
             self.recover_csv(error)
             return 2
@@ -348,6 +370,17 @@ class Run:
         where = "standard output" if self.args.out == files.STDOUT else self.args.out
         self.say(f"wrote the CSV to {where}")
         return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
+
+
+def what_failed(error, out) -> str:
+    """The file a failed CSV write did not write, and why: the CSV itself, or (a
+    :class:`csvio.SummaryWriteError`) only the edge summary beside it."""
+    if isinstance(error, csvio.SummaryWriteError):
+        return (
+            f"the edge summary {error.summary_path}: {reason(error.cause)} (the CSV {out} was "
+            "written)"
+        )
+    return f"the CSV to {out}: {reason(error)}"
 
 
 def _counts(row) -> tuple:
@@ -481,7 +514,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         try:
             run.write_csv()  # the header now: a place that cannot be written fails here
         except (OSError, GoniometerError) as error:
-            raise UsageError(f"cannot write {args.out}: {error}") from None
+            raise UsageError(f"could not write {what_failed(error, args.out)}") from None
 
     parallel = args.jobs > 1 and len(groups) > 1 and not blend
     if args.jobs > 1 and blend and not args.quiet:

@@ -74,9 +74,7 @@ def remove_plots(leaving) -> None:
     images = {image.name: image for edge in leaving if (image := plot_image(edge)) is not None}
     if not images:
         return
-    for obj in bpy.data.objects:
-        if obj.type != "MESH":
-            continue
+    for obj in bpy.data.objects:  # any type: a mesh converted to a curve keeps its records
         for edge in obj.vg.edges:
             if edge.as_pointer() not in going and (image := plot_image(edge)) is not None:
                 images.pop(image.name, None)
@@ -98,9 +96,7 @@ def remove_orphaned_plots() -> int:
     }
     if not tagged:
         return 0
-    for obj in bpy.data.objects:
-        if obj.type != "MESH":
-            continue
+    for obj in bpy.data.objects:  # any type: a mesh converted to a curve keeps its records
         for edge in obj.vg.edges:
             if (image := plot_image(edge)) is not None:
                 tagged.pop(image.name, None)

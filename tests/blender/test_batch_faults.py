@@ -252,6 +252,34 @@ def test_the_out_folder_vanishing_mid_run_keeps_measuring_and_keeps_the_rows(vg,
         path.unlink(missing_ok=True)
 
 
+def test_an_edge_summary_that_cannot_be_written_is_kept_and_said_as_such(vg, tmp_path, full_disk):
+    run_module = importlib.import_module(f"{vg.__name__}.batch.run")
+    measure = importlib.import_module(f"{vg.__name__}.batch.measure")
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    out = tmp_path / "o.csv"
+    (tmp_path / "o_edges.csv").symlink_to(full_disk / "o_edges.csv")  # its place: a full disk
+    args = argparse.Namespace(out=str(out), quiet=True, edge=[EDGE], edges_csv=None, sweep=None)
+    said = []
+    run = run_module.Run(args, [sources.MeshSource("a")], [], 1)
+    run.say = said.append
+    rows = importlib.import_module(f"{vg.__name__}.vg_addon.formats.csvio")  # the run's classes
+    station = rows.MeasurementRow(mesh_name="a", angle=91.5, x=0.0, y=0.0, z=0.0, edge_number=1)
+    edge = rows.EdgeRow(mesh_name="a", edge_number=1, n_stations=1, mean=91.5)
+    run.last_write = -math.inf  # a periodic write is due
+    run.add(measure.MeshResult(mesh=0, station_rows=[station], edge_rows=[edge]))
+    assert len(said) == 1 and "could not write the CSV" not in said[0], said
+    assert "edge summary" in said[0] and "No space left" in said[0], said
+    assert run.finish() == 2
+    assert [r.angle for r in csvio.read_measurements_csv(out)] == [91.5]
+    kept = [text for text in said if "the edge summary is in" in text]
+    assert len(kept) == 1 and "could not write the CSV" not in kept[0], said
+    path = Path(kept[0].split("the edge summary is in ")[1].split(" ")[0])
+    try:
+        assert [row.mean for row in csvio.read_edges_csv(path)] == [91.5]
+    finally:
+        path.unlink(missing_ok=True)
+
+
 @pytest.fixture
 def full_disk(tmp_path):
     """A small tmpfs, mounted for the test and filled up: every write into it fails with "No

@@ -80,6 +80,22 @@ def test_a_deleted_objects_plots_leave_the_file_when_it_is_saved(vg, tmp_path):
     assert plots.plot_image(bpy.data.objects["Kept"].vg.edges[0]).name == kept_plot
 
 
+def test_a_measured_mesh_converted_to_a_curve_keeps_its_plots_when_saved(vg, tmp_path):
+    plots = importlib.import_module(f"{vg.__name__}.bridge.plots")
+    obj = ramp("Converted")
+    measure_edge([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    plot = plots.plot_image(obj.vg.edges[0]).name
+    bpy.ops.object.select_all(action="DESELECT")
+    obj.select_set(True)
+    assert bpy.ops.object.convert(target="CURVE") == {"FINISHED"}
+    assert obj.type == "CURVE" and len(obj.vg.edges) == 1  # its records stay with the object
+    path = tmp_path / "saved.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    assert plot in bpy.data.images  # before: removed at the save, the edge kept in the records
+    assert plots.plot_image(bpy.data.objects["Converted"].vg.edges[0]).name == plot
+
+
 def test_a_sweep_to_a_path_relative_to_an_unsaved_file_writes_nothing(vg, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     wedge_object(100.0)

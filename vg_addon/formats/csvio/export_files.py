@@ -30,7 +30,17 @@ def holds_edge_summary(path) -> bool:
 
 
 class SummaryWriteError(GoniometerError):
-    """The measurement CSV was written, its edge summary was not (the message names both)."""
+    """The measurement CSV was written, its edge summary was not (the message names both).
+
+    ``summary_path`` is where the summary belongs, ``summary_text`` what it should hold (so a
+    caller can keep it elsewhere), ``cause`` why it could not be written.
+    """
+
+    def __init__(self, message, *, summary_path, summary_text, cause):
+        super().__init__(message)
+        self.summary_path = summary_path
+        self.summary_text = summary_text
+        self.cause = cause
 
 
 def write_export(
@@ -85,6 +95,9 @@ def write_export(
     except (OSError, GoniometerError) as error:
         raise SummaryWriteError(
             f"{os.fspath(path)} was written, but its edge summary {edges_path} was not ({error}): "
-            "the two no longer match; write the export again once that file can be replaced."
+            "the two no longer match; write the export again once that file can be replaced.",
+            summary_path=edges_path,
+            summary_text=edges_text,
+            cause=error,
         ) from error
     return edges_path
