@@ -118,20 +118,16 @@ def check_outputs(args) -> None:
     outputs = [(option, path) for option, path in outputs if path and path != files.STDOUT]
     edge_options = (("--edge", "edge"), ("--edges", "edges_csv"), ("--find-edges", "find_edges"))
     edges = [option for option, name in edge_options if getattr(args, name, None)]
-    if args.out and edges:
-        if _is_stream(args.out):
-            raise UsageError(
-                f"{edges[0]} writes the edge summary <out>_edges.csv and a plot per edge beside "
-                f"--out, so --out {args.out} must be a file name, not standard output or a stream."
-            )
-        outputs.append(("--out's edge summary", str(csvio.edges_path_for(args.out))))
-    elif (
-        args.out
-        and not _is_stream(args.out)
-        and csvio.holds_edge_summary(csvio.edges_path_for(args.out))
-    ):
-        # An earlier run's summary there is emptied (csvio.write_export): never an input.
-        outputs.append(("--out's edge summary", str(csvio.edges_path_for(args.out))))
+    if args.out and edges and _is_stream(args.out):
+        raise UsageError(
+            f"{edges[0]} writes the edge summary <out>_edges.csv and a plot per edge beside "
+            f"--out, so --out {args.out} must be a file name, not standard output or a stream."
+        )
+    summary = csvio.edges_path_for(args.out) if args.out and not _is_stream(args.out) else None
+    # Written with edges; without, an earlier run's summary there is emptied
+    # (csvio.write_export): either way never an input.
+    if summary is not None and (edges or csvio.holds_edge_summary(summary)):
+        outputs.append(("--out's edge summary", str(summary)))
     if args.sweep:
         if _is_stream(args.out):
             raise UsageError(

@@ -10,7 +10,7 @@ import sys
 
 from ..vg_addon.analysis.report import write_report
 from ..vg_addon.errors import bounded_list
-from .cli import UsageError
+from .cli import FINDER_SETTINGS, UsageError
 
 #: Options of a measuring run that mean nothing to a report.
 MEASURING_OPTIONS = (
@@ -19,9 +19,7 @@ MEASURING_OPTIONS = (
     ("--edge", "edge"),
     ("--edges", "edges_csv"),
     ("--find-edges", "find_edges"),
-    ("--min-length", "min_length"),
-    ("--find-scale", "find_scale"),
-    ("--min-bend", "min_bend"),
+    *((flag, name) for flag, _, name in FINDER_SETTINGS),
     ("--out", "out"),
     ("--save-blend", "save_blend"),
     ("--render", "render"),

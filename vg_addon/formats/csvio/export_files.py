@@ -1,9 +1,10 @@
 """An export's two files together: the measurement CSV and the edge summary beside it.
 
 They are one record. The summary is written whenever there are edges, and also when there are
-none but an earlier edge summary lies beside the CSV (it is emptied to its header: otherwise it would
-list edges the new CSV no longer has, and importing it would bring them back). Both targets are
-checked before either is written, so a summary that cannot be written leaves the CSV as it was.
+none but an earlier edge summary lies beside the CSV (it is emptied to its header: otherwise it
+would list edges the new CSV no longer has, and importing it would bring them back). Both targets
+are checked before either is written, so a summary that cannot be written leaves the CSV as it
+was.
 """
 
 from __future__ import annotations
