@@ -9,8 +9,10 @@ import math
 import statistics
 import subprocess
 import sys
+from fractions import Fraction
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytest.importorskip("scipy", reason="the report's statistics need SciPy (requirements/report.txt)")
@@ -109,6 +111,59 @@ def test_observers_a_constant_apart_have_an_icc_of_zero_and_no_f():
         icc.icc_absolute([[40, 50], [50, 40]])  # the two observers swapped: no estimate
 
 
+def exact_error_mean_square(table) -> Fraction:
+    """MSE of the two-way table in exact rational arithmetic on the floats as given."""
+    x = [[Fraction(v) for v in row] for row in table]
+    n, k = len(x), len(x[0])
+    grand = sum(map(sum, x)) / (n * k)
+    rows = [sum(row) / k for row in x]
+    cols = [sum(x[i][j] for i in range(n)) / n for j in range(k)]
+    residuals = (x[i][j] - rows[i] - cols[j] + grand for i in range(n) for j in range(k))
+    return sum(r * r for r in residuals) / ((n - 1) * (k - 1))
+
+
+def test_observers_a_rounded_constant_apart_have_no_f_and_no_p():
+    """Observer means of three readings (150, 150, 150 and 154, 154, 155): every break the
+    same 150 and 463/3 rounded, so MSR = MSE = 0 exactly. Before: MSR 1.9e-27 and MSE
+    -1.4e-15 from subtracting sums, so F = inf and p = 0 in agreement.csv."""
+    table = [[150.0, math.fsum([154.0, 154.0, 155.0]) / 3]] * 6
+    assert exact_error_mean_square(table) == 0
+    single, mean = icc.icc_absolute(table)
+    assert single.value == 0.0 and single.f is None and single.p is None
+    assert mean.value == 0.0
+
+
+def test_the_error_mean_square_is_zero_exactly_where_it_is_and_never_negative():
+    """Additive tables (a break's value plus an observer's offset, both rounded to 0.001) whose
+    exact MSE is 0 get 0; the others agree with the exact value (oracle: Fractions)."""
+    rng = np.random.default_rng(5)
+    zeros = 0
+    for _ in range(400):
+        n, k = int(rng.integers(2, 7)), int(rng.integers(2, 4))
+        table = np.round(
+            np.round(rng.uniform(0, 180, (n, 1)), 3) + np.round(rng.uniform(-1, 1, (1, k)), 3), 6
+        )
+        if rng.random() < 0.3:  # and some with error variance
+            table = table + np.round(rng.normal(0, 0.5, (n, k)), 3)
+        exact = exact_error_mean_square(table.tolist())
+        ms_error = icc.two_way(table).ms_error
+        assert ms_error >= 0
+        if exact == 0:
+            zeros += 1
+            assert ms_error == 0, table.tolist()
+        else:
+            assert ms_error == pytest.approx(float(exact), rel=1e-9, abs=1e-20)
+    assert zeros > 20  # the case is exercised
+
+
+def test_the_icc_agrees_with_exact_arithmetic_on_a_table_with_error():
+    """A table with real error variance keeps its figures: the Shrout & Fleiss table's MSE
+    summed from residuals is the exact one."""
+    assert icc.two_way(SHROUT_FLEISS).ms_error == pytest.approx(
+        float(exact_error_mean_square(SHROUT_FLEISS)), rel=1e-15
+    )
+
+
 # R's PlantGrowth data set (Dobson 1983), 10 plants per group.
 PLANT_GROWTH = {
     "ctrl": [4.17, 5.58, 5.18, 6.11, 4.50, 4.61, 5.17, 4.53, 5.33, 5.14],
@@ -143,6 +198,12 @@ def test_tukey_refuses_a_group_of_one_and_groups_without_variance():
         stats.tukey_hsd({"a": [1.0, 2.0], "b": [3.0]})
     with pytest.raises(ValueError, match="no variance"):
         stats.tukey_hsd({"a": [0.0, 0.0], "b": [3.0, 3.0]})
+    # Values whose mean rounds off them (fsum of 25 times 4/3, over 25, is not 4/3): still
+    # no variance (before: an SD of 2.3e-16, and p = 4.4e-16 from SciPy).
+    for a, b in (([4 / 3] * 25, [2 / 3] * 25), ([0.1] * 3, [0.2] * 3)):
+        assert math.fsum(a) / len(a) != a[0] or math.fsum(b) / len(b) != b[0]
+        with pytest.raises(ValueError, match="no variance"):
+            stats.tukey_hsd({"manual": a, "drag": b})
 
 
 # NIST StRD, Longley (1967): the certified values of the linear regression of employment on six
@@ -180,6 +241,11 @@ def test_regression_refuses_too_few_rows_and_collinear_predictors():
         stats.ols([1.0, 3.0, 5.0, 7.0, 9.0], {"a": [0.0, 1.0, 2.0, 3.0, 4.0], "b": [1, 0, 1, 0, 0]})
     with pytest.raises(ValueError, match="collinear"):
         stats.ols([1.0, 2.0, 3.0, 5.0, 4.0], {"a": [0.0] * 5, "b": [1.0, 2.0, 3.0, 4.0, 5.0]})
+    # A response that never varies (before: R² = -inf, a negative F, t of 1e15).
+    rng = np.random.default_rng(2)
+    predictors = {name: list(rng.normal(size=8)) for name in "abc"}
+    with pytest.raises(ValueError, match="nothing to explain"):
+        stats.ols([math.log(2 / 3)] * 8, predictors, response="angle IOV")
 
 
 def test_bland_altman_by_hand():

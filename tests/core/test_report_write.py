@@ -4,6 +4,7 @@ one break plotted as an edge profile, what was left out counted, the outputs nev
 from __future__ import annotations
 
 import csv
+import re
 
 import pytest
 
@@ -91,3 +92,53 @@ def test_a_compare_name_that_several_sessions_share_is_refused_with_its_reason(t
         "Bland–Altman other_drag.csv against drag_1.csv: not computed, 'drag_1.csv' names 2 "
         "sessions (of observers obs1, obs2): give the files names of their own"
     ) in outcome.not_computed
+
+
+def drag_sessions(folder, rows_of):
+    """Two drag sessions of one observer on three breaks; ``rows_of(repetition, break)`` gives
+    each row's x, radius and vertex count."""
+    paths = []
+    for repetition in (1, 2):
+        lines = ["Mesh,Break #,Angle,x,y,z,Radius,Number of Vertices"]
+        for number in (1, 2, 3):
+            x, radius, vertices = rows_of(repetition, number)
+            lines.append(f"m,{number},{90 + repetition + number},{x},0,0,{radius},{vertices}")
+        path = folder / f"obs1_drag_{repetition}.csv"
+        path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        paths.append(path)
+    return paths
+
+
+@pytest.mark.parametrize(
+    ("case", "rows_of"),
+    [
+        # Squares of centre distances past 1e154 overflowed: OverflowError out of the report.
+        ("far centres", lambda rep, _: (1e200 if rep == 1 else -1e200, 1, 100)),
+        ("centres at the float limit", lambda rep, _: (1e308 if rep == 1 else -1e308, 1, 100)),
+        # Radius IOVs near the float limit: fsum's running sum of them overflowed the same way.
+        ("huge radii", lambda rep, number: (0.1 * rep, 1e308 if rep == 1 else 1, 100 + number)),
+    ],
+)
+def test_numbers_near_the_float_limit_give_a_report_not_a_traceback(tmp_path, case, rows_of):
+    outcome = write_report(drag_sessions(tmp_path, rows_of), tmp_path / "out")
+    assert (tmp_path / "out" / "report.html").is_file(), case
+    assert outcome.sessions == 2
+    for name in ("breaks.csv", "sessions.csv", "report.html"):
+        text = (tmp_path / "out" / name).read_text(encoding="utf-8")
+        text = re.sub(r"data:[^\"')]*", "", text)  # the figures' pixels, base64
+        assert not re.search(r"\b(nan|inf|infinity)\b", text, re.IGNORECASE), (case, name)
+
+
+def test_a_vertex_count_no_patch_can_have_is_left_out_and_said(tmp_path):
+    counts = {1: 0, 2: "1e308", 3: -5}  # 1e308 crashed the report; -5 was taken as a count
+    outcome = write_report(
+        drag_sessions(
+            tmp_path, lambda rep, number: (0.1 * rep, 1, counts[number] if rep == 2 else 50)
+        ),
+        tmp_path / "out",
+    )
+    left = "\n".join(outcome.left_out)
+    assert "obs1_drag_2.csv: row 3: Number of Vertices 1e+308 is not a count" in left, left
+    assert "obs1_drag_2.csv: row 4: Number of Vertices -5 is not a count" in left, left
+    assert "row 2" not in left  # 0 vertices is a count (a refused patch)
+    assert (tmp_path / "out" / "report.html").is_file()

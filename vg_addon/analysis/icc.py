@@ -51,17 +51,28 @@ def _fsum(values) -> float:
 
 
 def two_way(table) -> TwoWay:
-    """The mean squares of a complete ``n x k`` table (no missing cells), summed exactly."""
+    """The mean squares of a complete ``n x k`` table (no missing cells), summed exactly.
+
+    Each sum of squares is summed from its own deviations (never one sum less others, which
+    leaves rounding residue of either sign), and a sum within rounding of zero is zero: a table
+    whose observers are a constant apart has no error variance, not 1e-15 of it.
+    """
     x = np.asarray(table, dtype=np.float64)
     n, k = x.shape
     grand = _fsum(x) / (n * k)
     row_means = np.array([_fsum(row) / k for row in x])
     col_means = np.array([_fsum(col) / n for col in x.T])
-    ss_rows = k * _fsum((row_means - grand) ** 2)
-    ss_cols = n * _fsum((col_means - grand) ** 2)
-    ss_total = _fsum((x - grand) ** 2)
-    ss_error = ss_total - ss_rows - ss_cols
-    ss_within = ss_total - ss_rows
+    # Each deviation carries a few units in the last place of the table's largest value.
+    floor = n * k * (8.0 * np.finfo(np.float64).eps * float(np.max(np.abs(x)))) ** 2
+
+    def summed(deviations) -> float:
+        total = _fsum(np.square(deviations))
+        return total if total > floor else 0.0
+
+    ss_rows = k * summed(row_means - grand)
+    ss_cols = n * summed(col_means - grand)
+    ss_error = summed(x - row_means[:, None] - col_means[None, :] + grand)
+    ss_within = summed(x - row_means[:, None])
     return TwoWay(
         n,
         k,

@@ -68,13 +68,18 @@ class Describe:
         values = list(values)
         if not values:
             return cls(0, None, None, None, None)
-        mean = math.fsum(values) / len(values)
-        sd = (
-            math.sqrt(math.fsum((v - mean) ** 2 for v in values) / (len(values) - 1))
-            if len(values) > 1
-            else None
-        )
-        return cls(len(values), mean, sd, min(values), max(values))
+        n, low, high = len(values), min(values), max(values)
+        if low == high:  # exactly: a rounded mean would leave an SD of 1e-16
+            return cls(n, low, 0.0 if n > 1 else None, low, high)
+        try:
+            mean = math.fsum(values) / n
+            sd = math.sqrt(math.fsum((v - mean) ** 2 for v in values) / (n - 1)) if n > 1 else None
+        except OverflowError:  # values near the float limit: the same sums, scaled down
+            scale = max(abs(low), abs(high))
+            mean = math.fsum(v / scale for v in values) / n * scale
+            spread = [(v / scale - mean / scale) ** 2 for v in values]
+            sd = scale * math.sqrt(math.fsum(spread) / (n - 1)) if n > 1 else None
+        return cls(n, mean, sd, low, high)
 
 
 def _iov(readings, quantity: str) -> float | None:

@@ -38,6 +38,12 @@ COLUMNS = {
 }
 REQUIRED = ("mesh", "break", "angle")
 
+#: Coordinates beyond this are no scan's (and two such centres' distance could overflow).
+MAX_COORDINATE = 1e300
+
+#: The largest vertex count a patch can have: Blender and MeshLab count vertices in 32-bit ints.
+MAX_VERTICES = 2**31 - 1
+
 #: Words of a file name that name a method, and the method they mean.
 METHOD_WORDS = {
     "man": "manual",
@@ -185,12 +191,16 @@ def _reading(number: int, cells, columns) -> tuple[Reading | None, str]:
     elif angle is not None and not 0.0 <= angle <= 180.0:
         problems.append(f"Angle {angle:g} is not an angle between two faces (0° to 180°)")
     parts = [_number(cells, columns, axis, number, problems) for axis in "xyz"]
+    if any(p is not None and abs(p) > MAX_COORDINATE for p in parts):
+        problems.append(f"x, y, z beyond {MAX_COORDINATE:g} are not a scan's coordinates")
     if any(p is not None for p in parts) and any(p is None for p in parts):
         problems.append("x, y, z must be all filled or all empty")
     radius = _number(cells, columns, "radius", number, problems)
     if radius is not None and radius <= 0:
         problems.append(f"Radius must be more than 0 (got {radius:g})")
     vertices = _number(cells, columns, "vertices", number, problems, whole=True)
+    if vertices is not None and not 0 <= vertices <= MAX_VERTICES:
+        problems.append(f"Number of Vertices {vertices:g} is not a count of a patch's vertices")
     if problems:
         return None, f"row {number}: " + "; ".join(problems)
     centre = None if None in parts else tuple(parts)
@@ -331,4 +341,8 @@ def load_sessions(paths, methods=None, observers=None) -> Loaded:
 
 def distance(a, b) -> float:
     """Euclidean distance between two centres, summed in a fixed order."""
-    return math.sqrt(math.fsum((p - q) ** 2 for p, q in zip(a, b, strict=True)))
+    differences = [p - q for p, q in zip(a, b, strict=True)]
+    total = math.fsum(d * d for d in differences)
+    if math.isinf(total):  # centres beyond 1e154 apart: their squares overflow, not the distance
+        return math.hypot(*differences)
+    return math.sqrt(total)

@@ -144,7 +144,8 @@ def ols(y, predictors: dict[str, list[float]], response: str = "y") -> Regressio
     Raises
     ------
     ValueError
-        Fewer rows than coefficients plus one, predictors that are collinear, or an exact fit.
+        Fewer rows than coefficients plus one, a response that never varies, predictors that
+        are collinear, or an exact fit.
     """
     from statsmodels.regression.linear_model import OLS
     from statsmodels.tools.tools import add_constant
@@ -161,6 +162,8 @@ def ols(y, predictors: dict[str, list[float]], response: str = "y") -> Regressio
         raise ValueError(
             "the predictors are collinear (one is constant or a combination of others)"
         )
+    if not np.ptp(y) > 0:
+        raise ValueError(f"every break has the same {response}, so there is nothing to explain")
     fit = OLS(y, x).fit()
     # Rounding leaves a residual of about 1e-30 where the fit is exact: none to speak of.
     if not fit.ssr > 1e-20 * float(np.sum((y - y.mean()) ** 2)):
