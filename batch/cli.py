@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 
 from ..bridge.map_edges import EDGE_ENDS
 from ..vg_addon import GoniometerError
@@ -31,6 +32,13 @@ FINDER_SETTINGS = (
 
 # --render-size and --render-samples: a map's cost grows with pixels times samples, and Cycles
 # cannot be stopped inside a view, so both are bounded before anything is rendered.
+# argparse takes an argument for a negative number only in plain notation (-0.05, not -5e-2,
+# which this project's own CSVs write) and reads anything else starting with "-" as an option;
+# this is the pattern it is given instead (not-finite values get through to their refusal).
+NEGATIVE_NUMBER = re.compile(
+    r"^-(?:(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|inf|infinity|nan)$", re.IGNORECASE
+)
+
 MAX_RENDER_SIDE = 8192
 MAX_RENDER_SAMPLES = 4096
 
@@ -158,6 +166,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    parser._negative_number_matcher = NEGATIVE_NUMBER  # see NEGATIVE_NUMBER
     parser.add_argument(
         "inputs",
         nargs="*",

@@ -111,6 +111,21 @@ def test_an_unclosed_quote_in_a_points_csv_stops_the_run_naming_its_line(scan, t
     assert "line 2 opens a quote" in result.stderr and not out.exists()
 
 
+def test_negative_numbers_in_scientific_notation_are_numbers(scan, tmp_path):
+    """-5e-2 (as the project's CSVs write small numbers) was read as an option: "--at: expected
+    3 arguments". The oracle: the same run in plain notation."""
+    rows = {}
+    for name, x, ends in (("plain", "-0.05", ("-0.4", "0.4")), ("sci", "-5e-2", ("-4e-1", "4E-1"))):
+        out = tmp_path / f"{name}.csv"
+        ok(batch(scan, "--at", x, "0", "0", "--radius", "0.3", "--edge", ends[0], "0", "0",
+                 ends[1], "0", "0", "--spacing", "0.2", "--out", out))  # fmt: skip
+        rows[name] = [(r.requested, r.angle) for r in csvio.read_measurements_csv(out)]
+    assert rows["sci"] == rows["plain"] and rows["sci"][0][0][0] == -0.05
+    assert len(rows["sci"]) > 3  # the point and the edge's stations
+    refused = batch(scan, "--at", "-inf", "0", "0", "--radius", "0.3", "--out", tmp_path / "i.csv")
+    assert refused.returncode == 2 and "finite" in refused.stderr, refused.stderr
+
+
 def test_paths_with_a_line_break_are_paths(scan, tmp_path):
     folder = tmp_path / "two\nlines"
     folder.mkdir()

@@ -190,8 +190,9 @@ def _checked_angle(normal_plus, normal_minus) -> float:
     angle = 180.0 - acos_degrees(dot3(normal_plus, normal_minus))
     if angle < FLAT_TOLERANCE_DEG:
         raise GoniometerError(
-            f"The two sides fit planes folded onto each other ({angle:.2f}°): the patch is too "
-            "small or straddles a thin sliver. Use a larger radius or move the centre."
+            f"The two sides fit planes folded onto each other ({angle:.2f}°): the patch "
+            "straddles a thin sliver, or reaches opposite faces of the fragment. Use a radius "
+            "that covers just the two faces at the edge, or move the centre."
         )
     if angle > 180.0 - FLAT_TOLERANCE_DEG:
         raise GoniometerError(
