@@ -98,6 +98,26 @@ def test_meshlab_rows_keep_the_papers_rule(tmp_path):
     assert abs(row.angle - expected) < 1e-5 and abs(expected - 90) > 5
 
 
+def test_an_export_without_its_rule_column_is_said_to_be_replayed_with_the_papers_rule(tmp_path):
+    """Before: "1 on a mesh or with a version other than the file's", when the mesh and the
+    version are the same and the file just names no rule."""
+    shape = wedge(90, n=40, irregular=True, seed=4, concave=True)
+    path = meshio.write_ply(tmp_path / "valley.ply", shape.points, shape.triangles)
+    export = tmp_path / "export.csv"
+    batch(path, "--at", "0.01", "0", "0", "--radius", "0.5", "--out", export)
+    with export.open(newline="", encoding="utf-8") as handle:
+        table = list(csv.reader(handle))
+    column = table[0].index("Rule")
+    assert table[1][column] == "refined"
+    without = tmp_path / "no_rule.csv"
+    with without.open("w", newline="", encoding="utf-8") as handle:
+        csv.writer(handle).writerows([row[:column] + row[column + 1 :] for row in table])
+    result = batch(path, "--points", without, "--out", tmp_path / "again.csv")
+    assert csvio.read_measurements_csv(tmp_path / "again.csv")[0].rule == "paper"
+    assert "1 without a Rule in the file, so measured with the paper's rule" in result.stderr
+    assert "other than the file's" not in result.stderr, result.stderr
+
+
 def test_inward_wound_closed_mesh_is_named_once(tmp_path):
     bone = bone_fragment(spacing=1.5)
     path = tmp_path / "bone.ply"

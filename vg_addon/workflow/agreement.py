@@ -32,6 +32,9 @@ class Agreement:
         Differing rows re-measured at another precision than the file says they were.
     stale : int
         Rows not compared: the file marks them Stale.
+    no_rule : int
+        Differing rows (at the file's precision) whose file names no rule: they were measured
+        with the paper's rule, as such rows are.
     """
 
     compared: int
@@ -39,6 +42,7 @@ class Agreement:
     largest: float
     other_precision: int
     stale: int
+    no_rule: int = 0
 
     @property
     def text(self) -> str:
@@ -55,10 +59,16 @@ class Agreement:
                     "(a batch run measures a mesh file's float64 coordinates, Blender its "
                     "float32 vertices): only the same precision replicates them exactly"
                 )
-            if self.differing > self.other_precision:
+            if self.no_rule:
                 why.append(
-                    f"{self.differing - self.other_precision} on a mesh or with a version "
-                    "other than the file's"
+                    f"{self.no_rule} without a Rule in the file, so measured with the paper's "
+                    "rule, as rows of MeshLab's and earlier files are (a Rule column names "
+                    "another)"
+                )
+            if self.differing > self.other_precision + self.no_rule:
+                why.append(
+                    f"{self.differing - self.other_precision - self.no_rule} on a mesh or with a "
+                    "version other than the file's"
                 )
             parts.append(
                 f"{self.differing} of {self.compared} angles differ from the file's, by up to "
@@ -78,6 +88,7 @@ def agreement(
     file_precisions: Sequence[str],
     precisions: Sequence[str],
     stale: Sequence[bool],
+    file_rules: Sequence[str] | None = None,
 ) -> Agreement:
     """Compare a file's angles with the same rows re-measured.
 
@@ -92,15 +103,18 @@ def agreement(
         ``"float64"``, or empty where not known).
     stale : sequence of bool
         Each row's ``Stale`` cell in the file.
+    file_rules : sequence of str, optional
+        Each row's ``Rule`` in the file (empty where it names none).
 
     Returns
     -------
     Agreement
     """
-    compared = differing = other_precision = passed_over = 0
+    compared = differing = other_precision = passed_over = no_rule = 0
     largest = 0.0
-    rows = zip(recorded, remeasured, file_precisions, precisions, stale, strict=True)
-    for old, new, old_precision, new_precision, was_stale in rows:
+    rules = [""] * len(recorded) if file_rules is None else file_rules
+    rows = zip(recorded, remeasured, file_precisions, precisions, stale, rules, strict=True)
+    for old, new, old_precision, new_precision, was_stale, rule in rows:
         if was_stale:
             passed_over += 1
             continue
@@ -109,9 +123,11 @@ def agreement(
         compared += 1
         if old != new:
             differing += 1
-            other_precision += bool(old_precision and new_precision != old_precision)
+            precision_differs = bool(old_precision and new_precision != old_precision)
+            other_precision += precision_differs
+            no_rule += file_rules is not None and not precision_differs and not rule.strip()
             largest = max(largest, abs(new - old))
-    return Agreement(compared, differing, largest, other_precision, passed_over)
+    return Agreement(compared, differing, largest, other_precision, passed_over, no_rule)
 
 
 def agreement_of_rows(file_rows: Sequence, remeasured: Sequence, precisions: Sequence[str]):
@@ -123,4 +139,5 @@ def agreement_of_rows(file_rows: Sequence, remeasured: Sequence, precisions: Seq
         [row.precision for row in file_rows],
         precisions,
         [row.stale for row in file_rows],
+        [row.rule for row in file_rows],
     )
