@@ -12,6 +12,7 @@ import numpy as np
 
 from ..bridge import colors, measuring, mesh_data, records
 from ..vg_addon import GoniometerError, Surface
+from ..vg_addon import units as units_module
 from ..vg_addon.formats import csvio, files, sweep_plot
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from .cli import UNITS
@@ -106,7 +107,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     while measuring.
     """
     result = MeshResult(mesh=index)
-    units = records.units_label(bpy.context.scene)
+    units = given_units_label(options.get("units")) or records.units_label(bpy.context.scene)
     name = source.name
 
     def fail_all(message: str) -> MeshResult:
@@ -161,6 +162,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
         ]
         if named:
             records.adopt_file_units(obj, named)
+    elif key := SCAN_UNITS.get(options["units"]):
+        records.choose_unit(obj, key)  # what the user said the scan is in
     units = records.units_label(bpy.context.scene, obj)  # a .blend object may be scaled
     result.winding = surface.winding
     measuring.note_winding(obj, surface)
@@ -317,6 +320,17 @@ def exact_surface(source: MeshSource, points: np.ndarray, geometry) -> Surface:
     return Surface(points, triangles)
 
 
+#: ``--units`` as an object's Scan Units: the CSV's Units cell then names the unit as every
+#: replay and import of it does ("mm"; "m" too, which a scene of 1 BU = 1 m cannot say).
+SCAN_UNITS = {"m": "M", "cm": "CM", "mm": "MM", "um": "UM", "in": "IN"}
+
+
+def given_units_label(unit: str | None) -> str | None:
+    """The Units cell of a run whose ``--units`` is ``unit`` (None: without, or ``none``)."""
+    key = SCAN_UNITS.get(unit or "")
+    return units_module.SYMBOLS[key] if key else None
+
+
 def set_units(scene, unit: str | None) -> None:
     """Set the scene's length units to ``unit`` (a key of :data:`UNITS`); None: leave them."""
     if not unit:
@@ -352,7 +366,7 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, 
         if sent:  # the rows are out: only the pictures are lost
             sent[0].picture_errors.append(f"pictures of {source.name}: {message}")
             return sent[0]
-        units = records.units_label(bpy.context.scene)
+        units = given_units_label(options.get("units")) or records.units_label(bpy.context.scene)
         result = MeshResult(mesh=index, failed=len(tasks))
         result.rows = [(t.index, error_row(t, source.name, message, units)) for t in tasks]
         ready(result)

@@ -319,6 +319,11 @@ def unit_symbol(obj, scene) -> str:
     return units.scene_symbol(settings.system, settings.scale_length)
 
 
+def choose_unit(obj, key: str) -> None:
+    """Set ``obj``'s Scan Units to ``key`` as the user's choice (the batch's ``--units``)."""
+    set_unit(obj.vg, key, guessed=False)
+
+
 def adopt_file_units(obj, texts) -> str | None:
     """Take the unit that the Units cells ``texts`` of a file of this extension all name as
     ``obj``'s Scan Units, unless the user chose them; returns the key taken, or None where

@@ -62,12 +62,13 @@ def plot_pixels(edge) -> np.ndarray:
 
 
 def test_a_runs_units_come_back_with_its_csvs(vg, tmp_path):
-    """A run with --units cm writes the scene's description ("BU (1 BU = 0.01 m, ...)"); its CSV
-    and its edges CSV imported in Blender take cm as the Scan Units, and every edge's plot names
-    cm on its axis (before: Scan Units untouched, the plots in "BU")."""
+    """A run with --units cm writes "cm" (before: the scene's description, "BU (1 BU = 0.01 m,
+    ...)", which a replay wrote as "cm"); its CSV and its edges CSV imported in Blender take cm
+    as the Scan Units, and every edge's plot names cm on its axis (before: Scan Units untouched,
+    the plots in "BU")."""
     run(tmp_path, "--units", "cm")
     out = tmp_path / "out.csv"
-    assert csvio.read_measurements_csv(out)[0].units.startswith("BU (1 BU = 0.01 m")
+    assert csvio.read_measurements_csv(out)[0].units == "cm"
     shape = wedge(90.0, n=30, irregular=True, seed=2)
     for name, path in (("stations", out), ("edges", csvio.edges_path_for(out))):
         obj = mesh_object(name, shape.points, shape.triangles)
@@ -202,7 +203,19 @@ def test_a_replay_without_units_takes_the_unit_its_files_name(tmp_path):
     assert single and single == [(r.x, r.y, r.z, r.angle) for r in rows[: len(single)]]
 
     rows, edge_rows = replay("chosen.csv", "--units", "cm")
-    assert all(row.units.startswith("BU (1 BU = 0.01 m") for row in [*rows, *edge_rows])
+    assert all(row.units == "cm" for row in [*rows, *edge_rows])
+    # Metres, chosen: said as "m", which a replay keeps (before: the scene's "1 BU = 1 m",
+    # Blender's default, which says nothing, so the replay wrote "BU").
+    in_metres, _ = replay("metres.csv", "--units", "m")
+    assert all(row.units == "m" for row in in_metres)
+    metres = tmp_path / "metres.csv"
+    again = tmp_path / "metres_again.csv"
+    result = batch(
+        mesh, "--points", metres, "--edges", csvio.edges_path_for(metres), "--out", again
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    rows = [*csvio.read_measurements_csv(again), *csvio.read_edges_csv(csvio.edges_path_for(again))]
+    assert len(rows) > 3 and all(row.units == "m" for row in rows)
 
     marks = iter(["cm"] + ["mm"] * len(first))
     mixed = edited_csv(out, tmp_path / "mixed.csv", lambda row: row.update(Units=next(marks)))
