@@ -170,7 +170,7 @@ def main(argv=None) -> None:
     print()
     print(f"Wedges: radius {RADIUS}, centre {CENTER} (on the crease), λ = 2, about 7,200 vertices;")
     print("bone fragment: radius 3 mm at its rim sites (0.5 mm spacing); HalfAnnulus: radius 0.3;")
-    print("IntersectingSpheres: 6% of its size. Cells: default (oriented) rule / paper rule, °.")
+    print("IntersectingSpheres: 6% of its size. Cells: oriented rule / paper rule, °.")
     if DATA.is_dir():
         print()
         print(sample_scan_summary())

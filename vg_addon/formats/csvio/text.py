@@ -434,8 +434,8 @@ def parse_table(text, source, schema, row_type, optional, what, check=None):
     if missing:
         problems.insert(
             0,
-            f"header: missing the column(s) {', '.join(missing)}; this reader needs a complete "
-            f"{what} of this extension (use read_replication_csv for other files)",
+            f"header: missing the column(s) {', '.join(missing)}; it is not {what} of this "
+            "extension, or not a complete one",
         )
     if problems:
         raise problems_error(source, problems)
