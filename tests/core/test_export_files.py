@@ -78,3 +78,19 @@ def test_a_file_named_like_a_summary_that_is_not_one_is_left_alone(tmp_path):
     assert csvio.write_export(out, ROWS, []) is None
     assert points.read_text(encoding="utf-8") == "x,y,z,radius,label\n0,0,0,0.3,my point\n"
     assert not csvio.holds_edge_summary(points)
+
+
+@pytest.mark.parametrize("summary", [True, False], ids=["a run with edges", "an export with edges"])
+def test_an_export_with_edges_refuses_to_replace_a_file_that_is_not_a_summary(tmp_path, summary):
+    """The user's notes named site_edges.csv: an export with edges replaced them (before). Now
+    nothing is written, and the message names the file; an empty file is no one's notes."""
+    out = tmp_path / "site.csv"
+    notes = tmp_path / "site_edges.csv"
+    notes.write_text("my notes, not a summary\n", encoding="utf-8")
+    edges = [] if summary else [EDGE]
+    with pytest.raises(GoniometerError, match="holds another file"):
+        csvio.write_export(out, [*ROWS, STATION], edges, summary=summary)
+    assert notes.read_text(encoding="utf-8") == "my notes, not a summary\n"
+    assert not out.exists()
+    notes.write_text("", encoding="utf-8")
+    assert csvio.write_export(out, [*ROWS, STATION], edges, summary=summary) == notes

@@ -77,7 +77,8 @@ def write_export(
     SummaryWriteError
         The summary failed after the CSV was written (a :class:`GoniometerError`).
     GoniometerError
-        Either target cannot be written (checked before anything is written).
+        Either target cannot be written, or the summary's place holds a file that is not an
+        edge summary (checked before anything is written).
     OSError
         The CSV itself could not be written (nothing was).
     """
@@ -88,6 +89,17 @@ def write_export(
     edges_text = format_edges_csv(edge_rows).encode("utf-8") if with_edges else b""
     if with_edges:
         output_target(edges_path)
+        if (
+            is_file
+            and os.path.isfile(edges_path)
+            and os.path.getsize(edges_path) > 0
+            and not holds_edge_summary(edges_path)
+        ):
+            raise GoniometerError(
+                f"{edges_path}, where the edge summary goes, holds another file (not an edge "
+                "summary this extension wrote): it is left alone, and nothing was written. Move "
+                "it, or write the CSV under another name."
+            )
     replace_atomically(path, csv_text)
     if not with_edges:
         return None
