@@ -150,6 +150,18 @@ def test_plain_points_file_with_aliases_bom_and_odd_case(tmp_path):
     assert rows[0].source_format == "points"
 
 
+def test_excels_separator_line_is_not_a_header(tmp_path):
+    """Excel writes and hides a first line "sep=," (before: "missing x, y, z (found: 'sep=')").
+    Rows are numbered as Excel shows them; a "sep=;" file is named as semicolon-separated."""
+    path = tmp_path / "points.csv"
+    path.write_bytes(b"\xef\xbb\xbfsep=,\r\nx,y,z,label\r\n1,2,3,first\r\n")
+    assert csvio.read_replication_csv(path) == [
+        ReplicationRow(2, None, 1.0, 2.0, 3.0, label="first")
+    ]
+    with pytest.raises(GoniometerError, match="semicolon"):
+        csvio.read_replication_csv("sep=;\nx;y;z\n1;2;3\n")
+
+
 @pytest.mark.parametrize(
     "header",
     ["x,y,z,SegParam", "x,y,z,Seg Param", "x,y,z,lambda", "x,y,z,Segmentation Parameter"],

@@ -230,10 +230,18 @@ def _check_delimiter(header_line: str, source: str) -> None:
         )
 
 
+# Excel's hint of the delimiter, a first line it writes and hides ("sep=,"): not a record.
+_EXCEL_SEPARATOR = re.compile(r'"?sep=.?"?', re.IGNORECASE)
+
+
 def read_records(text: str, source: str) -> list[tuple[int, list[str]]]:
-    """Every record with its spreadsheet row number, after the BOM and delimiter checks."""
+    """Every record with its spreadsheet row number, after the BOM and delimiter checks (an
+    Excel ``sep=`` first line is dropped, and not counted: Excel does not show it)."""
     if text.startswith("\ufeff"):
         text = text[1:]
+    first, newline, rest = text.partition("\n")
+    if newline and _EXCEL_SEPARATOR.fullmatch(first.rstrip("\r")):
+        text = rest
     if not text.strip():
         raise GoniometerError(
             f"{source} is empty: it needs a header line (e.g. 'x,y,z,radius') and one row per "
