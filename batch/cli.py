@@ -5,9 +5,11 @@ from __future__ import annotations
 import argparse
 import math
 import re
+from pathlib import Path
 
 from ..bridge.map_edges import EDGE_ENDS
 from ..vg_addon import GoniometerError
+from ..vg_addon.formats import picked_points
 from ..vg_addon.method.algorithm import as_lambda
 from ..vg_addon.method.break_edges import BreakEdgeParameters
 from ..vg_addon.method.sweep import sweep_radii
@@ -468,6 +470,11 @@ def check_positive(flag: str, value) -> None:
         raise UsageError(f"{flag} must be a positive, finite number (got {value:g}).")
 
 
+def is_picked_points(path: str) -> bool:
+    """Whether ``--edges`` names MeshLab picked-points files: a ``.pp`` file or a folder."""
+    return Path(path).is_dir() or Path(path).suffix.lower() == picked_points.SUFFIX
+
+
 def check_edge_settings(args) -> None:
     """Refuse, for ``--edge``, ``--edges`` and ``--find-edges``, a ``--spacing`` or ``--radius``
     that is not a finite number greater than 0 and a ``--lambda`` outside its range, before any
@@ -517,6 +524,13 @@ def check_args(args) -> None:
         )
     if args.edge and (args.spacing is None or args.radius is None):
         raise UsageError("--edge needs --spacing D and --radius R (in the mesh's units).")
+    summary_only = args.edges_csv and not is_picked_points(args.edges_csv)
+    if args.spacing is not None and summary_only and not (args.edge or args.find_edges):
+        raise UsageError(
+            "--spacing is for --edge, --find-edges and .pp files: each row of the edge summary "
+            f"{args.edges_csv} keeps its own Spacing and Radius (edit those cells to measure "
+            "with others)."
+        )
     if (args.edge or args.edges_csv) and (args.jobs > 1 or args.shard):
         raise UsageError("edges are measured in this process: drop --jobs and --shard.")
     check_find_edges(args)

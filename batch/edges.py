@@ -18,7 +18,7 @@ from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.algorithm import DEFAULT_RULE
 from ..vg_addon.method.edge_profile import check_station_count
 from ..vg_addon.workflow import batchplan
-from .cli import UsageError
+from .cli import UsageError, is_picked_points
 from .find_edges import found_edge_specs
 
 
@@ -136,11 +136,6 @@ def add_checked(specs: list, problems: list, spec: dict, where: str) -> None:
         problems.append(f"{where}: {error}")
     else:
         specs.append(spec)
-
-
-def is_picked_points(path: str) -> bool:
-    """Whether ``--edges`` names MeshLab picked-points files: a ``.pp`` file or a folder."""
-    return Path(path).is_dir() or Path(path).suffix.lower() == picked_points.SUFFIX
 
 
 def picked_point_specs(args, sources, passed_over: list | None = None) -> list[dict]:

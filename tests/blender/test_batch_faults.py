@@ -417,3 +417,19 @@ def test_a_row_of_another_object_is_not_taken_by_a_blend_objects_mesh_name(vg, t
         ("bone", 100.0),
         ("bone_left", 60.0),
     ]
+
+
+def test_a_spacing_for_an_edge_summarys_rows_is_refused_naming_why(scan, tmp_path):
+    """Each row of an edge summary keeps its own Spacing: --spacing with --edges SUMMARY did
+    nothing, silently (before). With .pp files it is their spacing, and it is used."""
+    first = tmp_path / "first.csv"
+    ok(batch(scan, *EDGE, "--spacing", "0.2", "--out", first))
+    summary = csvio.edges_path_for(first)
+    again = batch(scan, "--edges", summary, "--spacing", "0.1", "--out", tmp_path / "again.csv")
+    assert again.returncode == 2 and "keeps its own Spacing and Radius" in again.stderr
+    assert not (tmp_path / "again.csv").exists()
+    replay = tmp_path / "replay.csv"
+    ok(batch(scan, "--edges", summary, "--out", replay))
+    assert [r.angle for r in csvio.read_measurements_csv(replay)] == [
+        r.angle for r in csvio.read_measurements_csv(first)
+    ]
