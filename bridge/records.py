@@ -319,9 +319,16 @@ def unit_symbol(obj, scene) -> str:
     return units.scene_symbol(settings.system, settings.scale_length)
 
 
-def choose_unit(obj, key: str) -> None:
-    """Set ``obj``'s Scan Units to ``key`` as the user's choice (the batch's ``--units``)."""
+def choose_unit(obj, key: str) -> bool:
+    """Set ``obj``'s Scan Units to ``key`` (the batch's ``--units``, the unit of the scene's
+    Blender units) where that is the unit of the mesh's own coordinates: an object shown at its
+    own size, with no Scan Units chosen before. Returns whether they were set; else the label
+    stays the scene's (``units_label``), which says how a scaled object's units relate."""
+    scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
+    if obj.vg.unit_chosen or obj.vg.unit != units.SCENE or scale is None or abs(scale - 1) > 1e-6:
+        return False
     set_unit(obj.vg, key, guessed=False)
+    return True
 
 
 def adopt_file_units(obj, texts) -> str | None:

@@ -175,6 +175,31 @@ def test_an_edges_csv_row_is_measured_on_the_mesh_it_names_most_closely(tmp_path
     assert [(r.mesh_name, r.angle) for r in rows] == [(" lead", r.angle) for r in stations]
 
 
+def test_units_given_leave_a_scaled_or_already_unitised_blend_object_as_it_was(vg, tmp_path):
+    """--units m says what a Blender unit is; an object scaled by 0.001 has mesh units of
+    0.001 m, so its rows keep saying so (before: "m", and Scan Units m saved in its .blend),
+    and one whose Scan Units were chosen (cm) keeps them."""
+    shape = wedge(90.0, n=30, irregular=True, seed=2)
+    scaled = mesh_object("scaled", shape.points * 1000.0, shape.triangles)
+    scaled.scale = (0.001, 0.001, 0.001)
+    chosen = mesh_object("chosen", shape.points, shape.triangles)
+    chosen.vg.unit = "CM"
+    source, saved = tmp_path / "in.blend", tmp_path / "saved.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(source))
+    out = tmp_path / "out.csv"
+    result = batch(source, "--object", "scaled", "--object", "chosen", "--at", 300, 0, 0,
+                   "--radius", 200, "--units", "m",
+                   "--out", out, "--save-blend", saved)  # fmt: skip
+    assert result.returncode == 1, result.stdout + result.stderr  # 300 mm is off "chosen"
+    units = {row.mesh_name: row.units for row in csvio.read_measurements_csv(out)}
+    assert units["scaled"] == "mesh units (1 unit = 0.001 m in the scene, object scale 0.001)"
+    assert units["chosen"] == "cm"
+    bpy.ops.wm.open_mainfile(filepath=str(saved))
+    # Not set to m by --units (its size guesses mm, rightly, as a first measurement does).
+    assert bpy.data.objects["scaled"].vg.unit != "M"
+    assert bpy.data.objects["chosen"].vg.unit == "CM"
+
+
 def test_a_replay_without_units_takes_the_unit_its_files_name(tmp_path):
     """An export of a scan in mm (Units "mm", as Blender's export of an object with Scan Units
     mm writes) replayed by a run without --units: its rows and its edges' rows say mm, as the

@@ -114,7 +114,7 @@ def test_an_export_without_its_rule_column_is_said_to_be_replayed_with_the_paper
         csv.writer(handle).writerows([row[:column] + row[column + 1 :] for row in table])
     result = batch(path, "--points", without, "--out", tmp_path / "again.csv")
     assert csvio.read_measurements_csv(tmp_path / "again.csv")[0].rule == "paper"
-    assert "1 without a Rule in the file, so measured with the paper's rule" in result.stderr
+    assert "1 without a Rule in a file of a version that records it" in result.stderr
     assert "other than the file's" not in result.stderr, result.stderr
 
 

@@ -51,15 +51,17 @@ def test_a_reading_that_is_not_a_number_is_not_compared():
     assert agreement([None], [10.0], [""], [""], [True]).stale == 1  # stale, angle or not
 
 
-def test_rows_whose_file_names_no_rule_are_said_to_be_measured_with_the_papers_rule():
+def test_rows_whose_rule_was_dropped_are_said_to_be_measured_with_the_papers_rule():
+    """Only rows of a file of a version that records the rule: an older file's rows were
+    measured with the paper's rule, so that is not why they differ."""
     agreed = agreement(
         [90.0, 80.0, 70.0, 60.0],
         [90.5, 80.5, 70.5, 60.0],
         ["float64", "float64", "float32", "float64"],
         ["float64"] * 4,
         [False] * 4,
-        ["", "refined", "", ""],  # the third differs by its precision, the fourth not at all
+        [True, False, True, True],  # the third differs by its precision, the fourth not at all
     )
     assert (agreed.differing, agreed.other_precision, agreed.no_rule) == (3, 1, 1)
-    assert "1 without a Rule in the file, so measured with the paper's rule" in agreed.text
+    assert "1 without a Rule in a file of a version that records it" in agreed.text
     assert "1 on a mesh or with a version other than the file's" in agreed.text

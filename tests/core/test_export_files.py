@@ -88,9 +88,15 @@ def test_an_export_with_edges_refuses_to_replace_a_file_that_is_not_a_summary(tm
     notes = tmp_path / "site_edges.csv"
     notes.write_text("my notes, not a summary\n", encoding="utf-8")
     edges = [] if summary else [EDGE]
-    with pytest.raises(GoniometerError, match="holds another file"):
+    with pytest.raises(GoniometerError, match="lacks Edge #, Points and Spacing"):
         csvio.write_export(out, [*ROWS, STATION], edges, summary=summary)
     assert notes.read_text(encoding="utf-8") == "my notes, not a summary\n"
     assert not out.exists()
-    notes.write_text("", encoding="utf-8")
-    assert csvio.write_export(out, [*ROWS, STATION], edges, summary=summary) == notes
+    # A summary re-saved with semicolons is not read as one: refused, saying so.
+    notes.write_text("Edge #;Points;Spacing\n1;0 0 0;1\n", encoding="utf-8")
+    with pytest.raises(GoniometerError, match="semicolon"):
+        csvio.write_export(out, [*ROWS, STATION], edges, summary=summary)
+    for blank in (b"", b"\n", b"\r\n", b"\xef\xbb\xbf", b"\xef\xbb\xbf  \r\n"):  # no one's notes
+        notes.write_bytes(blank)
+        assert csvio.write_export(out, [*ROWS, STATION], edges, summary=summary) == notes
+        assert csvio.is_edges_csv(notes)

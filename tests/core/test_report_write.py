@@ -96,13 +96,14 @@ def test_a_compare_name_that_several_sessions_share_is_refused_with_its_reason(t
 
 def drag_sessions(folder, rows_of):
     """Two drag sessions of one observer on three breaks; ``rows_of(repetition, break)`` gives
-    each row's x, radius and vertex count."""
+    each row's x, radius and vertex count (and y, else 0)."""
     paths = []
     for repetition in (1, 2):
         lines = ["Mesh,Break #,Angle,x,y,z,Radius,Number of Vertices"]
         for number in (1, 2, 3):
-            x, radius, vertices = rows_of(repetition, number)
-            lines.append(f"m,{number},{90 + repetition + number},{x},0,0,{radius},{vertices}")
+            x, radius, vertices, *y = rows_of(repetition, number)
+            y = y[0] if y else 0
+            lines.append(f"m,{number},{90 + repetition + number},{x},{y},0,{radius},{vertices}")
         path = folder / f"obs1_drag_{repetition}.csv"
         path.write_text("\n".join(lines) + "\n", encoding="utf-8")
         paths.append(path)
@@ -115,6 +116,11 @@ def drag_sessions(folder, rows_of):
         # Squares of centre distances past 1e154 overflowed: OverflowError out of the report.
         ("far centres", lambda rep, _: (1e200 if rep == 1 else -1e200, 1, 100)),
         ("centres at the float limit", lambda rep, _: (1e308 if rep == 1 else -1e308, 1, 100)),
+        # Finite squares whose sum overflows: fsum raised instead of giving inf.
+        (
+            "squares summing past the limit",
+            lambda rep, _: (1.2e154 * (rep == 1), 1, 100, 1.2e154 * (rep == 1)),
+        ),
         # Radius IOVs near the float limit: fsum's running sum of them overflowed the same way.
         ("huge radii", lambda rep, number: (0.1 * rep, 1e308 if rep == 1 else 1, 100 + number)),
     ],

@@ -342,7 +342,10 @@ def load_sessions(paths, methods=None, observers=None) -> Loaded:
 def distance(a, b) -> float:
     """Euclidean distance between two centres, summed in a fixed order."""
     differences = [p - q for p, q in zip(a, b, strict=True)]
-    total = math.fsum(d * d for d in differences)
+    try:
+        total = math.fsum(d * d for d in differences)
+    except OverflowError:  # finite squares whose sum is not
+        total = math.inf
     if math.isinf(total):  # centres beyond 1e154 apart: their squares overflow, not the distance
         return math.hypot(*differences)
     return math.sqrt(total)

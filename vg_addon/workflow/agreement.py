@@ -33,8 +33,9 @@ class Agreement:
     stale : int
         Rows not compared: the file marks them Stale.
     no_rule : int
-        Differing rows (at the file's precision) whose file names no rule: they were measured
-        with the paper's rule, as such rows are.
+        Differing rows (at the file's precision) with no Rule though their file is of a version
+        that records it (their Convexity is filled: the Rule column was deleted or emptied):
+        they were measured with the paper's rule, as rows without a rule are.
     """
 
     compared: int
@@ -61,9 +62,9 @@ class Agreement:
                 )
             if self.no_rule:
                 why.append(
-                    f"{self.no_rule} without a Rule in the file, so measured with the paper's "
-                    "rule, as rows of MeshLab's and earlier files are (a Rule column names "
-                    "another)"
+                    f"{self.no_rule} without a Rule in a file of a version that records it, so "
+                    "measured with the paper's rule, as rows without one are (a Rule column "
+                    "names another)"
                 )
             if self.differing > self.other_precision + self.no_rule:
                 why.append(
@@ -88,7 +89,7 @@ def agreement(
     file_precisions: Sequence[str],
     precisions: Sequence[str],
     stale: Sequence[bool],
-    file_rules: Sequence[str] | None = None,
+    rule_missing: Sequence[bool] | None = None,
 ) -> Agreement:
     """Compare a file's angles with the same rows re-measured.
 
@@ -103,8 +104,8 @@ def agreement(
         ``"float64"``, or empty where not known).
     stale : sequence of bool
         Each row's ``Stale`` cell in the file.
-    file_rules : sequence of str, optional
-        Each row's ``Rule`` in the file (empty where it names none).
+    rule_missing : sequence of bool, optional
+        Each row: its file is of a version that records the rule, but its ``Rule`` is empty.
 
     Returns
     -------
@@ -112,9 +113,9 @@ def agreement(
     """
     compared = differing = other_precision = passed_over = no_rule = 0
     largest = 0.0
-    rules = [""] * len(recorded) if file_rules is None else file_rules
-    rows = zip(recorded, remeasured, file_precisions, precisions, stale, rules, strict=True)
-    for old, new, old_precision, new_precision, was_stale, rule in rows:
+    missing = [False] * len(recorded) if rule_missing is None else rule_missing
+    rows = zip(recorded, remeasured, file_precisions, precisions, stale, missing, strict=True)
+    for old, new, old_precision, new_precision, was_stale, no_rule_here in rows:
         if was_stale:
             passed_over += 1
             continue
@@ -125,7 +126,7 @@ def agreement(
             differing += 1
             precision_differs = bool(old_precision and new_precision != old_precision)
             other_precision += precision_differs
-            no_rule += file_rules is not None and not precision_differs and not rule.strip()
+            no_rule += bool(no_rule_here) and not precision_differs
             largest = max(largest, abs(new - old))
     return Agreement(compared, differing, largest, other_precision, passed_over, no_rule)
 
@@ -139,5 +140,5 @@ def agreement_of_rows(file_rows: Sequence, remeasured: Sequence, precisions: Seq
         [row.precision for row in file_rows],
         precisions,
         [row.stale for row in file_rows],
-        [row.rule for row in file_rows],
+        [not row.rule.strip() and bool(row.convexity.strip()) for row in file_rows],
     )

@@ -30,6 +30,24 @@ def holds_edge_summary(path) -> bool:
         return False
 
 
+def _not_a_summary(path) -> str:
+    """Why the file at ``path`` is not an edge summary the export may replace; ``""`` where it
+    is one, or there is none, or it holds nothing but blanks (and a byte-order mark)."""
+    if not os.path.isfile(path):
+        return ""
+    try:
+        with open(path, "rb") as handle:
+            start = handle.read(4096)
+    except OSError as error:
+        return error.strerror or str(error)
+    if not start.removeprefix(b"\xef\xbb\xbf").strip():
+        return ""
+    try:
+        return "" if is_edges_csv(path) else "its header lacks Edge #, Points and Spacing"
+    except (OSError, GoniometerError) as error:
+        return str(error).split("\n")[0].split(". ")[0]  # what it is, not the advice
+
+
 class SummaryWriteError(GoniometerError):
     """The measurement CSV was written, its edge summary was not (the message names both).
 
@@ -89,16 +107,11 @@ def write_export(
     edges_text = format_edges_csv(edge_rows).encode("utf-8") if with_edges else b""
     if with_edges:
         output_target(edges_path)
-        if (
-            is_file
-            and os.path.isfile(edges_path)
-            and os.path.getsize(edges_path) > 0
-            and not holds_edge_summary(edges_path)
-        ):
+        if is_file and (why := _not_a_summary(edges_path)):
             raise GoniometerError(
-                f"{edges_path}, where the edge summary goes, holds another file (not an edge "
-                "summary this extension wrote): it is left alone, and nothing was written. Move "
-                "it, or write the CSV under another name."
+                f"{edges_path}, where the edge summary goes, holds a file this extension does "
+                f"not read as its edge summary ({why}): it is left alone, and nothing was "
+                "written. Move it, or write the CSV under another name."
             )
     replace_atomically(path, csv_text)
     if not with_edges:
