@@ -32,8 +32,6 @@ FINDER_SETTINGS = (
 """The finder's settings on the command line (flag, metavar, argument name); each needs
 --find-edges."""
 
-# --render-size and --render-samples: a map's cost grows with pixels times samples, and Cycles
-# cannot be stopped inside a view, so both are bounded before anything is rendered.
 # argparse takes an argument for a negative number only in plain notation (-0.05, not -5e-2,
 # which this project's own CSVs write) and reads anything else starting with "-" as an option;
 # this is the pattern it is given instead (not-finite values get through to their refusal).
@@ -41,6 +39,8 @@ NEGATIVE_NUMBER = re.compile(
     r"^-(?:(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|inf|infinity|nan)$", re.IGNORECASE
 )
 
+# --render-size and --render-samples: a map's cost grows with pixels times samples, and Cycles
+# cannot be stopped inside a view, so both are bounded before anything is rendered.
 MAX_RENDER_SIDE = 8192
 MAX_RENDER_SAMPLES = 4096
 

@@ -107,7 +107,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     while measuring.
     """
     result = MeshResult(mesh=index)
-    units = given_units_label(options.get("units")) or records.units_label(bpy.context.scene)
+    units = run_units_label(options.get("units"))
     name = source.name
 
     def fail_all(message: str) -> MeshResult:
@@ -325,10 +325,11 @@ def exact_surface(source: MeshSource, points: np.ndarray, geometry) -> Surface:
 SCAN_UNITS = {"m": "M", "cm": "CM", "mm": "MM", "um": "UM", "in": "IN"}
 
 
-def given_units_label(unit: str | None) -> str | None:
-    """The Units cell of a run whose ``--units`` is ``unit`` (None: without, or ``none``)."""
+def run_units_label(unit: str | None) -> str:
+    """The Units cell of a row with no object to label it (a row that failed before one was
+    measured on): the symbol of the run's ``--units`` ``unit``, else the scene's label."""
     key = SCAN_UNITS.get(unit or "")
-    return units_module.SYMBOLS[key] if key else None
+    return units_module.SYMBOLS[key] if key else records.units_label(bpy.context.scene)
 
 
 def set_units(scene, unit: str | None) -> None:
@@ -366,7 +367,7 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, 
         if sent:  # the rows are out: only the pictures are lost
             sent[0].picture_errors.append(f"pictures of {source.name}: {message}")
             return sent[0]
-        units = given_units_label(options.get("units")) or records.units_label(bpy.context.scene)
+        units = run_units_label(options.get("units"))
         result = MeshResult(mesh=index, failed=len(tasks))
         result.rows = [(t.index, error_row(t, source.name, message, units)) for t in tasks]
         ready(result)

@@ -13,7 +13,6 @@ from pathlib import Path
 
 import bpy
 
-from ..bridge import records
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, files
@@ -26,7 +25,7 @@ from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError
 from .edges import edge_specs, profiled, spec_applies
 from .find_edges import find_options
-from .measure import MeshResult, error_row, given_units_label, safe_measure_mesh, set_units
+from .measure import MeshResult, error_row, run_units_label, safe_measure_mesh, set_units
 from .outputs import check_outputs, input_files, make_folders, sweep_paths
 from .pictures import reason
 from .sources import blend_objects, file_sources, start_file
@@ -56,9 +55,7 @@ class Run:
         self.last_write = 0.0  # when the CSV was last written (perf_counter seconds)
         self.write_seconds = 0.0  # how long that took
         self.in_flight: dict[int, int] = {}  # mesh -> points done so far (running meshes)
-        self.units = given_units_label(getattr(args, "units", None)) or records.units_label(
-            bpy.context.scene
-        )
+        self.units = run_units_label(getattr(args, "units", None))
         # A pipe or standard output gets the CSV once, at the end; a file is rewritten as the
         # meshes finish, so a run that is stopped keeps what it measured.
         self.stream = files.output_target(args.out) == "stream"

@@ -18,34 +18,33 @@ from ..files import output_target, replace_atomically
 from .edges import EdgeRow, edges_path_for, format_edges_csv, is_edges_csv
 from .measurements import MeasurementRow, format_measurements_csv
 
+#: :func:`_summary_place`'s words for a place the export may write its summary into.
+_EMPTY, _SUMMARY = "empty", "summary"
 
-def holds_edge_summary(path) -> bool:
-    """Whether ``path`` holds an edge summary an earlier export wrote. Any other file of that
-    name (a points list, the user's notes) is not this export's to empty."""
+
+def _summary_place(path) -> str:
+    """What the file at ``path`` is to an export: ``_EMPTY`` (none there, or nothing but blanks
+    and a byte-order mark), ``_SUMMARY`` (an edge summary an earlier export wrote), or why it is
+    not an edge summary the export may replace."""
     if not os.path.isfile(path):
-        return False
-    try:
-        return is_edges_csv(path)
-    except (OSError, GoniometerError):
-        return False
-
-
-def _not_a_summary(path) -> str:
-    """Why the file at ``path`` is not an edge summary the export may replace; ``""`` where it
-    is one, or there is none, or it holds nothing but blanks (and a byte-order mark)."""
-    if not os.path.isfile(path):
-        return ""
+        return _EMPTY
     try:
         with open(path, "rb") as handle:
             start = handle.read(4096)
     except OSError as error:
         return error.strerror or str(error)
     if not start.removeprefix(b"\xef\xbb\xbf").strip():
-        return ""
+        return _EMPTY
     try:
-        return "" if is_edges_csv(path) else "its header lacks Edge #, Points and Spacing"
+        return _SUMMARY if is_edges_csv(path) else "its header lacks Edge #, Points and Spacing"
     except (OSError, GoniometerError) as error:
         return str(error).split("\n")[0].split(". ")[0]  # what it is, not the advice
+
+
+def holds_edge_summary(path) -> bool:
+    """Whether ``path`` holds an edge summary an earlier export wrote. Any other file of that
+    name (a points list, the user's notes) is not this export's to empty."""
+    return _summary_place(path) == _SUMMARY
 
 
 class SummaryWriteError(GoniometerError):
@@ -103,14 +102,15 @@ def write_export(
     edges_path = edges_path_for(path)
     csv_text = format_measurements_csv(rows, lines=lines).encode("utf-8")
     is_file = output_target(path) == "file"
-    with_edges = bool(edge_rows) or summary or (is_file and holds_edge_summary(edges_path))
+    place = _summary_place(edges_path) if is_file else _EMPTY  # read once
+    with_edges = bool(edge_rows) or summary or place == _SUMMARY
     edges_text = format_edges_csv(edge_rows).encode("utf-8") if with_edges else b""
     if with_edges:
         output_target(edges_path)
-        if is_file and (why := _not_a_summary(edges_path)):
+        if place not in (_EMPTY, _SUMMARY):
             raise GoniometerError(
                 f"{edges_path}, where the edge summary goes, holds a file this extension does "
-                f"not read as its edge summary ({why}): it is left alone, and nothing was "
+                f"not read as its edge summary ({place}): it is left alone, and nothing was "
                 "written. Move it, or write the CSV under another name."
             )
     replace_atomically(path, csv_text)
