@@ -96,16 +96,18 @@ def _surfaces(package: str, quick: bool) -> list:
 
 
 def readings(package: str, quick: bool) -> list:
-    """Every case's readings (records, or ``("refused", text)``) with the core ``package``."""
+    """Every case's readings (records, or ``("refused", text)``) with the core ``package``, each
+    with what was measured: ``(case, radius, call)``."""
     refused = importlib.import_module(package + ".errors").GoniometerError
     goniometer = importlib.import_module(package + ".method.algorithm").goniometer
     out = []
 
     def take(measure, *args, **kwargs):
+        what = (name, None if measure is goniometer else args[1], kwargs)
         try:
-            out.append(_record(measure(*args, **kwargs)))
+            out.append((what, _record(measure(*args, **kwargs))))
         except refused as error:
-            out.append(("refused", str(error)))
+            out.append((what, ("refused", str(error))))
 
     for name, surface, where, radii in _surfaces(package, quick):
         draw = np.random.default_rng(len(name)).integers(0, len(where), 6 if quick else 14)
@@ -126,11 +128,14 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--commit", default=REFINED_SPEED_BASE, help="the core to compare with")
     parser.add_argument("--quick", action="store_true", help="fewer cases (about a quarter)")
+    parser.add_argument("--show", type=int, default=5, help="how many differences to print")
     args = parser.parse_args(argv)
     name = "vg_addon_at_" + "".join(c for c in args.commit if c.isalnum())
     if _core_at(args.commit, name) is None:
         return 1
     before, now = readings(name, args.quick), readings("vg_addon", args.quick)
+    cases = [what for what, _ in now]
+    before, now = [record for _, record in before], [record for _, record in now]
     differ = [k for k, (a, b) in enumerate(zip(before, now, strict=True)) if a != b]
     refusals = sum(1 for record in before if record[0] == "refused")
     applied = sum(
@@ -143,9 +148,16 @@ def main(argv=None) -> int:
         f"NumPy {np.__version__}: {len(before)} measurements ({refusals} refusals, the refinement "
         f"applied in {applied}) against {args.commit}: {len(differ)} differ"
     )
-    for k in differ[:5]:
+    for k in differ[: args.show]:
+        case, radius, options = cases[k]
+        at = "a given patch" if radius is None else f"radius {radius:.3g}"
+        where = f"  measurement {k} ({case}, {at}, {options or 'defaults'}):"
+        if "refused" in (before[k][0], now[k][0]):
+            print(where, " -> ".join(record[1][:90] if record[0] == "refused" else "measured"
+                                     for record in (before[k], now[k])))  # fmt: skip
+            continue
         fields = [a[0] for a, b in zip(before[k], now[k], strict=False) if a != b]
-        print(f"  measurement {k}: {', '.join(map(str, fields))}")
+        print(where, ", ".join(map(str, fields)))
     return 1 if differ else 0
 
 

@@ -33,6 +33,12 @@ MAX_LAMBDA = 1e6
 FLAT_TOLERANCE_DEG = 0.5
 """Angles closer than this to 180° mean the patch holds no break edge."""
 
+CREASE_REACH = 1.0
+"""Under the refined rule, the line where the two fitted planes meet must pass within this many
+radii of the centre: farther, the edge they measure is not in the patch (the patch reaches past
+the two faces at the edge and fitted others, or the centre is off the edge). Every right reading
+of the validation cases lies within 0.4 radii (docs/METHOD.md)."""
+
 RULES = ("refined", "oriented", "paper")
 """How a measurement is taken. ``"oriented"`` multiplies the position term of the projection by
 the sign of the covariance between ``Nᵀb`` and ``(X − x̄)ᵀb``, which makes concave edges and
@@ -202,12 +208,12 @@ def _checked_angle(normal_plus, normal_minus) -> float:
     return angle
 
 
-def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray, list]:
+def _split_and_fit(points, joined, projection) -> tuple[dict, tuple, list]:
     """Steps 9-13 of Algorithm 1: the WithinSS split of ``projection`` and a plane per side.
 
-    Returns the measured fields, the step from the "−" side's centroid to the "+" side's (their
-    own vertices), and each side's plane as (normal, centroid, fit error), ``None`` for a side
-    that borrowed a row (the refinement's first round starts from these).
+    Returns the measured fields, the centroids of the "+" and "−" sides' own vertices, and each
+    side's plane as (normal, centroid, fit error), ``None`` for a side that borrowed a row (the
+    refinement's first round starts from these).
     """
     threshold, _ = withinss_split(projection, min_size=MIN_SIDE_VERTICES)
     labels = projection >= threshold
@@ -232,14 +238,38 @@ def _split_and_fit(points, joined, projection) -> tuple[dict, np.ndarray, list]:
         None if shared_plus else (normal_plus, mean_plus, error_plus),
         None if shared_minus else (normal_minus, mean_minus, error_minus),
     ]
-    return fields, mean_plus - mean_minus, planes
+    return fields, (mean_plus, mean_minus), planes
 
 
-def _planes_form_ridge(fields, step) -> bool:
+def _planes_form_ridge(fields, centroids) -> bool:
     """Whether the fitted planes meet in a ridge (convex) rather than a valley, relative to their
-    normals: moving from the "−" side's centroid to the "+" side's (``step``), the normal turns the
-    same way."""
-    return dot3(step, fields["normal_plus"] - fields["normal_minus"]) > 0
+    normals: moving from the "−" side's centroid to the "+" side's, the normal turns the same
+    way."""
+    return dot3(centroids[0] - centroids[1], fields["normal_plus"] - fields["normal_minus"]) > 0
+
+
+def _check_crease_in_patch(fields, centroids, center, radius) -> None:
+    """Refuse where the line the two fitted planes meet in passes farther than
+    :data:`CREASE_REACH` radii from ``center`` (each plane through its side's ``centroids``)."""
+    (p0, p1, p2), (m0, m1, m2) = fields["normal_plus"].tolist(), fields["normal_minus"].tolist()
+    (c0, c1, c2), (a0, a1, a2), (b0, b1, b2) = (v.tolist() for v in (center, *centroids))
+    off_plus = (a0 - c0) * p0 + (a1 - c1) * p1 + (a2 - c2) * p2
+    off_minus = (b0 - c0) * m0 + (b1 - c1) * m1 + (b2 - c2) * m2
+    cosine = p0 * m0 + p1 * m1 + p2 * m2
+    # The squared distance to the line, (e₊² + e₋² − 2 c e₊ e₋) / (1 − c²), compared without
+    # dividing: 1 − c² is at least sin²(0.5°) once the flat and folded refusals have passed.
+    reach = CREASE_REACH * radius
+    spread = off_plus * off_plus + off_minus * off_minus - 2.0 * cosine * off_plus * off_minus
+    if spread <= reach * reach * (1.0 - cosine * cosine):
+        return
+    distance = math.sqrt(spread / (1.0 - cosine * cosine))
+    raise GoniometerError(
+        f"The two fitted planes (which would read {fields['angle']:.2f}°) meet {distance:.3g} from the "
+        f"centre, outside the patch (radius {radius:.3g}), so the edge they measure is not the "
+        "one at the centre: the patch reaches past the two faces at the edge and fitted other "
+        "faces, or the centre is not on a break edge. Use a radius that covers just the two "
+        "faces at the edge (look at the coloured sides), or move the centre onto the edge."
+    )
 
 
 def measure_patch(
@@ -291,7 +321,7 @@ def measure_patch(
     joined = np.concatenate((points, normals), axis=1)
     weak = abs(correlation) < WEAK_CORRELATION
     if not (oriented and weak and lam > 0):
-        fields, step, planes = _split_and_fit(points, joined, projection(orientation))
+        fields, centroids, planes = _split_and_fit(points, joined, projection(orientation))
         other_angle = None
     else:
         # The sign is weakly determined: measure with both and keep the better plane fit.
@@ -303,11 +333,11 @@ def measure_patch(
                 refusal = error
         if not readings:
             raise refusal
-        orientation, fields, step, planes = min(readings, key=lambda r: r[1]["fit_error"])
+        orientation, fields, centroids, planes = min(readings, key=lambda r: r[1]["fit_error"])
         other_angle = next(
             (r["angle"] for sign, r, *_ in readings if sign != orientation), fields["angle"]
         )
-    if weak or _planes_form_ridge(fields, step) != (correlation >= 0):
+    if weak or _planes_form_ridge(fields, centroids) != (correlation >= 0):
         convexity = "unclear"
     else:
         convexity = "convex" if correlation >= 0 else "concave"
@@ -323,7 +353,8 @@ def measure_patch(
         orientation_difference=0.0 if other_angle is None else abs(other_angle - fields["angle"]),
     )
     if rule == "refined":
-        _refine(points, normals, center, radius, fields, planes)
+        centroids = _refine(points, normals, center, radius, fields, planes) or centroids
+        _check_crease_in_patch(fields, centroids, center, radius)
     return fields
 
 
@@ -353,9 +384,10 @@ def _check_shared_row(points, labels, spacing) -> None:
         )
 
 
-def _refine(points, normals, center, radius, fields, planes) -> None:
-    """Replace Algorithm 1's planes by :func:`refine_sides`' where it applies (in place);
-    ``planes``: Algorithm 1's, as :func:`_split_and_fit` returns them."""
+def _refine(points, normals, center, radius, fields, planes) -> tuple | None:
+    """Replace Algorithm 1's planes by :func:`refine_sides`' where it applies (in place) and
+    return a point on each of them, or ``None`` where Algorithm 1's are kept; ``planes``:
+    Algorithm 1's, as :func:`_split_and_fit` returns them."""
     if fields["n_shared"]:
         _check_shared_row(points, fields["labels"], mean_edge_length(radius, points.shape[0]))
     refined = refine_sides(
@@ -369,12 +401,13 @@ def _refine(points, normals, center, radius, fields, planes) -> None:
         planes,
     )
     if refined is None:
-        return
+        return None
     try:
         angle = _checked_angle(refined["normal_plus"], refined["normal_minus"])
     except GoniometerError:
-        return  # the refined planes would be refused: keep Algorithm 1's reading
+        return None  # the refined planes would be refused: keep Algorithm 1's reading
     labels, used = refined.pop("labels"), refined.pop("used")
+    centroids = refined.pop("centroids")
     fields.update(
         refined,
         split_angle=fields["angle"],
@@ -385,6 +418,7 @@ def _refine(points, normals, center, radius, fields, planes) -> None:
         n_left_out=int((~used).sum()),
         left_out=~used,
     )
+    return centroids
 
 
 def as_points(name: str, values, *, allow_empty: bool = False) -> np.ndarray:

@@ -324,6 +324,7 @@ def _fields(plus, used, planes) -> dict:
         "fit_error_plus": planes[0][2],
         "fit_error_minus": planes[1][2],
         "fit_error": planes[0][2] + planes[1][2],
+        "centroids": (planes[0][1], planes[1][1]),
     }
 
 
@@ -550,7 +551,8 @@ def refine_sides(points, normals, labels, center, radius, spacing, split_error, 
     Returns
     -------
     dict or None
-        The refined fields (``labels``, ``used``, the two planes' normals and fit errors), or
+        The refined fields (``labels``, ``used``, the two planes' normals, fit errors and
+        ``centroids``, a point on each), or
         ``None`` where the refinement does not apply: nothing moved, a side ran out of vertices or
         no longer spans a plane, or one of the conditions in the module's description fails.
 
