@@ -531,6 +531,16 @@ def check_args(args) -> None:
             f"{args.edges_csv} keeps its own Spacing and Radius (edit those cells to measure "
             "with others)."
         )
+    if (
+        args.radius is not None
+        and summary_only
+        and not (args.edge or args.find_edges or args.at or args.points)
+    ):
+        raise UsageError(
+            "--radius is for --at, --points, --edge, --find-edges and .pp files: each row of the "
+            f"edge summary {args.edges_csv} keeps its own Spacing and Radius (edit those cells "
+            "to measure with others)."
+        )
     if (args.edge or args.edges_csv) and (args.jobs > 1 or args.shard):
         raise UsageError("edges are measured in this process: drop --jobs and --shard.")
     check_find_edges(args)

@@ -433,3 +433,20 @@ def test_a_spacing_for_an_edge_summarys_rows_is_refused_naming_why(scan, tmp_pat
     assert [r.angle for r in csvio.read_measurements_csv(replay)] == [
         r.angle for r in csvio.read_measurements_csv(first)
     ]
+
+
+def test_a_radius_for_an_edge_summarys_rows_is_refused_unless_points_take_it(scan, tmp_path):
+    """Each row of an edge summary keeps its own Radius: --radius with only --edges SUMMARY did
+    nothing, silently (before). Beside --at it is the points' radius, and it is used."""
+    first = tmp_path / "first.csv"
+    ok(batch(scan, *EDGE, "--spacing", "0.2", "--out", first))
+    summary = csvio.edges_path_for(first)
+    again = batch(scan, "--edges", summary, "--radius", "0.2", "--out", tmp_path / "again.csv")
+    assert again.returncode == 2 and "keeps its own Spacing and Radius" in again.stderr
+    assert "--radius is for" in again.stderr
+    assert not (tmp_path / "again.csv").exists()
+    both = tmp_path / "both.csv"
+    ok(batch(scan, "--edges", summary, "--at", "0.05", "0", "0", "--radius", "0.2", "--out", both))
+    rows = csvio.read_measurements_csv(both)
+    edge_rows = csvio.read_measurements_csv(first)
+    assert {r.radius for r in rows} == {0.2, edge_rows[0].radius}  # the point's and the edge's
