@@ -22,7 +22,7 @@ from ..vg_addon.method.winding import winding_message
 from ..vg_addon.workflow import agreement, batchplan
 from . import extension
 from .blend_file import append_objects, forget, save_blend
-from .cli import UsageError
+from .cli import UsageError, is_picked_points
 from .edges import edge_specs, profiled, spec_applies
 from .find_edges import find_options
 from .measure import MeshResult, error_row, run_units_label, safe_measure_mesh, set_units
@@ -108,6 +108,22 @@ class Run:
         )
         if agreed.text:
             self.say(f"re-measured {Path(self.args.points).name}: " + agreed.text[2:])
+
+    def say_edge_agreement(self) -> None:
+        """After re-measuring an edge summary (``--edges CSV``): a line saying how the edges'
+        figures agree with the file's (``workflow.agreement.edge_agreement``)."""
+        path = self.args.edges_csv
+        if not path or is_picked_points(path):
+            return
+        try:
+            file_rows = csvio.read_edges_csv(Path(path))
+        except (GoniometerError, OSError, ValueError):
+            return  # read when the run was planned; gone or changed since: nothing to compare
+        agreed = agreement.edge_agreement(
+            file_rows, self.profiled_edges, by_name=not self.args.ignore_mesh_names
+        )
+        if agreed.text:
+            self.say(f"re-measured {Path(path).name}: " + agreed.text[2:])
 
     def say_flagged(self, by_index: dict) -> None:
         """The summary's lines for unstable readings (points, then edge stations): how many,
@@ -329,6 +345,7 @@ class Run:
         by_index = {t.index: t for t in self.tasks}
         self.say_flagged(by_index)
         self.say_agreement()
+        self.say_edge_agreement()
         for index, row in failed[:10]:
             task = by_index[index]
             where = f"row {task.source_row}" if task.source_row else f"point {task.number}"

@@ -5,6 +5,7 @@ bounded before they are allocated, names as the user gave them. Run as a user ru
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import importlib
 import math
 import os
@@ -433,6 +434,32 @@ def test_a_spacing_for_an_edge_summarys_rows_is_refused_naming_why(scan, tmp_pat
     assert [r.angle for r in csvio.read_measurements_csv(replay)] == [
         r.angle for r in csvio.read_measurements_csv(first)
     ]
+
+
+def test_an_edge_summary_replayed_says_whether_its_figures_came_back(scan, tmp_path):
+    """A replay of --edges CSV said nothing of the file's figures (before), so an edge that came
+    back with other stations passed unnoticed. The oracle: the file's own cells, edited."""
+    first = tmp_path / "first.csv"
+    ok(batch(scan, *EDGE, "--spacing", "0.2", "--out", first))
+    summary = csvio.edges_path_for(first)
+    same = ok(batch(scan, "--edges", summary, "--out", tmp_path / "same.csv"))
+    assert (
+        "re-measured first_edges.csv: all 1 edges' stations, mean, min, max and pooled angle "
+        "equal the file's exactly"
+    ) in same.stderr
+    (row,) = csvio.read_edges_csv(summary)
+    edited = tmp_path / "edited_edges.csv"
+    csvio.write_edges_csv(edited, [dataclasses.replace(row, mean=row.mean + 0.5)])
+    moved = ok(batch(scan, "--edges", edited, "--out", tmp_path / "moved.csv"))
+    assert (
+        f"re-measured edited_edges.csv: 1 of 1 edges differ from the file's figures (row 2: "
+        f"mean {row.mean + 0.5:.4f}° → {row.mean:.4f}°)"
+    ) in moved.stderr
+    csvio.write_edges_csv(edited, [dataclasses.replace(row, stale=True)])
+    stale = ok(batch(scan, "--edges", edited, "--out", tmp_path / "stale.csv"))
+    assert "1 edge(s) marked Stale (measured before the mesh was edited) not compared" in (
+        stale.stderr
+    )
 
 
 def test_a_radius_for_an_edge_summarys_rows_is_refused_unless_points_take_it(scan, tmp_path):

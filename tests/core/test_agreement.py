@@ -65,3 +65,45 @@ def test_rows_whose_rule_was_dropped_are_said_to_be_measured_with_the_papers_rul
     assert (agreed.differing, agreed.other_precision, agreed.no_rule) == (3, 1, 1)
     assert "1 without a Rule in a file of a version that records it" in agreed.text
     assert "1 on a mesh or with a version other than the file's" in agreed.text
+
+
+def test_edges_are_matched_by_their_points_and_each_change_is_named():
+    from vg_addon.formats.csvio import EdgeRow
+    from vg_addon.workflow.agreement import LISTED_EDGES, edge_agreement
+
+    def edge(number, points, mean, mesh="bone", **fields):
+        return EdgeRow(mesh_name=mesh, edge_number=number, points=points, mean=mean,
+                       n_stations=5, min=mean - 1, max=mean + 1, pooled_angle=mean, **fields)  # fmt: skip
+
+    file_rows = [
+        edge(1, "0 0 0; 1 0 0", 90.0, row_number=2),
+        edge(2, "0 1 0; 1 1 0", 80.0, row_number=3),
+        edge(3, "0 2 0; 1 2 0", 70.0, row_number=4, error="not measured"),
+        edge(4, "0 3 0; 1 3 0", 60.0, row_number=5, stale=True),
+    ]
+    # A replay numbers its edges afresh and in its own order.
+    replayed = [
+        edge(7, "0 1 0; 1 1 0", 80.25),
+        edge(8, "0 0 0; 1 0 0", 90.0),
+        edge(9, "0 3 0; 1 3 0", 61.0),
+        edge(10, "5 5 5; 6 5 5", 10.0),  # given on the command line: in no row
+    ]
+    agreed = edge_agreement(file_rows, replayed)
+    assert (agreed.compared, agreed.stale) == (2, 1)
+    assert agreed.differing == [
+        "row 3: mean 80.0000° → 80.2500°, min 79.0000° → 79.2500°, max 81.0000° → 81.2500°, "
+        "pooled angle 80.0000° → 80.2500°"
+    ]
+    assert agreed.text.startswith("; 1 of 2 edges differ from the file's figures (row 3: ")
+    # Another mesh's edge through the same points is not this row's, unless names are ignored.
+    elsewhere = [edge(1, "0 0 0; 1 0 0", 91.0, mesh="other")]
+    assert edge_agreement(file_rows[:1], elsewhere).text == ""
+    assert (
+        edge_agreement(file_rows[:1], elsewhere, by_name=False)
+        .differing[0]
+        .startswith("row 2: mean 90.0000° → 91.0000°")
+    )
+    many = [edge(n, f"{n} 0 0; 9 9 9", 50.0, row_number=n + 1) for n in range(LISTED_EDGES + 2)]
+    moved = [edge(n, f"{n} 0 0; 9 9 9", 51.0) for n in range(LISTED_EDGES + 2)]
+    text = edge_agreement(many, moved).text
+    assert "; and 2 more)" in text and text.count("row ") == LISTED_EDGES

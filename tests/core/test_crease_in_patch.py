@@ -72,3 +72,24 @@ def test_a_patch_past_the_edges_faces_is_refused_not_read(annulus, radius):
     assert abs(wrong - CUT_OUTER_ANGLE) > 40.0
     with pytest.raises(GoniometerError, match="outside the patch"):
         annulus.measure(CUT_OUTER, radius)
+
+
+def test_the_refusal_says_how_far_in_radii(wedge_patch):
+    with pytest.raises(GoniometerError, match=r"1\.50 times the radius"):
+        goniometer(*wedge_patch, center=[0.1, 0.0, 1.5 * RADIUS], radius=RADIUS)
+
+
+def test_a_near_flat_reading_refused_advises_a_larger_radius():
+    # A 176° wedge measured from a centre beside its crease, out of the patch's reach: the
+    # advice for near-flat planes is another radius, not a smaller patch.
+    mesh = wedge(176, n=60)
+    surface = Surface(mesh.points, mesh.triangles)
+    ids = surface.patch(surface.snap([0.0, 0.0, 0.0], RADIUS)[0], RADIUS)
+    with pytest.raises(GoniometerError, match="nearly parallel") as refusal:
+        goniometer(surface.points[ids], surface.normals[ids], center=[0, 0, -0.6], radius=RADIUS)
+    assert "larger radius" in str(refusal.value)
+
+
+def test_a_centre_beyond_the_coordinate_limit_is_refused_as_such(wedge_patch):
+    with pytest.raises(GoniometerError, match="The centre reaches 1e\\+200"):
+        goniometer(*wedge_patch, center=[1e200, 0.0, 0.0], radius=1.0)

@@ -232,7 +232,8 @@ class Surface:
         GoniometerError
             Centre farther than ``radius`` from the surface, bad radius or λ, unknown patch mode,
             too few vertices, float32 coordinates rounded too coarsely for the patch, a flat
-            patch, or a side that is a line.
+            patch, a side that is a line, or (refined rule) two fitted planes that meet farther
+            than the radius from the centre.
         """
         requested = as_center(center)
         radius = as_radius(radius)

@@ -142,3 +142,102 @@ def agreement_of_rows(file_rows: Sequence, remeasured: Sequence, precisions: Seq
         [row.stale for row in file_rows],
         [not row.rule.strip() and bool(row.convexity.strip()) for row in file_rows],
     )
+
+
+EDGE_FIGURES = (
+    ("n_stations", "stations"),
+    ("mean", "mean"),
+    ("min", "min"),
+    ("max", "max"),
+    ("pooled_angle", "pooled angle"),
+)
+"""The figures of an edge summary row compared after a replay (field, as said), in order."""
+
+LISTED_EDGES = 5
+"""How many differing edges a report names; the rest are counted."""
+
+
+def _figure_text(field: str, value) -> str:
+    if value is None:
+        return "none"
+    return f"{value:d}" if field == "n_stations" else f"{value:.4f}°"
+
+
+@dataclasses.dataclass(frozen=True)
+class EdgeAgreement:
+    """How re-measured edges agree with an edge summary file's rows.
+
+    Attributes
+    ----------
+    compared : int
+        Edges of the file that were measured again (matched by their ``Points``).
+    differing : list of str
+        For each compared edge whose figures (:data:`EDGE_FIGURES`) are not the same numbers,
+        its row and what changed, e.g. ``"row 3: mean 95.3100° → 95.4200°"``.
+    stale : int
+        Edges the file marks Stale (measured before the mesh was edited): not compared.
+    """
+
+    compared: int
+    differing: list
+    stale: int
+
+    @property
+    def text(self) -> str:
+        """What a report adds ("" with nothing compared or passed over), each part starting
+        with "; "."""
+        parts = []
+        if self.compared and not self.differing:
+            parts.append(
+                f"all {self.compared} edges' stations, mean, min, max and pooled angle equal "
+                "the file's exactly"
+            )
+        elif self.differing:
+            listed = "; ".join(self.differing[:LISTED_EDGES])
+            more = len(self.differing) - LISTED_EDGES
+            listed += f"; and {more} more" if more > 0 else ""
+            parts.append(
+                f"{len(self.differing)} of {self.compared} edges differ from the file's figures "
+                f"({listed}): a batch run measures a mesh file's float64 coordinates where "
+                "Blender measured its float32 vertices, and another mesh, version or rule reads "
+                "other stations"
+            )
+        if self.stale:
+            parts.append(
+                f"{self.stale} edge(s) marked Stale (measured before the mesh was edited) not "
+                "compared"
+            )
+        return "".join(f"; {part}" for part in parts)
+
+
+def edge_agreement(file_rows: Sequence, remeasured: Sequence, by_name: bool = True):
+    """Compare an edge summary file's rows (``csvio.EdgeRow``) with the summary rows of the
+    edges measured again from it, matched by their ``Points`` (a replay numbers its edges
+    afresh) and, ``by_name``, their ``Mesh Name``. File rows with an ``error`` (never measured)
+    and re-measured edges that match no row are left out. Returns an :class:`EdgeAgreement`."""
+
+    def key(row):
+        return (row.mesh_name if by_name else "", row.points.strip())
+
+    replayed = {}
+    for row in remeasured:
+        replayed.setdefault(key(row), row)
+    compared, stale, differing = 0, 0, []
+    for old in file_rows:
+        new = replayed.get(key(old))
+        if old.error or new is None:
+            continue
+        if old.stale:
+            stale += 1
+            continue
+        compared += 1
+        changes = [
+            f"{said} {_figure_text(field, getattr(old, field))} → "
+            f"{_figure_text(field, getattr(new, field))}"
+            for field, said in EDGE_FIGURES
+            if getattr(old, field) != getattr(new, field)
+        ]
+        if changes:
+            where = f"row {old.row_number}" if old.row_number else f"edge {old.edge_number}"
+            differing.append(f"{where}: {', '.join(changes)}")
+    return EdgeAgreement(compared, differing, stale)
