@@ -198,6 +198,7 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                 )
                 summaries = csvio.read_edges_csv(path)
                 extra = adopt_units(obj, [row.units for row in summaries])
+                extra += edge_agreement_text(obj, summaries, edge_numbers)
                 failed = sum(1 for row in summaries if row.error)
                 if failed:
                     extra += (
@@ -333,6 +334,16 @@ def adopt_units(obj, texts) -> str:
         return ""
     edges.redraw_plots(obj)
     return f"; Scan Units {units.SYMBOLS[key]}, as the file says"
+
+
+def edge_agreement_text(obj, summaries, edge_numbers) -> str:
+    """How the edges just measured again from an edge summary file (``edge_numbers``) agree
+    with the file's rows (``summaries``): what to add to the report."""
+    numbers = set(edge_numbers)
+    replayed = [
+        records.edge_row(obj, edge, units="") for edge in obj.vg.edges if edge.number in numbers
+    ]
+    return agreement.edge_agreement(summaries, replayed).text
 
 
 def follow_export(obj, path, numbers) -> tuple[str, bool]:

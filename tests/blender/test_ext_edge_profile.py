@@ -2,6 +2,7 @@
 and replayable with vg.measure_xyz; its record, plot, CSV rows, re-import, undo and delete."""
 
 import csv
+import dataclasses
 import importlib
 import json
 
@@ -325,6 +326,35 @@ def test_panel_shows_only_for_a_mesh_and_the_settings_have_lengths(vg):
     assert settings.bl_rna.properties["edge_spacing"].unit == "NONE"
     assert bpy.types.VG_OT_measure_edge.poll(bpy.context)
     assert not bpy.types.VG_OT_delete_edge.poll(bpy.context)  # no edge yet
+
+
+def test_importing_an_edge_file_says_whether_its_edges_came_back(vg, tmp_path, capfd):
+    """An edge file imported said how many edges it re-measured, not whether they came back as
+    the file has them (before). The oracle: the file's own cells, edited."""
+    measure_obj, _ = ramp_object()
+    measure_edge()
+    path = tmp_path / "m.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    edge_file = csvio.edges_path_for(path)
+    ramp_object("Ramp.copy")
+    capfd.readouterr()
+    assert bpy.ops.vg.import_csv(filepath=str(edge_file), ignore_mesh_names=True) == {"FINISHED"}
+    said = capfd.readouterr()
+    assert (
+        "all 1 edges' stations, mean, min, max and pooled angle equal the file's exactly"
+        in said.out + said.err
+    )
+    (row,) = csvio.read_edges_csv(edge_file)
+    edited = tmp_path / "edited_edges.csv"
+    csvio.write_edges_csv(edited, [dataclasses.replace(row, n_stations=row.n_stations + 1)])
+    ramp_object("Ramp.other")
+    assert bpy.ops.vg.import_csv(filepath=str(edited), ignore_mesh_names=True) == {"FINISHED"}
+    said = capfd.readouterr()
+    assert (
+        f"1 of 1 edges differ from the file's figures (row 2 on 'Ramp.other': stations "
+        f"{row.n_stations + 1} → {row.n_stations})"
+    ) in said.out + said.err
+    assert measure_obj.vg.edges[0].n_stations == row.n_stations
 
 
 def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):

@@ -95,14 +95,15 @@ def test_edges_are_matched_by_their_points_and_each_change_is_named():
         "pooled angle 80.0000° → 80.2500°"
     ]
     assert agreed.text.startswith("; 1 of 2 edges differ from the file's figures (row 3: ")
-    # Another mesh's edge through the same points is not this row's, unless names are ignored.
-    elsewhere = [edge(1, "0 0 0; 1 0 0", 91.0, mesh="other")]
-    assert edge_agreement(file_rows[:1], elsewhere).text == ""
-    assert (
-        edge_agreement(file_rows[:1], elsewhere, by_name=False)
-        .differing[0]
-        .startswith("row 2: mean 90.0000° → 91.0000°")
-    )
+    # Through the same points on two meshes: the one the row names is its replay; where none
+    # has its name (a close name matched, or names ignored), each is.
+    both = [edge(1, "0 0 0; 1 0 0", 91.0, mesh="other"), edge(2, "0 0 0; 1 0 0", 90.0)]
+    assert edge_agreement(file_rows[:1], both).text.startswith("; all 1 edges'")
+    elsewhere = edge_agreement(file_rows[:1], both[:1])
+    assert elsewhere.differing == [
+        "row 2 on 'other': mean 90.0000° → 91.0000°, min 89.0000° → 90.0000°, "
+        "max 91.0000° → 92.0000°, pooled angle 90.0000° → 91.0000°"
+    ]
     many = [edge(n, f"{n} 0 0; 9 9 9", 50.0, row_number=n + 1) for n in range(LISTED_EDGES + 2)]
     moved = [edge(n, f"{n} 0 0; 9 9 9", 51.0) for n in range(LISTED_EDGES + 2)]
     text = edge_agreement(many, moved).text

@@ -210,34 +210,38 @@ class EdgeAgreement:
         return "".join(f"; {part}" for part in parts)
 
 
-def edge_agreement(file_rows: Sequence, remeasured: Sequence, by_name: bool = True):
+def edge_agreement(file_rows: Sequence, remeasured: Sequence) -> EdgeAgreement:
     """Compare an edge summary file's rows (``csvio.EdgeRow``) with the summary rows of the
-    edges measured again from it, matched by their ``Points`` (a replay numbers its edges
-    afresh) and, ``by_name``, their ``Mesh Name``. File rows with an ``error`` (never measured)
-    and re-measured edges that match no row are left out. Returns an :class:`EdgeAgreement`."""
+    edges measured again from it.
 
-    def key(row):
-        return (row.mesh_name if by_name else "", row.points.strip())
-
+    A replay numbers its edges afresh, so each row is matched by its ``Points``: to the
+    re-measured edges through the same points on a mesh of the row's ``Mesh Name``, or, where
+    none has that name (a mesh matched by a close name, or ``--ignore-mesh-names``), to every
+    re-measured edge through them. File rows with an ``error`` (never measured) and re-measured
+    edges that match no row are left out.
+    """
     replayed = {}
     for row in remeasured:
-        replayed.setdefault(key(row), row)
+        replayed.setdefault(row.points.strip(), []).append(row)
     compared, stale, differing = 0, 0, []
     for old in file_rows:
-        new = replayed.get(key(old))
-        if old.error or new is None:
+        candidates = replayed.get(old.points.strip(), [])
+        if old.error or not candidates:
             continue
         if old.stale:
             stale += 1
             continue
-        compared += 1
-        changes = [
-            f"{said} {_figure_text(field, getattr(old, field))} → "
-            f"{_figure_text(field, getattr(new, field))}"
-            for field, said in EDGE_FIGURES
-            if getattr(old, field) != getattr(new, field)
-        ]
-        if changes:
-            where = f"row {old.row_number}" if old.row_number else f"edge {old.edge_number}"
-            differing.append(f"{where}: {', '.join(changes)}")
+        named = [row for row in candidates if row.mesh_name == old.mesh_name]
+        for new in named or candidates:
+            compared += 1
+            changes = [
+                f"{said} {_figure_text(field, getattr(old, field))} → "
+                f"{_figure_text(field, getattr(new, field))}"
+                for field, said in EDGE_FIGURES
+                if getattr(old, field) != getattr(new, field)
+            ]
+            if changes:
+                where = f"row {old.row_number}" if old.row_number else f"edge {old.edge_number}"
+                on = "" if new.mesh_name == old.mesh_name else f" on {new.mesh_name!r}"
+                differing.append(f"{where}{on}: {', '.join(changes)}")
     return EdgeAgreement(compared, differing, stale)
