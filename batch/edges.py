@@ -89,6 +89,7 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
             "space": "world" if row.coordinates == csvio.WORLD_COORDINATES else "mesh",
             "given": f"{Path(args.edges_csv).name} row {number}",
             "units": row.units,
+            "file_row": number,  # the replay's summary row names it, to compare with the file
         }
         add_checked(specs, problems, spec, f"row {number}")
     if problems:
@@ -358,7 +359,8 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         except GoniometerError as error:
             obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
             station_rows.append(failed_edge_row(number, spec, name, str(error), units))
-            edge_rows.append(failed_edge_summary(number, spec, name, str(error), units, rule))
+            failed = failed_edge_summary(number, spec, name, str(error), units, rule)
+            edge_rows.append(dataclasses.replace(failed, row_number=spec.get("file_row")))
             continue
         # The edge's stations are the items it just appended: read those, not every stored one.
         measurements = obj.vg.measurements
@@ -380,7 +382,11 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
             for i in stations
         )
         edge_rows.append(
-            dataclasses.replace(records.edge_row(obj, edge, units=units), mesh_name=name)
+            dataclasses.replace(
+                records.edge_row(obj, edge, units=units),
+                mesh_name=name,
+                row_number=spec.get("file_row"),
+            )
         )
         path = f"{options['plots']}_{safe_name}_edge{edge.number}.png"
         data = functools.partial(

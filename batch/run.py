@@ -119,7 +119,7 @@ class Run:
             file_rows = csvio.read_edges_csv(Path(path))
         except (GoniometerError, OSError, ValueError):
             return  # read when the run was planned; gone or changed since: nothing to compare
-        agreed = agreement.edge_agreement(file_rows, self.profiled_edges)
+        agreed = agreement.edge_agreement(file_rows, self.edge_rows)
         if agreed.text:
             self.say(f"re-measured {Path(path).name}: " + agreed.text[2:])
 

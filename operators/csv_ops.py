@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 import time
 
@@ -337,11 +338,18 @@ def adopt_units(obj, texts) -> str:
 
 
 def edge_agreement_text(obj, summaries, edge_numbers) -> str:
-    """How the edges just measured again from an edge summary file (``edge_numbers``) agree
-    with the file's rows (``summaries``): what to add to the report."""
-    numbers = set(edge_numbers)
+    """How the edges just measured again from an edge summary file agree with the file's rows
+    (``summaries``): what to add to the report. ``edge_numbers``: the new edges, one for each
+    row without an error, in order (as ``edges.import_edges_csv`` records them)."""
+    by_number = {edge.number: edge for edge in obj.vg.edges}
+    measured_rows = [row for row in summaries if not row.error]
+    if len(measured_rows) != len(edge_numbers):
+        return ""  # the file changed since it was read: its rows are not these edges'
     replayed = [
-        records.edge_row(obj, edge, units="") for edge in obj.vg.edges if edge.number in numbers
+        dataclasses.replace(
+            records.edge_row(obj, by_number[number], units=""), row_number=row.row_number
+        )
+        for row, number in zip(measured_rows, edge_numbers, strict=True)
     ]
     return agreement.edge_agreement(summaries, replayed).text
 

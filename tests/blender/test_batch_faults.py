@@ -441,24 +441,35 @@ def test_an_edge_summary_replayed_says_whether_its_figures_came_back(scan, tmp_p
     back with other stations passed unnoticed. The oracle: the file's own cells, edited."""
     first = tmp_path / "first.csv"
     ok(batch(scan, *EDGE, "--spacing", "0.2", "--out", first))
-    summary = csvio.edges_path_for(first)
-    same = ok(batch(scan, "--edges", summary, "--out", tmp_path / "same.csv"))
+    (row,) = csvio.read_edges_csv(csvio.edges_path_for(first))
+    wider = tmp_path / "wider.csv"  # the same points at another radius: another edge
+    ok(batch(scan, *EDGE[:-1], "0.4", "--spacing", "0.2", "--out", wider))
+    (other,) = csvio.read_edges_csv(csvio.edges_path_for(wider))
+    assert other.points == row.points and other.mean != row.mean
+    both = tmp_path / "both_edges.csv"
+    csvio.write_edges_csv(both, [row, other])
+    same = ok(batch(scan, "--edges", both, "--out", tmp_path / "same.csv"))
     assert (
-        "re-measured first_edges.csv: all 1 edges' stations, mean, min, max and pooled angle "
+        "re-measured both_edges.csv: all 2 edges' stations, mean, min, max and pooled angle "
         "equal the file's exactly"
     ) in same.stderr
-    (row,) = csvio.read_edges_csv(summary)
+    # Points typed by hand (not as the run writes them), the mean edited; a row whose error was
+    # cleared (no figures to compare); a Stale row.
     edited = tmp_path / "edited_edges.csv"
-    csvio.write_edges_csv(edited, [dataclasses.replace(row, mean=row.mean + 0.5)])
+    typed = dataclasses.replace(row, points="-0.4 0 0;0.4 0 0", mean=row.mean + 0.5)
+    cleared = dataclasses.replace(other, n_stations=None, mean=None, std=None, min=None,
+                                  max=None, pooled_angle=None)  # fmt: skip
+    csvio.write_edges_csv(edited, [typed, cleared, dataclasses.replace(row, stale=True)])
     moved = ok(batch(scan, "--edges", edited, "--out", tmp_path / "moved.csv"))
     assert (
         f"re-measured edited_edges.csv: 1 of 1 edges differ from the file's figures (row 2: "
         f"mean {row.mean + 0.5:.4f}° → {row.mean:.4f}°)"
     ) in moved.stderr
-    csvio.write_edges_csv(edited, [dataclasses.replace(row, stale=True)])
-    stale = ok(batch(scan, "--edges", edited, "--out", tmp_path / "stale.csv"))
-    assert "1 edge(s) marked Stale (measured before the mesh was edited) not compared" in (
-        stale.stderr
+    assert "; 1 row(s) without figures in the file (not measured when it was written)" in (
+        moved.stderr
+    )
+    assert "; 1 edge(s) marked Stale (measured before the mesh was edited) not compared" in (
+        moved.stderr
     )
 
 

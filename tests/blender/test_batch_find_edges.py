@@ -393,12 +393,10 @@ def test_a_point_cloud_is_one_failed_row_saying_why(tmp_path):
         ],
         *[
             (
-                # An edge summary's rows keep their own spacing: none given with it.
+                # An edge summary's rows keep their own spacing and radius: none given with it.
                 (
                     *how,
-                    *(() if "e.csv" in how else ("--spacing", 1)),
-                    "--radius",
-                    1,
+                    *(() if "e.csv" in how else ("--spacing", 1, "--radius", 1)),
                     "--lambda",
                     -1,
                 ),

@@ -330,9 +330,11 @@ def test_panel_shows_only_for_a_mesh_and_the_settings_have_lengths(vg):
 
 def test_importing_an_edge_file_says_whether_its_edges_came_back(vg, tmp_path, capfd):
     """An edge file imported said how many edges it re-measured, not whether they came back as
-    the file has them (before). The oracle: the file's own cells, edited."""
+    the file has them (before). The oracle: the file's own cells, edited. Two edges through the
+    same points (two radii) are each compared with their own row."""
     measure_obj, _ = ramp_object()
     measure_edge()
+    measure_edge(radius=0.4)
     path = tmp_path / "m.csv"
     bpy.ops.vg.export_csv(filepath=str(path))
     edge_file = csvio.edges_path_for(path)
@@ -341,20 +343,22 @@ def test_importing_an_edge_file_says_whether_its_edges_came_back(vg, tmp_path, c
     assert bpy.ops.vg.import_csv(filepath=str(edge_file), ignore_mesh_names=True) == {"FINISHED"}
     said = capfd.readouterr()
     assert (
-        "all 1 edges' stations, mean, min, max and pooled angle equal the file's exactly"
+        "all 2 edges' stations, mean, min, max and pooled angle equal the file's exactly"
         in said.out + said.err
     )
-    (row,) = csvio.read_edges_csv(edge_file)
+    first, second = csvio.read_edges_csv(edge_file)
+    assert first.points == second.points and first.mean != second.mean
     edited = tmp_path / "edited_edges.csv"
-    csvio.write_edges_csv(edited, [dataclasses.replace(row, n_stations=row.n_stations + 1)])
+    more = dataclasses.replace(second, n_stations=second.n_stations + 1)
+    csvio.write_edges_csv(edited, [first, more])
     ramp_object("Ramp.other")
     assert bpy.ops.vg.import_csv(filepath=str(edited), ignore_mesh_names=True) == {"FINISHED"}
     said = capfd.readouterr()
     assert (
-        f"1 of 1 edges differ from the file's figures (row 2 on 'Ramp.other': stations "
-        f"{row.n_stations + 1} → {row.n_stations})"
+        f"1 of 2 edges differ from the file's figures (row 3: stations "
+        f"{second.n_stations + 1} → {second.n_stations})"
     ) in said.out + said.err
-    assert measure_obj.vg.edges[0].n_stations == row.n_stations
+    assert measure_obj.vg.edges[1].n_stations == second.n_stations
 
 
 def test_importing_an_edge_file_retraces_every_edge_or_none(vg, tmp_path):

@@ -67,44 +67,48 @@ def test_rows_whose_rule_was_dropped_are_said_to_be_measured_with_the_papers_rul
     assert "1 on a mesh or with a version other than the file's" in agreed.text
 
 
-def test_edges_are_matched_by_their_points_and_each_change_is_named():
+def test_edges_are_matched_to_the_rows_they_came_from_and_each_change_is_named():
     from vg_addon.formats.csvio import EdgeRow
     from vg_addon.workflow.agreement import LISTED_EDGES, edge_agreement
 
-    def edge(number, points, mean, mesh="bone", **fields):
-        return EdgeRow(mesh_name=mesh, edge_number=number, points=points, mean=mean,
-                       n_stations=5, min=mean - 1, max=mean + 1, pooled_angle=mean, **fields)  # fmt: skip
+    def edge(row, mean, points="0 0 0; 1 0 0", **fields):
+        return EdgeRow(mesh_name="bone", row_number=row, points=points, mean=mean, n_stations=5,
+                       min=mean - 1, max=mean + 1, pooled_angle=mean, **fields)  # fmt: skip
 
     file_rows = [
-        edge(1, "0 0 0; 1 0 0", 90.0, row_number=2),
-        edge(2, "0 1 0; 1 1 0", 80.0, row_number=3),
-        edge(3, "0 2 0; 1 2 0", 70.0, row_number=4, error="not measured"),
-        edge(4, "0 3 0; 1 3 0", 60.0, row_number=5, stale=True),
+        edge(2, 90.0),
+        edge(3, 80.0),  # the same points as row 2, measured with other settings
+        edge(4, 70.0, error="not measured"),
+        edge(5, 60.0, stale=True),
+        EdgeRow(mesh_name="bone", row_number=6, points="0 5 0; 1 5 0"),  # its error cleared
+        edge(7, 50.0),
     ]
-    # A replay numbers its edges afresh and in its own order.
+    # A replay numbers its edges afresh, in its own order, and its points may be in other
+    # coordinates: each carries the row it was measured from.
     replayed = [
-        edge(7, "0 1 0; 1 1 0", 80.25),
-        edge(8, "0 0 0; 1 0 0", 90.0),
-        edge(9, "0 3 0; 1 3 0", 61.0),
-        edge(10, "5 5 5; 6 5 5", 10.0),  # given on the command line: in no row
+        edge(3, 80.25, points="9 9 9; 8 8 8"),
+        edge(2, 90.0),
+        edge(5, 61.0),
+        edge(6, 40.0),
+        EdgeRow(mesh_name="bone", row_number=7, error="the patch holds 3 vertices"),
+        edge(None, 10.0),  # given on the command line: from no row
     ]
     agreed = edge_agreement(file_rows, replayed)
-    assert (agreed.compared, agreed.stale) == (2, 1)
+    assert (agreed.compared, agreed.stale, agreed.blank, agreed.failed) == (2, 1, 1, 1)
     assert agreed.differing == [
         "row 3: mean 80.0000° → 80.2500°, min 79.0000° → 79.2500°, max 81.0000° → 81.2500°, "
         "pooled angle 80.0000° → 80.2500°"
     ]
     assert agreed.text.startswith("; 1 of 2 edges differ from the file's figures (row 3: ")
-    # Through the same points on two meshes: the one the row names is its replay; where none
-    # has its name (a close name matched, or names ignored), each is.
-    both = [edge(1, "0 0 0; 1 0 0", 91.0, mesh="other"), edge(2, "0 0 0; 1 0 0", 90.0)]
-    assert edge_agreement(file_rows[:1], both).text.startswith("; all 1 edges'")
-    elsewhere = edge_agreement(file_rows[:1], both[:1])
-    assert elsewhere.differing == [
-        "row 2 on 'other': mean 90.0000° → 91.0000°, min 89.0000° → 90.0000°, "
-        "max 91.0000° → 92.0000°, pooled angle 90.0000° → 91.0000°"
-    ]
-    many = [edge(n, f"{n} 0 0; 9 9 9", 50.0, row_number=n + 1) for n in range(LISTED_EDGES + 2)]
-    moved = [edge(n, f"{n} 0 0; 9 9 9", 51.0) for n in range(LISTED_EDGES + 2)]
+    assert "; 1 edge(s) could not be measured again" in agreed.text
+    assert "; 1 row(s) without figures in the file" in agreed.text
+    # One edge the same: said in the singular; a change below four decimals shown in full.
+    assert edge_agreement(file_rows[:1], replayed[1:2]).text == (
+        "; its edge's stations, mean, min, max and pooled angle equal the file's exactly"
+    )
+    tiny = edge_agreement(file_rows[:1], [edge(2, 90.0 + 1e-11)])
+    assert f"mean 90.0° → {90.0 + 1e-11!r}°" in tiny.differing[0]
+    many = [edge(n, 50.0) for n in range(LISTED_EDGES + 2)]
+    moved = [edge(n, 51.0) for n in range(LISTED_EDGES + 2)]
     text = edge_agreement(many, moved).text
     assert "; and 2 more)" in text and text.count("row ") == LISTED_EDGES

@@ -157,10 +157,14 @@ LISTED_EDGES = 5
 """How many differing edges a report names; the rest are counted."""
 
 
-def _figure_text(field: str, value) -> str:
-    if value is None:
-        return "none"
-    return f"{value:d}" if field == "n_stations" else f"{value:.4f}°"
+def _figure_texts(field: str, old, new) -> tuple[str, str]:
+    """The two values as said: four decimals, or every digit where four would read the same."""
+    if new is None:
+        return _figure_texts(field, old, old)[0], "none"
+    if field == "n_stations":
+        return f"{old:d}", f"{new:d}"
+    texts = f"{old:.4f}°", f"{new:.4f}°"
+    return texts if texts[0] != texts[1] else (f"{old!r}°", f"{new!r}°")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -170,24 +174,35 @@ class EdgeAgreement:
     Attributes
     ----------
     compared : int
-        Edges of the file that were measured again (matched by their ``Points``).
+        Rows whose edge was measured again and whose figures were compared.
     differing : list of str
-        For each compared edge whose figures (:data:`EDGE_FIGURES`) are not the same numbers,
-        its row and what changed, e.g. ``"row 3: mean 95.3100° → 95.4200°"``.
+        For each compared row whose figures (:data:`EDGE_FIGURES`) are not the same numbers,
+        the row and what changed, e.g. ``"row 3: mean 95.3100° → 95.4200°"``.
     stale : int
-        Edges the file marks Stale (measured before the mesh was edited): not compared.
+        Rows the file marks Stale (measured before the mesh was edited): not compared.
+    blank : int
+        Rows without figures in the file (an edge the run that wrote it could not measure,
+        its error cleared to try again): measured, not compared.
+    failed : int
+        Rows whose edge could not be measured again (the replay's error says why).
     """
 
     compared: int
     differing: list
-    stale: int
+    stale: int = 0
+    blank: int = 0
+    failed: int = 0
 
     @property
     def text(self) -> str:
         """What a report adds ("" with nothing compared or passed over), each part starting
         with "; "."""
         parts = []
-        if self.compared and not self.differing:
+        if self.compared == 1 and not self.differing:
+            parts.append(
+                "its edge's stations, mean, min, max and pooled angle equal the file's exactly"
+            )
+        elif self.compared and not self.differing:
             parts.append(
                 f"all {self.compared} edges' stations, mean, min, max and pooled angle equal "
                 "the file's exactly"
@@ -198,9 +213,16 @@ class EdgeAgreement:
             listed += f"; and {more} more" if more > 0 else ""
             parts.append(
                 f"{len(self.differing)} of {self.compared} edges differ from the file's figures "
-                f"({listed}): a batch run measures a mesh file's float64 coordinates where "
-                "Blender measured its float32 vertices, and another mesh, version or rule reads "
-                "other stations"
+                f"({listed}): measured at another precision (Blender holds float32 vertices, a "
+                "batch run reads a mesh file's float64 coordinates), on an edited mesh, or with "
+                "another version or rule"
+            )
+        if self.failed:
+            parts.append(f"{self.failed} edge(s) could not be measured again (see their error)")
+        if self.blank:
+            parts.append(
+                f"{self.blank} row(s) without figures in the file (not measured when it was "
+                "written) not compared"
             )
         if self.stale:
             parts.append(
@@ -212,36 +234,35 @@ class EdgeAgreement:
 
 def edge_agreement(file_rows: Sequence, remeasured: Sequence) -> EdgeAgreement:
     """Compare an edge summary file's rows (``csvio.EdgeRow``) with the summary rows of the
-    edges measured again from it.
+    edges measured again from them.
 
-    A replay numbers its edges afresh, so each row is matched by its ``Points``: to the
-    re-measured edges through the same points on a mesh of the row's ``Mesh Name``, or, where
-    none has that name (a mesh matched by a close name, or ``--ignore-mesh-names``), to every
-    re-measured edge through them. File rows with an ``error`` (never measured) and re-measured
-    edges that match no row are left out.
+    Each re-measured row carries the ``row_number`` of the file row it was measured from (a
+    replay numbers its edges afresh, and may have moved its points into the mesh's
+    coordinates); re-measured rows without one (edges given otherwise) are left out, as are
+    file rows with an ``error`` (never measured, not measured again).
     """
-    replayed = {}
-    for row in remeasured:
-        replayed.setdefault(row.points.strip(), []).append(row)
-    compared, stale, differing = 0, 0, []
+    replayed = {row.row_number: row for row in remeasured if row.row_number is not None}
+    compared, differing, stale, blank, failed = 0, [], 0, 0, 0
     for old in file_rows:
-        candidates = replayed.get(old.points.strip(), [])
-        if old.error or not candidates:
+        new = replayed.get(old.row_number)
+        if old.error or new is None:
+            continue
+        if new.error:
+            failed += 1
             continue
         if old.stale:
             stale += 1
             continue
-        named = [row for row in candidates if row.mesh_name == old.mesh_name]
-        for new in named or candidates:
-            compared += 1
-            changes = [
-                f"{said} {_figure_text(field, getattr(old, field))} → "
-                f"{_figure_text(field, getattr(new, field))}"
-                for field, said in EDGE_FIGURES
-                if getattr(old, field) != getattr(new, field)
-            ]
-            if changes:
-                where = f"row {old.row_number}" if old.row_number else f"edge {old.edge_number}"
-                on = "" if new.mesh_name == old.mesh_name else f" on {new.mesh_name!r}"
-                differing.append(f"{where}{on}: {', '.join(changes)}")
-    return EdgeAgreement(compared, differing, stale)
+        if all(getattr(old, field) is None for field, _ in EDGE_FIGURES):
+            blank += 1
+            continue
+        compared += 1
+        changes = []
+        for field, said in EDGE_FIGURES:
+            before, after = getattr(old, field), getattr(new, field)
+            if before is not None and before != after:
+                was, now = _figure_texts(field, before, after)
+                changes.append(f"{said} {was} → {now}")
+        if changes:
+            differing.append(f"row {old.row_number}: {', '.join(changes)}")
+    return EdgeAgreement(compared, differing, stale, blank, failed)
