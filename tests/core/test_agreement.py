@@ -29,6 +29,18 @@ def test_one_ulp_off_is_a_difference_and_another_precision_is_named_as_the_reaso
     assert "2 on a mesh or with a version other than the file's" in agreed.text
 
 
+def test_a_precision_not_known_on_either_side_is_not_named_as_the_reason():
+    """Only two known precisions that differ explain a difference: an empty one on either side
+    says nothing (the re-measurement's empty was counted as "another precision")."""
+    agreed = agreement(
+        [90.0, 80.0, 70.0], [90.5, 80.5, 70.5], ["float32", "", "float32"],
+        ["", "float32", "float64"], [False] * 3,
+    )  # fmt: skip
+    assert (agreed.differing, agreed.other_precision) == (3, 1)
+    assert "1 measured at another precision than the file's" in agreed.text
+    assert "2 on a mesh or with a version other than the file's" in agreed.text
+
+
 def test_rows_without_an_angle_are_not_compared_and_stale_rows_are_counted_apart():
     agreed = agreement([None, 50.0, 70.0, 80.0], [10.0, 51.0, 70.0, None], ["", "float32",
                        "float32", "float32"], ["float32"] * 4, [False, True, False, False])  # fmt: skip

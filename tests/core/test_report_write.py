@@ -94,6 +94,23 @@ def test_a_compare_name_that_several_sessions_share_is_refused_with_its_reason(t
     ) in outcome.not_computed
 
 
+def test_a_compare_name_that_is_both_a_method_and_a_session_is_refused(tmp_path):
+    """A session file named as another session's method: --compare caliper drag_1.csv meant
+    the method silently. It is now not computed, saying the name is both."""
+    paths = []
+    for name, method, shift in (("caliper", "drag", 0), ("drag_1.csv", "caliper", 2)):
+        text = "Mesh,Break #,Angle,Method\n" + "".join(
+            f"m,{b},{90 + b + shift},{method}\n" for b in range(1, 5)
+        )
+        (tmp_path / name).write_text(text, encoding="utf-8")
+        paths.append(tmp_path / name)
+    outcome = write_report(paths, tmp_path / "out", compare=[("caliper", "drag_1.csv")])
+    assert (
+        "Bland–Altman caliper against drag_1.csv: not computed, 'caliper' names both a method "
+        "and a session file: rename the file, or give the method another name (--method)"
+    ) in outcome.not_computed
+
+
 def drag_sessions(folder, rows_of):
     """Two drag sessions of one observer on three breaks; ``rows_of(repetition, break)`` gives
     each row's x, radius and vertex count (and y, else 0)."""

@@ -94,6 +94,14 @@ def _pairs_to_compare(c: Context, compare) -> list[tuple[str, str, dict, dict]]:
         values = []
         for name in (a, b):
             sharing = [s for s in c.sessions if s.name == name]
+            if name in c.methods and sharing:
+                values = None
+                c.skip(
+                    f"Bland–Altman {a} against {b}",
+                    f"{name!r} names both a method and a session file: rename the file, or "
+                    "give the method another name (--method)",
+                )
+                break
             if name in c.methods:
                 values.append(method_means(name))
             elif len(sharing) > 1:

@@ -124,7 +124,9 @@ def agreement(
         compared += 1
         if old != new:
             differing += 1
-            precision_differs = bool(old_precision and new_precision != old_precision)
+            precision_differs = (
+                bool(old_precision and new_precision) and new_precision != old_precision
+            )
             other_precision += precision_differs
             no_rule += bool(no_rule_here) and not precision_differs
             largest = max(largest, abs(new - old))
