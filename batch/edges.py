@@ -279,11 +279,13 @@ def failed_edge_row(number: int | None, spec: dict, mesh_name: str, message: str
 
 def failed_edge_summary(number: int, spec: dict, mesh_name: str, message: str, units, rule: str):
     """The edges CSV row of an edge that could not be measured: its points and settings, so the
-    edge can be looked at or measured again, and why it failed; no figures."""
+    edge can be looked at or measured again, and why it failed; no figures. It keeps the number
+    of the row of an edges file it was given by (``spec["file_row"]``), as a measured edge does."""
     return csvio.EdgeRow(
         **_failure_fields(spec, mesh_name, message, units),
         edge_number=number,
         rule=rule,
+        row_number=spec.get("file_row"),
         points=csvio.format_points(spec["points"]),
         coordinates=(
             csvio.WORLD_COORDINATES if spec.get("space") == "world" else csvio.MESH_COORDINATES
@@ -359,8 +361,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         except GoniometerError as error:
             obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
             station_rows.append(failed_edge_row(number, spec, name, str(error), units))
-            failed = failed_edge_summary(number, spec, name, str(error), units, rule)
-            edge_rows.append(dataclasses.replace(failed, row_number=spec.get("file_row")))
+            edge_rows.append(failed_edge_summary(number, spec, name, str(error), units, rule))
             continue
         # The edge's stations are the items it just appended: read those, not every stored one.
         measurements = obj.vg.measurements

@@ -471,6 +471,14 @@ def test_an_edge_summary_replayed_says_whether_its_figures_came_back(scan, tmp_p
     assert "; 1 edge(s) marked Stale (measured before the mesh was edited) not compared" in (
         moved.stderr
     )
+    # An edge that fails on the replay (a radius too small for a patch) is counted as such.
+    failing = tmp_path / "failing_edges.csv"
+    csvio.write_edges_csv(failing, [row, dataclasses.replace(other, radius=1e-6)])
+    failed = ok(batch(scan, "--edges", failing, "--out", tmp_path / "failed.csv"), code=1)
+    assert (
+        "re-measured failing_edges.csv: its edge's stations, mean, min, max and pooled angle "
+        "equal the file's exactly; 1 edge(s) could not be measured again (see their error)"
+    ) in failed.stderr
 
 
 def test_a_radius_for_an_edge_summarys_rows_is_refused_unless_points_take_it(scan, tmp_path):

@@ -453,13 +453,22 @@ def as_points(name: str, values, *, allow_empty: bool = False) -> np.ndarray:
     if not allow_empty and array.shape[0] == 0:
         raise GoniometerError(f"There are no {name}: the mesh or patch is empty.")
     _check_finite(name, array)
+    _check_magnitude(
+        f"The {name} reach",
+        array,
+        "scale the mesh to a real unit (e.g. millimetres) before measuring",
+    )
+    return array
+
+
+def _check_magnitude(what: str, array: np.ndarray, advice: str) -> None:
+    """Refuse values beyond ±:data:`MAX_MAGNITUDE` ("``what`` 1e+200, beyond ...: ``advice``.")."""
     largest = float(np.abs(array).max()) if array.size else 0.0
     if largest > MAX_MAGNITUDE:
         raise GoniometerError(
-            f"The {name} reach {largest:.3g}, beyond ±{MAX_MAGNITUDE:g}, where squared distances "
-            "overflow: scale the mesh to a real unit (e.g. millimetres) before measuring."
+            f"{what} {largest:.3g}, beyond ±{MAX_MAGNITUDE:g}, where squared distances "
+            f"overflow: {advice}."
         )
-    return array
 
 
 def as_radius(radius) -> float:
@@ -560,12 +569,8 @@ def goniometer(
     order = canonical_order(points, normals)
     ordered_points, ordered_normals = points[order], normals[order]
     center = ordered_points.mean(axis=0) if center is None else as_center(center)
-    largest = float(np.abs(center).max())
-    if largest > MAX_MAGNITUDE:  # Surface.measure snaps to a vertex; a given centre is used as is
-        raise GoniometerError(
-            f"The centre reaches {largest:.3g}, beyond ±{MAX_MAGNITUDE:g}, where squared "
-            "distances overflow: give a centre among the points, in their units."
-        )
+    # Surface.measure snaps to a vertex; a given centre is used as is.
+    _check_magnitude("The centre reaches", center, "give a centre among the points, in their units")
     if radius is None:
         radius = float(np.sqrt(((ordered_points - center) ** 2).sum(axis=1).max()))
         if radius <= 0:
