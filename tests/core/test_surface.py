@@ -308,3 +308,13 @@ def test_a_point_cloud_too_wide_for_its_grid_is_refused_not_left_to_exhaust_memo
     mesh = wedge(100, n=60, irregular=True, seed=1)
     with pytest.raises(GoniometerError, match="far from the rest"):
         Surface(np.vstack([mesh.points, [[1e9, 0.0, 0.0]]]))
+
+
+def test_an_unsigned_index_past_the_vertices_is_named_as_given():
+    """A uint64 index of 2⁶³ or more wrapped negative in the cast to int64, and the refusal
+    named "vertex -9223372036854775808"."""
+    shape = wedge(100, n=10)
+    triangles = shape.triangles.astype(np.uint64)
+    triangles[-1, 2] = np.uint64(2**63 + 5)
+    with pytest.raises(GoniometerError, match=f"refers to vertex {2**63 + 5}, but the mesh"):
+        Surface(shape.points, triangles)

@@ -18,7 +18,7 @@ from .fixed_order import (
     row_dot,
     total,
 )
-from .planes import RANK_TOLERANCE
+from .planes import RANK_TOLERANCE, contradicting_normals_message, sides_contradict_normals
 from .refinement import NOISE_FLOOR, mean_edge_length, refine_sides
 from .result import Measurement
 from .withinss import withinss_split
@@ -560,7 +560,8 @@ def goniometer(
     GoniometerError
         On non-finite or mis-shaped input, too few vertices (in the patch or on a side), a flat patch
         or a side whose vertices are collinear; under the refined rule, two fitted planes that meet
-        farther than the radius from the centre.
+        farther than the radius from the centre, or sides whose normals face opposite ways for
+        where they lie (one face's normals pointing the other way: the supplement would be read).
     """
     points = as_points("points", points)
     normals = as_normals(normals, points.shape[0])
@@ -577,6 +578,15 @@ def goniometer(
             raise GoniometerError("All points coincide, so the patch has no extent to measure.")
     radius = as_radius(radius)
     fields = measure_patch(ordered_points, ordered_normals, center, radius, lam, rule)
+    if rule == "refined" and sides_contradict_normals(
+        ordered_points,
+        fields["labels"],
+        fields["normal_plus"],
+        fields["normal_minus"],
+        center,
+        radius,
+    ):
+        raise GoniometerError(contradicting_normals_message(fields["angle"]))
     labels = np.empty_like(fields["labels"])
     labels[order] = fields["labels"]
     fields["labels"] = labels

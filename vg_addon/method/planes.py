@@ -153,10 +153,34 @@ def sides_contradict_normals(points, labels, normal_plus, normal_minus, center, 
     return (reach[0] > 0) == (reach[1] > 0)
 
 
+def contradicting_normals_message(angle: float, *, cloud: bool = False) -> str:
+    """The refusal where :func:`sides_contradict_normals`: why, what the reading would have been
+    (``angle``) and what to do, for a point cloud's estimated normals or a mesh's (or given)
+    normals."""
+    if cloud:
+        return (
+            "The point cloud's estimated normals face opposite ways on the two sides of this "
+            "crease (one face's were oriented the wrong way round, as can happen across an "
+            f"acute edge), so the angle would read {angle:.2f}° (the edge would then be "
+            f"{180.0 - angle:.2f}°): measure the scan as a mesh, or give the cloud normals you "
+            "trust."
+        )
+    return (
+        "The two sides' normals face opposite ways for where the sides lie, so this reading, "
+        f"{angle:.2f}°, is not the edge's angle. Either one face's normals point the other way "
+        "(its triangles wound against the rest, or given normals pointing into the material: "
+        f"the edge would then be {180.0 - angle:.2f}°; make the normals consistent, e.g. in "
+        "Blender's Edit Mode with Mesh > Normals > Recalculate Outside), or the split did not "
+        "follow an edge (a flat, rounded or noisy patch: move the centre onto the edge or use a "
+        "larger radius). The 'oriented' rule replicates a reading taken with it."
+    )
+
+
 __all__ = [
     "LINE_REACH",
     "RANK_TOLERANCE",
     "SIDE_REACH",
+    "contradicting_normals_message",
     "crease_line",
     "distance_to_line",
     "side_plane",

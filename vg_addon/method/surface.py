@@ -21,7 +21,7 @@ from .algorithm import (
 from .geodesic import EdgeGraph
 from .normals import pca_normals, vertex_normals
 from .ordering import canonical_ranks
-from .planes import sides_contradict_normals
+from .planes import contradicting_normals_message, sides_contradict_normals
 from .precision import check_rounding, precision_of
 from .result import Measurement
 from .spatial import GridIndex, estimate_spacing
@@ -41,6 +41,12 @@ def _as_triangles(triangles, n_points: int) -> np.ndarray:
     if given.size and not np.issubdtype(given.dtype, np.integer):
         raise GoniometerError(
             f"The triangles must be integer vertex indices; got {given.dtype} values."
+        )
+    if given.size and given.dtype == np.uint64 and int(given.max()) >= n_points:
+        # Checked before the cast to int64, which would wrap an index of 2⁶³ or more negative.
+        raise GoniometerError(
+            f"A triangle refers to vertex {int(given.max())}, but the mesh has vertices 0 to "
+            f"{n_points - 1}: the face list does not match the points."
         )
     # int32 indices are kept as they are (every index fits; no copy of the largest array).
     dtype = np.int32 if given.dtype == np.int32 else np.int64
@@ -126,9 +132,28 @@ class Surface:
             self.normals, self.valid = pca_normals(self.points, full_index)
         self.valid_ids = np.flatnonzero(self.valid)
         if self.valid_ids.size == 0:
+            rounded = ""
+            if full_index is not None and n:
+                distinct = np.unique(self.points, axis=0).shape[0]
+                if 2 * distinct <= n:  # most points repeated: their neighbourhoods are copies
+                    rounded = (
+                        f" The cloud repeats its points ({distinct:,} distinct of {n:,}): merge "
+                        "the duplicates and measure again."
+                    )
+            largest = float(np.abs(self.points).max()) if n else 0.0
+            step = float(np.spacing(np.float32(largest)))
+            extent = float(np.ptp(self.points, axis=0).max()) if n else 0.0
+            # The rounding can have collapsed the faces only where the mesh spans few steps.
+            if self.precision == "float32" and n and not rounded and extent <= 100 * step:
+                rounded = (
+                    f" Its coordinates are float32 and reach {largest:.3g}, where float32 keeps "
+                    f"steps of {step:.2g}, and the whole mesh spans {extent:.2g}: the rounding "
+                    "has collapsed its faces; move the mesh near the origin (subtract an offset "
+                    "from its coordinates)."
+                )
             raise GoniometerError(
                 "No vertex of this mesh has a normal (no faces with area, or an empty point cloud): "
-                "nothing can be measured."
+                f"nothing can be measured.{rounded}"
             )
         if full_index is not None and self.valid_ids.size == n:
             self.index = full_index  # the same points: the normals' index serves the queries
@@ -233,7 +258,8 @@ class Surface:
             Centre farther than ``radius`` from the surface, bad radius or λ, unknown patch mode,
             too few vertices, float32 coordinates rounded too coarsely for the patch, a flat
             patch, a side that is a line, or (refined rule) two fitted planes that meet farther
-            than the radius from the centre.
+            than the radius from the centre or sides whose normals face opposite ways (a face
+            wound against the other; for point clouds under every rule).
         """
         requested = as_center(center)
         radius = as_radius(radius)
@@ -248,6 +274,11 @@ class Surface:
         ball, _ = self.index.ball(self.points[center_index], radius)
         indices = self._restrict(ball, center_index, radius, mode)
         if indices.size < 2 * MIN_SIDE_VERTICES:
+            # Far from the origin float32 rounding merges vertices: say so, not "too few", where
+            # its step is a tenth of the radius or more (else the radius is simply too small).
+            step = float(np.spacing(np.float32(np.abs(self.points[center_index]).max())))
+            if self.precision == "float32" and step >= 0.1 * radius:
+                check_rounding(np.take(self.points, indices, axis=0), radius, self.precision)
             raise GoniometerError(
                 f"The patch of radius {radius:g} holds only {indices.size} vertices; at least "
                 f"{2 * MIN_SIDE_VERTICES} are needed: use a larger radius."
@@ -264,7 +295,10 @@ class Surface:
             lam,
             rule,
         )
-        if self.estimated_orientation and sides_contradict_normals(
+        # A face whose normals point the other way reads as the supplement: a point cloud's
+        # estimated normals under every rule; a mesh's mixed winding under the refined one (the
+        # replication rules keep their readings, as the earlier implementations gave them).
+        if (self.estimated_orientation or rule == "refined") and sides_contradict_normals(
             patch_points,
             fields["labels"],
             fields["normal_plus"],
@@ -273,10 +307,7 @@ class Surface:
             radius,
         ):
             raise GoniometerError(
-                "The point cloud's estimated normals face opposite ways on the two sides of this "
-                "crease (one face's were oriented the wrong way round, as can happen across an "
-                "acute edge), so the angle would read as its supplement: measure the scan as a "
-                "mesh, or give the cloud normals you trust."
+                contradicting_normals_message(fields["angle"], cloud=self.estimated_orientation)
             )
         measurement = Measurement(
             **fields,

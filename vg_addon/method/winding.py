@@ -1,9 +1,12 @@
 """Which way a mesh's faces are wound: outward or inward for a closed surface, by its signed volume.
 
-The oriented rule reads the same angle whichever way the faces are wound, but the convex/concave
-label is relative to the normals: on an inward-wound mesh a convex edge reads "concave". A closed
-surface says which way is out (its signed volume is positive when the faces are wound outward);
-an open scan does not, so there the label is relative to the normals as given.
+The oriented rule reads the same angle whichever way the whole mesh is wound, but the
+convex/concave label is relative to the normals: on an inward-wound mesh a convex edge reads
+"concave". A closed surface says which way is out (its signed volume is positive when the faces
+are wound outward); an open scan does not, so there the label is relative to the normals as given.
+Where only some faces are flipped (mixed winding), an edge between a flipped face and another
+reads as the supplement of its angle: the refined rule refuses it where the sides show it
+(``planes.sides_contradict_normals``).
 """
 
 from __future__ import annotations
@@ -162,7 +165,9 @@ def winding_message(name: str, winding: str) -> str:
         )
     if winding == "mixed":
         return (
-            f"Some faces of '{name}' are wound against their neighbours: convex/concave labels "
-            "near them may be wrong. Recalculate its normals (outside) to fix them."
+            f"Some faces of '{name}' are wound against their neighbours: an edge between a "
+            "flipped face and another reads as the supplement of its angle (the refined rule "
+            "refuses it where it can tell), and labels near them may be wrong. Recalculate its "
+            "normals (outside) to fix them."
         )
     return ""
