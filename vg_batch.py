@@ -13,6 +13,7 @@ does it (see docs/BATCH.md).
 import importlib.util
 import os
 import shutil
+import signal
 import sys
 import traceback
 from pathlib import Path
@@ -23,6 +24,16 @@ PACKAGE = (
 )
 # Blender's own Python has imported bpy before it runs a --python script; a plain Python has not.
 IN_BLENDER = "bpy" in sys.modules
+
+
+STOPPED_WHILE_STARTING: list[int] = []
+"""Stop signals (Ctrl-C) that came while the script was starting: an interrupt raised inside an
+import (bpy's, NumPy's) leaves a module half-imported, and bpy swallows it. They are kept here
+and acted on once the imports are done (:func:`main`)."""
+
+
+def _stop_while_starting(signum, frame) -> None:
+    STOPPED_WHILE_STARTING.append(signum)
 
 
 def script_argv() -> list[str]:
@@ -89,6 +100,15 @@ def main() -> int:
         print(f"vg_batch: error: {error}", file=sys.stderr)
         return 2
     importlib.import_module(f"{package.__name__}.batch")
+    if signal.getsignal(signal.SIGINT) is _stop_while_starting:  # a worker's stays ignored
+        # From here a stop raises KeyboardInterrupt; the run installs its own handler at once.
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    if STOPPED_WHILE_STARTING:  # checked after the switch: no stop falls between the two
+        print(
+            "vg_batch: interrupted while starting; nothing was measured or written",
+            file=sys.stderr,
+        )
+        return 130
     try:
         return package.batch.main(script_argv())
     finally:
@@ -96,10 +116,16 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    # A worker's Ctrl-C is its parent's to handle (the parent stops it): ignored from the start.
+    child = any(flag in sys.argv for flag in ("--worker", "--map-worker"))
+    signal.signal(signal.SIGINT, signal.SIG_IGN if child else _stop_while_starting)
     try:
         status = main()
     except SystemExit as stop:  # argparse: --help (0) and usage errors (2)
         status = stop.code if isinstance(stop.code, int) else 2
+    except KeyboardInterrupt:  # outside the run's own handling (parsing the arguments, ...)
+        print("vg_batch: interrupted", file=sys.stderr)
+        status = 130
     except Exception:
         traceback.print_exc()
         status = 2

@@ -14,7 +14,7 @@ import signal
 import sys
 
 from ..vg_addon import GoniometerError
-from . import extension
+from . import extension, stopping
 from .cli import UsageError, build_parser, check_args
 
 
@@ -25,7 +25,24 @@ def _stop(signum, frame):
     # second signal must not cut that short, so it is ignored from now on.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    raise KeyboardInterrupt
+    stopping.request()  # raised again between steps where a Blender handler swallowed it
+    if not _in_blenders_scripts(frame):  # there bpy would print it as an error, and go on
+        raise KeyboardInterrupt
+
+
+def _in_blenders_scripts(frame) -> bool:
+    """Whether ``frame`` runs code of Blender's own add-ons or startup scripts, where its
+    handlers live (not its ``modules``: ``bpy.ops`` wrappers raise to their caller)."""
+    import os
+
+    import bpy
+
+    scripts = bpy.utils.system_resource("SCRIPTS")
+    if not scripts or frame is None:
+        return False
+    path = frame.f_code.co_filename
+    modules = os.path.join(scripts, "modules") + os.sep
+    return path.startswith(scripts) and not path.startswith(modules)
 
 
 def main(argv: list[str]) -> int:

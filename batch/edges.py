@@ -102,13 +102,23 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
     return specs
 
 
-def failed_rows_line(path, numbers: list[int]) -> str:
-    """The summary's line naming the rows of an edges CSV passed over because their ``error``
-    says the run that wrote them could not measure them."""
+def failed_rows_line(path, numbers: list[int], *, edges: bool = True) -> str:
+    """The summary's line naming the rows of an edges CSV (or, ``edges=False``, of a points or
+    measurements CSV) passed over because their ``error`` says the run that wrote them could
+    not measure them."""
     rows = ", ".join(str(n) for n in numbers[:10]) + (", ..." if len(numbers) > 10 else "")
+    what, advice = (
+        ("edge row(s)", "clear a row's error cell")
+        if edges
+        else (
+            "row(s)",
+            "copy a point's Requested x, y, z into its x, y, z and clear its error (an edge's "
+            "rows come back through its edges file, --edges NAME_edges.csv)",
+        )
+    )
     return (
-        f"passed over {len(numbers)} edge row(s) of {Path(path).name} whose error says they were "
-        f"not measured (row {rows}): clear a row's error cell to measure it again"
+        f"passed over {len(numbers)} {what} of {Path(path).name} whose error says they were "
+        f"not measured (row {rows}): to measure one again, {advice}"
     )
 
 

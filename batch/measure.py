@@ -6,6 +6,7 @@ import dataclasses
 import time
 import traceback
 from pathlib import Path
+from typing import NoReturn
 
 import bpy
 import numpy as np
@@ -15,6 +16,7 @@ from ..vg_addon import GoniometerError, Surface
 from ..vg_addon import units as units_module
 from ..vg_addon.formats import csvio, files, sweep_plot
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
+from . import stopping
 from .cli import UNITS
 from .edges import failed_edge_row, measure_edges, not_found_row, spec_applies
 from .map_process import draw_map
@@ -127,6 +129,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     start = time.perf_counter()
     exact_points = None
     try:
+        stopping.check()
         if source.path:
             obj, exact_points = import_mesh(source)
         else:
@@ -171,37 +174,69 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     data = obj.vg
     base = data.next_number - 1  # measurements already on a .blend object keep their numbers
     last_report = start = time.perf_counter()
+    stopped = None  # the run's stop (Ctrl-C, SIGTERM), raised once what was measured is recorded
     for first in range(0, len(tasks), _BLOCK):
         # Measure a block, then record it: alternating one measurement with one record costs
         # about a tenth more (measured), the records' writes evicting the measuring's data.
         block = tasks[first : first + _BLOCK]
         measured = []
-        for task in block:
-            measured.append(_measure_task(surface, geometry, task, options))
-            now = time.perf_counter()  # once a second however slow the block (a task each)
-            if progress is not None and now - last_report >= 1.0:
-                progress(first + len(measured))
-                last_report = now
-        for task, m in zip(block, measured, strict=True):
+        try:
+            for task in block:
+                stopping.check()  # also after the records, whose updates run Blender handlers
+                measured.append(_measure_task(surface, geometry, task, options))
+                now = time.perf_counter()  # once a second however slow the block (a task each)
+                if progress is not None and now - last_report >= 1.0:
+                    progress(first + len(measured))
+                    last_report = now
+        except KeyboardInterrupt as stop:  # the stop handler ignores a second signal
+            stopped = stop
+        for task, m in zip(block, measured, strict=False):
             if isinstance(m, GoniometerError):
                 result.rows.append((task.index, error_row(task, name, str(m), units)))
                 result.failed += 1
                 continue
             data.next_number = base + task.number
-            # The bridge's one record step, as a click takes; painted once at the end.
-            row = measuring.record_row(
-                obj,
-                m,
-                geometry,
-                units=units,
-                precision=precision,
-                note=task.label,
-                break_number=task.break_number,
-            )
+            try:
+                # The bridge's one record step, as a click takes; painted once at the end.
+                row = measuring.record_row(
+                    obj,
+                    m,
+                    geometry,
+                    units=units,
+                    precision=precision,
+                    note=task.label,
+                    break_number=task.break_number,
+                )
+            except KeyboardInterrupt as stop:  # this row is lost; the block's others are kept
+                stopped = stop
+                continue
             result.rows.append((task.index, dataclasses.replace(row, mesh_name=name)))
             result.measured += 1
+        if stopped is not None:
+            break
     result.measure_seconds = time.perf_counter() - start
+    if stopped is not None:
+        _stop_with(result, rows_ready, stopped)
     stem = picture_stem(index, source, options)
+    try:
+        stopping.check()
+        plots = _sites_and_edges(
+            result, obj, source, tasks, options, stem, (surface, geometry, precision, units)
+        )
+    except KeyboardInterrupt as stop:  # the points' rows are kept; the rest is not done
+        _stop_with(result, rows_ready, stop)
+    if rows_ready is not None:
+        rows_ready(result)  # the rows are written before any picture is drawn
+    draw_pictures(result, obj, options, stem, plots, name)
+    return result
+
+
+def _sites_and_edges(result, obj, source, tasks, options, stem, measured_on) -> list:
+    """After the points of :func:`measure_mesh`: the radius sweeps, the colours and the edges;
+    returns the plots to draw. ``measured_on``: the points' surface, geometry, precision and
+    units label."""
+    surface, geometry, precision, units = measured_on
+    name, data = source.name, obj.vg
     sweep_plots = []
     if options.get("sweep"):
         sweep_plots = sweep_sites(
@@ -221,11 +256,16 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
         result.station_rows, result.edge_rows, profile_plots, result.found_edges = measure_edges(
             obj, source, options, units, stem, surface, precision
         )
+    return sweep_plots + profile_plots
 
+
+def _stop_with(result, rows_ready, stop) -> NoReturn:
+    """Hand over the rows measured before the run was stopped (the run writes them with the
+    rest, and each task without a row as not measured), then stop. Nothing else is finished:
+    a stopped run saves no .blend and draws no picture."""
     if rows_ready is not None:
-        rows_ready(result)  # the rows are written before any picture is drawn
-    draw_pictures(result, obj, options, stem, sweep_plots + profile_plots, name)
-    return result
+        rows_ready(result)
+    raise stop
 
 
 def picture_stem(index: int, source: MeshSource, options) -> str:

@@ -20,10 +20,10 @@ from ..vg_addon.method.edge_summary import sd_text
 from ..vg_addon.method.result import stability_text, stability_warning
 from ..vg_addon.method.winding import winding_message
 from ..vg_addon.workflow import agreement, batchplan
-from . import extension
+from . import extension, stopping
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError, is_picked_points
-from .edges import edge_specs, profiled, spec_applies
+from .edges import edge_specs, failed_rows_line, profiled, spec_applies
 from .find_edges import find_options
 from .measure import MeshResult, error_row, run_units_label, safe_measure_mesh, set_units
 from .outputs import check_outputs, input_files, make_folders, sweep_paths
@@ -31,6 +31,9 @@ from .pictures import reason
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
 from .workers import run_workers
+
+STOPPED = "not measured: the run was stopped before this point"
+"""The error of a row the run had not measured when it was stopped."""
 
 
 class Run:
@@ -295,13 +298,15 @@ class Run:
         drawn = sum(r.sweep_plots for r in self.results)
         self.say(f"wrote {csv_path} ({len(rows):,} sweep rows) and {drawn} plot(s) in {plots}")
 
+    def unmeasured(self, task, message: str):
+        """The row of a task without a measurement, saying why."""
+        name = self.sources[task.mesh].name if task.mesh >= 0 else task.mesh_name
+        return error_row(task, name, message, self.units)
+
     def finish(self) -> int:
         missing = [t for t in self.tasks if t.index not in self.rows]
         for task in missing:  # e.g. a worker that could not even start
-            name = self.sources[task.mesh].name if task.mesh >= 0 else task.mesh_name
-            self.rows[task.index] = error_row(
-                task, name, "not measured: the run stopped before this mesh", self.units
-            )
+            self.rows[task.index] = self.unmeasured(task, STOPPED)
         try:
             self.write_csv()
         except csvio.SummaryWriteError as error:
@@ -381,9 +386,23 @@ class Run:
                 f"--find-edges found no break edge on {len(nothing)} mesh(es), which have no "
                 f"edge rows: {bounded_list(nothing)}"
             )
+        unswept = self.unswept_sites()
+        if unswept:
+            self.say(
+                f"--sweep measured no radius at {unswept} site(s) (see the sweep CSV's error "
+                "column)"
+            )
         where = "standard output" if self.args.out == files.STDOUT else self.args.out
         self.say(f"wrote the CSV to {where}")
-        return batchplan.exit_code(len(failed) + len(failed_edges), len(self.bad_files))
+        return batchplan.exit_code(len(failed) + len(failed_edges) + unswept, len(self.bad_files))
+
+    def unswept_sites(self) -> int:
+        """How many sites of ``--sweep`` have no radius measured (each radius refused)."""
+        angle = csvio.SWEEP_COLUMNS.index("Angle")
+        measured: dict[int, bool] = {}
+        for index, cells in self.sweep_rows:
+            measured[index] = measured.get(index, False) or bool(cells[angle])
+        return sum(1 for any_radius in measured.values() if not any_radius)
 
 
 def what_failed(error, out) -> str:
@@ -445,6 +464,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             raise UsageError(f"two inputs are both named {source.name!r}: rename one.")
         seen[source.name] = source
     replayed = 0  # rows of a --points file, in order: task i is its row i
+    passed_over = []  # the summary's lines on input rows not measured again
     try:
         if args.at:
             tasks = bp.plan_points(
@@ -459,7 +479,10 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             tasks = []  # edges only
         else:
             try:
-                rows = csvio.read_replication_csv(Path(args.points))  # a path, whatever it holds
+                failed = []  # a batch run's failed rows, passed over: said in the summary
+                rows = csvio.read_replication_csv(Path(args.points), failed)  # a path, whatever
+                if failed:
+                    passed_over.append(failed_rows_line(args.points, failed, edges=False))
             except OSError as error:
                 raise UsageError(f"{args.points}: {error.strerror or error}") from None
             replayed = len(rows)
@@ -478,7 +501,6 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             tasks = bp.shard(tasks, k, n)
     except GoniometerError as error:
         raise UsageError(str(error)) from None
-    passed_over = []
     edges = edge_specs(args, sources, passed_over)
     groups = {mesh: ts for mesh, ts in bp.by_mesh(tasks).items() if mesh >= 0}
     if edges or args.find_edges:  # every mesh with edges is measured, with or without points
@@ -556,6 +578,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             else:
                 rows_ready = functools.partial(run.add, pictures_follow=pictures)
                 for mesh, mesh_tasks in groups.items():
+                    stopping.check()
                     progress = functools.partial(run.progress, mesh)
                     result = safe_measure_mesh(
                         mesh, sources[mesh], mesh_tasks, options, progress, rows_ready
@@ -567,6 +590,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                         forget(result.object_name)
         finally:
             code = run.finish()  # also after an error or Ctrl-C: write what was measured
+        stopping.check()  # a stop a Blender handler swallowed: the run ends as stopped
         if args.save_blend:
             if parallel:
                 objects = append_objects(run.results)
@@ -589,4 +613,5 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         run.say(f"  could not write the {message}")
     if run.failed_outputs:
         code = max(code, 2)  # the CSV is complete, but an output asked for is missing
+    stopping.check()  # stopped while the .blend was saved (its handlers swallow the stop)
     return code, run

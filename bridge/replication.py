@@ -194,9 +194,10 @@ def replicate_steps(
     return numbers
 
 
-def read_rows(path) -> tuple[list, str]:
-    """The replication rows of the CSV at ``path`` and how messages name it."""
-    return csvio.read_replication_csv(Path(path)), f"'{Path(path).name}'"
+def read_rows(path, passed_over: list | None = None) -> tuple[list, str]:
+    """The replication rows of the CSV at ``path`` and how messages name it; the numbers of a
+    batch run's failed rows, skipped, are appended to ``passed_over`` if given."""
+    return csvio.read_replication_csv(Path(path), passed_over), f"'{Path(path).name}'"
 
 
 def import_csv(obj, path, *, depsgraph=None, **options) -> list[int]:

@@ -14,6 +14,7 @@ from bpy_extras.io_utils import ExportHelper, ImportHelper
 from ..bridge import edges, measuring, records, replication
 from ..bridge.mesh_data import check_measurable
 from ..vg_addon import GoniometerError, units
+from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
 from ..vg_addon.workflow import agreement
 from .common import absolute_path, poll_measurable, typed_value
@@ -213,7 +214,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                 )
                 _remember(path)
                 return {"FINISHED"}
-            rows, source = replication.read_rows(path)
+            self._passed_over = []
+            rows, source = replication.read_rows(path, self._passed_over)
             steps = replication.replicate_steps(
                 obj,
                 rows,
@@ -269,8 +271,14 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         extra, differing = follow_export(self._obj, self._full_path, numbers)
+        passed = getattr(self, "_passed_over", [])
+        if passed:
+            extra += (
+                f"; passed over {len(passed)} row(s) a batch run could not measure (rows "
+                f"{bounded_list(passed)}: no x, y, z; their error column says why)"
+            )
         self.report(
-            {"WARNING" if differing else "INFO"},
+            {"WARNING" if differing or passed else "INFO"},
             f"Re-measured {len(numbers)} row(s) of {self._path_name} on '{self._obj.name}' "
             f"(measurements {numbers[0]}–{numbers[-1]}){extra}",
         )

@@ -496,3 +496,21 @@ def test_a_radius_for_an_edge_summarys_rows_is_refused_unless_points_take_it(sca
     rows = csvio.read_measurements_csv(both)
     edge_rows = csvio.read_measurements_csv(first)
     assert {r.radius for r in rows} == {0.2, edge_rows[0].radius}  # the point's and the edge's
+
+
+def test_a_replay_says_which_failed_rows_of_its_file_it_passed_over(scan, tmp_path):
+    """A run's failed row (no x, y, z) is passed over by a replay of its CSV, as documented; the
+    replay said nothing of it ("all 2 angles equal the file's exactly", exit 0), so a point
+    dropped out of the study without a word. The summary now names the row and what to do."""
+    points = tmp_path / "points.csv"
+    points.write_text("x,y,z,radius\n0,0,0,0.3\n0,0,0,1e-9\n0.2,0,0,0.3\n", encoding="utf-8")
+    first = tmp_path / "first.csv"
+    ok(batch(scan, "--points", points, "--out", first), code=1)  # the tiny radius fails
+    rows = csvio.read_measurements_csv(first)
+    assert [bool(r.error) for r in rows] == [False, True, False]
+    replay = ok(batch(scan, "--points", first, "--out", tmp_path / "replay.csv"))
+    assert (
+        "passed over 1 row(s) of first.csv whose error says they were not measured (row 3): to "
+        "measure one again, copy a point's Requested x, y, z into its x, y, z and clear its error"
+    ) in replay.stderr
+    assert len(csvio.read_measurements_csv(tmp_path / "replay.csv")) == 2

@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -20,6 +21,7 @@ import threading
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from vg_addon.formats import csvio, meshio
@@ -283,10 +285,76 @@ def test_a_stop_signal_ends_the_run_cleanly(started, tmp_path, stop, to_group):
     assert all(not row.error for row in rows[:3])
     # A worker signalled with the group may end before the parent notices the stop: its rows
     # then say the worker stopped; either way they say why they hold no angle.
-    expected = ("the run stopped before this mesh",)
+    expected = ("the run was stopped before this point",)
     if to_group:
         expected += ("worker process measuring this mesh stopped (exit status 143)",)
     assert all(any(text in row.error for text in expected) for row in rows[3:])
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.13, 0.29, 0.47])
+def test_a_stop_keeps_the_rows_measured_on_the_mesh_being_measured(tmp_path, inputs, delay):
+    """One process, the slow mesh's 20,000 points: a stop in the middle of that mesh wrote every
+    row as "not measured" (the mesh's rows were handed over only when it was done). Now the rows
+    measured before the stop are kept, each with its angle, and only the rest say they were not
+    measured; the progress line the run printed is the oracle of how many at least (less the
+    one a stop in the middle of its record loses). The stop lands ``delay`` s after that line,
+    while points are measured or while a block of them is recorded."""
+    out = tmp_path / "out.csv"
+    run = Batch(tmp_path, inputs["slow"], "--points", inputs["points"], "--radius", "0.3",
+                "--ignore-mesh-names", "--out", out)  # fmt: skip
+    try:
+        seen = wait_for(lambda: _points_done(run.lines), "a progress line with points measured")
+        time.sleep(delay)
+        run.process.send_signal(signal.SIGINT)
+        code, stderr = run.finish()
+    finally:
+        run.stop()
+    assert code == 130 and "interrupted" in stderr and "Traceback" not in stderr, stderr
+    rows = csvio.read_measurements_csv(out)
+    assert len(rows) == 3 + SLOW_ROWS
+    measured = [row for row in rows if not row.error]
+    assert len(measured) >= seen - 1
+    assert all(row.angle is not None for row in measured)
+    rest = [row for row in rows if row.error]
+    assert rest and all(
+        r.error == "not measured: the run was stopped before this point" for r in rest
+    )
+
+
+def test_a_stop_at_any_moment_of_the_start_ends_cleanly(tmp_path, inputs):
+    """Ctrl-C in the first second: a KeyboardInterrupt traceback inside NumPy's import, then a run
+    that went on with a half-imported NumPy and exited 0, or one swallowed by a Blender handler
+    of the mesh import. A stop at any moment of the start now ends the run with status 130 and
+    no traceback, or, once the run is done, leaves it done."""
+    stops = np.linspace(0.05, 1.5, 16)
+    for when in stops:
+        out = tmp_path / f"start_{when:.2f}.csv"
+        process = subprocess.Popen(
+            [sys.executable, str(SCRIPT), str(inputs["fast"]), "--at", "0", "0", "0",
+             "--radius", "0.3", "--out", str(out)],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        time.sleep(when)
+        process.send_signal(signal.SIGINT)
+        _, stderr = process.communicate(timeout=WAIT)
+        said = f"stopped at {when:.2f} s: exit {process.returncode}\n{stderr}"
+        assert "Traceback" not in stderr and "Error in" not in stderr, said
+        if process.returncode == 0:  # the run was over before the stop
+            assert "wrote the CSV" in stderr and "interrupted" not in stderr, said
+            assert not csvio.read_measurements_csv(out)[0].error, said
+        else:
+            assert process.returncode == 130 and "interrupted" in stderr, said
+            rows = csvio.read_measurements_csv(out) if out.exists() else []
+            assert all(row.error or row.angle is not None for row in rows), said
+
+
+def _points_done(lines) -> int | None:
+    """The largest count of points a progress line says were measured (None before one does)."""
+    counts = [int(m.group(1).replace(",", "")) for m in map(_PROGRESS.search, lines) if m]
+    return max(counts) if counts and max(counts) > 0 else None
+
+
+_PROGRESS = re.compile(r"meshes, ([\d,]+)/[\d,]+ points")
 
 
 # --------------------------------------------------------------------------- a map rendering

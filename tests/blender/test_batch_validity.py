@@ -80,6 +80,24 @@ def test_a_sweep_site_that_no_radius_can_measure_fails_alone(tmp_path):
     assert all(r["Angle"] for r in sweep[:3]) and not any(r["Angle"] for r in sweep[3:])
 
 
+def test_a_sweep_that_measures_no_radius_fails_the_run_though_its_row_is_measured(tmp_path):
+    """Radii far below the mesh's spacing: every sweep row refused, the site's own row measured.
+    The run exited 0 as if the sweep had been done; it now exits 1, saying so."""
+    shape = wedge(100, n=40)
+    path = tmp_path / "wedge.ply"
+    meshio.write_ply(path, shape.points, shape.triangles)
+    out = tmp_path / "angles.csv"
+    run = run_batch(path, "--at", "0.01", "0", "0", "--radius", "0.3",
+                    "--sweep", "1e-9", "1e-7", "3", "--out", out)  # fmt: skip
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert "--sweep measured no radius at 1 site(s)" in run.stderr
+    (row,) = csvio.read_measurements_csv(out)
+    assert not row.error
+    with open(tmp_path / "angles_sweep.csv", newline="", encoding="utf-8") as handle:
+        sweep = list(csv.DictReader(handle))
+    assert len(sweep) == 3 and not any(r["Angle"] for r in sweep)
+
+
 def test_meshlab_rows_keep_the_papers_rule(tmp_path):
     shape = wedge(90, n=40, irregular=True, seed=4, concave=True)
     path = tmp_path / "valley.ply"

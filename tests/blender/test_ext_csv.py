@@ -409,3 +409,21 @@ def test_an_imported_break_at_the_largest_number_leaves_the_next_break_there(vg,
     assert bpy.ops.vg.import_csv(filepath=path) == {"FINISHED"}
     assert obj.vg.measurements[-1].break_number == last and obj.vg.break_number == last
     assert bpy.ops.vg.next_break() == {"FINISHED"} and obj.vg.break_number == last
+
+
+def test_an_import_says_which_failed_rows_it_passed_over(vg, tmp_path, capfd):
+    """A batch run's failed row (error filled, no x, y, z) is skipped by the import, as
+    documented; the report said only how many rows it re-measured, so the point dropped out
+    without a word. It now names the rows passed over, as a warning."""
+    wedge_object(100.0, "scan")
+    good = "scan,,1,1,,,,,0.5,0,0,0,,2,"
+    failed = "scan,,2,1,,,,,1e-9,,,,,2,The centre is farther than the radius from every vertex"
+    header = MESHLAB_HEADER + ",error"
+    path = write(tmp_path / "run.csv", f"{header}\n{good}\n{failed}\n")
+    capfd.readouterr()
+    assert bpy.ops.vg.import_csv(filepath=path) == {"FINISHED"}
+    said = capfd.readouterr()
+    assert (
+        "Re-measured 1 row(s) of run.csv on 'scan' (measurements 1–1); passed over 1 row(s) a "
+        "batch run could not measure (rows 3: no x, y, z; their error column says why)"
+    ) in said.out + said.err

@@ -174,7 +174,9 @@ def _source_format(header: list[str]) -> str:
     return "points"
 
 
-def parse_replication_csv(text: str, source: str = "The CSV text") -> list[ReplicationRow]:
+def parse_replication_csv(
+    text: str, source: str = "The CSV text", passed_over: list | None = None
+) -> list[ReplicationRow]:
     """Parse CSV text into replication rows; see :func:`read_replication_csv`.
 
     ``source`` names the text in error messages (e.g. ``"'points.csv'"``).
@@ -223,6 +225,8 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
             continue
         if cell("error").strip() and all(not cell(f).strip() for f in _REQUIRED):
             skipped += 1
+            if passed_over is not None:
+                passed_over.append(number)
             continue
         values: dict[str, float | None] = {}
         for field in ("x", "y", "z", "radius", "lam", "arc_length", "spacing"):
@@ -315,7 +319,7 @@ def parse_replication_csv(text: str, source: str = "The CSV text") -> list[Repli
     return rows
 
 
-def read_replication_csv(path_or_text) -> list[ReplicationRow]:
+def read_replication_csv(path_or_text, passed_over: list | None = None) -> list[ReplicationRow]:
     """Read the rows to re-measure (the paper's xyz method) from a CSV file or text.
 
     Parameters
@@ -347,7 +351,9 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
     apostrophe the writer puts before formula-like text is removed.
 
     Skipped: fully blank lines, and rows whose ``error`` cell is filled *and* whose x, y and z
-    are all blank (a batch run's failed rows). A failed row that has coordinates is kept.
+    are all blank (a batch run's failed rows; their row numbers are appended to
+    ``passed_over``, if given, so the caller can say so). A failed row that has coordinates is
+    kept.
 
     Raises
     ------
@@ -363,4 +369,4 @@ def read_replication_csv(path_or_text) -> list[ReplicationRow]:
         The file cannot be read.
     """
     text, source = load(path_or_text)
-    return parse_replication_csv(text, source)
+    return parse_replication_csv(text, source, passed_over)
