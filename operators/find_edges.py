@@ -87,14 +87,17 @@ def translate_find_event(
 ):
     """What a Blender event means to the review: ``"click"``, ``"accept"``, ``"accept_all"``,
     ``"reject"``, ``"trim"``, ``"next"``, ``"previous"``, ``"finish"``, ``"cancel"``,
-    ``"pass"`` (navigation: Blender's) or ``"ignore"`` (a key held down repeating: each
-    decision is one deliberate press, so holding A never accepts candidates not looked at)."""
+    ``"menu"`` (a right-click: Blender's menus off the viewport, nothing on it), ``"pass"``
+    (navigation: Blender's) or ``"ignore"`` (a key held down repeating: each decision is one
+    deliberate press, so holding A never accepts candidates not looked at)."""
     if event_type in _NAVIGATION:
         return "pass"
     if value != "PRESS" or ctrl or alt or repeat:
         return "ignore"
     if event_type == "LEFTMOUSE":
         return "click"
+    if event_type == "RIGHTMOUSE":
+        return "menu"
     action = _KEYS.get(event_type, "ignore")
     if shift and action in ("accept", "next"):
         return {"accept": "accept_all", "next": "previous"}[action]
@@ -232,6 +235,10 @@ class FindEdgesSession(ViewSession):
                 self._end_progress()  # back to the review: the measuring's progress ends
             else:
                 machine.cancel()
+        elif action == "menu":
+            # Off the viewport (a header, the sidebar, another editor) Blender's menus open, as
+            # a left-click there passes: the review must not lock the rest of the window.
+            return "running" if self.view_at(mouse) is not None else "pass"
         elif machine.working:
             return "running"  # only Esc and navigation while the work runs
         elif action == "click":

@@ -44,6 +44,25 @@ def test_keys_held_down_decide_nothing_and_focus_lost_cancels_nothing(vg, edge):
     assert f("X", "PRESS", repeat=True) == "ignore" and f("RET", "PRESS", repeat=True) == "ignore"
 
 
+def test_a_right_click_off_the_viewport_reaches_blender_during_a_review(vg, view):  # noqa: F811
+    """Every right-click was swallowed while a review ran, so no header's or sidebar's menu
+    opened (Close Area among them). Off the viewport it now passes; on it, it does nothing."""
+    find = importlib.import_module(f"{vg.__name__}.operators.find_edges")
+    assert find.translate_find_event("RIGHTMOUSE", "PRESS") == "menu"
+    assert find.translate_find_event("RIGHTMOUSE", "PRESS", ctrl=True) == "ignore"
+    with bpy.context.temp_override(window=view.window, area=view.area, region=view.region):
+        session = find.FindEdgesSession(bpy.context, view.obj, find.BreakEdgeParameters())
+    try:
+        header = next(r for r in view.area.regions if r.type == "HEADER" and r.width > 1)
+        on_header = (header.x + header.width // 2, header.y + header.height // 2)
+        middle = (view.region.x + view.region.width // 2, view.region.y + view.region.height // 2)
+        assert session.handle(bpy.context, "menu", on_header) == "pass"
+        assert session.handle(bpy.context, "menu", middle) == "running"
+        assert session.machine.working  # the finding goes on either way
+    finally:
+        session.finish()
+
+
 def test_another_scene_shown_keeps_the_clicks(edge, view):  # noqa: F811
     """Switching the window to another scene ended the session at the next mouse move, as "The
     object was deleted", with every click lost."""

@@ -249,3 +249,28 @@ def test_ctrl_z_undoes_the_whole_acceptance_in_one_step(gui, places):
     gui.key("ctrl+shift+z")
     state = gui.wait_for(lambda s: s["objects"][OBJ]["edges"], 20, "the redo")
     assert state["objects"][OBJ]["measurements"] == before["measurements"]
+
+
+def test_closing_the_viewport_mid_review_ends_it_recording_nothing(gui, places):
+    """The last test of the window: it closes the 3D viewport. A right-click on a header button
+    (let through during the review since right-clicks off the view reach Blender), then its
+    menu's Header > Close Area, by keys: the review ends at once, nothing recorded, no error."""
+    before = gui.state()["objects"][OBJ]
+    # The tests before opened the Selected Measurement panel above the button: found again.
+    gui.scroll_sidebar(30)
+    places = {"button": gui.find_button("UI", "vg.find_break_edges", upward=True)}
+    found = start_review(gui, places)
+    assert found["candidates"]
+    left, top, _width, height = gui.state()["regions"]["HEADER"]
+    gui.click((left + 20, top + height // 2), button=3)  # the editor-type button
+    gui.settle(3)
+    for key in ("Up", "Right", "Up"):  # the menu's last item, Header; its last, Close Area
+        gui.key(key)
+        gui.settle(2)
+    gui.screenshot("close_area_menu")
+    gui.key("Return")
+    state = gui.wait_for(lambda s: not running(s), 20, "the review to end")
+    assert state["find_edges"] is None and state["regions"] == {}, "the viewport is closed"
+    after = state["objects"][OBJ]
+    assert after["edges"] == before["edges"]
+    assert after["measurements"] == before["measurements"]
