@@ -299,7 +299,8 @@ class Run:
         self.say(f"wrote {csv_path} ({len(rows):,} sweep rows) and {drawn} plot(s) in {plots}")
 
     def unmeasured(self, task, message: str):
-        """The row of a task without a measurement, saying why."""
+        """The row of a task without a measurement, saying why (a stopped run, a worker that
+        failed its mesh)."""
         name = self.sources[task.mesh].name if task.mesh >= 0 else task.mesh_name
         return error_row(task, name, message, self.units)
 
@@ -578,7 +579,6 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             else:
                 rows_ready = functools.partial(run.add, pictures_follow=pictures)
                 for mesh, mesh_tasks in groups.items():
-                    stopping.check()
                     progress = functools.partial(run.progress, mesh)
                     result = safe_measure_mesh(
                         mesh, sources[mesh], mesh_tasks, options, progress, rows_ready

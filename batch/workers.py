@@ -34,7 +34,7 @@ from ..vg_addon.formats import csvio
 from ..vg_addon.workflow import batchplan
 from . import child_process, extension, map_process
 from .blend_file import forget, plot_images
-from .measure import MeshResult, error_row, safe_measure_mesh, set_units
+from .measure import MeshResult, safe_measure_mesh, set_units
 from .sources import MeshSource
 from .stdio import quiet_stdout
 
@@ -80,7 +80,7 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
             result = next(r for r in run.results if r.mesh == mesh)
             result.picture_errors.append(f"pictures of {name}: {message}")
         else:
-            result.rows = [(t.index, error_row(t, name, message, run.units)) for t in groups[mesh]]
+            result.rows = [(t.index, run.unmeasured(t, message)) for t in groups[mesh]]
             run.add(result)
         run.pictures_done(result)
 

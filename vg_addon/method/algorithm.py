@@ -298,11 +298,14 @@ def measure_patch(
     radius: float,
     lam: float,
     rule: str = DEFAULT_RULE,
+    estimated_normals: bool = False,
 ) -> dict:
     """Run Algorithm 1 on a validated, canonically ordered float64 patch.
 
     Returns a dict of the measured fields of :class:`~vg_addon.result.Measurement`; ``labels`` follow
     the order of ``points``. Callers normally use :func:`goniometer` or ``Surface.measure``.
+    ``estimated_normals``: the normals are a point cloud's estimate, whose orientation can fail
+    on one face; sides whose normals face opposite ways are then refused under every rule.
     """
     if not MIN_RADIUS <= radius <= MAX_MAGNITUDE:
         raise GoniometerError(
@@ -374,6 +377,16 @@ def measure_patch(
     if rule == "refined":
         centroids = _refine(points, normals, center, radius, fields, planes) or centroids
         _check_crease_in_patch(fields, centroids, center, radius)
+    # A face whose normals point the other way reads as the supplement: a point cloud's
+    # estimated normals under every rule; a mesh's mixed winding, or given normals pointing in,
+    # under the refined one (the replication rules keep their readings, as the earlier
+    # implementations gave them).
+    if (estimated_normals or rule == "refined") and sides_contradict_normals(
+        points, fields["labels"], fields["normal_plus"], fields["normal_minus"], center, radius
+    ):
+        raise GoniometerError(
+            contradicting_normals_message(fields["angle"], cloud=estimated_normals)
+        )
     return fields
 
 
@@ -578,15 +591,6 @@ def goniometer(
             raise GoniometerError("All points coincide, so the patch has no extent to measure.")
     radius = as_radius(radius)
     fields = measure_patch(ordered_points, ordered_normals, center, radius, lam, rule)
-    if rule == "refined" and sides_contradict_normals(
-        ordered_points,
-        fields["labels"],
-        fields["normal_plus"],
-        fields["normal_minus"],
-        center,
-        radius,
-    ):
-        raise GoniometerError(contradicting_normals_message(fields["angle"]))
     labels = np.empty_like(fields["labels"])
     labels[order] = fields["labels"]
     fields["labels"] = labels

@@ -21,7 +21,6 @@ from .algorithm import (
 from .geodesic import EdgeGraph
 from .normals import pca_normals, vertex_normals
 from .ordering import canonical_ranks
-from .planes import contradicting_normals_message, sides_contradict_normals
 from .precision import check_rounding, precision_of
 from .result import Measurement
 from .spatial import GridIndex, estimate_spacing
@@ -294,21 +293,8 @@ class Surface:
             radius,
             lam,
             rule,
+            estimated_normals=self.estimated_orientation,
         )
-        # A face whose normals point the other way reads as the supplement: a point cloud's
-        # estimated normals under every rule; a mesh's mixed winding under the refined one (the
-        # replication rules keep their readings, as the earlier implementations gave them).
-        if (self.estimated_orientation or rule == "refined") and sides_contradict_normals(
-            patch_points,
-            fields["labels"],
-            fields["normal_plus"],
-            fields["normal_minus"],
-            self.points[center_index],
-            radius,
-        ):
-            raise GoniometerError(
-                contradicting_normals_message(fields["angle"], cloud=self.estimated_orientation)
-            )
         measurement = Measurement(
             **fields,
             indices=indices,
