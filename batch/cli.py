@@ -489,6 +489,26 @@ def check_edge_settings(args) -> None:
         raise UsageError(f"--lambda: {error}") from None
 
 
+def check_nothing_ignored(args) -> None:
+    """Refuse an option that would do nothing with the others given (it was ignored without a
+    word): ``--spacing`` with no edges, ``--ignore-mesh-names`` with no CSV rows, an empty
+    ``--save-blend`` or ``--render`` path."""
+    if args.spacing is not None and not (args.edge or args.edges_csv or args.find_edges):
+        raise UsageError(
+            "--spacing D is the distance between an edge's stations: it is for --edge, --edges "
+            "and --find-edges (--at and --points measure single points, with --radius R)."
+        )
+    if args.ignore_mesh_names and not (args.points or args.edges_csv):
+        raise UsageError(
+            "--ignore-mesh-names is for the rows of a --points or --edges file (it measures "
+            "each on the one mesh given, whatever mesh the row names); --at, --edge and "
+            "--find-edges name no mesh."
+        )
+    for flag, value in (("--save-blend", args.save_blend), ("--render", args.render)):
+        if value is not None and not value.strip():
+            raise UsageError(f"{flag} needs a path (got an empty one).")
+
+
 def check_args(args) -> None:
     if args.demo:
         extra = [
@@ -524,6 +544,7 @@ def check_args(args) -> None:
         )
     if args.edge and (args.spacing is None or args.radius is None):
         raise UsageError("--edge needs --spacing D and --radius R (in the mesh's units).")
+    check_nothing_ignored(args)
     summary_only = args.edges_csv and not is_picked_points(args.edges_csv)
     if args.spacing is not None and summary_only and not (args.edge or args.find_edges):
         raise UsageError(

@@ -15,8 +15,9 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, picked_points, profile_plot
 from ..vg_addon.formats.record_codec import exact_numbers
-from ..vg_addon.method.algorithm import DEFAULT_RULE
+from ..vg_addon.method.algorithm import DEFAULT_RULE, as_lambda, as_radius, check_rule
 from ..vg_addon.method.edge_profile import check_station_count
+from ..vg_addon.method.surface import check_patch_mode
 from ..vg_addon.workflow import batchplan
 from .cli import UsageError, is_picked_points
 from .find_edges import found_edge_specs
@@ -139,8 +140,8 @@ def args_spec(args, points, *, mesh_name: str = "", note: str = "", given: str =
 
 
 def add_checked(specs: list, problems: list, spec: dict, where: str) -> None:
-    """Append ``spec`` to ``specs``, or, if its spacing makes too many stations, the reason
-    (after ``where``) to ``problems``."""
+    """Append ``spec`` to ``specs``, or, if :func:`check_spacing` refuses it, the reason (after
+    ``where``) to ``problems``."""
     try:
         check_spacing(spec)
     except GoniometerError as error:
@@ -215,12 +216,21 @@ def picked_point_specs(args, sources, passed_over: list | None = None) -> list[d
 
 
 def check_spacing(spec: dict) -> None:
-    """Refuse an edge whose spacing would make more stations than the core measures, before
-    any mesh is read: the traced path is at least as long as the straight lines through its
-    points, so their length already bounds the count from below."""
+    """Refuse an edge whose settings cannot measure it, before any mesh is read: a spacing,
+    radius, λ, patch mode or rule out of range (an edges CSV row's own cells; otherwise each of
+    its stations failed alike), or a spacing that would make more stations than the core
+    measures (the traced path is at least as long as the straight lines through its points, so
+    their length already bounds the count from below)."""
     spacing = spec["spacing"]
     if not (isinstance(spacing, float | int) and math.isfinite(spacing) and spacing > 0):
-        return  # refused with its own message when measured
+        raise GoniometerError(
+            f"the Spacing must be a finite number greater than 0; got {spacing!r}."
+        )
+    as_radius(spec["radius"])
+    as_lambda(spec["lam"])
+    check_patch_mode(spec["patch"])
+    if spec.get("rule"):
+        check_rule(spec["rule"])
     points = spec["points"]
     length = sum(math.dist(a, b) for a, b in itertools.pairwise(points))
     check_station_count(length, spacing)

@@ -514,3 +514,36 @@ def test_a_replay_says_which_failed_rows_of_its_file_it_passed_over(scan, tmp_pa
         "measure one again, copy a point's Requested x, y, z into its x, y, z and clear its error"
     ) in replay.stderr
     assert len(csvio.read_measurements_csv(tmp_path / "replay.csv")) == 2
+
+
+def test_an_edge_summary_row_with_settings_out_of_range_is_refused_before_the_run(scan, tmp_path):
+    """An edited edge summary's row with a Patch Mode, SegParam, Radius or Spacing that cannot
+    measure was traced and failed at every station, as error rows (before); now the run is
+    refused before any mesh is read, naming each row, as for a row without a Spacing."""
+    first = tmp_path / "first.csv"
+    ok(batch(scan, *EDGE, "--spacing", "0.2", "--out", first))
+    (row,) = csvio.read_edges_csv(csvio.edges_path_for(first))
+    edited = tmp_path / "edited_edges.csv"
+    bad = [
+        dataclasses.replace(row, patch="spherical"),
+        dataclasses.replace(row, lam=-1.0),
+        dataclasses.replace(row, radius=0.0),
+        dataclasses.replace(row, spacing=-0.2),
+    ]
+    csvio.write_edges_csv(edited, [row, *bad])
+    out = tmp_path / "out.csv"
+    result = ok(batch(scan, "--edges", edited, "--out", out), code=2)
+    assert "4 edge row(s) cannot be measured" in result.stderr
+    for number, words in zip(
+        (3, 4, 5, 6),
+        (
+            "Unknown patch mode 'spherical'",
+            "λ (SegParam) must be",
+            "radius must be",
+            "Spacing must",
+        ),
+        strict=True,
+    ):
+        (line,) = [line for line in result.stderr.splitlines() if f"row {number}: " in line]
+        assert words in line
+    assert not out.exists() and not csvio.edges_path_for(out).exists()

@@ -78,6 +78,17 @@ def test_mesh_names_are_file_stems_and_must_be_unique(tmp_path):
         mesh_names(["a/bone.ply", "b/bone.obj"])
 
 
+def test_a_mesh_file_given_twice_is_named_so_not_as_a_name_clash(tmp_path):
+    (tmp_path / "bone.ply").touch()
+    (tmp_path / "sub").mkdir()
+    twice = [tmp_path / "bone.ply", tmp_path / "sub" / ".." / "bone.ply"]
+    with pytest.raises(GoniometerError) as raised:
+        mesh_names(twice)
+    message = str(raised.value)
+    assert message.startswith("1 mesh file(s) given twice") and "share a name" not in message
+    assert f"(also as {twice[0]})" in message
+
+
 # --------------------------------------------------------------------------- planning
 
 

@@ -169,17 +169,28 @@ def mesh_names(files: Sequence[str | os.PathLike]) -> list[str]:
     """
     names = [Path(f).stem for f in files]
     seen: dict[str, str] = {}
-    clashes = []
+    clashes, repeats = [], []
     for name, path in zip(names, files, strict=True):
-        if name in seen:
-            clashes.append(f"{seen[name]} and {path} are both named {name!r}")
-        else:
+        if name not in seen:
             seen[name] = str(path)
+        elif os.path.realpath(seen[name]) == os.path.realpath(path):
+            repeats.append(
+                f"{path}" + (f" (also as {seen[name]})" if seen[name] != str(path) else "")
+            )
+        else:
+            clashes.append(f"{seen[name]} and {path} are both named {name!r}")
+    if repeats:
+        raise GoniometerError(
+            _listing(
+                "mesh file(s) given twice, as a file or in a folder given; give each once",
+                repeats,
+            )
+        )
     if clashes:
         raise GoniometerError(
             _listing(
-                "meshes share a name; rename one of each pair (a mesh is known by its file "
-                "name without the extension)",
+                "pair(s) of meshes share a name; rename one of each pair (a mesh is known by its "
+                "file name without the extension)",
                 clashes,
             )
         )
