@@ -18,12 +18,13 @@ else:
 
 if numpy_import_error is None:
     from . import operators, properties, ui
-    from .bridge import measuring, mesh_data, watch
+    from .bridge import edges, measuring, mesh_data, watch
 
     classes = (*operators.classes, *ui.classes)  # besides properties.classes
 
     def register():
         properties.register()
+        properties.unit_chosen_handlers.append(edges.redraw_plots)
         for cls in classes:
             bpy.utils.register_class(cls)
         operators.drag.register_tool()
@@ -39,6 +40,7 @@ if numpy_import_error is None:
         for cls in reversed(classes):
             bpy.utils.unregister_class(cls)
         properties.unregister()
+        properties.unit_chosen_handlers.clear()
         mesh_data.clear_cache()
         measuring.clear_cache()
 

@@ -304,10 +304,18 @@ UNIT_ITEMS = (
 )
 
 
+unit_chosen_handlers: list = []
+"""Called with the object after the user chose its Scan Units. The extension's registration adds
+the redrawing of the object's edge plots (their axis names the unit); the batch, which sets units
+from code, adds nothing."""
+
+
 def _unit_chosen(data, _context) -> None:
     """The user chose the unit: it is no longer a guess, and no later guess replaces it."""
     data.unit_chosen = True
     data.unit_guessed = False
+    for handler in unit_chosen_handlers:
+        handler(data.id_data)
 
 
 def set_unit(data, key: str, *, guessed: bool) -> None:

@@ -489,6 +489,16 @@ def check_edge_settings(args) -> None:
         raise UsageError(f"--lambda: {error}") from None
 
 
+def _given(value, default) -> bool:
+    """Whether an option's parsed ``value`` is not its ``default`` (an empty list, None and
+    False all mean "not given")."""
+    return value != default and bool(value or default)
+
+
+DEMO_OPTIONS = frozenset({"demo", "out_dir", "quiet", "help"})
+"""The options ``--demo`` takes (its run, outputs and settings are its own)."""
+
+
 def check_nothing_ignored(args) -> None:
     """Refuse an option that would do nothing with the others given (it was ignored without a
     word): ``--spacing`` with no edges, ``--ignore-mesh-names`` with no CSV rows, an empty
@@ -511,23 +521,15 @@ def check_nothing_ignored(args) -> None:
 
 def check_args(args) -> None:
     if args.demo:
+        # The demo sets up its own run: any other option would be ignored without a word.
         extra = [
-            name
-            for name, value in (
-                ("MESH", args.inputs),
-                ("--object", args.object),
-                ("--at", args.at),
-                ("--points", args.points),
-                ("--edge", args.edge),
-                ("--edges", args.edges_csv),
-                ("--find-edges", args.find_edges),
-                ("--out", args.out),
-                ("--shard", args.shard),
-            )
-            if value
+            (action.option_strings or [action.metavar or action.dest])[0]
+            for action in build_parser()._actions
+            if action.dest not in DEMO_OPTIONS
+            and _given(getattr(args, action.dest, action.default), action.default)
         ]
         if extra:
-            raise UsageError(f"--demo takes no {', '.join(extra)} (only --out-dir and --jobs).")
+            raise UsageError(f"--demo takes no {', '.join(extra)} (only --out-dir and --quiet).")
         return
     if args.out_dir:
         raise UsageError("--out-dir is for --demo; use --out CSV for a batch run.")

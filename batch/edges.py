@@ -35,7 +35,9 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
     ------
     UsageError
         An unreadable edges CSV, a row without Points, Spacing or Radius, or naming no mesh
-        given; a spacing that would make more than ``edge_profile.MAX_STATIONS`` stations.
+        given; a Spacing, Radius, SegParam or Patch Mode a row cannot be measured with, or a
+        spacing that would make more than ``edge_profile.MAX_STATIONS`` stations
+        (:func:`check_spacing`).
     """
     specs = [
         args_spec(args, [spec["start"], *spec["via"], spec["end"]], given=f"--edge {number}")

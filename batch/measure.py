@@ -333,7 +333,7 @@ def sweep_sites(result: MeshResult, surface, name: str, stem: str, tasks, option
             title = f"Radius sweep: {name}, site {task.number}"
             plots.append(("sweep plot", path, _sweep_png(points, units, title)))
         result.sweep_rows.extend(
-            (task.index, csvio.sweep_cells(name, task.number, point)) for point in points
+            (task.index, csvio.sweep_cells(name, task.number, point, units)) for point in points
         )
     return plots
 

@@ -29,7 +29,7 @@ from .mesh_data import (
     surface_for,
     uniform_scale,
 )
-from .plots import make_plot, plot_image, remove_plots
+from .plots import UNIT_KEY, make_plot, plot_image, remove_plots
 
 
 def free_break(obj) -> int:
@@ -422,6 +422,10 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
         spacing, closed), ...]}``, ``closed`` the CSV's ``Edge Closed`` (None where the file
         lacks it); the items are already recorded, in the order the CSV listed them. Edges are
         made in the order of the keys.
+    note_of : dict, optional
+        ``{(csv mesh name, csv edge number): note}``: each edge's own note (the User Data of the
+        edge summary written beside the CSV, where it may have been edited after the stations
+        were measured); an edge not in it takes its first station's note.
 
     Returns
     -------
@@ -430,7 +434,8 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
     """
     surface = surface_for(obj, geometry)
     numbers_made = []
-    for _, group in sorted(stations.items()):
+    note_of = note_of or {}
+    for key, group in sorted(stations.items()):
         group = sorted(group, key=lambda entry: entry[2])
         items, measurements = [g[0] for g in group], [g[1] for g in group]
         figures = summarize(surface, measurements)
@@ -455,7 +460,7 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
             measurements[0].patch,
             geometry.fingerprint,
             break_number=items[0].break_number,
-            note=items[0].note,
+            note=note_of.get(key, items[0].note),
         )
         for item, left in zip(items, figures.plus_left, strict=True):
             item.edge_number = edge.number
@@ -470,11 +475,16 @@ def edges_from_stations(obj, stations, geometry, *, note_of=None) -> list[int]:
 
 
 def redraw_plots(obj) -> None:
-    """Draw every edge's plot of ``obj`` again (after its Scan Units changed: the axis names
-    them), each replacing the image it had."""
+    """Draw again every edge's plot of ``obj`` whose axis names another unit than its Scan
+    Units now do (after they changed), each replacing the image it had."""
     # A batch run's object that is never saved has none. The old images go first, so the new
     # ones take their names (kept where a duplicate shows them); one look over every edge.
-    drawn = [edge for edge in obj.vg.edges if plot_image(edge) is not None]
+    units = records.unit_symbol(obj, bpy.context.scene)
+    drawn = [
+        edge
+        for edge in obj.vg.edges
+        if (image := plot_image(edge)) is not None and image.get(UNIT_KEY) != units
+    ]
     remove_plots(drawn)
     for edge in drawn:
         edge.plot = make_plot(obj, edge).name

@@ -24,6 +24,9 @@ PLOT_SIZE = (480, 240)
 PLOT_KEY = "vg_edge_plot"
 """The image's custom property holding :func:`plot_key` of the edge it was drawn for."""
 
+UNIT_KEY = "vg_plot_units"
+"""The image's custom property holding the unit its axis names (see :func:`make_plot`)."""
+
 
 def plot_key(edge) -> str:
     """What ties a plot to its edge: the edge's number and a digest of its exact numbers (set once,
@@ -37,12 +40,13 @@ def make_plot(obj, edge):
     edge's key: matplotlib's where Blender's Python has it, else the extension's NumPy drawing."""
     numbers = exact_numbers(edge)
     width, height = PLOT_SIZE
+    units = records.unit_symbol(obj, bpy.context.scene)
     rgba = profile_plot.render_profile(
         numbers["arc_lengths"],
         numbers["angles"],
         width=width,
         height=height,
-        units=records.unit_symbol(obj, bpy.context.scene),
+        units=units,
         title=f"{obj.name}, edge {edge.number}",
         pooled=numbers.get("pooled_angle"),
     )
@@ -52,6 +56,7 @@ def make_plot(obj, edge):
     image.pack()
     image.use_fake_user = True  # only the edge names it: without a user it would not be saved
     image[PLOT_KEY] = plot_key(edge)
+    image[UNIT_KEY] = units
     image.preview_ensure()  # the panel shows the plot as the image's preview icon
     return image
 

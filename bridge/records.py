@@ -4,6 +4,7 @@ a CSV row."""
 from __future__ import annotations
 
 import hashlib
+import math
 import tomllib
 from functools import cache, lru_cache
 from pathlib import Path
@@ -311,12 +312,27 @@ def replay_args(item) -> dict:
 
 def unit_symbol(obj, scene) -> str:
     """The symbol of ``obj``'s coordinate unit (``"mm"``): the one its Scan Units say, else what
-    one Blender unit is in ``scene`` (``"BU"`` if no unit is exactly that)."""
+    one Blender unit is in ``scene`` (``"BU"`` if no unit is exactly that) for an object shown at
+    its own size; ``"mesh units"`` for a scaled one, whose coordinates the scene's unit does not
+    measure (``units_label`` says how they relate)."""
     key = getattr(getattr(obj, "vg", None), "unit", units.SCENE)
     if key in units.SYMBOLS:
         return units.SYMBOLS[key]
+    if obj is not None and not is_shown_at_own_size(obj):
+        return MESH_UNITS
     settings = scene.unit_settings
     return units.scene_symbol(settings.system, settings.scale_length)
+
+
+MESH_UNITS = "mesh units"
+"""The unit of a scaled object's coordinates where no Scan Units name it."""
+
+
+def is_shown_at_own_size(obj) -> bool:
+    """Whether ``obj``'s transform keeps lengths (a uniform scale of 1): then one mesh unit is
+    one Blender unit."""
+    scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
+    return scale is not None and math.isclose(scale, 1.0, rel_tol=1e-6)
 
 
 def choose_unit(obj, key: str) -> bool:

@@ -4,6 +4,7 @@ top of the measuring pipeline (``measuring``) and the edge records (``edges``)."
 
 from __future__ import annotations
 
+from collections import Counter
 from pathlib import Path
 
 from ..vg_addon import GoniometerError
@@ -27,6 +28,8 @@ def replicate_rows(
     rule=DEFAULT_RULE,
     stability=False,
     progress=None,
+    edge_notes=None,
+    notes_taken=None,
 ):
     """Re-measure every replication row on ``obj`` and record them all, or nothing.
 
@@ -46,6 +49,12 @@ def replicate_rows(
     progress : callable, optional
         Called as ``progress(done, total)`` before each row is measured; returning False
         cancels the import (a GoniometerError; nothing is recorded).
+    edge_notes : dict, optional
+        The edge summary's rows beside the CSV (:func:`edge_notes_beside`): a rebuilt edge whose
+        stations agree with its row takes the row's note, any other its first station's.
+    notes_taken : list, optional
+        Where :func:`replicate_steps` appends the keys of the edges whose note came from
+        ``edge_notes`` and differs from their stations'.
 
     Rows in mesh coordinates (``row.coordinates == "mesh"``: every file but this extension's
     exports from before it measured in mesh coordinates) are measured as they are. Rows in
@@ -78,6 +87,8 @@ def replicate_rows(
         source=source,
         rule=rule,
         stability=stability,
+        edge_notes=edge_notes,
+        notes_taken=notes_taken,
     )
     try:
         while True:
@@ -104,6 +115,8 @@ def replicate_steps(
     source="the CSV",
     rule=DEFAULT_RULE,
     stability=False,
+    edge_notes=None,
+    notes_taken=None,
 ):
     """:func:`replicate_rows` a row at a time: a generator that yields ``(done, total)`` before
     each row is measured and returns the new measurements' numbers (``StopIteration.value``)
@@ -131,10 +144,13 @@ def replicate_steps(
             if row_radius is None:
                 raise GoniometerError("no radius (the CSV has no Radius for this row)")
             location = (row.x, row.y, row.z)
+            lengths = (row.arc_length or 0.0, row.spacing or 0.0)  # an edge station's
             if row.coordinates == records.WORLD:
                 location, row_radius = measuring.from_world(
                     location, row_radius, geometry.matrix, scale_radius=row.radius is not None
                 )
+                if row.edge_number is not None:
+                    lengths = edges.mesh_lengths(obj, *lengths)
             m = surface.measure(
                 location,
                 row_radius,
@@ -146,7 +162,7 @@ def replicate_steps(
         except GoniometerError as error:
             failures.append(f"row {row.row_number}: {error}")
             continue
-        results.append((row, m))
+        results.append((row, m, lengths))
     if failures:
         raise GoniometerError(
             f"{len(failures)} of {len(rows)} rows of {source} could not be measured on "
@@ -160,10 +176,11 @@ def replicate_steps(
     with edges.recorded_whole(obj):  # a failure part way records no row
         numbers = []
         stations: dict[tuple[str, int], list] = {}  # by mesh and edge: files may hold several
-        for row, m in results:
+        settings: dict[tuple[str, int], set] = {}  # each edge's Spacing and Radius cells
+        for row, m, (arc_length, spacing) in results:
             station = None
             if row.edge_number is not None:  # numbered and oriented when its edge is rebuilt
-                station = (0, row.arc_length or 0.0, row.spacing or 0.0, True)
+                station = (0, arc_length, spacing, True)
             item = measuring.record(
                 obj,
                 m,
@@ -175,11 +192,14 @@ def replicate_steps(
             )
             numbers.append(item.number)
             if station is not None:
-                stations.setdefault((row.mesh_name or "", row.edge_number), []).append(
+                key = (row.mesh_name or "", row.edge_number)
+                stations.setdefault(key, []).append(
                     (item.number, m, station[1], station[2], row.edge_closed)
                 )
+                settings.setdefault(key, set()).add((row.spacing, row.radius))
         if stations:
             by_number = {item.number: item for item in obj.vg.measurements}
+            notes = _matching_notes(edge_notes or {}, stations, settings)
             edges.edges_from_stations(
                 obj,
                 {
@@ -187,11 +207,61 @@ def replicate_steps(
                     for key, group in stations.items()
                 },
                 geometry,
+                note_of=notes,
             )
+            if notes_taken is not None:
+                notes_taken.extend(
+                    key
+                    for key, note in notes.items()
+                    if note != by_number[stations[key][0][0]].note
+                )
     records.continue_after_recorded_breaks(obj)
     measuring.repaint(obj, depsgraph=depsgraph, geometry=geometry)
     colors.show_sides_once(obj)
     return numbers
+
+
+def _matching_notes(edge_notes: dict, stations: dict, settings: dict) -> dict:
+    """The notes of :func:`edge_notes_beside` for the rebuilt edges whose summary row is of
+    the same edge: as many stations, with the Spacing and Radius its station rows carry (a
+    summary left from an earlier export of other edges does not rename them)."""
+    return {
+        key: note
+        for key, (count, spacing, radius, note) in edge_notes.items()
+        if key in stations and len(stations[key]) == count and settings[key] == {(spacing, radius)}
+    }
+
+
+def edge_notes_beside(path) -> tuple[dict, str]:
+    """The notes of the edges in the edge summary an export wrote beside the measurement CSV
+    ``path`` (``NAME_edges.csv``), and that file's name; ``({}, "")`` where there is none or it
+    cannot be read (the stations' own notes then name the edges). An edge's note edited after it
+    was measured is only there: its stations keep the note they were measured with.
+
+    Returns
+    -------
+    dict, str
+        ``{(mesh name, edge number): (stations, spacing, radius, note)}`` (the import uses a
+        note only for an edge whose stations agree with the row), and the file's name.
+    """
+    beside = csvio.edges_path_for(Path(path))
+    if not csvio.holds_edge_summary(beside):
+        return {}, ""
+    try:
+        rows = csvio.read_edges_csv(beside)
+    except (OSError, GoniometerError):
+        return {}, ""
+    notes = {
+        (row.mesh_name or "", row.edge_number): (
+            row.n_stations,
+            row.spacing,
+            row.radius,
+            row.user_data,
+        )
+        for row in rows
+        if not row.error
+    }
+    return notes, beside.name
 
 
 def read_rows(path, passed_over: list | None = None) -> tuple[list, str]:
@@ -202,9 +272,13 @@ def read_rows(path, passed_over: list | None = None) -> tuple[list, str]:
 
 def import_csv(obj, path, *, depsgraph=None, **options) -> list[int]:
     """Read a measurement CSV (ours, MeshLab's, the earlier add-on's or plain x, y, z points) and
-    replicate it on ``obj``; ``options`` as for :func:`replicate_rows`."""
+    replicate it on ``obj``; ``options`` as for :func:`replicate_rows`. Rebuilt edges take
+    their notes from the edge summary beside it (:func:`edge_notes_beside`)."""
     rows, source = read_rows(path)
-    return replicate_rows(obj, rows, depsgraph=depsgraph, source=source, **options)
+    notes, _ = edge_notes_beside(path)
+    return replicate_rows(
+        obj, rows, depsgraph=depsgraph, source=source, edge_notes=notes, **options
+    )
 
 
 def export_rows(objects, scene, *, depsgraph=None) -> list:
@@ -240,3 +314,14 @@ def export_tables(objects, scene, *, depsgraph=None) -> tuple[list, list]:
             for edge in obj.vg.edges
         )
     return rows, edge_rows
+
+
+def short_edges(rows, edge_rows) -> list[str]:
+    """The edges of ``edge_rows`` (as "'mesh' edge N") with fewer station rows in ``rows``
+    than they were measured with: stations deleted since."""
+    held = Counter((row.mesh_name, row.edge_number) for row in rows if row.edge_number is not None)
+    return [
+        f"'{edge.mesh_name}' edge {edge.edge_number}"
+        for edge in edge_rows
+        if held[edge.mesh_name, edge.edge_number] < (edge.n_stations or 0)
+    ]

@@ -126,7 +126,17 @@ class VG_OT_export_csv(bpy.types.Operator, ExportHelper):
             edges = f"; {summary}, from an earlier export, now lists no edge"
         else:
             edges = ""
-        self.report({"INFO"}, f"Wrote {len(rows)} measurement(s){note} to {path}{edges}")
+        short = replication.short_edges(rows, edge_rows)
+        if short:
+            edges += (
+                f"; {len(short)} edge(s) lost stations after they were measured "
+                f"({bounded_list(short)}): their summary rows keep the figures of every station "
+                "as recorded, and importing the summary traces and measures them all again"
+            )
+        self.report(
+            {"WARNING" if short else "INFO"},
+            f"Wrote {len(rows)} measurement(s){note} to {path}{edges}",
+        )
         return {"FINISHED"}
 
 
@@ -216,6 +226,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                 return {"FINISHED"}
             self._passed_over = []
             rows, source = replication.read_rows(path, self._passed_over)
+            edge_notes, self._notes_from = replication.edge_notes_beside(path)
+            self._notes_taken = []
             steps = replication.replicate_steps(
                 obj,
                 rows,
@@ -227,6 +239,8 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                 source=source,
                 rule=settings.rule,
                 stability=settings.stability,
+                edge_notes=edge_notes,
+                notes_taken=self._notes_taken,
             )
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
@@ -271,6 +285,11 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         extra, differing = follow_export(self._obj, self._full_path, numbers)
+        if taken := getattr(self, "_notes_taken", []):
+            extra += (
+                f"; {len(taken)} edge(s) take their note from {self._notes_from} (edited after "
+                "they were measured: their stations keep theirs)"
+            )
         passed = getattr(self, "_passed_over", [])
         if passed:
             extra += (

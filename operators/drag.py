@@ -10,8 +10,6 @@ records the measurement it took (not a second one) through the bridge's one reco
 
 from __future__ import annotations
 
-import math
-
 import bpy
 import numpy as np
 from bpy_extras import view3d_utils
@@ -24,10 +22,9 @@ from ..bridge.mesh_data import (
     mesh_points,
     ray_tree_for,
     surface_for,
-    uniform_scale,
     world_points,
 )
-from ..bridge.records import colours_as_painted, unit_symbol
+from ..bridge.records import MESH_UNITS, colours_as_painted, is_shown_at_own_size, unit_symbol
 from ..vg_addon import GoniometerError
 from ..vg_addon.units import length_text
 from ..vg_addon.workflow.drag_state import DragMachine, Phase, surface_callbacks
@@ -133,10 +130,9 @@ def mesh_length_text(scene, value: float, obj) -> str:
     """A length in ``obj``'s mesh units as a header shows it: in its Scan Units, or the
     scene's length units where those measure it (an unscaled object); on a scaled object
     without Scan Units, "N mesh units" (the scene's units measure world lengths)."""
-    scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
-    if obj.vg.unit != "SCENE" or (scale is not None and math.isclose(scale, 1.0, rel_tol=1e-6)):
+    if obj.vg.unit != "SCENE" or is_shown_at_own_size(obj):
         return format_length(scene, value, obj)
-    return f"{value:.5g} mesh units"
+    return f"{value:.5g} {MESH_UNITS}"
 
 
 def ray_cast_object(obj, depsgraph, region, region_data, coord):

@@ -66,7 +66,9 @@ class VG_OT_radius_sweep(LocationProperties, bpy.types.Operator, ExportHelper):
                 space=self.space.lower(),
             )
             image = str(Path(path).with_suffix(".png"))
-            csvio.write_sweep_csv(path, obj.name, points)
+            csvio.write_sweep_csv(
+                path, obj.name, points, units=records.units_label(context.scene, obj)
+            )
             sweep_plot.write_sweep_png(
                 image,
                 points,

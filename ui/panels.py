@@ -3,7 +3,7 @@
 import bpy
 
 from ..bridge.plots import plot_image
-from ..bridge.records import unit_symbol, units_label
+from ..bridge.records import is_shown_at_own_size, unit_symbol, units_label
 from ..operators.measure import non_uniform_scale_note
 from ..vg_addon.formats.record_codec import exact_numbers, study_texts
 from ..vg_addon.method.edge_summary import sd_text
@@ -198,7 +198,8 @@ def selected_rows(item, scene) -> list[tuple[str, str]]:
         if key in stability:
             rows.append((label, exact_text(stability[key]) + "°"))
     obj = item.id_data
-    if obj.vg.unit != "SCENE":  # the scan's own unit, whatever the object's scale
+    if obj.vg.unit != "SCENE" or not is_shown_at_own_size(obj):
+        # The scan's own unit, whatever the object's scale; or how a scaled object's relate.
         rows.append(("Lengths in", units_label(scene, obj)))
     else:
         units = scene.unit_settings

@@ -667,37 +667,3 @@ def test_progress_is_reported_each_second_while_measuring(vg, monkeypatch):
     result = measure.measure_mesh(0, sources.MeshSource("Wedge"), tasks, {}, reported.append)
     assert result.failed == 10 and result.measured == 60
     assert reported == list(range(1, len(tasks) + 1))
-
-
-@pytest.mark.parametrize(
-    ("arguments", "words"),
-    [
-        (("--at", 0, 0, 0, "--radius", 1, "--spacing", 1), "--spacing D is the distance between"),
-        (("--at", 0, 0, 0, "--radius", 1, "--ignore-mesh-names"), "--ignore-mesh-names is for"),
-        (
-            ("--edge", 0, 0, 0, 1, 0, 0, "--spacing", 1, "--radius", 1, "--ignore-mesh-names"),
-            "--ignore-mesh-names is for",
-        ),
-        (("--at", 0, 0, 0, "--radius", 1, "--save-blend", ""), "--save-blend needs a path"),
-        (("--at", 0, 0, 0, "--radius", 1, "--render", " "), "--render needs a path"),
-    ],
-)
-def test_an_option_that_would_do_nothing_is_refused(tmp_path, arguments, words):
-    # Before: each was ignored without a word (no .blend, no map, the spacing unused) and the
-    # run exited 0. The mesh does not exist: the refusal comes before anything is read.
-    out = tmp_path / "out.csv"
-    result = ok(batch(tmp_path / "none.ply", *arguments, "--out", out), 2)
-    assert words in result.stderr
-    assert not out.exists()
-
-
-def test_a_mesh_given_twice_is_named_as_given_twice(tmp_path):
-    shape = wedge(90.0, n=10)
-    mesh = tmp_path / "w.ply"
-    meshio.write_ply(mesh, shape.points, shape.triangles)
-    out = tmp_path / "out.csv"
-    result = ok(batch(mesh, tmp_path, "--at", 0, 0, 0, "--radius", 0.5, "--out", out), 2)
-    assert "1 mesh file(s) given twice, as a file or in a folder given; give each once:" in (
-        result.stderr
-    )
-    assert "share a name" not in result.stderr and not out.exists()

@@ -44,6 +44,7 @@ def test_concave_wedge_rules_stability_and_sweep(tmp_path):
         sweep = list(csv.DictReader(handle))
     assert [float(r["Radius"]) for r in sweep] == list(np.linspace(0.1, 0.6, 6))
     assert {r["Measurement #"] for r in sweep} == {"1"}
+    assert {r["Units"] for r in sweep} == {row.units}  # the measurement CSV's, on every row
     assert (tmp_path / "angles_sweep" / "valley_1.png").read_bytes()[:4] == b"\x89PNG"
     assert "angles_sweep.csv" in run.stderr
 

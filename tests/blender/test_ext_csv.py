@@ -1,6 +1,7 @@
 """CSV export and import (replication): the MeshLab header, bit-identical angles, all or nothing."""
 
 import csv
+import dataclasses
 import math
 import os
 import tomllib
@@ -426,4 +427,69 @@ def test_an_import_says_which_failed_rows_it_passed_over(vg, tmp_path, capfd):
     assert (
         "Re-measured 1 row(s) of run.csv on 'scan' (measurements 1–1); passed over 1 row(s) a "
         "batch run could not measure (rows 3: no x, y, z; their error column says why)"
+    ) in said.out + said.err
+
+
+def test_an_edge_note_edited_after_measuring_comes_back_with_the_export(vg, tmp_path, capfd):
+    """An edge's note edited in the panel is written to its summary row (NAME_edges.csv); its
+    stations keep the note they were measured with. Importing the export's main CSV rebuilt
+    the edge with its first station's note (before): the edit was lost. The oracle: the note
+    typed, and the summary file as exported."""
+    import json
+
+    obj = wedge_object(100.0, "scan")
+    bpy.ops.vg.measure_edge(
+        points=json.dumps([[-0.6, 0.0, 0.0], [0.6, 0.0, 0.0]]), space="MESH", spacing=0.2,
+        radius=0.4, note="as measured",
+    )  # fmt: skip
+    obj.vg.edges[0].note = "edited: spiral fracture, fresh"
+    path = tmp_path / "out.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    (summary,) = csvio.read_edges_csv(csvio.edges_path_for(path))
+    assert summary.user_data == "edited: spiral fracture, fresh"
+    assert {row.user_data for row in csvio.read_measurements_csv(path)} == {"as measured"}
+    bpy.ops.vg.clear_measurements()
+    capfd.readouterr()
+    assert bpy.ops.vg.import_csv(filepath=str(path)) == {"FINISHED"}
+    assert obj.vg.edges[0].note == "edited: spiral fracture, fresh"
+    assert {item.note for item in obj.vg.measurements} == {"as measured"}  # the stations' own
+    said = capfd.readouterr()
+    assert "; 1 edge(s) take their note from out_edges.csv" in said.out + said.err
+    # A summary of other stations (left from an earlier export) names no rebuilt edge.
+    other = dataclasses.replace(summary, n_stations=summary.n_stations + 1, user_data="stale")
+    csvio.write_edges_csv(csvio.edges_path_for(path), [other])
+    bpy.ops.vg.clear_measurements()
+    assert bpy.ops.vg.import_csv(filepath=str(path)) == {"FINISHED"}
+    assert obj.vg.edges[0].note == "as measured"
+    # Without the summary beside it the stations' note names the edge, as before.
+    alone = tmp_path / "alone" / "out.csv"
+    alone.parent.mkdir()
+    alone.write_bytes(path.read_bytes())
+    bpy.ops.vg.clear_measurements()
+    assert bpy.ops.vg.import_csv(filepath=str(alone)) == {"FINISHED"}
+    assert obj.vg.edges[0].note == "as measured"
+
+
+def test_an_export_of_an_edge_with_a_station_deleted_says_its_summary_keeps_it(vg, tmp_path, capfd):
+    """A station deleted from an edge: the CSV holds one station row fewer while the summary
+    row keeps the figures of every station (as the panel says), and importing the summary
+    measures the deleted station again. The export said nothing (before); it now warns."""
+    import json
+
+    obj = wedge_object(100.0, "scan")
+    bpy.ops.vg.measure_edge(
+        points=json.dumps([[-0.6, 0.0, 0.0], [0.6, 0.0, 0.0]]), space="MESH", spacing=0.2,
+        radius=0.4,
+    )  # fmt: skip
+    stations = obj.vg.edges[0].n_stations
+    bpy.ops.vg.delete_measurement(index=2)
+    path = tmp_path / "out.csv"
+    capfd.readouterr()
+    assert bpy.ops.vg.export_csv(filepath=str(path)) == {"FINISHED"}
+    said = capfd.readouterr()
+    assert len(csvio.read_measurements_csv(path)) == stations - 1
+    assert csvio.read_edges_csv(csvio.edges_path_for(path))[0].n_stations == stations
+    assert (
+        "1 edge(s) lost stations after they were measured ('scan' edge 1): their summary rows "
+        "keep the figures of every station as recorded"
     ) in said.out + said.err

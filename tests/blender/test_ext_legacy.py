@@ -184,3 +184,44 @@ def test_a_blend_saved_before_lam_was_one_name_loads_and_replays(vg, tmp_path):
             numbers["center"], numbers["radius"], numbers["lam"], rule=numbers["rule"]
         )
         assert again.angle == numbers["angle"] and abs(again.angle - 80.0) < 1e-4
+
+
+def test_a_world_space_csv_of_an_edge_imported_on_a_scaled_object_keeps_mesh_lengths(vg, tmp_path):
+    """A measurement CSV of an earlier version (Coordinates world) of an object scaled by 2:
+    the stations' centres and radius were taken to mesh units, the rebuilt edge's spacing,
+    length and arc lengths were not (before: twice the edge's). The oracle: the same edge
+    measured on the mesh, exported and written as that version wrote it, the lengths doubled."""
+    import csv
+
+    obj = wedge_object(100.0)
+    bpy.ops.vg.measure_edge(
+        points=json.dumps([[-0.6, 0.0, 0.0], [0.6, 0.0, 0.0]]), space="MESH", spacing=0.2,
+        radius=0.4,
+    )  # fmt: skip
+    first = exact(obj.vg.edges[0])
+    mesh_csv = tmp_path / "mesh.csv"
+    bpy.ops.vg.export_csv(filepath=str(mesh_csv))
+    with open(mesh_csv, encoding="utf-8-sig", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    for row in rows:
+        for name in ("x", "y", "z", "Radius", "Arc Length", "Spacing"):
+            if row[name]:
+                row[name] = repr(2.0 * float(row[name]))
+        row["Coordinates"] = "world"
+    world_csv = tmp_path / "world.csv"
+    with open(world_csv, "w", encoding="utf-8", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    bpy.ops.vg.clear_measurements()
+    assert bpy.ops.vg.import_csv(filepath=str(mesh_csv)) == {"FINISHED"}
+    rebuilt = exact(obj.vg.edges[0])  # an edge rebuilt from stations, in mesh coordinates
+    bpy.ops.vg.clear_measurements()
+    obj.scale = (2.0, 2.0, 2.0)
+    bpy.context.view_layer.update()
+    assert bpy.ops.vg.import_csv(filepath=str(world_csv)) == {"FINISHED"}
+    again = exact(obj.vg.edges[0])
+    assert again["spacing"] == first["spacing"] == rebuilt["spacing"]
+    assert again["arc_lengths"] == pytest.approx(first["arc_lengths"], abs=1e-12)
+    assert again["length"] == pytest.approx(rebuilt["length"], abs=1e-12)
+    assert again["angles"] == first["angles"]

@@ -140,3 +140,72 @@ def test_the_edge_file_and_a_file_with_failed_rows_carry_the_scan_units_on_impor
         assert copy.vg.unit == "MM" and copy.vg.unit_guessed
         assert bpy.ops.vg.import_csv(filepath=str(source), ignore_mesh_names=True) == {"FINISHED"}
         assert copy.vg.unit == "CM", source.name
+
+
+def test_a_scaled_object_without_scan_units_is_labelled_in_mesh_units(vg, tmp_path):
+    """Scene in millimetres (Unit Scale 0.001, so nothing is guessed), the object shown at a
+    tenth: one mesh unit is 0.1 mm. The panel's labels, Selected Measurement, the plot's axis
+    and the drag header said "mm" and "BU (1 BU = 0.001 m)" (before), while the CSV said
+    "mesh units (1 unit = 0.0001 m ...)". The oracle: the CSV's Units and the transform."""
+    panels, drag = modules(vg)
+    records = importlib.import_module(f"{vg.__name__}.bridge.records")
+    units = bpy.context.scene.unit_settings
+    units.system, units.scale_length, units.length_unit = "METRIC", 0.001, "MILLIMETERS"
+    obj = wedge_object(100.0)
+    obj.scale = (0.1, 0.1, 0.1)
+    bpy.context.view_layer.update()
+    bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), space="MESH", radius=0.4)
+    assert obj.vg.unit == "SCENE"  # the scene names its unit: no guess
+    path = tmp_path / "scaled.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    (row,) = csvio.read_measurements_csv(path)
+    assert row.units.startswith("mesh units (1 unit = 0.0001 m")
+    assert records.unit_symbol(obj, bpy.context.scene) == "mesh units"
+    assert lengths_in(panels, obj) == row.units
+    assert drag.mesh_length_text(bpy.context.scene, 0.4, obj) == "0.4 mesh units"
+    obj.scale = (1.0, 1.0, 1.0)  # at its own size the scene's unit measures it
+    bpy.context.view_layer.update()
+    assert records.unit_symbol(obj, bpy.context.scene) == "mm"
+    assert lengths_in(panels, obj) == "BU (1 BU = 0.001 m)"
+
+
+def test_choosing_scan_units_draws_the_edges_plots_again_naming_them(vg):
+    """The plot's axis names the unit; choosing Scan Units in the panel kept the plot drawn
+    with the guessed one (before). The oracle: the plot drawn from the edge's own numbers with
+    each unit by the plotting module."""
+    plots = importlib.import_module(f"{vg.__name__}.bridge.plots")
+    from vg_addon.formats import profile_plot
+    from vg_addon.formats.record_codec import exact_numbers
+    from vg_addon.units import SYMBOLS
+
+    obj = wedge_object(100.0)
+    bpy.ops.vg.measure_edge(
+        points=json.dumps([[-0.6, 0.0, 0.0], [0.6, 0.0, 0.0]]), space="MESH", spacing=0.2,
+        radius=0.4,
+    )  # fmt: skip
+    edge = obj.vg.edges[0]
+    numbers = exact_numbers(edge)
+
+    def drawn_with(unit):
+        width, height = plots.PLOT_SIZE
+        rgba = profile_plot.render_profile(
+            numbers["arc_lengths"], numbers["angles"], width=width, height=height, units=unit,
+            title=f"{obj.name}, edge {edge.number}", pooled=numbers.get("pooled_angle"),
+        )  # fmt: skip
+        return rgba[::-1].ravel().astype(np.int64)
+
+    def shown():
+        image = plots.plot_image(edge)
+        pixels = np.empty(len(image.pixels), dtype=np.float32)
+        image.pixels.foreach_get(pixels)
+        return np.rint(pixels * 255.0).astype(np.int64)  # the image keeps bytes
+
+    guessed = obj.vg.unit
+    assert obj.vg.unit_guessed and np.array_equal(shown(), drawn_with(SYMBOLS[guessed]))
+    obj.vg.unit = "CM"  # as the panel's menu sets it
+    assert np.array_equal(shown(), drawn_with("cm"))
+    assert not np.array_equal(shown(), drawn_with(SYMBOLS[guessed]))
+    assert len([i for i in bpy.data.images if plots.PLOT_KEY in i]) == 1  # replaced, not added
+    kept = plots.plot_image(edge)
+    obj.vg.unit = "CM"  # the same unit chosen again: nothing to draw
+    assert plots.plot_image(edge) == kept and kept.name in bpy.data.images

@@ -101,6 +101,12 @@ def test_radius_sweep_writes_its_csv_and_png(vg, tmp_path):
         rows = list(csv.DictReader(handle))
     assert [float(r["Radius"]) for r in rows] == list(np.linspace(0.05, 0.6, 6))
     assert all(abs(float(r["Angle"]) - 70.0) < 0.1 for r in rows if r["Angle"])
+    obj.vg.unit = "MM"  # the unit the measurement CSV would name, on every row
+    assert bpy.ops.vg.radius_sweep(filepath=str(path), start=0.05, stop=0.6, count=6) == {
+        "FINISHED"
+    }
+    with open(path, newline="", encoding="utf-8") as handle:
+        assert {r["Units"] for r in csv.DictReader(handle)} == {"mm"}
     png = path.with_suffix(".png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and zlib.crc32(png[12:29]) == int.from_bytes(
         png[29:33], "big"

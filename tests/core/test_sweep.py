@@ -62,9 +62,10 @@ def test_bad_sweeps_are_refused(start, stop, count, match):
 
 def test_sweep_csv_reads_back_exactly(surface):
     points = radius_sweep(surface, [0.01, 0.0, 0.0], 0.02, 0.5, 5)
-    text = csvio.format_sweep_rows(csvio.sweep_cells("=wedge", 3, p) for p in points)
+    text = csvio.format_sweep_rows(csvio.sweep_cells("=wedge", 3, p, "mm") for p in points)
     rows = list(csv.DictReader(io.StringIO(text)))
     assert list(rows[0]) == list(csvio.SWEEP_COLUMNS)
+    assert {row["Units"] for row in rows} == {"mm"}  # also on the refused radius's row
     assert rows[0]["Mesh Name"] == "'=wedge" and rows[0]["Measurement #"] == "3"
     assert rows[0]["Angle"] == "" and "larger radius" in rows[0]["error"]
     for row, point in zip(rows[1:], points[1:], strict=True):

@@ -207,8 +207,9 @@ def write_report(
     Raises
     ------
     GoniometerError
-        The libraries are missing, no session could be used, or an output would overwrite an
-        input; nothing is written then.
+        The libraries are missing, no session could be used, sessions hold centres and radii
+        of one mesh in different coordinate spaces (``sessions.load_sessions``), or an output
+        would overwrite an input; nothing is written then.
     """
     missing = missing_message()
     if missing:

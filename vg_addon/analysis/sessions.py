@@ -3,8 +3,9 @@
 A session is any CSV with a mesh, a break number and an angle per row: this extension's export,
 a batch run's ``--out``, the MeshLab plugin's file, or a plain table of manual goniometer readings
 (``Mesh, Break #, Angle``). The centre, radius and vertex count are used where the file has
-them. Every row that is left out, and every file, is named with the reason; nothing is dropped
-without a line saying so.
+them; centres and radii in Blender's world space (``Coordinates``, docs/CSV.md) are never compared
+with ones in mesh coordinates. Every row that is left out, and every file, is named with the
+reason; nothing is dropped without a line saying so.
 """
 
 from __future__ import annotations
@@ -12,11 +13,13 @@ from __future__ import annotations
 import math
 import os
 import re
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import GoniometerError
+from ..errors import GoniometerError, bounded_list
 from ..formats import csvio
+from ..formats.csvio.replication import default_coordinates
 
 #: Column names the analysis reads (matched ignoring case, spaces and ``_``).
 COLUMNS = {
@@ -35,6 +38,7 @@ COLUMNS = {
     "error": ("error",),
     "date": ("Date",),
     "kind": ("Break Type", "Fracture Type", "Type"),
+    "coordinates": ("Coordinates", "Coordinate Space"),
 }
 REQUIRED = ("mesh", "break", "angle")
 
@@ -83,6 +87,16 @@ class Reading:
         from one file given twice).
     kind : str
         The break's type (``Break Type`` column, e.g. transverse, oblique, spiral), or empty.
+    coordinates : str
+        The space of ``centre`` and ``radius``: ``"mesh"`` (the mesh's own coordinates) or
+        ``"world"`` (Blender world space), from the ``Coordinates`` cell; blank or absent,
+        ``"mesh"`` (see ``space_assumed``).
+    space_assumed : bool
+        The cell is blank or absent in an export of this extension written before the column,
+        whose coordinates are world space (the importer converts them with the object's
+        transform). The report has no transform: it takes them as mesh coordinates, which they
+        are for every batch run (its object is never transformed) and for an object never
+        moved, rotated or scaled, and says so (:func:`assumed_spaces`).
     """
 
     mesh: str
@@ -94,6 +108,8 @@ class Reading:
     row: int = 0
     date: str = ""
     kind: str = ""
+    coordinates: str = csvio.MESH_COORDINATES
+    space_assumed: bool = False
 
 
 @dataclass
@@ -171,8 +187,9 @@ def _cell(cells, columns, key) -> str:
     return cells[index] if index is not None and index < len(cells) else ""
 
 
-def _reading(number: int, cells, columns) -> tuple[Reading | None, str]:
-    """A row as a reading, or ``None`` and why it is left out."""
+def _reading(number: int, cells, columns, blank_space: str) -> tuple[Reading | None, str]:
+    """A row as a reading, or ``None`` and why it is left out; ``blank_space`` is the
+    coordinate space of a blank or absent ``Coordinates`` cell."""
     error = _cell(cells, columns, "error").strip()
     if error:
         return None, f"row {number}: not measured in its run ({error})"
@@ -201,12 +218,25 @@ def _reading(number: int, cells, columns) -> tuple[Reading | None, str]:
     vertices = _number(cells, columns, "vertices", number, problems, whole=True)
     if vertices is not None and not 0 <= vertices <= MAX_VERTICES:
         problems.append(f"Number of Vertices {vertices:g} is not a count of a patch's vertices")
+    space = _cell(cells, columns, "coordinates").strip()
+    if space and space.casefold() not in csvio.COORDINATE_SPACES:
+        problems.append(
+            f"Coordinates {space!r} is not {' or '.join(csvio.COORDINATE_SPACES)}, so its centre "
+            "and radius cannot be compared"
+        )
     if problems:
         return None, f"row {number}: " + "; ".join(problems)
     centre = None if None in parts else tuple(parts)
     date = _cell(cells, columns, "date").strip()
     kind = csvio.text_cell(_cell(cells, columns, "kind").strip())
-    return Reading(mesh, break_number, angle, centre, radius, vertices, number, date, kind), ""
+    assumed = not space and blank_space == csvio.WORLD_COORDINATES
+    space = space.casefold() or csvio.MESH_COORDINATES
+    return (
+        Reading(
+            mesh, break_number, angle, centre, radius, vertices, number, date, kind, space, assumed
+        ),
+        "",
+    )
 
 
 def _read_file(path, method, observer) -> tuple[list[Session], str]:
@@ -228,6 +258,7 @@ def _read_file(path, method, observer) -> tuple[list[Session], str]:
         return [], f"{source}: left out: {'; '.join(problems)}"
     if not records:
         return [], f"{source}: left out, it has a header but no rows"
+    blank_space = default_coordinates(header)
     by_key: dict[tuple[str, str, str], Session] = {}
     for number, cells in records:
         row_method = method or _method_of(_cell(cells, columns, "method")) or method_word(name)
@@ -243,7 +274,7 @@ def _read_file(path, method, observer) -> tuple[list[Session], str]:
         if session is None:
             session = by_key[key] = Session(name, os.fspath(path), row_method or "", row_observer)
         session.rows += 1
-        reading, why = _reading(number, cells, columns)
+        reading, why = _reading(number, cells, columns, blank_space)
         if reading is None:
             session.left_out.append(why)
         else:
@@ -280,6 +311,52 @@ def _identifies(session: Session) -> bool:
     return any(r.date or r.centre is not None for r in session.readings)
 
 
+def spaces_apart(sessions: list[Session]) -> list[str]:
+    """One line per mesh whose sessions hold centres or radii in more than one coordinate
+    space, naming each session and its rows in each space; empty when there is none."""
+    by_mesh: dict[str, dict[str, Counter]] = {}
+    for session in sessions:
+        for r in session.readings:
+            if r.centre is not None or r.radius is not None:
+                named = by_mesh.setdefault(r.mesh, {})
+                named.setdefault(session.name, Counter())[r.coordinates] += 1
+    lines = []
+    for mesh, named in by_mesh.items():
+        if len({space for counts in named.values() for space in counts}) > 1:
+            parts = [
+                f"{name} has "
+                + " and ".join(
+                    f"{n} row{'s' if n > 1 else ''} in {space}"
+                    for space, n in sorted(counts.items())
+                )
+                + " coordinates"
+                for name, counts in named.items()
+            ]
+            lines.append(f"{mesh}: " + "; ".join(parts))
+    return lines
+
+
+def assumed_spaces(sessions: list[Session]) -> list[str]:
+    """One note per session whose centres or radii are taken as mesh coordinates though its
+    file does not say so (:attr:`Reading.space_assumed`)."""
+    notes = []
+    for session in sessions:
+        count = sum(
+            r.space_assumed and (r.centre is not None or r.radius is not None)
+            for r in session.readings
+        )
+        if count:
+            notes.append(
+                f"{session.name}: written before the Coordinates column, so its {count} centre(s) "
+                "and radii are in Blender's world space; they are compared as mesh coordinates, "
+                "which they are for a batch run and for an object never moved, rotated or scaled. "
+                "If the object was, its centre and radius IOVs and the stations matched by centre "
+                "are wrong here: export it again with the current version (opening its .blend "
+                "converts the measurements)"
+            )
+    return notes
+
+
 def load_sessions(paths, methods=None, observers=None) -> Loaded:
     """Read each CSV as one session (or several, where its Method, Observer or Repetition
     columns hold several values).
@@ -295,6 +372,15 @@ def load_sessions(paths, methods=None, observers=None) -> Loaded:
     Loaded
         The sessions, and one line per file or session left out: unreadable, without the
         needed columns, of unknown method, or the same session as an earlier file.
+
+    Raises
+    ------
+    GoniometerError
+        ``--method`` or ``--observer`` given neither once nor once per file; or sessions whose
+        centres or radii on one mesh are in different coordinate spaces (world and mesh, see
+        :attr:`Reading.coordinates`): without the object's transform neither can be converted,
+        and comparing them would give wrong centre and radius IOVs and match stations, and so
+        angles, wrongly (:func:`spaces_apart` names them).
     """
     paths = list(paths)
     per_file = []
@@ -336,6 +422,22 @@ def load_sessions(paths, methods=None, observers=None) -> Loaded:
                 continue
             seen.setdefault(fingerprint, session.name)
             loaded.sessions.append(session)
+    loaded.notes.extend(assumed_spaces(loaded.sessions))
+    apart = spaces_apart(loaded.sessions)
+    if apart:
+        raise GoniometerError(
+            "these sessions hold centres and radii in different coordinate spaces (Blender's "
+            "world space and the mesh's own), which cannot be compared: their centre and radius "
+            "IOVs would mix the two, and stations matched by centre would pair the wrong angles; "
+            "no report is made:\n"
+            + bounded_list(apart, lines=True)
+            + "\nWorld rows come from exports of versions before the Coordinates column (or say "
+            "world in it), and converting them needs the object's transform, which a CSV does "
+            "not hold. Export those measurements again with the current version (opening their "
+            ".blend in it converts them to mesh coordinates) or measure again; or, if the object "
+            "had no location, rotation or scale when they were measured (world coordinates are "
+            "then mesh coordinates), set their Coordinates cells to mesh."
+        )
     return loaded
 
 

@@ -53,7 +53,8 @@ class ReplicationRow:
     x, y, z : float
         The centre to measure at.
     radius : float or None
-        Patch radius (> 0); ``None`` when the file has no radius column or the cell is blank.
+        Patch radius (> 0); ``None`` when the file has no radius column (an ``r`` column beside
+        ``g`` and ``b`` is a colour's red, not a radius) or the cell is blank.
     lam : float or None
         λ (≥ 0), from ``SegParam`` / ``lambda`` / ...; ``None`` when absent or blank.
     patch : str or None
@@ -135,6 +136,10 @@ _REPLICATION_ALIASES = {
 
 _REQUIRED = ("x", "y", "z")
 
+#: Columns that, all three in one header, are a colour: its ``r`` is red (0 to 255 in a
+#: coloured point list, as CloudCompare and MeshLab write ``X,Y,Z,R,G,B``), not a radius.
+_COLOUR = ("r", "g", "b")
+
 
 #: The largest ``Break #`` (Blender stores it as a 32-bit signed integer).
 MAX_BREAK_NUMBER = 2**31 - 1
@@ -166,6 +171,24 @@ def _parse_name(raw: str) -> str | None:
     return text_cell(raw) if raw.strip() else None
 
 
+def _aliases(header: list[str]) -> dict:
+    """The reader's aliases for this header: without ``r`` for the radius where the header
+    also has ``g`` and ``b`` (a colour's red, which taken as the radius would measure every row
+    with a patch as wide as its red value)."""
+    names = {normalise(name) for name in header}
+    if not set(_COLOUR) <= names:
+        return _REPLICATION_ALIASES
+    radius = tuple(a for a in _REPLICATION_ALIASES["radius"] if a not in _COLOUR)
+    return {**_REPLICATION_ALIASES, "radius": radius}
+
+
+def default_coordinates(header: list[str]) -> str:
+    """The coordinate space of a row whose ``Coordinates`` cell is blank or absent, in a file
+    with this header: ``"world"`` in this extension's exports (it wrote world coordinates until
+    it wrote the column), ``"mesh"`` in every other file."""
+    return WORLD_COORDINATES if _source_format(header) == "extension" else MESH_COORDINATES
+
+
 def _source_format(header: list[str]) -> str:
     names = [normalise(name) for name in header]
     if names[: len(MESHLAB_COLUMNS)] == [normalise(c) for c in MESHLAB_COLUMNS]:
@@ -184,7 +207,7 @@ def parse_replication_csv(
     records = read_records(text, source)
     header_at, header = header_of(records, source)
     problems: list[str] = []
-    columns = resolve_columns(header, _REPLICATION_ALIASES, problems)
+    columns = resolve_columns(header, _aliases(header), problems)
     missing = [field for field in _REQUIRED if field not in columns]
     if missing:
         found = ", ".join(repr(name.strip()) for name in header if name.strip()) or "none"
@@ -198,6 +221,7 @@ def parse_replication_csv(
         raise problems_error(source, problems)
 
     fmt = _source_format(header)
+    blank_space = default_coordinates(header)
     width = len(header)
     data = [(number, cells) for number, cells in records[header_at + 1 :] if not is_blank(cells)]
     if not data:
@@ -265,9 +289,7 @@ def parse_replication_csv(
                 )
         coordinates = optional_text(cell("coordinates"))
         if coordinates is None:
-            # This extension wrote world coordinates until it wrote the column; every other
-            # tool writes the mesh's own.
-            coordinates = WORLD_COORDINATES if fmt == "extension" else MESH_COORDINATES
+            coordinates = blank_space
         coordinates = coordinates.casefold()
         if coordinates not in COORDINATE_SPACES:
             problems.append(
@@ -338,7 +360,9 @@ def read_replication_csv(path_or_text, passed_over: list | None = None) -> list[
     Blender add-on's (both have the 14 MeshLab columns; the add-on writes the text ``fill`` in
     ``fit``, which is not read); and a plain points CSV. Header names are matched
     case-insensitively, ignoring surrounding whitespace and with ``_`` read as a space, with
-    aliases: ``Mesh Name``/``Mesh``/``Object``; ``x``/``Center x``; ``Radius``/``r``;
+    aliases: ``Mesh Name``/``Mesh``/``Object``; ``x``/``Center x``; ``Radius``/``r`` (not ``r``
+    in a header that also has ``g`` and ``b``: that is a colour's red, and the rows then have no
+    radius, as in a file without the column);
     ``SegParam``/``Seg Param``/``lambda``/``λ``/``Segmentation Parameter``;
     ``Patch Mode``/``patch``; ``label``/``User Data``/``note`` (``label`` wins over
     ``User Data``); ``Measurement #``; ``Break #``; ``Rule`` (``oriented`` or ``paper``);

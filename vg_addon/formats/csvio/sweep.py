@@ -29,13 +29,16 @@ SWEEP_COLUMNS = (
     "Patch Mode",
     "Rule",
     "error",
+    "Units",
 )
 
 
-def sweep_cells(mesh_name: str, number: int | None, point) -> list[str]:
+def sweep_cells(mesh_name: str, number: int | None, point, units: str = "") -> list[str]:
     """The cells of one :data:`SWEEP_COLUMNS` row for a ``vg_addon.method.sweep.SweepPoint``.
 
-    A refused radius keeps its radius and message; its measured cells are empty.
+    A refused radius keeps its radius and message; its measured cells are empty. ``units``
+    says what one coordinate unit is (the Units cell of the measurement CSV: the radius and
+    x, y, z are in the mesh's coordinates).
     """
     m = point.measurement
 
@@ -45,7 +48,7 @@ def sweep_cells(mesh_name: str, number: int | None, point) -> list[str]:
     cells = [escape_text(str(mesh_name)), "" if number is None else str(int(number))]
     cells.append(cell(point.radius, "Radius"))
     if m is None:
-        cells += [""] * (len(SWEEP_COLUMNS) - 4)
+        cells += [""] * (len(SWEEP_COLUMNS) - 5)
     else:
         cells += [
             cell(m.angle, "Angle"),
@@ -61,6 +64,7 @@ def sweep_cells(mesh_name: str, number: int | None, point) -> list[str]:
             m.rule,
         ]
     cells.append(escape_text(point.error))
+    cells.append(escape_text(units))
     return cells
 
 
@@ -69,7 +73,9 @@ def format_sweep_rows(rows: Iterable[Sequence[str]]) -> str:
     return csv_line(SWEEP_COLUMNS) + "".join(csv_line(cells) for cells in rows)
 
 
-def write_sweep_csv(path, mesh_name: str, points, number: int | None = None) -> None:
+def write_sweep_csv(
+    path, mesh_name: str, points, number: int | None = None, units: str = ""
+) -> None:
     """Write one site's sweep to ``path`` atomically (as :func:`write_measurements_csv`)."""
-    text = format_sweep_rows(sweep_cells(mesh_name, number, point) for point in points)
+    text = format_sweep_rows(sweep_cells(mesh_name, number, point, units) for point in points)
     replace_atomically(os.fspath(path), text.encode("utf-8"))
