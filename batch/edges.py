@@ -37,7 +37,7 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
         An unreadable edges CSV, a row without Points, Spacing or Radius, or naming no mesh
         given; a Spacing, Radius, SegParam or Patch Mode a row cannot be measured with, or a
         spacing that would make more than ``edge_profile.MAX_STATIONS`` stations
-        (:func:`check_spacing`).
+        (:func:`check_edge_spec`).
     """
     specs = [
         args_spec(args, [spec["start"], *spec["via"], spec["end"]], given=f"--edge {number}")
@@ -45,7 +45,7 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
     ]
     for number, spec in enumerate(specs, start=1):
         try:
-            check_spacing(spec)
+            check_edge_spec(spec)
         except GoniometerError as error:
             raise UsageError(f"--edge {number} with --spacing {args.spacing:g}: {error}") from None
     if not args.edges_csv:
@@ -142,10 +142,10 @@ def args_spec(args, points, *, mesh_name: str = "", note: str = "", given: str =
 
 
 def add_checked(specs: list, problems: list, spec: dict, where: str) -> None:
-    """Append ``spec`` to ``specs``, or, if :func:`check_spacing` refuses it, the reason (after
+    """Append ``spec`` to ``specs``, or, if :func:`check_edge_spec` refuses it, the reason (after
     ``where``) to ``problems``."""
     try:
-        check_spacing(spec)
+        check_edge_spec(spec)
     except GoniometerError as error:
         problems.append(f"{where}: {error}")
     else:
@@ -217,7 +217,7 @@ def picked_point_specs(args, sources, passed_over: list | None = None) -> list[d
     return specs
 
 
-def check_spacing(spec: dict) -> None:
+def check_edge_spec(spec: dict) -> None:
     """Refuse an edge whose settings cannot measure it, before any mesh is read: a spacing,
     radius, λ, patch mode or rule out of range (an edges CSV row's own cells; otherwise each of
     its stations failed alike), or a spacing that would make more stations than the core

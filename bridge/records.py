@@ -310,6 +310,10 @@ def replay_args(item) -> dict:
     }
 
 
+MESH_UNITS = "mesh units"
+"""The unit of a scaled object's coordinates where no Scan Units name it."""
+
+
 def unit_symbol(obj, scene) -> str:
     """The symbol of ``obj``'s coordinate unit (``"mm"``): the one its Scan Units say, else what
     one Blender unit is in ``scene`` (``"BU"`` if no unit is exactly that) for an object shown at
@@ -324,10 +328,6 @@ def unit_symbol(obj, scene) -> str:
     return units.scene_symbol(settings.system, settings.scale_length)
 
 
-MESH_UNITS = "mesh units"
-"""The unit of a scaled object's coordinates where no Scan Units name it."""
-
-
 def is_shown_at_own_size(obj) -> bool:
     """Whether ``obj``'s transform keeps lengths (a uniform scale of 1): then one mesh unit is
     one Blender unit."""
@@ -340,8 +340,7 @@ def choose_unit(obj, key: str) -> bool:
     Blender units) where that is the unit of the mesh's own coordinates: an object shown at its
     own size, with no Scan Units chosen before. Returns whether they were set; else the label
     stays the scene's (``units_label``), which says how a scaled object's units relate."""
-    scale = uniform_scale(np.array(obj.matrix_world, dtype=np.float64))
-    if obj.vg.unit_chosen or obj.vg.unit != units.SCENE or scale is None or abs(scale - 1) > 1e-6:
+    if obj.vg.unit_chosen or obj.vg.unit != units.SCENE or not is_shown_at_own_size(obj):
         return False
     set_unit(obj.vg, key, guessed=False)
     return True

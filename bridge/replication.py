@@ -232,11 +232,12 @@ def _matching_notes(edge_notes: dict, stations: dict, settings: dict) -> dict:
     }
 
 
-def edge_notes_beside(path) -> tuple[dict, str]:
+def edge_notes_beside(path, rows) -> tuple[dict, str]:
     """The notes of the edges in the edge summary an export wrote beside the measurement CSV
-    ``path`` (``NAME_edges.csv``), and that file's name; ``({}, "")`` where there is none or it
-    cannot be read (the stations' own notes then name the edges). An edge's note edited after it
-    was measured is only there: its stations keep the note they were measured with.
+    ``path`` (``NAME_edges.csv``), and that file's name; ``({}, "")`` where its ``rows`` hold no
+    edge station, or there is no summary or it cannot be read (the stations' own notes then name
+    the edges). An edge's note edited after it was measured is only there: its stations keep the
+    note they were measured with.
 
     Returns
     -------
@@ -244,6 +245,8 @@ def edge_notes_beside(path) -> tuple[dict, str]:
         ``{(mesh name, edge number): (stations, spacing, radius, note)}`` (the import uses a
         note only for an edge whose stations agree with the row), and the file's name.
     """
+    if all(row.edge_number is None for row in rows):
+        return {}, ""
     beside = csvio.edges_path_for(Path(path))
     if not csvio.holds_edge_summary(beside):
         return {}, ""
@@ -275,7 +278,7 @@ def import_csv(obj, path, *, depsgraph=None, **options) -> list[int]:
     replicate it on ``obj``; ``options`` as for :func:`replicate_rows`. Rebuilt edges take
     their notes from the edge summary beside it (:func:`edge_notes_beside`)."""
     rows, source = read_rows(path)
-    notes, _ = edge_notes_beside(path)
+    notes, _ = edge_notes_beside(path, rows)
     return replicate_rows(
         obj, rows, depsgraph=depsgraph, source=source, edge_notes=notes, **options
     )

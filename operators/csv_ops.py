@@ -226,7 +226,7 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
                 return {"FINISHED"}
             self._passed_over = []
             rows, source = replication.read_rows(path, self._passed_over)
-            edge_notes, self._notes_from = replication.edge_notes_beside(path)
+            edge_notes, self._notes_from = replication.edge_notes_beside(path, rows)
             self._notes_taken = []
             steps = replication.replicate_steps(
                 obj,
