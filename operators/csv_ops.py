@@ -263,6 +263,10 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             self._progress = Progress(context, f"Re-measuring {self._path_name} (Esc cancels)")
             self._timer = wm.event_timer_add(0.01, window=context.window)
             wm.modal_handler_add(self)
+            # Blender registers this very operator when it ends, and Repeat Last or Adjust Last
+            # Operation call its execute again: started modal a second time, it crashed Blender
+            # 4.3 as it ended. Those repeats run in one go.
+            self.interactive = False
             return {"RUNNING_MODAL"}
         self._progress = Progress(context, f"Re-measuring {self._path_name}")
         try:

@@ -177,6 +177,11 @@ def _find_edges(window, area):
     return None
 
 
+def _plot_units(name: str):
+    image = bpy.data.images.get(name) if name else None
+    return None if image is None else image.get("vg_plot_units")
+
+
 def _objects(scene_) -> dict:
     objects = {}
     for obj in scene_.objects:
@@ -197,12 +202,15 @@ def _objects(scene_) -> dict:
                 for item in obj.vg.measurements
             ],
             "active_index": obj.vg.active_index,
+            "unit": obj.vg.unit,
             "edges": [
                 {
                     "number": edge.number,
                     "break_number": edge.break_number,
                     "n_stations": edge.n_stations,
                     "mean": edge.mean,
+                    # The unit its plot's axis names (the image's custom property).
+                    "plot_units": _plot_units(edge.plot),
                 }
                 for edge in obj.vg.edges
             ],

@@ -22,6 +22,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from vg_addon import units
+
 OBJ = "Wedge"
 REPORT_LIBS = True  # conftest binds the report's libraries into the root (one test uses them)
 WEDGE_ANGLE = 100.0
@@ -206,6 +208,35 @@ def test_import_remeasures_every_row_through_the_file_browser(gui, places):
     assert not any("import_csv" in op.lower() for op in gui.state()["modal_operators"])
 
 
+def test_repeat_last_after_the_import_measures_the_rows_once_more(gui, places):
+    """Repeat Last (Shift+R over the view) after the file-browser import runs the import once
+    more, to its end, with the rows' angles exact; Blender goes on (no operator left running,
+    nothing in the console)."""
+    with places["csv"].open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    before = measurements(gui)
+    gui.move(point(gui, "crease"))
+    gui.key("shift+r")
+    gui.wait_for(
+        lambda s: len(s["objects"][OBJ]["measurements"]) >= len(before) + len(rows),
+        60,
+        "the repeated import",
+    )
+    items = gui.settle(5)["objects"][OBJ]["measurements"]
+    assert len(items) == len(before) + len(rows), "the repeat imported the rows once"
+    assert [m["exact"]["angle"] for m in items[len(before) :]] == [
+        float(row["Angle"]) for row in rows
+    ]
+    assert not any("import_csv" in op.lower() for op in gui.state()["modal_operators"])
+    gui.key("ctrl+z")  # the repeat is one undo step: the measurements before it are back
+    state = gui.wait_for(
+        lambda s: len(s["objects"][OBJ]["measurements"]) == len(before), 20, "the undo"
+    )
+    assert [m["exact"]["angle"] for m in state["objects"][OBJ]["measurements"]] == [
+        m["exact"]["angle"] for m in before
+    ]
+
+
 def test_replication_report_refuses_without_its_libraries(gui, places):
     """Issue 23: Replication Report from the CSV panel in a distribution's Blender, whose Python
     has NumPy only: refused when pressed, naming what to install and the vg_batch.py --report
@@ -286,6 +317,30 @@ def test_edge_profiles_list_shows_each_edge_and_picks_by_click(gui, places):
         gui.find_button("UI", f"edges[{selected}].note", key="ctrl+shift+c", upward=True, step=6)
     except LookupError:
         pytest.fail(f"the Edge Profiles panel does not draw down to the edge's note ({figures})")
+
+
+def test_choosing_scan_units_draws_the_edges_plots_again_in_that_unit(gui, places):
+    """The Scan Units menu at the head of the panel, changed as a user can (Ctrl+wheel over it):
+    every edge's plot is drawn again, its axis in the unit chosen (the unit's symbol from the
+    project's table of units), and the plot shows in the panel."""
+    gui.scroll_sidebar(-40)
+    state = gui.state()
+    before = state["objects"][OBJ]
+    assert before["edges"] and all(edge["plot_units"] for edge in before["edges"])
+    menu = gui.find_button("UI", "vg.unit", key="ctrl+shift+c", step=6)
+    gui.click(menu, button=5, modifier="ctrl")  # the next unit of the menu
+    state = gui.wait_for(lambda s: s["objects"][OBJ]["unit"] != before["unit"], 20, "a unit")
+    chosen = state["objects"][OBJ]["unit"]
+    assert chosen in units.SYMBOLS, f"Ctrl+wheel chose {chosen}"
+    state = gui.settle(3)
+    assert [e["plot_units"] for e in state["objects"][OBJ]["edges"]] == [
+        units.SYMBOLS[chosen]
+    ] * len(before["edges"])
+    _left, top, _width, height = state["regions"]["UI"]
+    sidebar_shot(gui, "scan_units", top, height)
+    gui.scroll_sidebar(40)
+    gui.settle(3)
+    sidebar_shot(gui, "edge_plot_in_chosen_unit", top, height)
 
 
 def test_an_edge_profile_is_recorded_only_on_the_object_its_clicks_are_on(gui, places):
