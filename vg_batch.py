@@ -10,21 +10,8 @@ and registers it, so the measurements are taken, stored and coloured exactly as 
 does it (see docs/BATCH.md).
 """
 
-import importlib.util
-import os
-import shutil
 import signal
 import sys
-import traceback
-from pathlib import Path
-
-ROOT = Path(__file__).resolve().parent
-PACKAGE = (
-    "virtual_goniometer"  # the name this folder is imported under when Blender does not run it
-)
-# Blender's own Python has imported bpy before it runs a --python script; a plain Python has not.
-IN_BLENDER = "bpy" in sys.modules
-
 
 STOPPED_WHILE_STARTING: list[int] = []
 """Stop signals (Ctrl-C) that came while the script was starting: an interrupt raised inside an
@@ -34,6 +21,27 @@ and acted on once the imports are done (:func:`main`)."""
 
 def _stop_while_starting(signum, frame) -> None:
     STOPPED_WHILE_STARTING.append(signum)
+
+
+if __name__ == "__main__":
+    # Before any other import: a Ctrl-C in the first tens of milliseconds (while shutil was being
+    # imported) was a KeyboardInterrupt traceback. A worker's Ctrl-C is its parent's to handle
+    # (the parent stops it): ignored from the start.
+    _CHILD = any(flag in sys.argv for flag in ("--worker", "--map-worker"))
+    signal.signal(signal.SIGINT, signal.SIG_IGN if _CHILD else _stop_while_starting)
+
+import importlib.util  # noqa: E402 (after the stop handler, above)
+import os  # noqa: E402
+import shutil  # noqa: E402
+import traceback  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent
+PACKAGE = (
+    "virtual_goniometer"  # the name this folder is imported under when Blender does not run it
+)
+# Blender's own Python has imported bpy before it runs a --python script; a plain Python has not.
+IN_BLENDER = "bpy" in sys.modules
 
 
 def script_argv() -> list[str]:
@@ -116,9 +124,6 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    # A worker's Ctrl-C is its parent's to handle (the parent stops it): ignored from the start.
-    child = any(flag in sys.argv for flag in ("--worker", "--map-worker"))
-    signal.signal(signal.SIGINT, signal.SIG_IGN if child else _stop_while_starting)
     try:
         status = main()
     except SystemExit as stop:  # argparse: --help (0) and usage errors (2)

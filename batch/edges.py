@@ -58,6 +58,12 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
         raise UsageError(f"{args.edges_csv}: {error.strerror or error}") from None
     except GoniometerError as error:
         raise UsageError(str(error)) from None
+    several = len(sources) > 1
+    if several and args.ignore_mesh_names:
+        raise UsageError(
+            "--ignore-mesh-names needs a single mesh: with several, each edge row's Mesh Name "
+            "says which one to measure it on."
+        )
     problems, failed = [], []
     for row in rows:
         number = row.row_number
@@ -72,7 +78,12 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
         if row.spacing is None or row.radius is None or len(points) < 2:
             problems.append(f"row {number}: an edge needs two Points, a Spacing and a Radius")
             continue
-        name = "" if args.ignore_mesh_names else row.mesh_name
+        name = "" if args.ignore_mesh_names else (row.mesh_name or "")
+        if several and not name.strip():  # else measured on every mesh, as an --edge is
+            problems.append(
+                f"row {number} names no mesh, and several are given: fill in its Mesh Name"
+            )
+            continue
         mesh, why = closest_source(name, sources, f"row {number}")
         if why:
             problems.append(why)

@@ -101,8 +101,9 @@ def _is_stream(out) -> bool:
 
 
 def sweep_paths(out) -> tuple[Path, Path]:
-    """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``."""
-    out = Path(out).resolve()
+    """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``,
+    beside ``out`` as given (a link's target's folder would part them from the CSV)."""
+    out = Path(out).absolute()
     return out.with_name(out.stem + "_sweep.csv"), out.with_name(out.stem + "_sweep")
 
 

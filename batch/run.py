@@ -298,6 +298,25 @@ class Run:
         drawn = sum(r.sweep_plots for r in self.results)
         self.say(f"wrote {csv_path} ({len(rows):,} sweep rows) and {drawn} plot(s) in {plots}")
 
+    def empty_earlier_sweep(self) -> None:
+        """An earlier run's ``<out>_sweep.csv`` beside this run's CSV is emptied to its header:
+        left, it would pair this CSV with the sweep of other points. Said, as its plots left in
+        ``<out>_sweep/`` are; a failure is a failed output (exit 2)."""
+        if self.args.out == files.STDOUT:
+            return
+        csv_path, plots = sweep_paths(self.args.out)
+        if not csvio.holds_sweep(csv_path):
+            return
+        try:
+            files.replace_atomically(str(csv_path), csvio.format_sweep_rows([]).encode("utf-8"))
+        except (OSError, GoniometerError) as error:
+            self.failed_outputs.append(f"sweep CSV {csv_path}: {reason(error, csv_path.parent)}")
+            return
+        self.say(
+            f"emptied {csv_path} to its header: it held an earlier run's radius sweep and this "
+            f"run made none (the plots in {plots} are an earlier run's)"
+        )
+
     def unmeasured(self, task, message: str):
         """The row of a task without a measurement, saying why (a stopped run, a worker that
         failed its mesh)."""
@@ -318,6 +337,8 @@ class Run:
             return 2
         if self.args.sweep:
             self.write_sweep_csv()
+        else:
+            self.empty_earlier_sweep()
         failed = [(i, row) for i, row in sorted(self.rows.items()) if row.error]
         failed_edges = [row for row in self.station_rows if row.error]
         measured = len(self.rows) - len(failed)
@@ -534,7 +555,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
         "find_edges": find_options(args),
         "picture_names": stems,
         "inputs": input_files(args),
-        "plots": str(Path(args.out).resolve().parent / Path(args.out).stem)
+        "plots": str(Path(args.out).absolute().with_name(Path(args.out).stem))
         if edges or args.find_edges
         else "",
     }

@@ -21,6 +21,10 @@ from . import records
 PLOT_SIZE = (480, 240)
 """Width and height of a plot image, pixels."""
 
+PREVIEW_SIZE = (256, 192)
+"""Width and height of the plot's picture in the panel (its preview icon), pixels: about what the
+sidebar shows, so its tick labels are drawn at the size they are seen."""
+
 PLOT_KEY = "vg_edge_plot"
 """The image's custom property holding :func:`plot_key` of the edge it was drawn for."""
 
@@ -57,8 +61,22 @@ def make_plot(obj, edge):
     image.use_fake_user = True  # only the edge names it: without a user it would not be saved
     image[PLOT_KEY] = plot_key(edge)
     image[UNIT_KEY] = units
-    image.preview_ensure()  # the panel shows the plot as the image's preview icon
+    _draw_preview(image, numbers)
     return image
+
+
+def _draw_preview(image, numbers) -> None:
+    """Draw the panel's picture of the plot into ``image``'s preview icon, at
+    :data:`PREVIEW_SIZE`. Blender's own preview shrinks the plot to 128 pixels wide, and the
+    sidebar then stretches it: its tick labels were specks."""
+    width, height = PREVIEW_SIZE
+    rgba = profile_plot.draw_profile(
+        numbers["arc_lengths"], numbers["angles"], width=width, height=height
+    )
+    preview = image.preview_ensure()
+    preview.image_size = (width, height)
+    # Blender's rows run bottom-up, as the image's.
+    preview.image_pixels_float.foreach_set((rgba[::-1].astype(np.float32) / 255.0).ravel())
 
 
 def plot_image(edge):

@@ -597,3 +597,58 @@ def test_the_demo_refuses_every_option_it_would_ignore(tmp_path, arguments, name
     result = ok(batch("--demo", "--out-dir", tmp_path / "demo", *arguments), 2)
     assert f"--demo takes no {named} (only --out-dir and --quiet)" in result.stderr
     assert not (tmp_path / "demo").exists()
+
+
+# --------------------------------------------------------------------------- outputs together
+
+
+def test_an_edge_row_naming_no_mesh_among_several_is_refused(tmp_path):
+    """An edge summary row with a blank Mesh Name, replayed on two meshes, is refused as a
+    points row is (before: traced on both, and the replay report compared the file's row with
+    the other mesh's edge); so is --ignore-mesh-names with several meshes."""
+    a, b = write_wedge(tmp_path / "a.ply", 100.0), write_wedge(tmp_path / "b.ply", 60.0, seed=4)
+    ok(batch(a, b, *EDGE, "--spacing", "0.2", "--out", tmp_path / "e.csv"))
+    lines = (tmp_path / "e_edges.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    cells = lines[1].split(",")
+    cells[header.index("Mesh Name")] = ""
+    blank = tmp_path / "blank_edges.csv"
+    blank.write_text("\n".join([lines[0], ",".join(cells)]) + "\n")
+    result = ok(batch(a, b, "--edges", blank, "--out", tmp_path / "r.csv"), code=2)
+    assert "row 2 names no mesh, and several are given" in result.stderr
+    result = ok(
+        batch(a, b, "--edges", tmp_path / "e_edges.csv", "--ignore-mesh-names", "--out",
+              tmp_path / "r.csv"),
+        code=2,
+    )  # fmt: skip
+    assert "--ignore-mesh-names needs a single mesh" in result.stderr
+    assert not (tmp_path / "r.csv").exists()
+    ok(batch(a, "--edges", blank, "--out", tmp_path / "one.csv"))  # one mesh: measured on it
+
+
+def test_a_run_without_a_sweep_empties_an_earlier_sweep_beside_its_csv(scan, tmp_path):
+    """Before, ``<out>_sweep.csv`` of an earlier run stayed beside the new CSV, pairing it with
+    the sweep of other points; a file of that name that is not a sweep is left alone."""
+    out = tmp_path / "o.csv"
+    ok(batch(scan, *AT, "--sweep", "0.2", "0.4", "3", "--out", out))
+    sweep = tmp_path / "o_sweep.csv"
+    assert len(sweep.read_text().splitlines()) == 4
+    result = ok(batch(scan, *AT, "--out", out))
+    assert sweep.read_text() == csvio.format_sweep_rows([])
+    assert f"emptied {sweep} to its header" in result.stdout + result.stderr
+    sweep.write_text("x,y,z\n1,2,3\n")  # the user's own file of that name
+    ok(batch(scan, *AT, "--out", out))
+    assert sweep.read_text() == "x,y,z\n1,2,3\n"
+
+
+def test_every_output_beside_a_linked_out_is_beside_the_link(scan, tmp_path):
+    """``--out`` a symbolic link into another folder: the edge summary, the edge plots and the
+    sweep all go beside the link, named after it (before: three places under two names)."""
+    (tmp_path / "sub").mkdir()
+    link = tmp_path / "lk.csv"
+    link.symlink_to(tmp_path / "sub" / "real.csv")
+    ok(batch(scan, *EDGE, "--spacing", "0.2", "--sweep", "0.2", "0.4", "3", "--out", link))
+    assert (tmp_path / "sub" / "real.csv").is_file()  # the CSV through the link
+    beside = {p.name for p in tmp_path.iterdir()}
+    assert {"lk_edges.csv", "lk_sweep.csv", "lk_sweep", "lk_scan_edge1.png"} <= beside
+    assert sorted(p.name for p in (tmp_path / "sub").iterdir()) == ["real.csv"]

@@ -107,6 +107,17 @@ def test_plot_image_is_made_packed_and_saved(vg, tmp_path):
     image.pixels.foreach_get(pixels)
     rgba = np.round(pixels.reshape(240, 480, 4)[::-1] * 255).astype(np.uint8)
     assert np.array_equal(rgba, expected)  # the plot drawn from the recorded numbers
+    # The panel's picture: drawn at the size the sidebar shows it and saved with the file (before:
+    # Blender's own 128-pixel preview of the plot, stretched, its tick labels specks).
+    preview = image.preview
+    assert preview.is_image_custom and tuple(preview.image_size) == (256, 192)
+    pixels = np.empty(256 * 192 * 4, dtype=np.float32)
+    preview.image_pixels_float.foreach_get(pixels)
+    shown = np.round(pixels.reshape(192, 256, 4)[::-1] * 255).astype(np.uint8)
+    drawn = profile_plot.draw_profile(
+        numbers["arc_lengths"], numbers["angles"], width=256, height=192
+    )
+    assert np.array_equal(shown, drawn)
 
 
 def test_each_edge_shows_and_deletes_only_its_own_plot(vg, tmp_path):

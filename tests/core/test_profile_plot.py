@@ -190,3 +190,14 @@ def test_matplotlib_images_are_exactly_the_size_asked_for():
             figure = mpl_plots.profile_figure(ARC, ANGLES, width=width, height=height, dpi=dpi)
             data = mpl_plots.png(figure)
             assert struct.unpack(">II", data[16:24]) == (width, height), dpi
+
+
+@pytest.mark.parametrize("size", [(480, 240), (256, 192)])
+def test_the_widest_tick_label_is_drawn_whole(size):
+    """An edge at 100° has the tick label "101.0°", wider than the first version's margin: its
+    first digit ran off the picture's left side. Every label now starts inside, four pixels
+    from the edge or more."""
+    image = profile_plot.draw_profile([0.0], [100.0], width=size[0], height=size[1])
+    ink = (image[..., :3] == profile_plot.AXES[:3]).all(axis=2)
+    assert not ink[:, :4].any()
+    assert ink[:, 4:12].any()  # the widest label's first digit, whole

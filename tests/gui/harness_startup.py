@@ -193,6 +193,7 @@ def _objects(scene_) -> dict:
                 {
                     "number": item.number,
                     "break_number": item.break_number,
+                    "edge_number": item.edge_number,
                     "exact": json.loads(item.exact) if item.exact else {},
                     "patch": item.patch,
                     "n_vertices": item.n_vertices,

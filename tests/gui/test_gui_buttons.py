@@ -343,6 +343,35 @@ def test_choosing_scan_units_draws_the_edges_plots_again_in_that_unit(gui, place
     sidebar_shot(gui, "edge_plot_in_chosen_unit", top, height)
 
 
+def side_button(gui, copied: str) -> tuple[float, float]:
+    """The button beside a list whose Ctrl+C copies ``copied``: hovered down the column at the
+    sidebar's right (``find_button`` tries the middle columns, where the list itself is)."""
+    left, top, width, height = gui.state()["regions"]["UI"]
+    for y in range(top + 4, top + height - 4, 5):
+        text = gui.copies((left + width - 50, y))
+        if text is not None and copied in text:
+            return left + width - 50, y
+    raise LookupError(f"no button copying {copied!r} beside a list")
+
+
+def test_the_edge_lists_minus_deletes_the_selected_edge_and_its_stations(gui, places):
+    """The − beside the Edge Profiles list: the selected edge goes, with its stations (the
+    measurements recorded for it); the other edges and measurements stay as they were."""
+    before = gui.state()["objects"][OBJ]
+    selected = before["edges"][before["active_edge_index"]]
+    gui.click(side_button(gui, "vg.delete_edge"))
+    state = gui.wait_for(
+        lambda s: len(s["objects"][OBJ]["edges"]) == len(before["edges"]) - 1, 20, "a delete"
+    )
+    after = state["objects"][OBJ]
+    assert [e["number"] for e in after["edges"]] == [
+        e["number"] for e in before["edges"] if e["number"] != selected["number"]
+    ]
+    kept = [m for m in before["measurements"] if m["edge_number"] != selected["number"]]
+    assert len(kept) == len(before["measurements"]) - selected["n_stations"]
+    assert [m["number"] for m in after["measurements"]] == [m["number"] for m in kept]
+
+
 def test_an_edge_profile_is_recorded_only_on_the_object_its_clicks_are_on(gui, places):
     """Clicks outside the viewport reach Blender during an Edge Profile session, so another
     object can become active (a click in the Outliner). Before, Enter then recorded the clicks

@@ -93,6 +93,27 @@ def test_an_unstable_reading_is_flagged_in_the_list(gui, places):
     sidebar_shot(gui, "unstable_row", places["list"][1] - 120, 260)
 
 
+def test_the_flagged_rows_button_selects_its_reading(gui, places):
+    """The flagged row's angle is a button (its tooltip the reason): another row selected
+    first, pressing it selects the flagged reading again."""
+    flagged = len(items(gui)) - 1
+    y = int(places["list"][1])
+    span = gui.list_span("active_index", range(y - 150, y + 150, 4))
+    left, _top, width, _height = gui.state()["regions"]["UI"]
+    # Hovered, the flagged row's button copies no index: the row is just below the span.
+    rows = range(span[0], span[-1] + 40, 3)
+    button = gui.find_button("UI", "vg.stability_warning", rows=rows)
+    other = next(row for row in span if abs(row - button[1]) > 14)
+    gui.click((left + width // 3, other))
+    state = gui.wait_for(lambda s: s["objects"][OBJ]["active_index"] != flagged, 20, "a row")
+    assert state["objects"][OBJ]["active_index"] < flagged
+    gui.move(button)
+    gui.settle(30)  # the tooltip shows after a pause
+    sidebar_shot(gui, "flagged_row_tooltip", button[1] - 120, 300)
+    gui.click(button)
+    gui.wait_for(lambda s: s["objects"][OBJ]["active_index"] == flagged, 20, "the flagged row")
+
+
 def test_the_radius_sweep_writes_its_csv_and_plot_through_the_file_browser(gui, places):
     gui.click(point(gui, "crease"), button=3, modifier="shift")
     # Radius Sweep: second from the sidebar's foot (CSV, Radius Sweep, Measurement Map).
@@ -141,6 +162,24 @@ def list_button(gui, copied: str) -> tuple[float, float]:
         if text is not None and copied in text:
             return x, y
     raise LookupError(f"no list button copying {copied!r}")
+
+
+def test_the_refresh_button_beside_the_list_checks_the_colours(gui, places):
+    """The refresh button beside the list (Update Colours) runs and says the colours of the
+    unchanged mesh are up to date; every reading is kept, none stale."""
+    gui.scroll_sidebar(-30)
+    before = items(gui)
+    start = gui.log_size()
+
+    def reported(_state) -> bool:
+        text = (gui.tmp / "blender.log").read_bytes()[start:].decode(errors="replace")
+        return f"Colours of '{OBJ}' are up to date" in text
+
+    gui.click(list_button(gui, "vg.repaint"))
+    gui.wait_for(reported, 20, "its report")
+    after = items(gui)
+    assert [m["exact"] for m in after] == [m["exact"] for m in before]
+    assert not any(m["stale"] for m in after)
 
 
 def test_delete_and_clear_from_the_list_buttons(gui, places):

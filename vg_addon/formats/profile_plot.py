@@ -54,9 +54,21 @@ def nice_ticks(low: float, high: float, count: int = 5) -> np.ndarray:
     return np.arange(first, high + step * 1e-9, step)
 
 
+def _text_width(text: str) -> int:
+    """Width of ``text`` in pixels, as :func:`_text` draws it."""
+    return len(text) * 4 * _SCALE - _SCALE
+
+
+def _y_labels(y_range) -> tuple[np.ndarray, list[str]]:
+    """The angle axis's ticks and their labels."""
+    ticks = nice_ticks(*y_range)
+    step = float(ticks[1] - ticks[0]) if ticks.size > 1 else 1.0
+    return ticks, [_label(tick, step) + "°" for tick in ticks]
+
+
 def _text(image, x: int, y: int, text: str, color, anchor: str = "left") -> None:
     """Draw ``text`` with its top at row ``y``; ``anchor`` left/right/centre at column ``x``."""
-    width = len(text) * 4 * _SCALE - _SCALE
+    width = _text_width(text)
     x0 = {"left": x, "right": x - width, "centre": x - width // 2}[anchor]
     for k, char in enumerate(text):
         rows = _GLYPHS.get(char, _GLYPHS[" "])
@@ -106,7 +118,9 @@ def plot_frame(arc_lengths, angles, width: int, height: int):
     y_low, y_high = float(angle.min()), float(angle.max())
     pad = max((y_high - y_low) * 0.1, 1.0)
     y_low, y_high = y_low - pad, y_high + pad
-    left, right = _MARGIN_LEFT, width - _MARGIN_RIGHT
+    # Wide enough for the widest tick label ("101.0°" did not fit: its first digit was cut).
+    widest = max(_text_width(label) for label in _y_labels((y_low, y_high))[1])
+    left, right = max(_MARGIN_LEFT, widest + 8), width - _MARGIN_RIGHT
     top, bottom = _MARGIN_TOP, height - _MARGIN_BOTTOM
 
     def to_x(value):
@@ -179,16 +193,15 @@ def draw_profile(arc_lengths, angles, *, width: int = 480, height: int = 240) ->
     image = np.empty((height, width, 4), dtype=np.uint8)
     image[:] = BACKGROUND
     to_x, to_y, x_range, y_range = plot_frame(arc, angle, width, height)
-    left, right = _MARGIN_LEFT, width - _MARGIN_RIGHT
+    left, right = round(float(to_x(x_range[0]))), width - _MARGIN_RIGHT
     top, bottom = _MARGIN_TOP, height - _MARGIN_BOTTOM
-    y_ticks = nice_ticks(*y_range)
+    y_ticks, y_labels = _y_labels(y_range)
     x_ticks = nice_ticks(*x_range)
-    y_step = float(y_ticks[1] - y_ticks[0]) if y_ticks.size > 1 else 1.0
     x_step = float(x_ticks[1] - x_ticks[0]) if x_ticks.size > 1 else 1.0
-    for tick in y_ticks:
+    for tick, label in zip(y_ticks, y_labels, strict=True):
         row = round(float(to_y(tick)))
         image[row, left:right] = GRID
-        _text(image, left - 4, row - 5, _label(tick, y_step) + "°", AXES, anchor="right")
+        _text(image, left - 4, row - 5, label, AXES, anchor="right")
     for tick in x_ticks:
         column = round(float(to_x(tick)))
         image[top:bottom, column] = GRID

@@ -65,7 +65,7 @@ from .replication import (
     parse_replication_csv,
     read_replication_csv,
 )
-from .sweep import SWEEP_COLUMNS, format_sweep_rows, sweep_cells, write_sweep_csv
+from .sweep import SWEEP_COLUMNS, format_sweep_rows, holds_sweep, sweep_cells, write_sweep_csv
 from .text import (
     COORDINATE_SPACES,
     MESH_COORDINATES,
@@ -109,6 +109,7 @@ __all__ = [
     "format_table",
     "header_columns",
     "holds_edge_summary",
+    "holds_sweep",
     "is_edges_csv",
     "mesh_name_match",
     "mesh_name_matches",

@@ -182,6 +182,38 @@ def _aliases(header: list[str]) -> dict:
     return {**_REPLICATION_ALIASES, "radius": radius}
 
 
+#: Fields that decide what is measured and where. A header that names one of them twice, by two
+#: of its aliases (``lambda`` and ``SegParam``), is refused: the first alias would be measured
+#: and the other column ignored without a word.
+_SETTINGS = {
+    "x": "x",
+    "y": "y",
+    "z": "z",
+    "radius": "radius",
+    "lam": "λ (SegParam)",
+    "patch": "patch mode",
+    "rule": "rule",
+    "coordinates": "coordinate space",
+    "units": "units",
+    "spacing": "spacing",
+}
+
+
+def _settings_named_twice(header: list[str], aliases: dict) -> list[str]:
+    """A problem for each setting the header gives in two differently named columns."""
+    names = [normalise(name) for name in header]
+    problems = []
+    for field, words in _SETTINGS.items():
+        found = [i for i, name in enumerate(names) if name in aliases[field]]
+        if len({names[i] for i in found}) > 1:
+            listed = " and ".join(f"{i + 1} ({header[i].strip()!r})" for i in found)
+            problems.append(
+                f"header: columns {listed} both give the {words} of each row, and only one "
+                "would be used; keep one of them"
+            )
+    return problems
+
+
 def default_coordinates(header: list[str]) -> str:
     """The coordinate space of a row whose ``Coordinates`` cell is blank or absent, in a file
     with this header: ``"world"`` in this extension's exports (it wrote world coordinates until
@@ -207,7 +239,9 @@ def parse_replication_csv(
     records = read_records(text, source)
     header_at, header = header_of(records, source)
     problems: list[str] = []
-    columns = resolve_columns(header, _aliases(header), problems)
+    aliases = _aliases(header)
+    columns = resolve_columns(header, aliases, problems)
+    problems += _settings_named_twice(header, aliases)
     missing = [field for field in _REQUIRED if field not in columns]
     if missing:
         found = ", ".join(repr(name.strip()) for name in header if name.strip()) or "none"

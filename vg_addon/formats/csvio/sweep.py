@@ -5,8 +5,9 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Sequence
 
+from ...errors import GoniometerError
 from ..files import replace_atomically
-from .text import csv_line, escape_text, float_cell
+from .text import csv_line, escape_text, float_cell, header_of, load, normalise, read_records
 
 #: The columns of a radius-sweep CSV: one row per radius, refused radii with their message.
 SWEEP_COLUMNS = (
@@ -79,3 +80,19 @@ def write_sweep_csv(
     """Write one site's sweep to ``path`` atomically (as :func:`write_measurements_csv`)."""
     text = format_sweep_rows(sweep_cells(mesh_name, number, point, units) for point in points)
     replace_atomically(os.fspath(path), text.encode("utf-8"))
+
+
+def holds_sweep(path) -> bool:
+    """Whether the file ``path`` is a radius-sweep CSV (its header begins with
+    :data:`SWEEP_COLUMNS`; files written before the ``Units`` column count too). Any other file
+    of that name is not a sweep's to empty."""
+    if not os.path.isfile(path):
+        return False
+    try:
+        text, source = load(path)
+        _, header = header_of(read_records(text, source), source)
+    except (OSError, GoniometerError):
+        return False
+    names = [normalise(name) for name in header]
+    earliest = [normalise(column) for column in SWEEP_COLUMNS[:-1]]
+    return names[: len(earliest)] == earliest

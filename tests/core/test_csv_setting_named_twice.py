@@ -1,0 +1,36 @@
+"""A points header that names one setting twice, by two of its names (``lambda`` and
+``SegParam``): refused, as a column named twice alike is. Before, the first name the reader
+knows was measured and the other column ignored without a word."""
+
+import pytest
+
+from vg_addon import GoniometerError
+from vg_addon.formats import csvio
+
+
+@pytest.mark.parametrize(
+    ("header", "row", "columns"),
+    [
+        ("x,y,z,lambda,SegParam", "0,0,0,3,2", "4 ('lambda') and 5 ('SegParam')"),
+        ("x,y,z,patch radius,radius", "0,0,0,0.3,0.5", "4 ('patch radius') and 5 ('radius')"),
+        ("x,y,z,Center X", "0,0,0,5", "1 ('x') and 4 ('Center X')"),
+        ("x,y,z,Patch,Patch Mode", "0,0,0,euclidean,geodesic", "4 ('Patch') and 5"),
+    ],
+)
+def test_a_setting_given_by_two_of_its_names_is_refused(header, row, columns):
+    with pytest.raises(GoniometerError, match="nothing was read") as refusal:
+        csvio.read_replication_csv(f"{header}\n{row}\n")
+    assert f"columns {columns}" in str(refusal.value)
+    assert "keep one of them" in str(refusal.value)
+
+
+def test_other_columns_given_twice_are_read_as_before():
+    """A label beside a note, or an object beside the mesh name, decide nothing measured: the
+    first name the reader knows is read, as before."""
+    rows = csvio.read_replication_csv("x,y,z,Label,Note,Mesh Name,Object\n1,2,3,a,b,m,o\n")
+    assert (rows[0].label, rows[0].mesh_name) == ("a", "m")
+
+
+def test_one_name_per_setting_reads_as_before():
+    rows = csvio.read_replication_csv("x,y,z,SegParam,Radius,Patch Mode\n1,2,3,2,0.4,geodesic\n")
+    assert (rows[0].lam, rows[0].radius, rows[0].patch) == (2.0, 0.4, "geodesic")
