@@ -58,8 +58,7 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
         raise UsageError(f"{args.edges_csv}: {error.strerror or error}") from None
     except GoniometerError as error:
         raise UsageError(str(error)) from None
-    several = len(sources) > 1
-    if several and args.ignore_mesh_names:
+    if len(sources) > 1 and args.ignore_mesh_names:
         raise UsageError(
             "--ignore-mesh-names needs a single mesh: with several, each edge row's Mesh Name "
             "says which one to measure it on."
@@ -78,12 +77,7 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
         if row.spacing is None or row.radius is None or len(points) < 2:
             problems.append(f"row {number}: an edge needs two Points, a Spacing and a Radius")
             continue
-        name = "" if args.ignore_mesh_names else (row.mesh_name or "")
-        if several and not name.strip():  # else measured on every mesh, as an --edge is
-            problems.append(
-                f"row {number} names no mesh, and several are given: fill in its Mesh Name"
-            )
-            continue
+        name = "" if args.ignore_mesh_names else row.mesh_name
         mesh, why = closest_source(name, sources, f"row {number}")
         if why:
             problems.append(why)
@@ -256,12 +250,11 @@ def profiled(edge_rows: list) -> list:
 
 def closest_source(name: str, sources, where: str) -> tuple[list | None, str]:
     """The mesh an edge naming the mesh ``name`` is measured on, as its key for
-    :func:`spec_applies` (None for every mesh where ``name`` is empty), and why there is none
-    ("" when there is): the closest match among ``sources``, as for points
-    (``batchplan.closest_mesh``)."""
-    if not name:
-        return None, ""
-    index, why = batchplan.closest_mesh(name, [source.names for source in sources], where)
+    :func:`spec_applies`, and why there is none ("" when there is): the closest match among
+    ``sources``, as for points (``batchplan.closest_mesh``: an empty name is the one mesh given,
+    and refused among several)."""
+    names = [source.names for source in sources]
+    index, why = batchplan.closest_mesh(name or "", names, where)
     if index < 0:
         return None, why
     return [sources[index].name, sources[index].path], ""
