@@ -26,6 +26,8 @@ def _stop(signum, frame):
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     stopping.request()  # raised again between steps where a Blender handler swallowed it
+    if stopping.deferring():  # the run acts on it at its next check, losing nothing done
+        return
     if not _in_blenders_scripts(frame):  # there bpy would print it as an error, and go on
         raise KeyboardInterrupt
 

@@ -96,7 +96,9 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     ``result.picture_errors``, never a row's.
 
     ``rows_ready(result)`` is called once, when every row is known and before any picture is
-    drawn: the caller writes the rows then, so a run stopped while drawing keeps them. Rows
+    drawn: the caller writes the rows then, so a run stopped while drawing keeps them; a run
+    stopped while measuring hands over the rows measured so far (none if stopped before the
+    first point, while the mesh loads). Rows
     name the mesh as the user gave it (``source.name``: a mesh file's stem), whatever name
     Blender gave its object.
 
@@ -171,32 +173,60 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     result.winding = surface.winding
     measuring.note_winding(obj, surface)
 
+    stem = picture_stem(index, source, options)
+    handed = False
+    try:
+        with stopping.deferred():  # a stop is acted on between points: nothing measured is lost
+            _measure_points(
+                result, obj, name, tasks, options, progress, (surface, geometry, precision, units)
+            )
+        stopping.check()
+        plots = _sites_and_edges(
+            result, obj, source, tasks, options, stem, (surface, geometry, precision, units)
+        )
+        with stopping.deferred():  # the rows are handed over whole, before any picture
+            handed = True
+            if rows_ready is not None:
+                rows_ready(result)
+        stopping.check()
+    except KeyboardInterrupt as stop:  # the points' rows so far are kept; the rest is not done
+        if not handed:
+            _stop_with(result, rows_ready, stop)
+        raise
+    draw_pictures(result, obj, options, stem, plots, name)
+    return result
+
+
+def _measure_points(result, obj, name, tasks, options, progress, measured_on) -> None:
+    """Measure the mesh's points and record them into ``result``, a block at a time.
+
+    Run inside ``stopping.deferred()``: a stop is acted on before the next point, once every
+    point already measured is recorded, by raising KeyboardInterrupt. ``measured_on``: the
+    surface, geometry, precision and units label, as for :func:`_sites_and_edges`."""
+    surface, geometry, precision, units = measured_on
     data = obj.vg
     base = data.next_number - 1  # measurements already on a .blend object keep their numbers
     last_report = start = time.perf_counter()
-    stopped = None  # the run's stop (Ctrl-C, SIGTERM), raised once what was measured is recorded
-    for first in range(0, len(tasks), _BLOCK):
-        # Measure a block, then record it: alternating one measurement with one record costs
-        # about a tenth more (measured), the records' writes evicting the measuring's data.
-        block = tasks[first : first + _BLOCK]
-        measured = []
-        try:
+    try:
+        for first in range(0, len(tasks), _BLOCK):
+            # Measure a block, then record it: alternating one measurement with one record costs
+            # about a tenth more (measured), the records' writes evicting the measuring's data.
+            block = tasks[first : first + _BLOCK]
+            measured = []
             for task in block:
-                stopping.check()  # also after the records, whose updates run Blender handlers
+                if stopping.requested():
+                    break
                 measured.append(_measure_task(surface, geometry, task, options))
                 now = time.perf_counter()  # once a second however slow the block (a task each)
                 if progress is not None and now - last_report >= 1.0:
                     progress(first + len(measured))
                     last_report = now
-        except KeyboardInterrupt as stop:  # the stop handler ignores a second signal
-            stopped = stop
-        for task, m in zip(block, measured, strict=False):
-            if isinstance(m, GoniometerError):
-                result.rows.append((task.index, error_row(task, name, str(m), units)))
-                result.failed += 1
-                continue
-            data.next_number = base + task.number
-            try:
+            for task, m in zip(block, measured, strict=False):
+                if isinstance(m, GoniometerError):
+                    result.rows.append((task.index, error_row(task, name, str(m), units)))
+                    result.failed += 1
+                    continue
+                data.next_number = base + task.number
                 # The bridge's one record step, as a click takes; painted once at the end.
                 row = measuring.record_row(
                     obj,
@@ -207,28 +237,11 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
                     note=task.label,
                     break_number=task.break_number,
                 )
-            except KeyboardInterrupt as stop:  # this row is lost; the block's others are kept
-                stopped = stop
-                continue
-            result.rows.append((task.index, dataclasses.replace(row, mesh_name=name)))
-            result.measured += 1
-        if stopped is not None:
-            break
-    result.measure_seconds = time.perf_counter() - start
-    if stopped is not None:
-        _stop_with(result, rows_ready, stopped)
-    stem = picture_stem(index, source, options)
-    try:
-        stopping.check()
-        plots = _sites_and_edges(
-            result, obj, source, tasks, options, stem, (surface, geometry, precision, units)
-        )
-    except KeyboardInterrupt as stop:  # the points' rows are kept; the rest is not done
-        _stop_with(result, rows_ready, stop)
-    if rows_ready is not None:
-        rows_ready(result)  # the rows are written before any picture is drawn
-    draw_pictures(result, obj, options, stem, plots, name)
-    return result
+                result.rows.append((task.index, dataclasses.replace(row, mesh_name=name)))
+                result.measured += 1
+            stopping.check()
+    finally:
+        result.measure_seconds = time.perf_counter() - start
 
 
 def _sites_and_edges(result, obj, source, tasks, options, stem, measured_on) -> list:
@@ -388,7 +401,8 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, 
     """:func:`measure_mesh`, with an unexpected error (a bug) turned into failed rows for this
     mesh only, its traceback on stderr, so the other meshes are still measured. An error after
     the rows were handed to ``rows_ready`` costs only the pictures. ``rows_ready`` is called
-    exactly once either way."""
+    exactly once either way, unless the run is stopped before the mesh's first point is measured
+    (the run then writes each of its rows as not measured)."""
     sent = []
 
     def ready(result):
