@@ -19,6 +19,7 @@ from ..vg_addon.method.algorithm import DEFAULT_RULE, as_lambda, as_radius, chec
 from ..vg_addon.method.edge_profile import check_station_count
 from ..vg_addon.method.surface import check_patch_mode
 from ..vg_addon.workflow import batchplan
+from . import stopping
 from .cli import UsageError, is_picked_points
 from .find_edges import found_edge_specs
 
@@ -303,7 +304,9 @@ def failed_edge_row(number: int | None, spec: dict, mesh_name: str, message: str
     )
 
 
-def failed_edge_summary(number: int, spec: dict, mesh_name: str, message: str, units, rule: str):
+def failed_edge_summary(
+    number: int | None, spec: dict, mesh_name: str, message: str, units, rule: str
+):
     """The edges CSV row of an edge that could not be measured: its points and settings, so the
     edge can be looked at or measured again, and why it failed; no figures. It keeps the number
     of the row of an edges file it was given by (``spec["file_row"]``), as a measured edge does."""
@@ -319,62 +322,128 @@ def failed_edge_summary(number: int, spec: dict, mesh_name: str, message: str, u
     )
 
 
-def measure_edges(obj, source, options: dict, units: str, safe_name: str, surface, precision):
+STOPPED_EDGE = "the run was stopped before this edge"
+"""Why an edge the run had not measured when it was stopped has no figures."""
+
+
+def measure_edges(obj, source, options: dict, units: str, safe_name: str, surface, precision, kept):
     """Measure the run's edges that apply to ``source`` on its object ``obj`` (on ``surface``,
     the surface the points are measured on: the file's float64 coordinates where Blender's
     float32 copy would round them), and record each as one break of stations, each station
     measured with the edge's rule (an edges CSV row's ``Rule``; else the options' ``rule``) and,
     with ``--stability``, its stability figure.
 
+    Each edge's rows go into ``kept`` (a ``MeshResult``) as soon as the edge is recorded:
+    ``kept.station_rows``, every edge's stations in order, or one error row for an edge that
+    failed; ``kept.edge_rows``, one summary per edge (an edge that failed has its points,
+    settings and ``error`` and no figures); rows name the mesh as the user gave it
+    (``source.name``). A stop (KeyboardInterrupt) keeps the edges recorded before it, gives each
+    edge not recorded an error row saying the run was stopped before it, and is raised again.
+
     Returns
     -------
-    station_rows : list of csvio.MeasurementRow
-        Every edge's stations in order, or one error row for an edge that failed; rows name the
-        mesh as the user gave it (``source.name``).
-    edge_rows : list of csvio.EdgeRow
-        One summary per edge, in order; an edge that failed has its points, settings and
-        ``error`` and no figures.
     plots : list of (what, path, png bytes function)
         Each profile's plot, to draw beside the output CSV once the rows are written.
     found : int
         How many edges ``--find-edges`` found on the mesh (-1: not looked for, or the finder
         could not run, which is an error row).
     """
-    station_rows, edge_rows, plots = [], [], []
-    found = -1
-    name = source.name
+    plots, found, name = [], -1, source.name
     painted = None  # the geometry the edges were measured on, once one is recorded
     specs = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
-    if options.get("find_edges"):
-        try:
-            found_specs = found_edge_specs(surface, options, name)
-            found = len(found_specs)
-            specs += found_specs
-        except GoniometerError as error:
-            station_rows.append(not_found_row(options, name, str(error), units))
-    for spec in specs:
-        number = obj.vg.next_edge_number
-        rule = spec.get("rule") or options.get("rule", DEFAULT_RULE)
-        try:
-            spacing, radius = spec["spacing"], spec["radius"]
-            if spec.get("space") == "world":  # an edge file of an earlier version
-                spacing, radius = edges.mesh_lengths(obj, spacing, radius)
-            profile, geometry, clicks = edges.measure_edge(
-                obj,
-                spec["points"],
-                spacing,
-                radius,
-                spec["lam"],
-                spec["patch"],
-                space=spec.get("space", "mesh"),
-                surface=surface,
-                given=spec.get("given", ""),
-                rule=rule,
-                stability=bool(options.get("stability")),
+    done = 0  # specs whose rows are in ``kept``
+    looked = not options.get("find_edges")  # whether --find-edges looked, or need not
+    try:
+        if not looked:
+            try:
+                found_specs, not_found = found_edge_specs(surface, options, name), None
+            except GoniometerError as error:
+                found_specs, not_found = [], not_found_row(options, name, str(error), units)
+            with stopping.deferred():  # what the finder found is kept whole
+                specs += found_specs
+                found = -1 if not_found is not None else len(found_specs)
+                kept.station_rows.extend([] if not_found is None else [not_found])
+                looked = True
+            stopping.check()
+        for spec in specs:
+            rows = _measure_edge_rows(obj, spec, options, units, surface, precision, name)
+            with stopping.deferred():  # the edge is recorded and its rows kept, or neither
+                stations, summary, edge, numbers, geometry = rows()
+                kept.station_rows.extend(stations)
+                kept.edge_rows.append(summary)
+                done += 1
+            stopping.check()
+            if edge is None:
+                continue
+            painted = geometry
+            path = f"{options['plots']}_{safe_name}_edge{edge.number}.png"
+            data = functools.partial(
+                profile_plot.profile_png,
+                numbers["arc_lengths"],
+                numbers["angles"],
+                units=units,
+                title=f"Edge profile: {name}, edge {edge.number}",
+                pooled=numbers["pooled_angle"],
             )
+            plots.append(("profile plot", path, data))
+    except KeyboardInterrupt:
+        for spec in specs[done:]:
+            rule = spec.get("rule") or options.get("rule", DEFAULT_RULE)
+            kept.station_rows.append(failed_edge_row(None, spec, name, STOPPED_EDGE, units))
+            kept.edge_rows.append(failed_edge_summary(None, spec, name, STOPPED_EDGE, units, rule))
+        if not looked:
+            kept.station_rows.append(not_found_row(options, name, STOPPED_EDGE, units))
+        raise
+    if painted is not None:
+        measuring.repaint(obj, geometry=painted)
+    return plots, found
+
+
+def _measure_edge_rows(obj, spec, options, units, surface, precision, name):
+    """Measure one edge (the slow part, which a stop may cut short); returns the function that
+    records it on ``obj`` and returns its station rows, its summary, the edge record (None for an
+    edge that failed), its numbers and the geometry it was measured on."""
+    number = obj.vg.next_edge_number
+    rule = spec.get("rule") or options.get("rule", DEFAULT_RULE)
+
+    def failed(error):
+        def rows():
+            obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
+            return (
+                [failed_edge_row(number, spec, name, str(error), units)],
+                failed_edge_summary(number, spec, name, str(error), units, rule),
+                None,
+                None,
+                None,
+            )
+
+        return rows
+
+    try:
+        spacing, radius = spec["spacing"], spec["radius"]
+        if spec.get("space") == "world":  # an edge file of an earlier version
+            spacing, radius = edges.mesh_lengths(obj, spacing, radius)
+        profile, geometry, clicks = edges.measure_edge(
+            obj,
+            spec["points"],
+            spacing,
+            radius,
+            spec["lam"],
+            spec["patch"],
+            space=spec.get("space", "mesh"),
+            surface=surface,
+            given=spec.get("given", ""),
+            rule=rule,
+            stability=bool(options.get("stability")),
+        )
+    except GoniometerError as error:
+        return failed(error)
+
+    def rows():
+        try:
             # Recorded without repainting: the colours are painted once, after every edge. The
             # plot kept in the object is drawn only for a .blend that is saved (--save-blend);
-            # the run writes its own plot file below.
+            # the run writes its own plot file.
             edge = edges.record_profile(
                 obj,
                 profile,
@@ -383,18 +452,13 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
                 note=spec.get("note", ""),
                 plot=bool(options.get("save_blend")),
             )
-            painted = geometry
         except GoniometerError as error:
-            obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
-            station_rows.append(failed_edge_row(number, spec, name, str(error), units))
-            edge_rows.append(failed_edge_summary(number, spec, name, str(error), units, rule))
-            continue
+            return failed(error)()
         # The edge's stations are the items it just appended: read those, not every stored one.
         measurements = obj.vg.measurements
-        stations = range(len(measurements) - edge.n_stations, len(measurements))
         numbers = exact_numbers(edge)
         closed = records.edge_is_closed(numbers)
-        station_rows.extend(
+        stations = [
             dataclasses.replace(
                 records.to_row(
                     obj,
@@ -406,25 +470,13 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
                 ),
                 mesh_name=name,
             )
-            for i in stations
+            for i in range(len(measurements) - edge.n_stations, len(measurements))
+        ]
+        summary = dataclasses.replace(
+            records.edge_row(obj, edge, units=units),
+            mesh_name=name,
+            row_number=spec.get("file_row"),
         )
-        edge_rows.append(
-            dataclasses.replace(
-                records.edge_row(obj, edge, units=units),
-                mesh_name=name,
-                row_number=spec.get("file_row"),
-            )
-        )
-        path = f"{options['plots']}_{safe_name}_edge{edge.number}.png"
-        data = functools.partial(
-            profile_plot.profile_png,
-            numbers["arc_lengths"],
-            numbers["angles"],
-            units=units,
-            title=f"Edge profile: {name}, edge {edge.number}",
-            pooled=numbers["pooled_angle"],
-        )
-        plots.append(("profile plot", path, data))
-    if painted is not None:
-        measuring.repaint(obj, geometry=painted)
-    return station_rows, edge_rows, plots, found
+        return stations, summary, edge, numbers, geometry
+
+    return rows

@@ -266,8 +266,8 @@ def _sites_and_edges(result, obj, source, tasks, options, stem, measured_on) -> 
 
     profile_plots = []
     if options.get("edges") or options.get("find_edges"):
-        result.station_rows, result.edge_rows, profile_plots, result.found_edges = measure_edges(
-            obj, source, options, units, stem, surface, precision
+        profile_plots, result.found_edges = measure_edges(
+            obj, source, options, units, stem, surface, precision, result
         )
     return sweep_plots + profile_plots
 
@@ -345,9 +345,12 @@ def sweep_sites(result: MeshResult, surface, name: str, stem: str, tasks, option
             path = folder / f"{stem}_{task.number}.png"
             title = f"Radius sweep: {name}, site {task.number}"
             plots.append(("sweep plot", path, _sweep_png(points, units, title)))
-        result.sweep_rows.extend(
+        cells = [
             (task.index, csvio.sweep_cells(name, task.number, point, units)) for point in points
-        )
+        ]
+        with stopping.deferred():  # a site's radii are kept whole or not at all
+            result.sweep_rows.extend(cells)
+        stopping.check()
     return plots
 
 
