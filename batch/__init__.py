@@ -10,41 +10,11 @@ run, ``sources`` imports the meshes, ``measure`` measures one mesh through the b
 
 from __future__ import annotations
 
-import signal
 import sys
 
 from ..vg_addon import GoniometerError
 from . import extension, stopping
 from .cli import UsageError, build_parser, check_args
-
-
-def _stop(signum, frame):
-    # SIGINT (Ctrl-C) and SIGTERM (`kill PID`, a job scheduler's stop) end the run at once: a
-    # map being rendered is killed with its child process, the workers are stopped, the CSV is
-    # written with what was measured, the temporary folders are removed, exit status 130. A
-    # second signal must not cut that short, so it is ignored from now on.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    stopping.request()  # raised again between steps where a Blender handler swallowed it
-    if stopping.deferring():  # the run acts on it at its next check, losing nothing done
-        return
-    if not _in_blenders_scripts(frame):  # there bpy would print it as an error, and go on
-        raise KeyboardInterrupt
-
-
-def _in_blenders_scripts(frame) -> bool:
-    """Whether ``frame`` runs code of Blender's own add-ons or startup scripts, where its
-    handlers live (not its ``modules``: ``bpy.ops`` wrappers raise to their caller)."""
-    import os
-
-    import bpy
-
-    scripts = bpy.utils.system_resource("SCRIPTS")
-    if not scripts or frame is None:
-        return False
-    path = frame.f_code.co_filename
-    modules = os.path.join(scripts, "modules") + os.sep
-    return path.startswith(scripts) and not path.startswith(modules)
 
 
 def main(argv: list[str]) -> int:
@@ -62,8 +32,7 @@ def main(argv: list[str]) -> int:
             return worker_main(args.worker)
         # Set here, not left to Python: Blender's own SIGINT handler (blender -b) only asks a
         # render to stop.
-        signal.signal(signal.SIGINT, _stop)
-        signal.signal(signal.SIGTERM, _stop)
+        stopping.handle_stop_signals()
         if args.report:
             from .report import check_report_args, run_report
 

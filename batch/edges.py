@@ -51,6 +51,11 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
             raise UsageError(f"--edge {number} with --spacing {args.spacing:g}: {error}") from None
     if not args.edges_csv:
         return specs
+    if len(sources) > 1 and args.ignore_mesh_names:
+        raise UsageError(
+            "--ignore-mesh-names needs a single mesh: with several, each edge row's Mesh Name "
+            "(each .pp file's name) says which one to measure it on."
+        )
     if is_picked_points(args.edges_csv):
         return specs + picked_point_specs(args, sources, passed_over)
     try:
@@ -59,11 +64,6 @@ def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
         raise UsageError(f"{args.edges_csv}: {error.strerror or error}") from None
     except GoniometerError as error:
         raise UsageError(str(error)) from None
-    if len(sources) > 1 and args.ignore_mesh_names:
-        raise UsageError(
-            "--ignore-mesh-names needs a single mesh: with several, each edge row's Mesh Name "
-            "says which one to measure it on."
-        )
     problems, failed = [], []
     for row in rows:
         number = row.row_number
@@ -185,11 +185,13 @@ def picked_point_specs(args, sources, passed_over: list | None = None) -> list[d
         raise UsageError(str(error)) from None
     if not paths:
         raise UsageError(f"--edges {given}: the folder has no {picked_points.SUFFIX} files.")
-    single = args.ignore_mesh_names and len(sources) == 1
     names = [source.name for source in sources]
     specs, problems, unmatched = [], [], []
     for path in paths:
-        name = sources[0].name if single else picked_points.mesh_for_file(path, names)
+        # --ignore-mesh-names comes with a single mesh (edge_specs)
+        name = (
+            sources[0].name if args.ignore_mesh_names else picked_points.mesh_for_file(path, names)
+        )
         if name is None:
             if folder:
                 unmatched.append(path.name)
@@ -274,7 +276,7 @@ def not_found_row(options: dict, mesh_name: str, message: str, units):
     """The output row of a mesh whose edges ``--find-edges`` could not look for."""
     spec = {key: options["find_edges"][key] for key in ("spacing", "radius", "lam", "patch")}
     row = failed_edge_row(None, {**spec, "points": [None]}, mesh_name, message, units)
-    return dataclasses.replace(row, error=f"edges not found: {message}")
+    return dataclasses.replace(row, error=NOT_FOUND + message)
 
 
 def _failure_fields(spec: dict, mesh_name: str, message: str, units) -> dict:
@@ -322,8 +324,77 @@ def failed_edge_summary(
     )
 
 
-STOPPED_EDGE = "the run was stopped before this edge"
-"""Why an edge the run had not measured when it was stopped has no figures."""
+STOPPED_EDGE = batchplan.STOPPED_EDGE
+
+STOPPED_SEARCH = "the run was stopped before they were looked for"
+"""Why ``--find-edges`` has no edges for a mesh the run was stopped before it searched."""
+
+NOT_FOUND = "edges not found: "
+"""How the error of the row of a mesh whose edges ``--find-edges`` could not look for begins."""
+
+
+def is_search_row(row) -> bool:
+    """Whether a failed row is ``--find-edges``' row for a mesh it could not search, not an
+    edge's."""
+    return bool(row.error) and row.error.startswith(NOT_FOUND)
+
+
+def edges_of(source, options: dict) -> list[dict]:
+    """The edges of the run (``options["edges"]``) that are measured on the mesh ``source``."""
+    return [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
+
+
+def edge_rule(spec: dict, options: dict) -> str:
+    """The rule an edge's stations are measured with: its edges CSV row's ``Rule``, else the
+    run's."""
+    return spec.get("rule") or options.get("rule", DEFAULT_RULE)
+
+
+def unmeasured_edges(specs, options: dict, mesh_name: str, message: str, units, **kw) -> tuple:
+    """The station rows and summary rows of the edges ``specs`` of the mesh ``mesh_name`` that
+    were not measured, saying why (``message``), each with its points and settings.
+
+    ``numbered=True`` numbers them 1, 2, ... (a mesh none of whose edges could be measured);
+    otherwise they have no edge number. ``search``, if given, adds the row saying why
+    ``--find-edges`` found no edge on the mesh.
+    """
+    numbered, search = kw.pop("numbered", False), kw.pop("search", None)
+    stations, summaries = [], []
+    for number, spec in enumerate(specs, start=1):
+        number = number if numbered else None
+        stations.append(failed_edge_row(number, spec, mesh_name, message, units))
+        rule = edge_rule(spec, options)
+        summaries.append(failed_edge_summary(number, spec, mesh_name, message, units, rule))
+    if search is not None:
+        stations.append(not_found_row(options, mesh_name, search, units))
+    return stations, summaries
+
+
+@dataclasses.dataclass
+class EdgesToDo:
+    """A mesh's edges and how far the run has measured them, so that a stop can give each edge
+    it came before a row: ``specs[:done]`` are recorded; ``search``: whether ``--find-edges``
+    has still to look for the mesh's edges (the edges it finds are appended to ``specs``)."""
+
+    specs: list
+    search: bool
+    done: int = 0
+
+    @classmethod
+    def of(cls, source, options: dict) -> EdgesToDo:
+        """The edges of ``source`` before any is measured."""
+        return cls(edges_of(source, options), bool(options.get("find_edges")))
+
+    def add_stopped(self, kept, options: dict, mesh_name: str, units) -> None:
+        """Add to ``kept`` (a ``MeshResult``) the rows of the edges not recorded, saying the
+        run was stopped before them, and mark them done."""
+        search = STOPPED_SEARCH if self.search else None
+        stations, summaries = unmeasured_edges(
+            self.specs[self.done :], options, mesh_name, STOPPED_EDGE, units, search=search
+        )
+        kept.station_rows.extend(stations)
+        kept.edge_rows.extend(summaries)
+        self.done, self.search = len(self.specs), False
 
 
 def measure_edges(obj, source, options: dict, units: str, safe_name: str, surface, precision, kept):
@@ -333,12 +404,12 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
     measured with the edge's rule (an edges CSV row's ``Rule``; else the options' ``rule``) and,
     with ``--stability``, its stability figure.
 
-    Each edge's rows go into ``kept`` (a ``MeshResult``) as soon as the edge is recorded:
-    ``kept.station_rows``, every edge's stations in order, or one error row for an edge that
-    failed; ``kept.edge_rows``, one summary per edge (an edge that failed has its points,
-    settings and ``error`` and no figures); rows name the mesh as the user gave it
-    (``source.name``). A stop (KeyboardInterrupt) keeps the edges recorded before it, gives each
-    edge not recorded an error row saying the run was stopped before it, and is raised again.
+    ``kept`` is the mesh's ``(MeshResult, EdgesToDo)``. Each edge's rows go into the result as
+    soon as the edge is recorded, and it is counted done: ``station_rows``, every edge's
+    stations in order, or one error row for an edge that failed; ``edge_rows``, one summary per
+    edge (an edge that failed has its points, settings and ``error`` and no figures); rows name
+    the mesh as the user gave it (``source.name``). On a stop (KeyboardInterrupt) the caller
+    gives the edges not done their rows (``EdgesToDo.add_stopped``).
 
     Returns
     -------
@@ -348,82 +419,57 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
         How many edges ``--find-edges`` found on the mesh (-1: not looked for, or the finder
         could not run, which is an error row).
     """
+    result, todo = kept
     plots, found, name = [], -1, source.name
     painted = None  # the geometry the edges were measured on, once one is recorded
-    specs = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
-    done = 0  # specs whose rows are in ``kept``
-    looked = not options.get("find_edges")  # whether --find-edges looked, or need not
-    try:
-        if not looked:
-            try:
-                found_specs, not_found = found_edge_specs(surface, options, name), None
-            except GoniometerError as error:
-                found_specs, not_found = [], not_found_row(options, name, str(error), units)
-            with stopping.deferred():  # what the finder found is kept whole
-                specs += found_specs
-                found = -1 if not_found is not None else len(found_specs)
-                kept.station_rows.extend([] if not_found is None else [not_found])
-                looked = True
-            stopping.check()
-        for spec in specs:
-            rows = _measure_edge_rows(obj, spec, options, units, surface, precision, name)
-            with stopping.deferred():  # the edge is recorded and its rows kept, or neither
-                stations, summary, edge, numbers, geometry = rows()
-                kept.station_rows.extend(stations)
-                kept.edge_rows.append(summary)
-                done += 1
-            stopping.check()
-            if edge is None:
-                continue
-            painted = geometry
-            path = f"{options['plots']}_{safe_name}_edge{edge.number}.png"
-            data = functools.partial(
-                profile_plot.profile_png,
-                numbers["arc_lengths"],
-                numbers["angles"],
-                units=units,
-                title=f"Edge profile: {name}, edge {edge.number}",
-                pooled=numbers["pooled_angle"],
+    if todo.search:
+        try:
+            found_specs, not_found = found_edge_specs(surface, options, name), None
+        except GoniometerError as error:
+            found_specs, not_found = [], not_found_row(options, name, str(error), units)
+        with stopping.deferred():  # what the finder found is kept whole
+            todo.specs += found_specs
+            found = -1 if not_found is not None else len(found_specs)
+            result.station_rows.extend([] if not_found is None else [not_found])
+            todo.search = False
+        stopping.check()
+    for spec in todo.specs:
+        outcome = _measure_edge(obj, spec, options, surface)
+        with stopping.deferred():  # the edge is recorded and its rows kept, or neither
+            stations, summary, edge, numbers, geometry = _record_edge(
+                obj, spec, options, units, precision, name, outcome
             )
-            plots.append(("profile plot", path, data))
-    except KeyboardInterrupt:
-        for spec in specs[done:]:
-            rule = spec.get("rule") or options.get("rule", DEFAULT_RULE)
-            kept.station_rows.append(failed_edge_row(None, spec, name, STOPPED_EDGE, units))
-            kept.edge_rows.append(failed_edge_summary(None, spec, name, STOPPED_EDGE, units, rule))
-        if not looked:
-            kept.station_rows.append(not_found_row(options, name, STOPPED_EDGE, units))
-        raise
+            result.station_rows.extend(stations)
+            result.edge_rows.append(summary)
+            todo.done += 1
+        stopping.check()
+        if edge is None:
+            continue
+        painted = geometry
+        path = f"{options['plots']}_{safe_name}_edge{edge.number}.png"
+        data = functools.partial(
+            profile_plot.profile_png,
+            numbers["arc_lengths"],
+            numbers["angles"],
+            units=units,
+            title=f"Edge profile: {name}, edge {edge.number}",
+            pooled=numbers["pooled_angle"],
+        )
+        plots.append(("profile plot", path, data))
     if painted is not None:
         measuring.repaint(obj, geometry=painted)
     return plots, found
 
 
-def _measure_edge_rows(obj, spec, options, units, surface, precision, name):
-    """Measure one edge (the slow part, which a stop may cut short); returns the function that
-    records it on ``obj`` and returns its station rows, its summary, the edge record (None for an
-    edge that failed), its numbers and the geometry it was measured on."""
-    number = obj.vg.next_edge_number
-    rule = spec.get("rule") or options.get("rule", DEFAULT_RULE)
-
-    def failed(error):
-        def rows():
-            obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
-            return (
-                [failed_edge_row(number, spec, name, str(error), units)],
-                failed_edge_summary(number, spec, name, str(error), units, rule),
-                None,
-                None,
-                None,
-            )
-
-        return rows
-
+def _measure_edge(obj, spec, options, surface):
+    """Measure one edge on ``obj`` (the slow part, which a stop may cut short): its profile, the
+    geometry and the clicks it was measured from, or the GoniometerError saying why it cannot
+    be."""
     try:
         spacing, radius = spec["spacing"], spec["radius"]
         if spec.get("space") == "world":  # an edge file of an earlier version
             spacing, radius = edges.mesh_lengths(obj, spacing, radius)
-        profile, geometry, clicks = edges.measure_edge(
+        return edges.measure_edge(
             obj,
             spec["points"],
             spacing,
@@ -433,13 +479,20 @@ def _measure_edge_rows(obj, spec, options, units, surface, precision, name):
             space=spec.get("space", "mesh"),
             surface=surface,
             given=spec.get("given", ""),
-            rule=rule,
+            rule=edge_rule(spec, options),
             stability=bool(options.get("stability")),
         )
     except GoniometerError as error:
-        return failed(error)
+        return error
 
-    def rows():
+
+def _record_edge(obj, spec, options, units, precision, name, outcome):
+    """Record the edge ``outcome`` of :func:`_measure_edge` on ``obj`` (under the next edge
+    number, which a failed edge keeps too); returns its station rows, its summary, the edge
+    record (None for an edge that failed), its numbers and the geometry it was measured on."""
+    number = obj.vg.next_edge_number
+    if not isinstance(outcome, GoniometerError):
+        profile, geometry, clicks = outcome
         try:
             # Recorded without repainting: the colours are painted once, after every edge. The
             # plot kept in the object is drawn only for a .blend that is saved (--save-blend);
@@ -453,30 +506,38 @@ def _measure_edge_rows(obj, spec, options, units, surface, precision, name):
                 plot=bool(options.get("save_blend")),
             )
         except GoniometerError as error:
-            return failed(error)()
-        # The edge's stations are the items it just appended: read those, not every stored one.
-        measurements = obj.vg.measurements
-        numbers = exact_numbers(edge)
-        closed = records.edge_is_closed(numbers)
-        stations = [
-            dataclasses.replace(
-                records.to_row(
-                    obj,
-                    measurements[i],
-                    stale=False,
-                    units=units,
-                    precision=precision,
-                    edge_closed=closed,
-                ),
-                mesh_name=name,
-            )
-            for i in range(len(measurements) - edge.n_stations, len(measurements))
-        ]
-        summary = dataclasses.replace(
-            records.edge_row(obj, edge, units=units),
-            mesh_name=name,
-            row_number=spec.get("file_row"),
+            outcome = error
+    if isinstance(outcome, GoniometerError):
+        obj.vg.next_edge_number = number + 1  # the number stays with the failed edge
+        rule, message = edge_rule(spec, options), str(outcome)
+        return (
+            [failed_edge_row(number, spec, name, message, units)],
+            failed_edge_summary(number, spec, name, message, units, rule),
+            None,
+            None,
+            None,
         )
-        return stations, summary, edge, numbers, geometry
-
-    return rows
+    # The edge's stations are the items it just appended: read those, not every stored one.
+    measurements = obj.vg.measurements
+    numbers = exact_numbers(edge)
+    closed = records.edge_is_closed(numbers)
+    stations = [
+        dataclasses.replace(
+            records.to_row(
+                obj,
+                measurements[i],
+                stale=False,
+                units=units,
+                precision=precision,
+                edge_closed=closed,
+            ),
+            mesh_name=name,
+        )
+        for i in range(len(measurements) - edge.n_stations, len(measurements))
+    ]
+    summary = dataclasses.replace(
+        records.edge_row(obj, edge, units=units),
+        mesh_name=name,
+        row_number=spec.get("file_row"),
+    )
+    return stations, summary, edge, numbers, geometry

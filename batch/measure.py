@@ -18,7 +18,7 @@ from ..vg_addon.formats import csvio, files, sweep_plot
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from . import stopping
 from .cli import UNITS
-from .edges import failed_edge_row, measure_edges, not_found_row, spec_applies
+from .edges import EdgesToDo, edges_of, measure_edges, unmeasured_edges
 from .map_process import draw_map
 from .pictures import reason, try_picture
 from .render import add_sides_material
@@ -97,8 +97,9 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
 
     ``rows_ready(result)`` is called once, when every row is known and before any picture is
     drawn: the caller writes the rows then, so a run stopped while drawing keeps them; a run
-    stopped while measuring hands over the rows measured so far (none if stopped before the
-    first point, while the mesh loads). Rows
+    stopped while measuring hands over the rows measured so far and a row for each edge not
+    recorded, saying the run was stopped before it (nothing if stopped while the mesh loads: the
+    run then writes every row of the mesh as not measured). Rows
     name the mesh as the user gave it (``source.name``: a mesh file's stem), whatever name
     Blender gave its object.
 
@@ -117,13 +118,10 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     def fail_all(message: str) -> MeshResult:
         result.rows = [(t.index, error_row(t, name, message, units)) for t in tasks]
         result.failed = len(tasks)
-        applying = [spec for spec in options.get("edges", ()) if spec_applies(spec, source)]
-        result.station_rows = [
-            failed_edge_row(number, spec, name, message, units)
-            for number, spec in enumerate(applying, start=1)
-        ]
-        if options.get("find_edges"):
-            result.station_rows.append(not_found_row(options, name, message, units))
+        search = message if options.get("find_edges") else None
+        result.station_rows, result.edge_rows = unmeasured_edges(
+            edges_of(source, options), options, name, message, units, numbered=True, search=search
+        )
         if rows_ready is not None:
             rows_ready(result)
         return result
@@ -160,11 +158,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     if not options.get("units_given"):
         # A replayed export's rows say what unit the scan is in, as Blender's import takes it.
         named = [task.units for task in tasks if task.units]
-        named += [
-            spec["units"]
-            for spec in options.get("edges", ())
-            if spec.get("units") and spec_applies(spec, source)
-        ]
+        named += [spec["units"] for spec in edges_of(source, options) if spec.get("units")]
         if named:
             records.adopt_file_units(obj, named)
     elif key := SCAN_UNITS.get(options["units"]):
@@ -174,7 +168,7 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     measuring.note_winding(obj, surface)
 
     stem = picture_stem(index, source, options)
-    handed = False
+    handed, todo = False, EdgesToDo.of(source, options)
     try:
         with stopping.deferred():  # a stop is acted on between points: nothing measured is lost
             _measure_points(
@@ -182,15 +176,17 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
             )
         stopping.check()
         plots = _sites_and_edges(
-            result, obj, source, tasks, options, stem, (surface, geometry, precision, units)
+            (result, todo), obj, source, tasks, options, stem, (surface, geometry, precision, units)
         )
         with stopping.deferred():  # the rows are handed over whole, before any picture
             handed = True
             if rows_ready is not None:
                 rows_ready(result)
         stopping.check()
-    except KeyboardInterrupt as stop:  # the points' rows so far are kept; the rest is not done
+    except KeyboardInterrupt as stop:  # the rows so far are kept; the rest is not done
         if not handed:
+            with stopping.deferred():
+                todo.add_stopped(result, options, name, units)
             _stop_with(result, rows_ready, stop)
         raise
     draw_pictures(result, obj, options, stem, plots, name)
@@ -244,10 +240,11 @@ def _measure_points(result, obj, name, tasks, options, progress, measured_on) ->
         result.measure_seconds = time.perf_counter() - start
 
 
-def _sites_and_edges(result, obj, source, tasks, options, stem, measured_on) -> list:
-    """After the points of :func:`measure_mesh`: the radius sweeps, the colours and the edges;
-    returns the plots to draw. ``measured_on``: the points' surface, geometry, precision and
-    units label."""
+def _sites_and_edges(kept, obj, source, tasks, options, stem, measured_on) -> list:
+    """After the points of :func:`measure_mesh`: the radius sweeps, the colours and the edges,
+    into ``kept``, the mesh's ``(MeshResult, EdgesToDo)``; returns the plots to draw.
+    ``measured_on``: the points' surface, geometry, precision and units label."""
+    result = kept[0]
     surface, geometry, precision, units = measured_on
     name, data = source.name, obj.vg
     sweep_plots = []
@@ -267,7 +264,7 @@ def _sites_and_edges(result, obj, source, tasks, options, stem, measured_on) -> 
     profile_plots = []
     if options.get("edges") or options.get("find_edges"):
         profile_plots, result.found_edges = measure_edges(
-            obj, source, options, units, stem, surface, precision, result
+            obj, source, options, units, stem, surface, precision, kept
         )
     return sweep_plots + profile_plots
 
@@ -404,8 +401,9 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, 
     """:func:`measure_mesh`, with an unexpected error (a bug) turned into failed rows for this
     mesh only, its traceback on stderr, so the other meshes are still measured. An error after
     the rows were handed to ``rows_ready`` costs only the pictures. ``rows_ready`` is called
-    exactly once either way, unless the run is stopped before the mesh's first point is measured
-    (the run then writes each of its rows as not measured)."""
+    exactly once either way, unless the run is stopped while the mesh loads (the run then writes
+    each of its rows as not measured). An unexpected error gives each of the mesh's points and
+    edges a row saying so."""
     sent = []
 
     def ready(result):
@@ -427,5 +425,9 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, 
         units = run_units_label(options.get("units"))
         result = MeshResult(mesh=index, failed=len(tasks))
         result.rows = [(t.index, error_row(t, source.name, message, units)) for t in tasks]
+        search = message if options.get("find_edges") else None
+        result.station_rows, result.edge_rows = unmeasured_edges(
+            edges_of(source, options), options, source.name, message, units, search=search
+        )
         ready(result)
         return result

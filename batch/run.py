@@ -23,7 +23,17 @@ from ..vg_addon.workflow import agreement, batchplan
 from . import extension, stopping
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError, is_picked_points
-from .edges import edge_specs, failed_rows_line, profiled, spec_applies
+from .edges import (
+    STOPPED_EDGE,
+    STOPPED_SEARCH,
+    edge_specs,
+    edges_of,
+    failed_rows_line,
+    is_search_row,
+    profiled,
+    spec_applies,
+    unmeasured_edges,
+)
 from .find_edges import find_options
 from .measure import MeshResult, error_row, run_units_label, safe_measure_mesh, set_units
 from .outputs import check_outputs, input_files, make_folders, sweep_paths
@@ -39,9 +49,12 @@ STOPPED = "not measured: the run was stopped before this point"
 class Run:
     """The state of a batch run in the parent process: results, progress, partial CSV writes."""
 
-    def __init__(self, args, sources, tasks, total_meshes):
+    def __init__(self, args, sources, tasks, meshes, options: dict | None = None):
+        """A run of ``tasks`` (points) on ``sources``, measuring the meshes ``meshes`` (indices
+        into ``sources``) with ``options`` (its edges, ``--find-edges``...)."""
         self.args, self.sources, self.tasks = args, sources, tasks
-        self.total_meshes = total_meshes
+        self.meshes, self.options = list(meshes), options or {}
+        self.total_meshes = len(self.meshes)
         self.jobs = 1  # processes measuring at once
         self.rows: dict[int, object] = {}
         self.sweep_rows: list = []  # (task index, cells), --sweep
@@ -205,6 +218,8 @@ class Run:
             measured_edges = profiled(result.edge_rows)
             stations = sum(edge.n_stations or 0 for edge in measured_edges)
             edges = f"{len(measured_edges)} edge(s) profiled ({stations:,} stations)"
+            unprofiled = len(result.edge_rows) - len(measured_edges)
+            edges += f", {unprofiled} failed" if unprofiled else ""
             if points or not result.edge_rows:  # an edges-only run has no points to count
                 self.say(
                     f"{source.name}: {result.measured:,} measured, {result.failed:,} failed"
@@ -323,10 +338,35 @@ class Run:
         name = self.sources[task.mesh].name if task.mesh >= 0 else task.mesh_name
         return error_row(task, name, message, self.units)
 
+    def add_unmeasured(self, tasks, message: str) -> None:
+        """Give each of ``tasks`` without a row one saying why it has no measurement."""
+        with self.lock:
+            for task in tasks:
+                if task.index not in self.rows:
+                    self.rows[task.index] = self.unmeasured(task, message)
+
+    def unmeasured_edges(self, mesh: int, message: str, search: str = "") -> tuple[list, list]:
+        """The station rows and summary rows of the edges of mesh ``mesh`` when none of them was
+        measured, saying why (``message``: a stopped run, a worker that failed its mesh), and
+        its ``--find-edges`` row, saying ``search`` (default ``message``)."""
+        source = self.sources[mesh]
+        search = (search or message) if self.options.get("find_edges") else None
+        specs = edges_of(source, self.options)
+        return unmeasured_edges(
+            specs, self.options, source.name, message, self.units, search=search
+        )
+
     def finish(self) -> int:
         missing = [t for t in self.tasks if t.index not in self.rows]
         for task in missing:  # e.g. a worker that could not even start
             self.rows[task.index] = self.unmeasured(task, STOPPED)
+        for mesh in self.meshes:  # a mesh the run never reached, or lost with its worker
+            if mesh not in self.edges_by_mesh:
+                stations, summaries = self.unmeasured_edges(mesh, STOPPED_EDGE, STOPPED_SEARCH)
+                self.edges_by_mesh[mesh] = (
+                    [csvio.writable_row(row) for row in stations],
+                    [csvio.writable_row(row) for row in summaries],
+                )
         try:
             self.write_csv()
         except csvio.SummaryWriteError as error:
@@ -390,7 +430,10 @@ class Run:
                 )
             )
         for row in failed_edges[:10]:
-            what = "finding edges" if row.edge_number is None else f"edge {row.edge_number}"
+            if is_search_row(row):
+                what = "finding edges"
+            else:
+                what = "an edge" if row.edge_number is None else f"edge {row.edge_number}"
             self.say(f"  failed: {what} on {row.mesh_name!r}: {row.error}")
         if len(failed_edges) > 10:
             self.say(f"  ... and {len(failed_edges) - 10} more failed edges (see the error column)")
@@ -561,7 +604,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     }
     if args.sweep:
         sweep_paths(args.out)[1].mkdir(parents=True, exist_ok=True)
-    run = Run(args, sources, tasks, len(groups))
+    run = Run(args, sources, tasks, groups, options)
     run.passed_over = passed_over
     run.replayed = replayed
     for note in renamed:

@@ -14,6 +14,8 @@ records the stop, and the run acts on it at its next :func:`check`.
 from __future__ import annotations
 
 import contextlib
+import os
+import signal
 
 _requested = False
 _deferring = 0
@@ -50,3 +52,56 @@ def deferred():
 def deferring() -> bool:
     """Whether a stop signal should only be recorded (see :func:`deferred`)."""
     return _deferring > 0
+
+
+def handle_stop_signals() -> None:
+    """Stop the run on SIGINT (Ctrl-C) and SIGTERM (``kill PID``, a job scheduler's stop, or the
+    parent of a ``--jobs`` worker stopping it) with :func:`on_stop_signal`."""
+    signal.signal(signal.SIGINT, on_stop_signal)
+    signal.signal(signal.SIGTERM, on_stop_signal)
+
+
+def on_stop_signal(signum, frame) -> None:
+    """The stop signals' handler: record the stop and raise KeyboardInterrupt, unless the run
+    works :func:`deferred` or the signal came inside Blender's own scripts (its handlers, where
+    bpy would print the interrupt as an error and carry on): the run then acts on it at its next
+    :func:`check`.
+
+    The run ends at once: a map being rendered is killed with its child process, the workers
+    are stopped, the CSV is written with what was measured, the temporary folders are removed,
+    exit status 130 (a worker hands over the rows it measured first). A second signal must not
+    cut that short, so it is ignored from now on.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    request()
+    if deferring():
+        return
+    if not _in_a_blender_handler(frame):
+        raise KeyboardInterrupt
+
+
+def _in_a_blender_handler(frame) -> bool:
+    """Whether ``frame`` runs inside a handler Blender calls (``bpy.app.handlers``: its own, in
+    its add-ons and startup scripts, or the extension's), where an exception raised is printed
+    as an error and swallowed; ``bpy.ops`` wrappers, which raise to their caller, are not."""
+    import bpy
+
+    scripts = bpy.utils.system_resource("SCRIPTS")
+    if scripts:
+        path = frame.f_code.co_filename if frame is not None else ""
+        modules = os.path.join(scripts, "modules") + os.sep
+        if path.startswith(scripts) and not path.startswith(modules):
+            return True
+    handlers = bpy.app.handlers
+    codes = {
+        getattr(function, "__code__", None)
+        for name in dir(handlers)
+        if isinstance(getattr(handlers, name), list)
+        for function in getattr(handlers, name)
+    }
+    while frame is not None:
+        if frame.f_code in codes:
+            return True
+        frame = frame.f_back
+    return False

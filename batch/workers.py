@@ -8,8 +8,10 @@ rows.
 
 Nothing outlives the run: a worker watches its parent and, when the parent is gone (killed, even
 with SIGKILL), removes the run's temporary folder and exits; Ctrl-C is the parent's to handle
-(workers ignore SIGINT), and an interrupted parent stops its workers before it removes the
-folder, so no worker writes into a folder that is gone.
+(workers ignore SIGINT), and an interrupted parent stops its workers (SIGTERM) and waits for them
+before it removes the folder, so no worker writes into a folder that is gone. A worker stopped
+while it measures a mesh hands over the rows it measured, as a run in one process does, then
+quits.
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ import bpy
 
 from ..vg_addon.formats import csvio
 from ..vg_addon.workflow import batchplan
-from . import child_process, extension, map_process
+from . import child_process, extension, map_process, stopping
 from .blend_file import forget, plot_images
 from .measure import MeshResult, safe_measure_mesh, set_units
 from .sources import MeshSource
@@ -61,7 +63,7 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
     lock = threading.Lock()
     row_type = csvio.MeasurementRow
     processes: set[subprocess.Popen] = set()
-    stopping = threading.Event()
+    ending = threading.Event()  # the parent is stopping its workers
 
     def start():
         # Blender makes a session folder in the temporary directory of every process: the
@@ -69,6 +71,8 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
         process = child_process.start(["--worker", plan_path], folder)
         with lock:
             processes.add(process)
+            if ending.is_set():  # started as the run was stopped: stopped with the others
+                process.terminate()
         return process
 
     rows_in: set[int] = set()  # meshes whose rows the parent has (their pictures may follow)
@@ -78,9 +82,14 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
         result = MeshResult(mesh=mesh, failed=len(groups[mesh]))
         if mesh in rows_in:  # the rows are written: only the pictures are lost
             result = next(r for r in run.results if r.mesh == mesh)
-            result.picture_errors.append(f"pictures of {name}: {message}")
+            if plan["pictures"]:
+                result.picture_errors.append(f"pictures of {name}: {message}")
+            # A worker stopped alone (SIGTERM to it, the run going on) hands over the rows it
+            # measured: the others say why they have none.
+            run.add_unmeasured(groups[mesh], message)
         else:
             result.rows = [(t.index, run.unmeasured(t, message)) for t in groups[mesh]]
+            result.station_rows, result.edge_rows = run.unmeasured_edges(mesh, message)
             run.add(result)
         run.pictures_done(result)
 
@@ -92,7 +101,7 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
         process = None
         while True:
             with lock:
-                if not queue or stopping.is_set():
+                if not queue or ending.is_set():
                     break
                 mesh = queue.popleft()
             if process is None:
@@ -133,8 +142,8 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
                 continue
             code = process.wait()
             process = None
-            if stopping.is_set():
-                break  # the run is being interrupted: its rows are "not measured"
+            if ending.is_set():
+                break  # the run is being stopped: rows not handed over are "not measured"
             fail(
                 mesh,
                 f"the worker process measuring this mesh stopped (exit status {code}); see its "
@@ -147,17 +156,28 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
                 process.stdin.close()
             process.wait()
 
-    threads = [threading.Thread(target=slot, daemon=True) for _ in range(min(jobs, len(queue)))]
-    for thread in threads:
-        thread.start()
+    # Each slot says when it is done with an event, not by its thread's join: under Python 3.11
+    # a join that Ctrl-C interrupts marks the thread ended while it still runs, so waiting on it
+    # again returned at once and the CSV was written while a worker's rows were still coming in
+    # (measured: rows a stopped worker had handed over written as "not measured").
+    done = [threading.Event() for _ in range(min(jobs, len(queue)))]
+
+    def run_slot(finished: threading.Event) -> None:
+        try:
+            slot()
+        finally:
+            finished.set()
+
+    for finished in done:
+        threading.Thread(target=run_slot, args=(finished,), daemon=True).start()
     try:
-        for thread in threads:
-            thread.join()
+        for finished in done:
+            finished.wait()
     except BaseException:
         # Ctrl-C (or any error) in the parent: stop every worker before the caller writes the
         # CSV and removes the temporary folder they write into.
-        stopping.set()
-        with lock:
+        with lock:  # a worker started from now on is stopped as it starts (start())
+            ending.set()
             running = list(processes)
         for process in running:
             with contextlib.suppress(OSError):
@@ -168,8 +188,8 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
-        for thread in threads:  # they end once their worker has: none may outlive the run
-            thread.join(timeout=STOP_SECONDS)
+        for finished in done:  # they end once their worker has: none may outlive the run
+            finished.wait(timeout=STOP_SECONDS)
         raise
 
 
@@ -194,13 +214,15 @@ class Parent:
     and the parent's Blender session folder, and exits at once. It learns of it from whichever
     comes first: a thread that checks the parent every :data:`PARENT_POLL_SECONDS`, the end of
     stdin without the parent's last word (:data:`END`), or a broken pipe when it reports.
-    SIGTERM (the parent stopping its workers) ends the worker without a traceback.
+    SIGTERM (the parent stopping its workers) stops the worker as a stop signal stops a run
+    (``stopping.on_stop_signal``): the rows of the mesh it measures are handed over, then
+    :func:`worker_main` quits without a traceback.
     """
 
     def __init__(self, pid: int, folder: str, parent_session: str):
         self.pid = pid
         self.folders = [folder, parent_session]
-        signal.signal(signal.SIGTERM, lambda signum, frame: _quit([bpy.app.tempdir], 143))
+        signal.signal(signal.SIGTERM, stopping.on_stop_signal)
         self._stop = threading.Event()
         self._watcher = threading.Thread(target=self._watch, name="vg-parent-watch", daemon=True)
         self._watcher.start()
@@ -241,11 +263,15 @@ def worker_main(plan_path: str) -> int:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with open(plan_path, encoding="utf-8") as handle:
         plan = json.load(handle)
-    parent = Parent(plan["parent"], plan["folder"], plan.get("parent_session", ""))
+    parent = None
     try:
+        parent = Parent(plan["parent"], plan["folder"], plan.get("parent_session", ""))
         return _measure_from_stdin(plan, parent)
+    except KeyboardInterrupt:  # stopped: the rows of the mesh measured, if any, are handed over
+        _quit([bpy.app.tempdir], 143)
     finally:
-        parent.stop_watching()
+        if parent is not None:
+            parent.stop_watching()
 
 
 def _measure_from_stdin(plan: dict, parent: Parent) -> int:
@@ -286,6 +312,7 @@ def _measure_from_stdin(plan: dict, parent: Parent) -> int:
         if not _write_result(Path(plan["folder"]) / f"mesh-{mesh}.json", result):
             return 1  # the run is over and its folder removed: nobody waits for this result
         parent.tell(f"done {mesh}")
+        stopping.check()  # a stop a Blender handler swallowed: do not wait for another mesh
     parent.gone()  # stdin ended without the parent's last word
 
 

@@ -248,7 +248,7 @@ def test_the_out_folder_vanishing_mid_run_keeps_measuring_and_keeps_the_rows(vg,
     out = folder / "o.csv"
     args = argparse.Namespace(out=str(out), quiet=True, edge=[], edges_csv=None, sweep=None)
     said = []
-    run = run_module.Run(args, [sources.MeshSource("a"), sources.MeshSource("b")], [], 2)
+    run = run_module.Run(args, [sources.MeshSource("a"), sources.MeshSource("b")], [], [0, 1])
     run.say = said.append
     run.write_csv()
     shutil.rmtree(folder)
@@ -276,7 +276,7 @@ def test_an_edge_summary_that_cannot_be_written_is_kept_and_said_as_such(vg, tmp
     (tmp_path / "o_edges.csv").symlink_to(full_disk / "o_edges.csv")  # its place: a full disk
     args = argparse.Namespace(out=str(out), quiet=True, edge=[EDGE], edges_csv=None, sweep=None)
     said = []
-    run = run_module.Run(args, [sources.MeshSource("a")], [], 1)
+    run = run_module.Run(args, [sources.MeshSource("a")], [], [0])
     run.say = said.append
     rows = importlib.import_module(f"{vg.__name__}.vg_addon.formats.csvio")  # the run's classes
     station = rows.MeasurementRow(mesh_name="a", angle=91.5, x=0.0, y=0.0, z=0.0, edge_number=1)
@@ -605,7 +605,8 @@ def test_the_demo_refuses_every_option_it_would_ignore(tmp_path, arguments, name
 def test_an_edge_row_naming_no_mesh_among_several_is_refused(tmp_path):
     """An edge summary row with a blank Mesh Name, replayed on two meshes, is refused as a
     points row is (before: traced on both, and the replay report compared the file's row with
-    the other mesh's edge); so is --ignore-mesh-names with several meshes."""
+    the other mesh's edge); so is --ignore-mesh-names with several meshes, for an edges CSV
+    and for a .pp file."""
     a, b = write_wedge(tmp_path / "a.ply", 100.0), write_wedge(tmp_path / "b.ply", 60.0, seed=4)
     ok(batch(a, b, *EDGE, "--spacing", "0.2", "--out", tmp_path / "e.csv"))
     lines = (tmp_path / "e_edges.csv").read_text().splitlines()
@@ -619,6 +620,20 @@ def test_an_edge_row_naming_no_mesh_among_several_is_refused(tmp_path):
     result = ok(
         batch(a, b, "--edges", tmp_path / "e_edges.csv", "--ignore-mesh-names", "--out",
               tmp_path / "r.csv"),
+        code=2,
+    )  # fmt: skip
+    assert "--ignore-mesh-names needs a single mesh" in result.stderr
+    # A .pp file likewise (before: the option was passed over without a word, the file's name
+    # choosing the mesh).
+    picked = tmp_path / "a_1.pp"
+    picked.write_text(
+        '<PickedPoints>\n<point x="-0.4" y="0" z="0" name="1" active="1"/>\n'
+        '<point x="0.4" y="0" z="0" name="2" active="1"/>\n</PickedPoints>\n',
+        encoding="utf-8",
+    )
+    result = ok(
+        batch(a, b, "--edges", picked, "--spacing", "0.2", "--radius", "0.3",
+              "--ignore-mesh-names", "--out", tmp_path / "r.csv"),
         code=2,
     )  # fmt: skip
     assert "--ignore-mesh-names needs a single mesh" in result.stderr

@@ -165,6 +165,32 @@ def test_a_worker_killed_with_sigkill_loses_only_its_mesh(started, tmp_path):
     assert list(run.temp.iterdir()) == []
 
 
+def test_a_worker_stopped_alone_hands_over_what_it_measured(started, tmp_path):
+    """SIGTERM to one worker (not the run): it hands over the rows it measured, as a stopped run
+    does, the rest of its mesh's rows say the worker stopped, and the run ends as with any failed
+    row (exit 1), with no word of pictures that were never asked for."""
+    out = tmp_path / "out.csv"
+    run = started("--out", out)
+    wait_for(lambda: run.said("fast: 3 measured"), "the fast mesh to be measured")
+    seen = wait_for(
+        lambda: (_points_done(run.lines) or 0) > 3 and _points_done(run.lines),
+        "a progress line with the slow mesh's points under way",
+    )
+    (worker,) = wait_for(lambda: run.workers() if len(run.workers()) == 1 else None, "one worker")
+    os.kill(worker, signal.SIGTERM)
+    code, stderr = run.finish()
+    assert code == 1, stderr
+    assert "Traceback" not in stderr and "could not write" not in stderr, stderr
+    rows = csvio.read_measurements_csv(out)
+    assert len(rows) == 3 + SLOW_ROWS
+    measured = [row for row in rows[3:] if not row.error]
+    assert len(measured) >= seen - 3 and all(row.angle is not None for row in measured)
+    rest = [row for row in rows[3:] if row.error]
+    stopped = "worker process measuring this mesh stopped (exit status 143)"
+    assert rest and all(stopped in row.error for row in rest), rest[:1]
+    assert list(run.temp.iterdir()) == []
+
+
 def test_the_parent_killed_with_sigkill_leaves_no_worker_and_no_temporary_folder(started, tmp_path):
     run = started("--out", tmp_path / "out.csv")
     workers = wait_for(lambda: run.workers() if len(run.workers()) == 2 else None, "two workers")
@@ -271,6 +297,11 @@ def test_a_stop_signal_ends_the_run_cleanly(started, tmp_path, stop, to_group):
     run = started("--out", out)
     workers = wait_for(lambda: run.workers() if len(run.workers()) >= 1 else None, "a worker")
     wait_for(lambda: run.said("fast: 3 measured") or None, "the fast mesh to be measured")
+    # The slow mesh's points under way in the other worker (the count includes the fast 3).
+    seen = wait_for(
+        lambda: (_points_done(run.lines) or 0) > 3 and _points_done(run.lines),
+        "a progress line with the slow mesh's points under way",
+    )
     if to_group:  # as a shell's or a scheduler's stop: the parent and every worker at once
         os.killpg(run.process.pid, stop)
     else:
@@ -283,12 +314,13 @@ def test_a_stop_signal_ends_the_run_cleanly(started, tmp_path, stop, to_group):
     rows = csvio.read_measurements_csv(out)
     assert len(rows) == 3 + SLOW_ROWS
     assert all(not row.error for row in rows[:3])
-    # A worker signalled with the group may end before the parent notices the stop: its rows
-    # then say the worker stopped; either way they say why they hold no angle.
+    # The worker stopped hands over the slow mesh's rows measured so far (before: none, every
+    # row of that mesh said it was not measured); the rest say why they hold no angle.
+    measured = [row for row in rows[3:] if not row.error]
+    assert len(measured) >= seen - 3 and all(row.angle is not None for row in measured)
     expected = ("the run was stopped before this point",)
-    if to_group:
-        expected += ("worker process measuring this mesh stopped (exit status 143)",)
-    assert all(any(text in row.error for text in expected) for row in rows[3:])
+    rest = [row for row in rows[3:] if row.error]
+    assert rest and all(any(text in row.error for text in expected) for row in rest), rest[:1]
 
 
 @pytest.mark.parametrize("delay", [0.0, 0.13, 0.29, 0.47])
@@ -319,6 +351,50 @@ def test_a_stop_keeps_the_rows_measured_on_the_mesh_being_measured(tmp_path, inp
     assert rest and all(
         r.error == "not measured: the run was stopped before this point" for r in rest
     )
+
+
+@pytest.mark.parametrize("find", [False, True], ids=["--edge", "--find-edges"])
+def test_a_stop_gives_every_edge_not_measured_a_row_saying_so(tmp_path, inputs, find):
+    """``--edge`` (or ``--find-edges``) on two meshes, the slow one's points first: a stop while
+    they are measured left both meshes' edges without any row, in the CSV or the edges file, as
+    if never asked for. Now each edge the run was stopped before has its row in both, with its
+    points and the reason, and the summary names it an edge; with ``--find-edges``, each mesh has
+    a row saying its edges were not looked for, which the summary names "finding edges"."""
+    points = tmp_path / "slow_first.csv"
+    rows = inputs["points"].read_text().splitlines()
+    points.write_text("\n".join([rows[0], *rows[4:], *rows[1:4]]) + "\n")  # slow, then fast
+    out = tmp_path / "out.csv"
+    edges = ["--find-edges"] if find else ["--edge", "-0.4", "0", "0", "0.4", "0", "0"]
+    run = Batch(tmp_path, inputs["slow"], inputs["fast"], "--points", points, "--radius", "0.3",
+                *edges, "--spacing", "0.2", "--out", out)  # fmt: skip
+    try:
+        # The slow mesh's points are under way; the fast mesh is not reached.
+        wait_for(lambda: _points_done(run.lines), "a progress line with points measured")
+        run.process.send_signal(signal.SIGINT)
+        code, stderr = run.finish()
+    finally:
+        run.stop()
+    assert code == 130 and "interrupted" in stderr and "Traceback" not in stderr, stderr
+    stopped = (
+        "edges not found: the run was stopped before they were looked for"
+        if find
+        else "edge not measured: the run was stopped before this edge"
+    )
+    edge_rows = csvio.read_measurements_csv(out)[3 + SLOW_ROWS :]
+    assert [row.mesh_name for row in edge_rows] == ["slow", "fast"], edge_rows
+    assert all(row.error == stopped for row in edge_rows), edge_rows
+    summaries = csvio.read_edges_csv(tmp_path / "out_edges.csv")
+    if find:
+        assert summaries == [] and f"failed: finding edges on 'slow': {stopped}" in stderr
+        return
+    assert all(row.requested == (-0.4, 0, 0) for row in edge_rows)
+    assert [row.mesh_name for row in summaries] == ["slow", "fast"], summaries
+    for row in summaries:
+        assert row.error == stopped, row.error
+        points = [list(point) for point in csvio.parse_points(row.points)]
+        assert points == [[-0.4, 0, 0], [0.4, 0, 0]], row.points
+        assert (row.spacing, row.radius) == (0.2, 0.3)
+    assert f"failed: an edge on 'slow': {stopped}" in stderr, stderr
 
 
 def test_a_stop_at_any_moment_of_the_start_ends_cleanly(tmp_path, inputs):

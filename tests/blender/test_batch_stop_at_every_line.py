@@ -2,8 +2,10 @@
 
 A real SIGINT, handled by the run's own stop handler, is sent to this process at each line of
 ``measure_mesh`` and ``_measure_points``, the code that measures and records a mesh's points, in
-turn (a tracer sees the line run and sends the signal there). CI once caught a stop landing on a line of the record loop outside its guard: the
-whole mesh's rows were written as "not measured" although 1,057 of them had been measured.
+turn (a tracer sees the line run and sends the signal there); then of the code that measures its
+edges and its radius sweeps. CI once caught a stop landing on a line of the record loop outside
+its guard: the whole mesh's rows were written as "not measured" although 1,057 of them had been
+measured. Each edge the stop comes before must have a row saying so.
 
 Oracles, independent of the code under test: how many times the measuring step returned (seen by
 the tracer) and the measurements Blender holds on the object afterwards.
@@ -22,13 +24,21 @@ from bpy_helpers import mesh_object
 
 from vg_addon.synthetic_meshes import wedge
 
+STOPPED_EDGE = "the run was stopped before this edge"  # a stopped edge's error says it
+EDGE = {"points": [[-0.6, 0.0, 0.0], [0.6, 0.0, 0.0]], "spacing": 0.15, "radius": 0.3, "lam": 2.0,
+        "patch": "euclidean", "mesh_name": "", "note": ""}  # fmt: skip
 TASKS = 90  # two blocks of the run's 64: the stop comes while the second block is under way
 FIRST_BLOCK_DONE = 66  # measurements returned before the signal is sent
 
 
-def _lines_of(function) -> list[int]:
-    code = function.__code__
-    return sorted({line for _, _, line in code.co_lines() if line and line > code.co_firstlineno})
+def _code_lines(function) -> list[int]:
+    """The lines of ``function`` and of the functions defined inside it."""
+    lines, codes = set(), [function.__code__]
+    while codes:
+        code = codes.pop()
+        lines |= {line for _, _, line in code.co_lines() if line and line > code.co_firstlineno}
+        codes += [const for const in code.co_consts if hasattr(const, "co_lines")]
+    return sorted(lines)
 
 
 class _SignalAtLine:
@@ -81,14 +91,12 @@ def _measure_under(tracer, stop_handler, measure, sources, obj, tasks, options):
 @pytest.fixture
 def stop_handler(vg):
     """The run's own stop handler on SIGINT and SIGTERM (pytest's put back after)."""
-    package = importlib.import_module(f"{vg.__name__}.batch")
     stopping = importlib.import_module(f"{vg.__name__}.batch.stopping")
     saved = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
 
     def install():
         stopping._requested = False  # a fresh run's state
-        signal.signal(signal.SIGINT, package._stop)
-        signal.signal(signal.SIGTERM, package._stop)
+        stopping.handle_stop_signals()
 
     yield install
     signal.signal(signal.SIGINT, saved[0])
@@ -96,7 +104,9 @@ def stop_handler(vg):
     stopping._requested = False
 
 
-def test_a_stop_at_any_line_of_the_points_loop_keeps_every_point_measured(vg, stop_handler):
+def test_a_stop_at_any_line_of_the_points_loop_keeps_every_point_measured(
+    vg, stop_handler, tmp_path
+):
     measure = importlib.import_module(f"{vg.__name__}.batch.measure")
     sources = importlib.import_module(f"{vg.__name__}.batch.sources")
     batchplan = importlib.import_module(f"{vg.__name__}.vg_addon.workflow.batchplan")
@@ -116,12 +126,16 @@ def test_a_stop_at_any_line_of_the_points_loop_keeps_every_point_measured(vg, st
     functions = [measure.measure_mesh]
     if hasattr(measure, "_measure_points"):
         functions.append(measure._measure_points)
-    targets = [line for function in functions for line in _lines_of(function)]
+    targets = [line for function in functions for line in _code_lines(function)]
+    # Two edges after the points: a stop before them gives each a row saying so.
+    options = {"edges": [dict(EDGE) for _ in range(2)], "plots": str(tmp_path / "o")}
     stopped_at = []
     for line in targets:
         obj = mesh_object("Wedge", shape.points, shape.triangles)
         tracer = _SignalAtLine(measure.__file__, line)
-        stopped, handed = _measure_under(tracer, stop_handler, measure, sources, obj, tasks, {})
+        stopped, handed = _measure_under(
+            tracer, stop_handler, measure, sources, obj, tasks, options
+        )
         assert stopped == tracer.sent, (line, stopped, tracer.sent)
         assert len(handed) == 1, (line, len(handed))  # the rows are handed over once
         result = handed[0]
@@ -130,24 +144,20 @@ def test_a_stop_at_any_line_of_the_points_loop_keeps_every_point_measured(vg, st
         if tracer.sent and tracer.returned_when_sent < len(tasks):
             assert tracer.returned <= tracer.returned_when_sent + 1, (line, tracer.returned)
         measured = [row for _, row in result.rows if not row.error]
-        recorded = sorted(item.angle for item in obj.vg.measurements)
+        points = [item for item in obj.vg.measurements if not item.edge_number]  # no stations
+        recorded = sorted(item.angle for item in points)
         assert sorted(row.angle for row in measured) == pytest.approx(recorded, abs=1e-4), line
         assert len(measured) == result.measured
+        assert len(result.edge_rows) == 2, (line, result.edge_rows)
+        stopped_edges = [row for row in result.edge_rows if row.error]
+        assert len(stopped_edges) == 2 - len(obj.vg.edges), (line, stopped_edges)
+        assert all(STOPPED_EDGE in row.error for row in stopped_edges), (line, stopped_edges)
+        assert sum(bool(row.error) for row in result.station_rows) == len(stopped_edges), line
         if tracer.sent:
             stopped_at.append(line)
         bpy.data.objects.remove(obj)
     # The signal landed in both loops (measuring and recording), not only between meshes.
     assert len(stopped_at) >= 10, stopped_at
-
-
-def _code_lines(function) -> list[int]:
-    """The lines of ``function`` and of the functions defined inside it."""
-    lines, codes = set(), [function.__code__]
-    while codes:
-        code = codes.pop()
-        lines |= {line for _, _, line in code.co_lines() if line and line > code.co_firstlineno}
-        codes += [const for const in code.co_consts if hasattr(const, "co_lines")]
-    return sorted(lines)
 
 
 class _SignalAtEdgeLine(_SignalAtLine):
@@ -179,14 +189,13 @@ def test_a_stop_at_any_line_of_the_edges_loop_keeps_every_edge_recorded(vg, stop
     measure = importlib.import_module(f"{vg.__name__}.batch.measure")
     sources = importlib.import_module(f"{vg.__name__}.batch.sources")
     shape = wedge(80.0, n=20, irregular=True, seed=2)
-    spec = {"points": [[-0.6, 0.0, 0.0], [0.6, 0.0, 0.0]], "spacing": 0.15, "radius": 0.3,
-            "lam": 2.0, "patch": "euclidean", "mesh_name": "", "note": ""}  # fmt: skip
-    options = {"edges": [dict(spec) for _ in range(EDGES)], "plots": str(tmp_path / "o")}
+    options = {"edges": [dict(EDGE) for _ in range(EDGES)], "plots": str(tmp_path / "o")}
     targets = [
         (function.__code__.co_filename, line)
         for function in (
             edges_module.measure_edges,
-            getattr(edges_module, "_measure_edge_rows", None),
+            getattr(edges_module, "_measure_edge", None),
+            getattr(edges_module, "_record_edge", None),
         )
         if function is not None
         for line in _code_lines(function)
@@ -206,7 +215,7 @@ def test_a_stop_at_any_line_of_the_edges_loop_keeps_every_edge_recorded(vg, stop
             assert sum(row.edge_number == number for row in result.station_rows) == count, line
         assert len(result.edge_rows) == EDGES, line  # an edge not recorded has its row, saying why
         for row in result.edge_rows:
-            assert not row.error or edges_module.STOPPED_EDGE in row.error, (line, row.error)
+            assert not row.error or STOPPED_EDGE in row.error, (line, row.error)
         if tracer.sent:
             assert 1 <= len(recorded) <= tracer.returned_when_sent + 1, (line, len(recorded))
             stopped_at.append(line)
@@ -264,3 +273,30 @@ def test_a_stop_at_any_line_of_the_sweeps_keeps_each_site_whole(vg, stop_handler
             stopped_at.append(line)
         bpy.data.objects.remove(obj)
     assert len(stopped_at) >= 5, stopped_at
+
+
+def test_a_stop_inside_a_handler_blender_calls_is_noted_and_acted_on_after(vg, stop_handler, capfd):
+    """A stop signal that lands inside a function Blender calls from ``bpy.app.handlers`` (the
+    extension's geometry watcher is one) must not be raised there: bpy would print it as an
+    error with its traceback and carry on. It is noted, and the run acts on it at its next
+    check (before: only Blender's own scripts were recognised as such places)."""
+    stopping = importlib.import_module(f"{vg.__name__}.batch.stopping")
+    seen = []
+
+    def handler(*args):
+        seen.append("in")
+        signal.raise_signal(signal.SIGINT)
+        seen.append("after")
+
+    stop_handler()
+    bpy.app.handlers.depsgraph_update_post.append(handler)
+    try:
+        bpy.ops.mesh.primitive_cube_add()  # a depsgraph update: Blender calls the handler
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(handler)
+        bpy.data.objects.remove(bpy.context.object)
+    assert seen[:2] == ["in", "after"], seen
+    assert "KeyboardInterrupt" not in capfd.readouterr().err
+    assert stopping.requested()
+    with pytest.raises(KeyboardInterrupt):
+        stopping.check()

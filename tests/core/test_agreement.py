@@ -94,6 +94,7 @@ def test_edges_are_matched_to_the_rows_they_came_from_and_each_change_is_named()
         edge(5, 60.0, stale=True),
         EdgeRow(mesh_name="bone", row_number=6, points="0 5 0; 1 5 0"),  # its error cleared
         edge(7, 50.0),
+        edge(8, 45.0),
     ]
     # A replay numbers its edges afresh, in its own order, and its points may be in other
     # coordinates: each carries the row it was measured from.
@@ -103,16 +104,24 @@ def test_edges_are_matched_to_the_rows_they_came_from_and_each_change_is_named()
         edge(5, 61.0),
         edge(6, 40.0),
         EdgeRow(mesh_name="bone", row_number=7, error="the patch holds 3 vertices"),
+        # A replay stopped (Ctrl-C) before row 8's edge: not a failure to measure it again.
+        EdgeRow(
+            mesh_name="bone",
+            row_number=8,
+            error="edge not measured: the run was stopped before this edge",
+        ),
         edge(None, 10.0),  # given on the command line: from no row
     ]
     agreed = edge_agreement(file_rows, replayed)
-    assert (agreed.compared, agreed.stale, agreed.blank, agreed.failed) == (2, 1, 1, 1)
+    counts = (agreed.compared, agreed.stale, agreed.blank, agreed.failed, agreed.stopped)
+    assert counts == (2, 1, 1, 1, 1)
     assert agreed.differing == [
         "row 3: mean 80.0000° → 80.2500°, min 79.0000° → 79.2500°, max 81.0000° → 81.2500°, "
         "pooled angle 80.0000° → 80.2500°"
     ]
     assert agreed.text.startswith("; 1 of 2 edges differ from the file's figures (row 3: ")
     assert "; 1 edge(s) could not be measured again" in agreed.text
+    assert "; 1 edge(s) not measured again: the run was stopped first" in agreed.text
     assert "; 1 row(s) without figures in the file" in agreed.text
     # One edge the same: said in the singular; a change below four decimals shown in full.
     assert edge_agreement(file_rows[:1], replayed[1:2]).text == (

@@ -15,6 +15,8 @@ import dataclasses
 import math
 from collections.abc import Sequence
 
+from .batchplan import STOPPED_EDGE
+
 
 @dataclasses.dataclass(frozen=True)
 class Agreement:
@@ -187,6 +189,8 @@ class EdgeAgreement:
         its error cleared to try again): measured, not compared.
     failed : int
         Rows whose edge could not be measured again (the replay's error says why).
+    stopped : int
+        Rows whose edge the replay was stopped before (not measured again, not failed).
     """
 
     compared: int
@@ -194,6 +198,7 @@ class EdgeAgreement:
     stale: int = 0
     blank: int = 0
     failed: int = 0
+    stopped: int = 0
 
     @property
     def text(self) -> str:
@@ -221,6 +226,8 @@ class EdgeAgreement:
             )
         if self.failed:
             parts.append(f"{self.failed} edge(s) could not be measured again (see their error)")
+        if self.stopped:
+            parts.append(f"{self.stopped} edge(s) not measured again: the run was stopped first")
         if self.blank:
             parts.append(
                 f"{self.blank} row(s) without figures in the file (not measured when it was "
@@ -244,13 +251,16 @@ def edge_agreement(file_rows: Sequence, remeasured: Sequence) -> EdgeAgreement:
     file rows with an ``error`` (never measured, not measured again).
     """
     replayed = {row.row_number: row for row in remeasured if row.row_number is not None}
-    compared, differing, stale, blank, failed = 0, [], 0, 0, 0
+    compared, differing, stale, blank, failed, stopped = 0, [], 0, 0, 0, 0
     for old in file_rows:
         new = replayed.get(old.row_number)
         if old.error or new is None:
             continue
         if new.error:
-            failed += 1
+            if STOPPED_EDGE in new.error:
+                stopped += 1
+            else:
+                failed += 1
             continue
         if old.stale:
             stale += 1
@@ -267,4 +277,4 @@ def edge_agreement(file_rows: Sequence, remeasured: Sequence) -> EdgeAgreement:
                 changes.append(f"{said} {was} → {now}")
         if changes:
             differing.append(f"row {old.row_number}: {', '.join(changes)}")
-    return EdgeAgreement(compared, differing, stale, blank, failed)
+    return EdgeAgreement(compared, differing, stale, blank, failed, stopped)

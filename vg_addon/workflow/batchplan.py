@@ -21,6 +21,9 @@ from ..formats.meshio import MESH_EXTENSIONS
 from ..method.algorithm import DEFAULT_RULE, as_center, as_lambda, as_radius
 from ..method.surface import check_patch_mode
 
+STOPPED_EDGE = "the run was stopped before this edge"
+"""Why an edge a run had not measured when it was stopped has no figures (its row's error)."""
+
 
 @dataclass(frozen=True)
 class Task:
