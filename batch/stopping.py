@@ -1,10 +1,11 @@
 """The run's stop (Ctrl-C, SIGTERM): asked for by the signal, acted on where the run can act.
 
-The signal handler raises KeyboardInterrupt where Python happens to be. Inside a Blender handler
-(a mesh import runs Blender's own ``version_update`` handlers) bpy catches it, prints it as an
-error and carries on, so the run would end as if never stopped. The handler therefore also
-records the stop here, and the run calls :func:`check` between steps (each mesh, each block of
-points) and :func:`requested` before each point.
+The signal handler (:func:`on_stop_signal`) raises KeyboardInterrupt where Python happens to be,
+except inside a handler Blender calls (a mesh import runs Blender's own ``version_update``
+handlers; the extension's geometry watcher runs on depsgraph updates): there bpy would catch it,
+print it as an error and carry on, so the run would end as if never stopped. The handler
+therefore records the stop here, and the run calls :func:`check` between steps (each mesh, each
+block of points) and :func:`requested` before each point.
 
 Where an interrupt raised at an arbitrary line would lose work already done (points measured but
 not yet recorded, rows half handed over), the run works :func:`deferred`: the handler only
@@ -63,8 +64,8 @@ def handle_stop_signals() -> None:
 
 def on_stop_signal(signum, frame) -> None:
     """The stop signals' handler: record the stop and raise KeyboardInterrupt, unless the run
-    works :func:`deferred` or the signal came inside Blender's own scripts (its handlers, where
-    bpy would print the interrupt as an error and carry on): the run then acts on it at its next
+    works :func:`deferred` or the signal came inside a handler Blender calls (where bpy would
+    print the interrupt as an error and carry on): the run then acts on it at its next
     :func:`check`.
 
     The run ends at once: a map being rendered is killed with its child process, the workers
