@@ -350,7 +350,9 @@ def edge_rule(spec: dict, options: dict) -> str:
     return spec.get("rule") or options.get("rule", DEFAULT_RULE)
 
 
-def unmeasured_edges(specs, options: dict, mesh_name: str, message: str, units, **kw) -> tuple:
+def unmeasured_edges(
+    specs, options: dict, mesh_name: str, message: str, units, *, numbered=False, search=None
+) -> tuple:
     """The station rows and summary rows of the edges ``specs`` of the mesh ``mesh_name`` that
     were not measured, saying why (``message``), each with its points and settings.
 
@@ -358,7 +360,6 @@ def unmeasured_edges(specs, options: dict, mesh_name: str, message: str, units, 
     otherwise they have no edge number. ``search``, if given, adds the row saying why
     ``--find-edges`` found no edge on the mesh.
     """
-    numbered, search = kw.pop("numbered", False), kw.pop("search", None)
     stations, summaries = [], []
     for number, spec in enumerate(specs, start=1):
         number = number if numbered else None
@@ -368,6 +369,16 @@ def unmeasured_edges(specs, options: dict, mesh_name: str, message: str, units, 
     if search is not None:
         stations.append(not_found_row(options, mesh_name, search, units))
     return stations, summaries
+
+
+def unmeasured_mesh_edges(source, options: dict, message: str, units, *, numbered=False, search=""):
+    """:func:`unmeasured_edges` for every edge of the mesh ``source`` (none of them measured),
+    and, with ``--find-edges``, its row saying ``search`` (default ``message``)."""
+    found = (search or message) if options.get("find_edges") else None
+    return unmeasured_edges(
+        edges_of(source, options), options, source.name, message, units, numbered=numbered,
+        search=found,
+    )  # fmt: skip
 
 
 @dataclasses.dataclass

@@ -18,7 +18,7 @@ from ..vg_addon.formats import csvio, files, sweep_plot
 from ..vg_addon.method.sweep import SweepPoint, radius_sweep, sweep_radii
 from . import stopping
 from .cli import UNITS
-from .edges import EdgesToDo, edges_of, measure_edges, unmeasured_edges
+from .edges import EdgesToDo, edges_of, measure_edges, unmeasured_mesh_edges
 from .map_process import draw_map
 from .pictures import reason, try_picture
 from .render import add_sides_material
@@ -118,9 +118,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     def fail_all(message: str) -> MeshResult:
         result.rows = [(t.index, error_row(t, name, message, units)) for t in tasks]
         result.failed = len(tasks)
-        search = message if options.get("find_edges") else None
-        result.station_rows, result.edge_rows = unmeasured_edges(
-            edges_of(source, options), options, name, message, units, numbered=True, search=search
+        result.station_rows, result.edge_rows = unmeasured_mesh_edges(
+            source, options, message, units, numbered=True
         )
         if rows_ready is not None:
             rows_ready(result)
@@ -425,9 +424,8 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, 
         units = run_units_label(options.get("units"))
         result = MeshResult(mesh=index, failed=len(tasks))
         result.rows = [(t.index, error_row(t, source.name, message, units)) for t in tasks]
-        search = message if options.get("find_edges") else None
-        result.station_rows, result.edge_rows = unmeasured_edges(
-            edges_of(source, options), options, source.name, message, units, search=search
+        result.station_rows, result.edge_rows = unmeasured_mesh_edges(
+            source, options, message, units
         )
         ready(result)
         return result

@@ -27,12 +27,11 @@ from .edges import (
     STOPPED_EDGE,
     STOPPED_SEARCH,
     edge_specs,
-    edges_of,
     failed_rows_line,
     is_search_row,
     profiled,
     spec_applies,
-    unmeasured_edges,
+    unmeasured_mesh_edges,
 )
 from .find_edges import find_options
 from .measure import MeshResult, error_row, run_units_label, safe_measure_mesh, set_units
@@ -350,11 +349,7 @@ class Run:
         measured, saying why (``message``: a stopped run, a worker that failed its mesh), and
         its ``--find-edges`` row, saying ``search`` (default ``message``)."""
         source = self.sources[mesh]
-        search = (search or message) if self.options.get("find_edges") else None
-        specs = edges_of(source, self.options)
-        return unmeasured_edges(
-            specs, self.options, source.name, message, self.units, search=search
-        )
+        return unmeasured_mesh_edges(source, self.options, message, self.units, search=search)
 
     def finish(self) -> int:
         missing = [t for t in self.tasks if t.index not in self.rows]
