@@ -396,13 +396,14 @@ class EdgesToDo:
         """The edges of ``source`` before any is measured."""
         return cls(edges_of(source, options), bool(options.get("find_edges")))
 
-    def add_stopped(self, kept, options: dict, mesh_name: str, units) -> None:
-        """Add to ``kept`` (a ``MeshResult``) the rows of the edges not recorded, saying the
-        run was stopped before them, and mark them done."""
-        search = STOPPED_SEARCH if self.search else None
+    def add_not_done(self, kept, options: dict, mesh_name: str, units, message="") -> None:
+        """Add to ``kept`` (a ``MeshResult``) the rows of the edges not recorded, saying
+        ``message`` (default: the run was stopped before them), and mark them done."""
+        search = (message or STOPPED_SEARCH) if self.search else None
         stations, summaries = unmeasured_edges(
-            self.specs[self.done :], options, mesh_name, STOPPED_EDGE, units, search=search
-        )
+            self.specs[self.done :], options, mesh_name, message or STOPPED_EDGE, units,
+            search=search,
+        )  # fmt: skip
         kept.station_rows.extend(stations)
         kept.edge_rows.extend(summaries)
         self.done, self.search = len(self.specs), False
@@ -420,7 +421,7 @@ def measure_edges(obj, source, options: dict, units: str, safe_name: str, surfac
     stations in order, or one error row for an edge that failed; ``edge_rows``, one summary per
     edge (an edge that failed has its points, settings and ``error`` and no figures); rows name
     the mesh as the user gave it (``source.name``). On a stop (KeyboardInterrupt) the caller
-    gives the edges not done their rows (``EdgesToDo.add_stopped``).
+    gives the edges not done their rows (``EdgesToDo.add_not_done``).
 
     Returns
     -------

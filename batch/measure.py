@@ -99,8 +99,9 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     drawn: the caller writes the rows then, so a run stopped while drawing keeps them; a run
     stopped while measuring hands over the rows measured so far and a row for each edge not
     recorded, saying the run was stopped before it (nothing if stopped while the mesh loads: the
-    run then writes every row of the mesh as not measured). Rows
-    name the mesh as the user gave it (``source.name``: a mesh file's stem), whatever name
+    run then writes every row of the mesh as not measured). An unexpected error (a bug) while
+    measuring keeps the rows measured before it too: its traceback goes to stderr, and each
+    point and edge not measured has a row saying so. Rows name the mesh as the user gave it (``source.name``: a mesh file's stem), whatever name
     Blender gave its object.
 
     The numbers come from the extension's own pipeline: the object's evaluated mesh in its own
@@ -185,11 +186,40 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     except KeyboardInterrupt as stop:  # the rows so far are kept; the rest is not done
         if not handed:
             with stopping.deferred():
-                todo.add_stopped(result, options, name, units)
+                todo.add_not_done(result, options, name, units)
             _stop_with(result, rows_ready, stop)
         raise
+    except Exception as error:  # a bug: the rows so far are kept, the rest say what happened
+        if handed:
+            raise  # only the pictures are lost (safe_measure_mesh says so)
+        traceback.print_exc()
+        with stopping.deferred():
+            _fail_the_rest(result, todo, tasks, options, (name, units, internal_error(error)))
+            if rows_ready is not None:
+                rows_ready(result)
+        stopping.check()
+        return result
     draw_pictures(result, obj, options, stem, plots, name)
     return result
+
+
+def internal_error(error: Exception) -> str:
+    """The row error of what an unexpected error (a bug) kept from being measured."""
+    return (
+        f"internal error while measuring this mesh ({type(error).__name__}: {error}); "
+        "please report it with the traceback printed on stderr"
+    )
+
+
+def _fail_the_rest(result: MeshResult, todo, tasks, options, why) -> None:
+    """Give each task of ``tasks`` with no row in ``result``, and each edge of ``todo`` not
+    done, a row saying ``why`` (the mesh's name, its units label and the message)."""
+    name, units, message = why
+    done = {index for index, _ in result.rows}
+    rest = [task for task in tasks if task.index not in done]
+    result.rows += [(task.index, error_row(task, name, message, units)) for task in rest]
+    result.failed += len(rest)
+    todo.add_not_done(result, options, name, units, message)
 
 
 def _measure_points(result, obj, name, tasks, options, progress, measured_on) -> None:
@@ -401,8 +431,9 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, 
     mesh only, its traceback on stderr, so the other meshes are still measured. An error after
     the rows were handed to ``rows_ready`` costs only the pictures. ``rows_ready`` is called
     exactly once either way, unless the run is stopped while the mesh loads (the run then writes
-    each of its rows as not measured). An unexpected error gives each of the mesh's points and
-    edges a row saying so."""
+    each of its rows as not measured). An unexpected error while the mesh loads gives each of
+    its points and edges a row saying so (one while measuring keeps the rows measured before
+    it: :func:`measure_mesh`)."""
     sent = []
 
     def ready(result):
@@ -414,10 +445,7 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, 
         return measure_mesh(index, source, tasks, options, progress, ready)
     except Exception as error:
         traceback.print_exc()
-        message = (
-            f"internal error while measuring this mesh ({type(error).__name__}: {error}); "
-            "please report it with the traceback printed on stderr"
-        )
+        message = internal_error(error)
         if sent:  # the rows are out: only the pictures are lost
             sent[0].picture_errors.append(f"pictures of {source.name}: {message}")
             return sent[0]

@@ -344,6 +344,15 @@ class Run:
                 if task.index not in self.rows:
                     self.rows[task.index] = self.unmeasured(task, message)
 
+    def say_why_edges_stopped(self, mesh: int, message: str) -> None:
+        """Make the edge rows of mesh ``mesh`` that say the run was stopped before them say
+        ``message`` instead: its worker was stopped alone, and the run went on."""
+        with self.lock:
+            self.edges_by_mesh[mesh] = tuple(
+                [_stopped_saying(row, message) for row in rows]
+                for rows in self.edges_by_mesh.get(mesh, ([], []))
+            )
+
     def unmeasured_edges(self, mesh: int, message: str, search: str = "") -> tuple[list, list]:
         """The station rows and summary rows of the edges of mesh ``mesh`` when none of them was
         measured, saying why (``message``: a stopped run, a worker that failed its mesh), and
@@ -463,6 +472,15 @@ class Run:
         for index, cells in self.sweep_rows:
             measured[index] = measured.get(index, False) or bool(cells[angle])
         return sum(1 for any_radius in measured.values() if not any_radius)
+
+
+def _stopped_saying(row, message: str):
+    """``row``, or, if its error says the run was stopped before it, a copy saying ``message``."""
+    error = row.error or ""
+    for stopped in (STOPPED_EDGE, STOPPED_SEARCH):
+        if stopped in error:
+            return dataclasses.replace(row, error=error.replace(stopped, message))
+    return row
 
 
 def what_failed(error, out) -> str:

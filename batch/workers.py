@@ -82,11 +82,13 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
         result = MeshResult(mesh=mesh, failed=len(groups[mesh]))
         if mesh in rows_in:  # the rows are written: only the pictures are lost
             result = next(r for r in run.results if r.mesh == mesh)
-            if plan["pictures"]:
+            if _would_draw(result, plan["options"]):
                 result.picture_errors.append(f"pictures of {name}: {message}")
             # A worker stopped alone (SIGTERM to it, the run going on) hands over the rows it
-            # measured: the others say why they have none.
+            # measured: the others say why they have none (its edges not reached said the run
+            # was stopped: a worker cannot tell who sent the signal).
             run.add_unmeasured(groups[mesh], message)
+            run.say_why_edges_stopped(mesh, message)
         else:
             result.rows = [(t.index, run.unmeasured(t, message)) for t in groups[mesh]]
             result.station_rows, result.edge_rows = run.unmeasured_edges(mesh, message)
@@ -254,6 +256,13 @@ class Parent:
         if os.getppid() != self.pid:
             _quit(self.folders, 1)
         _quit([bpy.app.tempdir], 1)  # the parent lives and left this worker: its folder is its own
+
+
+def _would_draw(result: MeshResult, options: dict) -> bool:
+    """Whether the mesh whose rows are ``result`` has pictures to draw after them: its map
+    (``--render``), a radius sweep's plots, or an edge profiled."""
+    profiled = any(not row.error for row in result.edge_rows)
+    return bool(options.get("render") or result.sweep_rows or profiled)
 
 
 def worker_main(plan_path: str) -> int:

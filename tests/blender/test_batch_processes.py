@@ -167,10 +167,11 @@ def test_a_worker_killed_with_sigkill_loses_only_its_mesh(started, tmp_path):
 
 def test_a_worker_stopped_alone_hands_over_what_it_measured(started, tmp_path):
     """SIGTERM to one worker (not the run): it hands over the rows it measured, as a stopped run
-    does, the rest of its mesh's rows say the worker stopped, and the run ends as with any failed
+    does, the rest of its mesh's rows say the worker stopped, its row of ``--find-edges`` too
+    (before: "the run was stopped before they were looked for", though the run went on), and the run ends as with any failed
     row (exit 1), with no word of pictures that were never asked for."""
     out = tmp_path / "out.csv"
-    run = started("--out", out)
+    run = started("--find-edges", "--spacing", "0.2", "--out", out)
     wait_for(lambda: run.said("fast: 3 measured"), "the fast mesh to be measured")
     seen = wait_for(
         lambda: (_points_done(run.lines) or 0) > 3 and _points_done(run.lines),
@@ -182,12 +183,18 @@ def test_a_worker_stopped_alone_hands_over_what_it_measured(started, tmp_path):
     assert code == 1, stderr
     assert "Traceback" not in stderr and "could not write" not in stderr, stderr
     rows = csvio.read_measurements_csv(out)
-    assert len(rows) == 3 + SLOW_ROWS
-    measured = [row for row in rows[3:] if not row.error]
+    points, stations = rows[: 3 + SLOW_ROWS], rows[3 + SLOW_ROWS :]
+    measured = [row for row in points[3:] if not row.error]
     assert len(measured) >= seen - 3 and all(row.angle is not None for row in measured)
-    rest = [row for row in rows[3:] if row.error]
+    rest = [row for row in points[3:] if row.error]
     stopped = "worker process measuring this mesh stopped (exit status 143)"
     assert rest and all(stopped in row.error for row in rest), rest[:1]
+    # The fast mesh's crease is found and profiled; the slow mesh has one row, saying its edges
+    # were not looked for because its worker stopped.
+    assert {row.mesh_name for row in stations if not row.error} == {"fast"}
+    (search,) = [row for row in stations if row.mesh_name == "slow"]
+    assert search.error.startswith("edges not found: ") and stopped in search.error, search.error
+    assert "run was stopped" not in stderr, stderr
     assert list(run.temp.iterdir()) == []
 
 
