@@ -192,9 +192,12 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
     except Exception as error:  # a bug: the rows so far are kept, the rest say what happened
         if handed:
             raise  # only the pictures are lost (safe_measure_mesh says so)
-        traceback.print_exc()
-        with stopping.deferred():
-            _fail_the_rest(result, todo, tasks, options, (name, units, internal_error(error)))
+        with stopping.deferred():  # a stop now must not cost the rows measured
+            traceback.print_exc()
+            message = internal_error(error)
+            _fail_the_rest(result, todo, tasks, options, (name, units, message))
+            # Neither pictures nor colours are made after a bug: the run says so (exit 2).
+            result.picture_errors.append(f"pictures and colours of {name}: {message}")
             if rows_ready is not None:
                 rows_ready(result)
         stopping.check()
@@ -212,13 +215,22 @@ def internal_error(error: Exception) -> str:
 
 
 def _fail_the_rest(result: MeshResult, todo, tasks, options, why) -> None:
-    """Give each task of ``tasks`` with no row in ``result``, and each edge of ``todo`` not
-    done, a row saying ``why`` (the mesh's name, its units label and the message)."""
+    """Give each task of ``tasks`` with no row in ``result``, each ``--sweep`` site not swept
+    and each edge of ``todo`` not done a row saying ``why`` (the mesh's name, its units label
+    and the message)."""
     name, units, message = why
     done = {index for index, _ in result.rows}
     rest = [task for task in tasks if task.index not in done]
     result.rows += [(task.index, error_row(task, name, message, units)) for task in rest]
     result.failed += len(rest)
+    if options.get("sweep"):
+        swept = {index for index, _ in result.sweep_rows}
+        result.sweep_rows += [
+            (task.index, csvio.sweep_cells(name, task.number, SweepPoint(float(r), None, message), units))
+            for task in tasks
+            if task.index not in swept
+            for r in sweep_radii(*options["sweep"])
+        ]  # fmt: skip
     todo.add_not_done(result, options, name, units, message)
 
 
@@ -430,7 +442,8 @@ def safe_measure_mesh(index: int, source: MeshSource, tasks, options, progress, 
     """:func:`measure_mesh`, with an unexpected error (a bug) turned into failed rows for this
     mesh only, its traceback on stderr, so the other meshes are still measured. An error after
     the rows were handed to ``rows_ready`` costs only the pictures. ``rows_ready`` is called
-    exactly once either way, unless the run is stopped while the mesh loads (the run then writes
+    exactly once either way (twice only if it raises itself: the second time with every row
+    failed), unless the run is stopped while the mesh loads (the run then writes
     each of its rows as not measured). An unexpected error while the mesh loads gives each of
     its points and edges a row saying so (one while measuring keeps the rows measured before
     it: :func:`measure_mesh`)."""

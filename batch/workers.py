@@ -144,7 +144,9 @@ def run_workers(run: Run, groups: dict, plan: dict, jobs: int) -> None:
                 continue
             code = process.wait()
             process = None
-            if ending.is_set():
+            # A stop to the whole process group reaches the workers as it reaches the run: one
+            # that ends first is not a worker stopped alone.
+            if ending.is_set() or stopping.requested():
                 break  # the run is being stopped: rows not handed over are "not measured"
             fail(
                 mesh,

@@ -17,6 +17,11 @@ Sides" colours), never the viewport shading or the active colour attribute: undo
 brings the mesh back, and the next check brings the flags and colours back with it, so there is
 nothing of the timer's own for the user to undo. Its writes join the edit's undo step.
 
+An edge's plot names the unit of its axis, which follows the object's Scan Units, and, where
+they are the scene's, its scale and the scene's unit system: after the object is scaled or the
+scene's units change, the same timer draws again each plot whose axis names another unit
+(``edges.redraw_plots``), so a plot never names a unit its numbers are not in.
+
 On file load (``on_load``) the caches are emptied and measurements recorded in world space by
 earlier versions are brought into mesh coordinates (see ``legacy``). Before a save
 (``on_save``) the plot images of deleted objects' edges are removed.
@@ -28,12 +33,14 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..vg_addon import GoniometerError
-from . import legacy, mesh_data, painting, plots, records
+from . import edges, legacy, mesh_data, painting, plots, records
 from .measuring import forget_paint, migrate_fingerprints, repaint
 from .mesh_data import check_measurable, evaluated_geometry
 
 _DELAY = 0.5  # seconds of quiet after the last edit before checking
 _pending: set[str] = set()
+_plots_pending: set[str] = set()  # objects with edges whose plots' unit may have changed
+_scene_units: dict[int, tuple] = {}  # each scene's unit system and scale, as last seen
 
 
 def refresh(obj, depsgraph=None) -> bool:
@@ -64,14 +71,42 @@ def _check_pending():
     _pending.clear()
     for name in names:
         refresh(bpy.data.objects.get(name))
+    names = sorted(_plots_pending)
+    _plots_pending.clear()
+    for name in names:
+        obj = bpy.data.objects.get(name)
+        if obj is not None and obj.library is None and len(obj.vg.edges):
+            edges.redraw_plots(obj)  # only the plots whose axis names another unit
     return None  # do not repeat
+
+
+def _note_plot_units(update) -> None:
+    """Note the objects whose plots may name another unit after ``update``: one with edges
+    transformed (its scale), every one with edges in a scene whose units changed."""
+    changed = update.id.original
+    if isinstance(changed, bpy.types.Scene):
+        settings = changed.unit_settings
+        seen = (settings.system, settings.scale_length)
+        if _scene_units.setdefault(changed.as_pointer(), seen) != seen:
+            _scene_units[changed.as_pointer()] = seen
+            _plots_pending.update(
+                obj.name for obj in changed.objects if obj.type == "MESH" and len(obj.vg.edges)
+            )
+    elif (
+        update.is_updated_transform
+        and isinstance(changed, bpy.types.Object)
+        and changed.type == "MESH"
+        and len(changed.vg.edges)
+    ):
+        _plots_pending.add(changed.name)
 
 
 @persistent
 def on_depsgraph_update(scene, depsgraph):
     """Drop the kept geometry of objects whose geometry changed (not a mere move); note the
-    measured ones, to check them soon."""
+    measured ones, to check them soon, and those whose plots may name another unit."""
     for update in depsgraph.updates:
+        _note_plot_units(update)
         if not update.is_updated_geometry:
             continue
         obj = update.id.original
@@ -83,7 +118,7 @@ def on_depsgraph_update(scene, depsgraph):
         vg = getattr(obj, "vg", None)
         if vg is not None and len(vg.measurements):
             _pending.add(obj.name)
-    if _pending:
+    if _pending or _plots_pending:
         if bpy.app.timers.is_registered(_check_pending):
             bpy.app.timers.unregister(_check_pending)
         bpy.app.timers.register(_check_pending, first_interval=_DELAY)
@@ -103,6 +138,8 @@ def clear_caches() -> None:
     mesh_data.clear_cache()
     forget_paint()
     _pending.clear()
+    _plots_pending.clear()
+    _scene_units.clear()
     if bpy.app.timers.is_registered(_check_pending):
         bpy.app.timers.unregister(_check_pending)
 
@@ -172,3 +209,5 @@ def unregister() -> None:
     if bpy.app.timers.is_registered(_check_pending):
         bpy.app.timers.unregister(_check_pending)
     _pending.clear()
+    _plots_pending.clear()
+    _scene_units.clear()

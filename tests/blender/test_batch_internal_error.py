@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from bpy_helpers import mesh_object
 
+from vg_addon.formats import csvio
 from vg_addon.synthetic_meshes import wedge
 
 EDGE = {"points": [[-0.6, 0.0, 0.0], [0.6, 0.0, 0.0]], "spacing": 0.15, "radius": 0.3, "lam": 2.0,
@@ -52,14 +53,15 @@ def _failing_on_call(function, call: int):
     return wrapped
 
 
-def _run(vg, tmp_path, fault=None):
+def _run(vg, tmp_path, fault=None, **more):
     """Measure the wedge's points and 3 edges through ``safe_measure_mesh``, with ``fault``
-    (module, name, call) injected; returns the result handed over and the object."""
+    (module, name, call) injected and ``more`` options; returns the result handed over and the
+    object."""
     measure = importlib.import_module(f"{vg.__name__}.batch.measure")
     sources = importlib.import_module(f"{vg.__name__}.batch.sources")
     shape = wedge(80.0, n=20, irregular=True, seed=2)
     obj = mesh_object("Wedge", shape.points, shape.triangles)
-    options = {"edges": [dict(EDGE) for _ in range(3)], "plots": str(tmp_path / "o")}
+    options = {"edges": [dict(EDGE) for _ in range(3)], "plots": str(tmp_path / "o"), **more}
     handed = []
     patch = pytest.MonkeyPatch()
     if fault is not None:
@@ -113,4 +115,41 @@ def test_a_bug_keeps_every_row_measured_before_it(
         assert "internal error" in row.error and FAULT in row.error, row.error
     stations = [row for row in result.station_rows if not row.error]
     assert len(stations) == sum(edge.n_stations for edge in obj.vg.edges)
+    bpy.data.objects.remove(obj)
+
+
+def test_a_bug_after_every_row_is_measured_says_the_pictures_and_colours_are_not_made(
+    vg, tmp_path, capfd
+):
+    """A bug while the object is painted, every row measured: the rows are kept as measured,
+    and the run is told that the pictures and colours were not made (it exits 2, an output
+    missing), not left to exit 0 with a traceback alone."""
+    result, obj = _run(vg, tmp_path, ("bridge.measuring", "repaint", 1))
+    assert FAULT in capfd.readouterr().err
+    assert result.measured == TASKS and result.failed == 0
+    assert all(not row.error for _, row in result.rows)
+    assert len(result.picture_errors) == 1
+    assert "pictures and colours of Wedge: internal error" in result.picture_errors[0]
+    bpy.data.objects.remove(obj)
+
+
+def test_a_bug_in_a_radius_sweep_gives_each_site_not_swept_its_rows(vg, tmp_path, capfd):
+    """``--sweep``: a bug at the fifth site. The four sites swept keep their rows with their
+    angles; each later site has a row per radius saying "internal error" (before: no row at
+    all, a site the run's count of unswept sites did not see)."""
+    sweep = {"sweep": (0.2, 0.4, 3), "sweep_plots": str(tmp_path / "sweep")}
+    result, obj = _run(vg, tmp_path, ("batch.measure", "radius_sweep", 5), **sweep)
+    assert FAULT in capfd.readouterr().err
+    assert result.measured == TASKS  # the points were measured before the sweeps
+    angle, error = (csvio.SWEEP_COLUMNS.index(c) for c in ("Angle", "error"))
+    by_site = {}
+    for index, cells in result.sweep_rows:
+        by_site.setdefault(index, []).append(cells)
+    assert sorted(by_site) == list(range(TASKS))  # every site has its rows
+    assert all(len(rows) == 3 for rows in by_site.values())  # one per radius
+    for index, rows in by_site.items():
+        if index < 4:
+            assert all(cells[angle] and not cells[error] for cells in rows), index
+        else:
+            assert all(not cells[angle] and FAULT in cells[error] for cells in rows), index
     bpy.data.objects.remove(obj)

@@ -2,6 +2,7 @@
 guessed from its size, shown in the panel, the drag header and the CSV; stored numbers never
 change."""
 
+import functools
 import importlib
 import json
 
@@ -169,36 +170,49 @@ def test_a_scaled_object_without_scan_units_is_labelled_in_mesh_units(vg, tmp_pa
     assert lengths_in(panels, obj) == "BU (1 BU = 0.001 m)"
 
 
+def _profiled(obj):
+    """``obj``'s edge along the wedge's crease, profiled by the extension's operator."""
+    bpy.ops.vg.measure_edge(
+        points=json.dumps([[-0.6, 0.0, 0.0], [0.6, 0.0, 0.0]]), space="MESH", spacing=0.2,
+        radius=0.4,
+    )  # fmt: skip
+    return obj.vg.edges[0]
+
+
+def _drawn_with(plots, obj, edge, unit):
+    """The plot of ``edge`` with ``unit`` on its axis, drawn by the plotting module itself
+    from the edge's own numbers (the oracle)."""
+    from vg_addon.formats import profile_plot
+    from vg_addon.formats.record_codec import exact_numbers
+
+    numbers = exact_numbers(edge)
+    width, height = plots.PLOT_SIZE
+    rgba = profile_plot.render_profile(
+        numbers["arc_lengths"], numbers["angles"], width=width, height=height, units=unit,
+        title=f"{obj.name}, edge {edge.number}", pooled=numbers.get("pooled_angle"),
+    )  # fmt: skip
+    return rgba[::-1].ravel().astype(np.int64)
+
+
+def _shown(plots, edge):
+    """The pixels of the plot image ``edge`` shows."""
+    image = plots.plot_image(edge)
+    pixels = np.empty(len(image.pixels), dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    return np.rint(pixels * 255.0).astype(np.int64)  # the image keeps bytes
+
+
 def test_choosing_scan_units_draws_the_edges_plots_again_naming_them(vg):
     """The plot's axis names the unit; choosing Scan Units in the panel kept the plot drawn
     with the guessed one (before). The oracle: the plot drawn from the edge's own numbers with
     each unit by the plotting module."""
     plots = importlib.import_module(f"{vg.__name__}.bridge.plots")
-    from vg_addon.formats import profile_plot
-    from vg_addon.formats.record_codec import exact_numbers
     from vg_addon.units import SYMBOLS
 
     obj = wedge_object(100.0)
-    bpy.ops.vg.measure_edge(
-        points=json.dumps([[-0.6, 0.0, 0.0], [0.6, 0.0, 0.0]]), space="MESH", spacing=0.2,
-        radius=0.4,
-    )  # fmt: skip
-    edge = obj.vg.edges[0]
-    numbers = exact_numbers(edge)
-
-    def drawn_with(unit):
-        width, height = plots.PLOT_SIZE
-        rgba = profile_plot.render_profile(
-            numbers["arc_lengths"], numbers["angles"], width=width, height=height, units=unit,
-            title=f"{obj.name}, edge {edge.number}", pooled=numbers.get("pooled_angle"),
-        )  # fmt: skip
-        return rgba[::-1].ravel().astype(np.int64)
-
-    def shown():
-        image = plots.plot_image(edge)
-        pixels = np.empty(len(image.pixels), dtype=np.float32)
-        image.pixels.foreach_get(pixels)
-        return np.rint(pixels * 255.0).astype(np.int64)  # the image keeps bytes
+    edge = _profiled(obj)
+    drawn_with = functools.partial(_drawn_with, plots, obj, edge)
+    shown = functools.partial(_shown, plots, edge)
 
     guessed = obj.vg.unit
     assert obj.vg.unit_guessed and np.array_equal(shown(), drawn_with(SYMBOLS[guessed]))
@@ -209,3 +223,37 @@ def test_choosing_scan_units_draws_the_edges_plots_again_naming_them(vg):
     kept = plots.plot_image(edge)
     obj.vg.unit = "CM"  # the same unit chosen again: nothing to draw
     assert plots.plot_image(edge) == kept and kept.name in bpy.data.images
+
+
+def test_scaling_the_object_or_changing_the_scenes_units_draws_its_plots_again(vg):
+    """A plot's axis names the unit its numbers are in: with Scan Units "Scene", the scene's
+    unit, and "mesh units" for a scaled object. After the scene's unit scale changed, or the
+    object was scaled, the plot kept naming the unit it was drawn with (before). The watcher
+    draws it again once the edits pause; the oracle: the plot drawn with each unit by the
+    plotting module."""
+    plots = importlib.import_module(f"{vg.__name__}.bridge.plots")
+    watch = importlib.import_module(f"{vg.__name__}.bridge.watch")
+    units = bpy.context.scene.unit_settings
+    units.system, units.scale_length, units.length_unit = "METRIC", 0.001, "MILLIMETERS"
+    obj = wedge_object(100.0)
+    bpy.context.view_layer.update()
+    edge = _profiled(obj)
+    assert obj.vg.unit == "SCENE"  # the scene names its unit: no guess
+    drawn_with = functools.partial(_drawn_with, plots, obj, edge)
+    assert np.array_equal(_shown(plots, edge), drawn_with("mm"))
+
+    units.scale_length = 1.0
+    bpy.context.view_layer.update()
+    watch._check_pending()  # the watcher's timer, once the edits pause (timers do not run in bpy)
+    assert np.array_equal(_shown(plots, edge), drawn_with("m"))
+
+    obj.scale = (2.0, 2.0, 2.0)
+    bpy.context.view_layer.update()
+    watch._check_pending()
+    assert np.array_equal(_shown(plots, edge), drawn_with("mesh units"))
+    assert len([i for i in bpy.data.images if plots.PLOT_KEY in i]) == 1  # replaced, not added
+    kept = plots.plot_image(edge)
+    obj.location = (1.0, 0.0, 0.0)  # a move: the unit stays, nothing is drawn again
+    bpy.context.view_layer.update()
+    watch._check_pending()
+    assert plots.plot_image(edge) == kept

@@ -204,6 +204,7 @@ def _objects(scene_) -> dict:
             ],
             "active_index": obj.vg.active_index,
             "unit": obj.vg.unit,
+            "scale": list(obj.scale),
             "edges": [
                 {
                     "number": edge.number,

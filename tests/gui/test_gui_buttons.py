@@ -354,6 +354,58 @@ def side_button(gui, copied: str) -> tuple[float, float]:
     raise LookupError(f"no button copying {copied!r} beside a list")
 
 
+def test_scaling_the_object_draws_its_plots_again_and_undo_puts_them_back(gui, places):
+    """With Scan Units "Scene Units", a plot's axis names the scene's unit; once the object is
+    scaled (S 2 Enter over the view, as a user scales it) its lengths are mesh units, and every
+    plot is drawn again naming them, once the edit pauses (before: the plot kept naming the
+    scene's unit). Ctrl+Z puts the scale and the plots back."""
+    gui.scroll_sidebar(-40)
+    menu = gui.find_button("UI", "vg.unit", key="ctrl+shift+c", step=6)
+    wheel = 4  # Ctrl+wheel steps through the menu; "Scene Units" is its first item
+    for _ in range(2 * (len(units.SYMBOLS) + 1)):
+        before = gui.state()["objects"][OBJ]["unit"]
+        if before == "SCENE":
+            break
+        gui.click(menu, button=wheel, modifier="ctrl")
+        state = gui.settle(3)
+        if state["objects"][OBJ]["unit"] == before:
+            wheel = 9 - wheel  # at the menu's other end: step the other way
+    scene_unit = units.scene_symbol("METRIC", 1.0)  # the test scene's: Blender's default
+    state = gui.wait_for(
+        lambda s: (
+            s["objects"][OBJ]["unit"] == "SCENE"
+            and {e["plot_units"] for e in s["objects"][OBJ]["edges"]} == {scene_unit}
+        ),
+        20,
+        "Scene Units, the plots naming the scene's unit",
+    )
+    count = len(state["objects"][OBJ]["edges"])
+    gui.scroll_sidebar(40)
+    gui.click(point(gui, "plus_out"))  # selected, with the Select tool, as a user selects it
+    gui.move(point(gui, "crease"))  # keys go to the view under the pointer
+    gui.key("s")
+    gui.type_text("2")
+    gui.key("Return")
+    gui.wait_for(
+        lambda s: (
+            s["objects"][OBJ]["scale"] == [2.0, 2.0, 2.0]
+            and [e["plot_units"] for e in s["objects"][OBJ]["edges"]] == ["mesh units"] * count
+        ),
+        20,
+        "the object scaled by 2 and its plots naming mesh units",
+    )
+    gui.move(point(gui, "crease"))
+    gui.key("ctrl+z")
+    gui.wait_for(
+        lambda s: (
+            s["objects"][OBJ]["scale"] == [1.0, 1.0, 1.0]
+            and [e["plot_units"] for e in s["objects"][OBJ]["edges"]] == [scene_unit] * count
+        ),
+        20,
+        "the scale and the plots put back",
+    )
+
+
 def test_the_edge_lists_minus_deletes_the_selected_edge_and_its_stations(gui, places):
     """The − beside the Edge Profiles list: the selected edge goes, with its stations (the
     measurements recorded for it); the other edges and measurements stay as they were."""
