@@ -196,8 +196,8 @@ def measure_mesh(index: int, source: MeshSource, tasks, options, progress=None, 
             traceback.print_exc()
             message = internal_error(error)
             _fail_the_rest(result, todo, tasks, options, (name, units, message))
-            # Neither pictures nor colours are made after a bug: the run says so (exit 2).
-            result.picture_errors.append(f"pictures and colours of {name}: {message}")
+            if _makes_outputs(source, options):  # not made after a bug: the run says so
+                result.picture_errors.append(f"pictures and colours of {name}: {message}")
             if rows_ready is not None:
                 rows_ready(result)
         stopping.check()
@@ -212,6 +212,13 @@ def internal_error(error: Exception) -> str:
         f"internal error while measuring this mesh ({type(error).__name__}: {error}); "
         "please report it with the traceback printed on stderr"
     )
+
+
+def _makes_outputs(source: MeshSource, options) -> bool:
+    """Whether the run makes pictures or keeps colours of the mesh ``source`` once its rows are
+    handed over: a map, sweep or profile plots, a saved .blend, or a .blend input's object."""
+    asked = ("render", "sweep", "edges", "find_edges", "save_blend")
+    return any(options.get(key) for key in asked) or not source.path
 
 
 def _fail_the_rest(result: MeshResult, todo, tasks, options, why) -> None:

@@ -74,10 +74,37 @@ def _check_pending():
     names = sorted(_plots_pending)
     _plots_pending.clear()
     for name in names:
-        obj = bpy.data.objects.get(name)
-        if obj is not None and obj.library is None and len(obj.vg.edges):
-            edges.redraw_plots(obj)  # only the plots whose axis names another unit
+        _redraw_plots(bpy.data.objects.get(name))
     return None  # do not repeat
+
+
+def _redraw_plots(obj) -> None:
+    """Draw again the plots of ``obj`` whose axis names another unit than its lengths are in
+    now; an object that cannot be changed here (linked, an override) is left as it is."""
+    if obj is None or obj.type != "MESH" or not len(obj.vg.edges):
+        return
+    if obj.library is not None or obj.override_library is not None or not obj.is_editable:
+        return
+    try:
+        edges.redraw_plots(obj)
+    except (RuntimeError, ValueError, MemoryError) as error:  # a plot is not worth a traceback
+        print(f"Virtual Goniometer: the plots of '{obj.name}' were not drawn again: {error}")
+
+
+def _remember_scene_units() -> None:
+    """Note every scene's units as they are now (a file loaded, an undo): a change from here
+    on is one the plots must follow."""
+    _scene_units.clear()
+    for scene in bpy.data.scenes:
+        settings = scene.unit_settings
+        _scene_units[scene.as_pointer()] = (settings.system, settings.scale_length)
+
+
+def _schedule_check() -> None:
+    """Run the check once the edits pause (:data:`_DELAY` after the last call)."""
+    if bpy.app.timers.is_registered(_check_pending):
+        bpy.app.timers.unregister(_check_pending)
+    bpy.app.timers.register(_check_pending, first_interval=_DELAY)
 
 
 def _note_plot_units(update) -> None:
@@ -119,17 +146,23 @@ def on_depsgraph_update(scene, depsgraph):
         if vg is not None and len(vg.measurements):
             _pending.add(obj.name)
     if _pending or _plots_pending:
-        if bpy.app.timers.is_registered(_check_pending):
-            bpy.app.timers.unregister(_check_pending)
-        bpy.app.timers.register(_check_pending, first_interval=_DELAY)
+        _schedule_check()
 
 
 @persistent
 def on_undo_or_redo(*_args):
     """Undo and redo may restore any geometry and any records: read them again before
-    trusting what was kept."""
+    trusting what was kept. They may also bring back plots drawn before a scale or a unit
+    change that the step they return to keeps (the plots were drawn after it was stored): every
+    object's plots are checked once the edits pause."""
     mesh_data.invalidate_all()
     painting.new_generation()
+    _remember_scene_units()
+    _plots_pending.update(
+        obj.name for obj in bpy.data.objects if obj.type == "MESH" and len(obj.vg.edges)
+    )
+    if _plots_pending:
+        _schedule_check()
 
 
 def clear_caches() -> None:
@@ -149,6 +182,7 @@ def on_load(*_args):
     """Another file: forget everything kept for the previous one, and bring world-space
     measurements of earlier versions into mesh coordinates."""
     clear_caches()
+    _remember_scene_units()
     for obj in bpy.data.objects:
         if obj.type != "MESH":
             continue

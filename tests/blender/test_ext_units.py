@@ -257,3 +257,41 @@ def test_scaling_the_object_or_changing_the_scenes_units_draws_its_plots_again(v
     bpy.context.view_layer.update()
     watch._check_pending()
     assert plots.plot_image(edge) == kept
+
+
+def test_an_undo_to_a_step_stored_before_the_plots_were_drawn_again_draws_them_again(vg):
+    """The watcher draws the plots again after the edit's undo step was stored: that step holds
+    the new scale with the old plots. Undoing back to it (a later step undone) showed plots
+    naming the scene's unit on a scaled object (before); the undo now has them checked."""
+    plots = importlib.import_module(f"{vg.__name__}.bridge.plots")
+    watch = importlib.import_module(f"{vg.__name__}.bridge.watch")
+    units = bpy.context.scene.unit_settings
+    units.system, units.scale_length, units.length_unit = "METRIC", 1.0, "METERS"
+    wedge_object(100.0)
+    bpy.context.view_layer.update()
+    bpy.context.active_object.vg.unit = "SCENE"  # the unit the scene says
+    _profiled(bpy.context.active_object)
+
+    def current():
+        return bpy.data.objects["Wedge"]  # undo reloads the data: old references go stale
+
+    def drawn_in(unit) -> bool:
+        edge = current().vg.edges[0]
+        return np.array_equal(_shown(plots, edge), _drawn_with(plots, current(), edge, unit))
+
+    assert drawn_in("m")
+    bpy.ops.ed.undo_push(message="profiled")
+    current().scale = (2.0, 2.0, 2.0)
+    bpy.context.view_layer.update()
+    bpy.ops.ed.undo_push(message="scaled")  # stored before the watcher's timer runs
+    watch._check_pending()  # the timer (timers do not run in bpy)
+    assert drawn_in("mesh units")
+    current().location = (0.5, 0.0, 0.0)
+    bpy.context.view_layer.update()
+    bpy.ops.ed.undo_push(message="moved")
+    watch._check_pending()
+    bpy.ops.ed.undo()  # back to "scaled": scale 2, with the plot stored then
+    assert tuple(current().scale) == (2.0, 2.0, 2.0)
+    assert drawn_in("m")  # the plot the step stored
+    watch._check_pending()
+    assert drawn_in("mesh units")

@@ -361,15 +361,11 @@ def test_scaling_the_object_draws_its_plots_again_and_undo_puts_them_back(gui, p
     scene's unit). Ctrl+Z puts the scale and the plots back."""
     gui.scroll_sidebar(-40)
     menu = gui.find_button("UI", "vg.unit", key="ctrl+shift+c", step=6)
-    wheel = 4  # Ctrl+wheel steps through the menu; "Scene Units" is its first item
-    for _ in range(2 * (len(units.SYMBOLS) + 1)):
-        before = gui.state()["objects"][OBJ]["unit"]
-        if before == "SCENE":
+    for _ in range(len(units.SYMBOLS) + 1):  # Ctrl+wheel steps round the menu's items
+        if gui.state()["objects"][OBJ]["unit"] == "SCENE":
             break
-        gui.click(menu, button=wheel, modifier="ctrl")
-        state = gui.settle(3)
-        if state["objects"][OBJ]["unit"] == before:
-            wheel = 9 - wheel  # at the menu's other end: step the other way
+        gui.click(menu, button=4, modifier="ctrl")
+        gui.settle(3)
     scene_unit = units.scene_symbol("METRIC", 1.0)  # the test scene's: Blender's default
     state = gui.wait_for(
         lambda s: (
@@ -381,8 +377,11 @@ def test_scaling_the_object_draws_its_plots_again_and_undo_puts_them_back(gui, p
     )
     count = len(state["objects"][OBJ]["edges"])
     gui.scroll_sidebar(40)
-    gui.click(point(gui, "plus_out"))  # selected, with the Select tool, as a user selects it
-    gui.move(point(gui, "crease"))  # keys go to the view under the pointer
+    sidebar_left = gui.state()["regions"]["UI"][0]
+    face, crease = point(gui, "plus_out"), point(gui, "crease")
+    assert max(face[0], crease[0]) < sidebar_left - 20, "the wedge is under the sidebar"
+    gui.click(face)  # selected, with the Select tool, as a user selects it
+    gui.move(crease)  # keys go to the view under the pointer
     gui.key("s")
     gui.type_text("2")
     gui.key("Return")
@@ -394,7 +393,7 @@ def test_scaling_the_object_draws_its_plots_again_and_undo_puts_them_back(gui, p
         20,
         "the object scaled by 2 and its plots naming mesh units",
     )
-    gui.move(point(gui, "crease"))
+    gui.move(crease)
     gui.key("ctrl+z")
     gui.wait_for(
         lambda s: (
