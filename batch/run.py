@@ -69,6 +69,9 @@ class Run:
         self.last_progress = 0.0
         self.last_write = 0.0  # when the CSV was last written (perf_counter seconds)
         self.write_seconds = 0.0  # how long that took
+        # The header's write (mostly the disk's flush) says nothing of what rows cost: the first
+        # rows are written at once, before any picture.
+        self.wrote_rows = False
         self.in_flight: dict[int, int] = {}  # mesh -> points done so far (running meshes)
         self.units = run_units_label(getattr(args, "units", None))
         # A pipe or standard output gets the CSV once, at the end; a file is rewritten as the
@@ -177,10 +180,11 @@ class Run:
     def add(self, result: MeshResult, pictures_follow: bool = False) -> None:
         """Take a mesh's rows (before its pictures are drawn). A row that cannot be written
         costs only its own cells (``csvio.writable_row``); the CSV is rewritten now and then, so
-        a run that is stopped keeps them: at least every 5 s, and before a mesh's pictures
-        whenever the last rewrite took under 50 ms or under a tenth of the time since (the whole
-        CSV is rewritten each time, so rewriting before every mesh's pictures would cost a run
-        of many meshes time that grows with the square of their number)."""
+        a run that is stopped keeps them: the first rows at once, then at least every 5 s, and
+        before a mesh's pictures whenever the last rewrite took under 50 ms or under a tenth of
+        the time since (the whole CSV is rewritten each time, so rewriting before every mesh's
+        pictures would cost a run of many meshes time that grows with the square of their
+        number)."""
         with self.lock:
             self.in_flight.pop(result.mesh, None)
             self.results.append(result)
@@ -195,7 +199,7 @@ class Run:
                 self.bad_files.append(result.bad_file)
             # Each write costs more as rows accumulate; finish() always writes.
             since = time.perf_counter() - self.last_write
-            due = since >= max(5.0, 10.0 * self.write_seconds)
+            due = not self.wrote_rows or since >= max(5.0, 10.0 * self.write_seconds)
             cheap = self.write_seconds < 0.05 or since >= 10.0 * self.write_seconds
             if not self.stream and (due or (pictures_follow and cheap)):
                 self.try_write_csv()
@@ -299,6 +303,7 @@ class Run:
         csvio.write_export(out, rows, self.edge_rows, lines=self.csv_lines, summary=edges)
         self.last_write = time.perf_counter()
         self.write_seconds = self.last_write - start
+        self.wrote_rows = self.wrote_rows or bool(rows)
 
     def write_sweep_csv(self) -> None:
         """Write ``<out>_sweep.csv``; a failure is a failed output (exit 2), the rows kept."""
