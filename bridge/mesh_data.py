@@ -302,6 +302,12 @@ def other_names(obj) -> tuple[str, ...]:
     return tuple(sorted(names - own))
 
 
+def is_changeable(block) -> bool:
+    """Whether ``block`` (an object, a mesh) may be changed in this file: neither linked from a
+    library nor a library override, and editable."""
+    return block.library is None and block.override_library is None and block.is_editable
+
+
 def check_measurable(obj) -> None:
     """Raise a :class:`GoniometerError` saying why ``obj`` cannot be measured, if it cannot."""
     if obj is None:
@@ -313,7 +319,7 @@ def check_measurable(obj) -> None:
             f"'{obj.name}' is not a mesh but an object of type {obj.type}: select a mesh object."
         )
     for block in (obj, obj.data):
-        if block.library is not None or block.override_library is not None or not block.is_editable:
+        if not is_changeable(block):
             source = block.library.filepath if block.library is not None else "a library override"
             raise GoniometerError(
                 f"'{block.name}' is linked from {source} and cannot be changed here: make it "

@@ -83,7 +83,7 @@ def _redraw_plots(obj) -> None:
     now; an object that cannot be changed here (linked, an override) is left as it is."""
     if obj is None or obj.type != "MESH" or not len(obj.vg.edges):
         return
-    if obj.library is not None or obj.override_library is not None or not obj.is_editable:
+    if not mesh_data.is_changeable(obj):
         return
     try:
         edges.redraw_plots(obj)

@@ -34,8 +34,12 @@ lane() {  # lane LABEL PYTHON PYTEST-ARGS...: one lane, in the foreground
 pair() {  # pair LABEL1 PYTHON1 TESTS1 LABEL2 PYTHON2 TESTS2 PYTEST-ARGS...: two lanes at once
     local first=("$1" "$2" "$3") second=("$4" "$5" "$6") start=$SECONDS code=0
     shift 6
-    local log="$logs/${#second[0]}-$RANDOM"
-    "${second[1]}" -m pytest -p no:cacheprovider "${second[2]}" "$@" > "$log" 2>&1 &
+    local log
+    log=$(mktemp "$logs/lane.XXXXXX")
+    # A shell without job control starts background commands with Ctrl-C and SIGQUIT ignored,
+    # and a process inherits that: the stop tests' runs would not stop. Restored first.
+    (trap - INT QUIT && exec "${second[1]}" -m pytest -p no:cacheprovider "${second[2]}" "$@") \
+        > "$log" 2>&1 &
     local background=$!
     lane "${first[0]}" "${first[1]}" "${first[2]}" "$@"
     wait "$background" || code=$?

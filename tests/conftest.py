@@ -3,6 +3,7 @@ extension zip the Blender and GUI tests install."""
 
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -17,6 +18,15 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 import unprivileged  # noqa: E402  (tests/ is on sys.path once this file is imported)
+
+# Started in the background by a shell without job control (or by nohup), pytest would pass
+# Ctrl-C and SIGQUIT on ignored to every run it starts, and the stop tests' runs would not stop.
+for _signal, _default in (
+    (signal.SIGINT, signal.default_int_handler),
+    (signal.SIGQUIT, signal.SIG_DFL),
+):
+    if signal.getsignal(_signal) == signal.SIG_IGN:
+        signal.signal(_signal, _default)
 
 
 @pytest.fixture(scope="session")
