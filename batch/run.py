@@ -70,8 +70,8 @@ class Run:
         self.last_write = 0.0  # when the CSV was last written (perf_counter seconds)
         self.write_seconds = 0.0  # how long that took
         # The header's write (mostly the disk's flush) says nothing of what rows cost: the first
-        # rows are written at once, before any picture.
-        self.wrote_rows = False
+        # measured rows are written at once, before any picture.
+        self.wrote_rows = False  # a write of measured rows was tried
         self.in_flight: dict[int, int] = {}  # mesh -> points done so far (running meshes)
         self.units = run_units_label(getattr(args, "units", None))
         # A pipe or standard output gets the CSV once, at the end; a file is rewritten as the
@@ -203,6 +203,7 @@ class Run:
             cheap = self.write_seconds < 0.05 or since >= 10.0 * self.write_seconds
             if not self.stream and (due or (pictures_follow and cheap)):
                 self.try_write_csv()
+                self.wrote_rows = True
 
     def pictures_done(self, result: MeshResult) -> None:
         """Take a mesh's pictures (after :meth:`add`): note those that failed, report the
@@ -303,7 +304,6 @@ class Run:
         csvio.write_export(out, rows, self.edge_rows, lines=self.csv_lines, summary=edges)
         self.last_write = time.perf_counter()
         self.write_seconds = self.last_write - start
-        self.wrote_rows = self.wrote_rows or bool(rows)
 
     def write_sweep_csv(self) -> None:
         """Write ``<out>_sweep.csv``; a failure is a failed output (exit 2), the rows kept."""

@@ -23,9 +23,9 @@ import unprivileged  # noqa: E402  (tests/ is on sys.path once this file is impo
 # Ctrl-C and SIGQUIT on ignored to every run it starts, and the stop tests' runs would not stop.
 for _signal, _default in (
     (signal.SIGINT, signal.default_int_handler),
-    (signal.SIGQUIT, signal.SIG_DFL),
+    (getattr(signal, "SIGQUIT", None), signal.SIG_DFL),  # no SIGQUIT on Windows
 ):
-    if signal.getsignal(_signal) == signal.SIG_IGN:
+    if _signal is not None and signal.getsignal(_signal) == signal.SIG_IGN:
         signal.signal(_signal, _default)
 
 

@@ -321,7 +321,7 @@ class VIEW3D_PT_vg_edges(_GoniometerPanel, bpy.types.Panel):
             scale = ui_scale(context)
             units = max(8.0, (region_width(context) - 60 * scale) / (20 * scale))
             layout.template_icon(icon_value=layout.icon(image), scale=units)
-            layout.label(text="Angle (°) against arc length")
+            layout.label(text=f"Angle (°) against arc length ({unit})")
         layout.prop(edge, "note")
 
 

@@ -379,15 +379,25 @@ runpy.run_path(sys.argv[0], run_name="__main__")
 """
 
 
-@pytest.mark.parametrize("flush_delay", [0.0, 0.5], ids=["disk", "slow disk"])
-def test_a_run_killed_while_its_map_renders_keeps_the_meshs_rows(tmp_path, flush_delay):
+@pytest.mark.parametrize(
+    ("flush_delay", "unmatched"),
+    [(0.0, False), (1.5, False), (1.5, True)],
+    ids=["disk", "slow disk", "slow disk, a row for no mesh"],
+)
+def test_a_run_killed_while_its_map_renders_keeps_the_meshs_rows(tmp_path, flush_delay, unmatched):
     """Rows are written before pictures: SIGKILL the run as soon as a map has begun (its hidden
     folder appears in the render folder), and the CSV on disk holds that mesh's rows. On a slow
-    disk the header's write once made the rows' write look too dear, so they were not written."""
+    disk the header's write once made the rows' write look too dear, so they were not written
+    (also where the header's write holds a refused row: a --points row naming no mesh given)."""
     mesh = write_wedge(tmp_path / "w.ply")
     maps, out = tmp_path / "maps", tmp_path / "o.csv"
+    where = list(AT)
+    if unmatched:
+        points = tmp_path / "points.csv"
+        points.write_text("Mesh Name,x,y,z,Radius\nelsewhere,0.05,0,0,0.3\nw,0.05,0,0,0.3\n")
+        where = ["--points", str(points)]
     process = subprocess.Popen(
-        [sys.executable, "-c", SLOW_DISK, str(flush_delay), str(SCRIPT), str(mesh), *AT,
+        [sys.executable, "-c", SLOW_DISK, str(flush_delay), str(SCRIPT), str(mesh), *where,
          "--render", str(maps), "--render-size", "1200", "900", "--render-samples", "64",
          "--out", str(out)],
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
@@ -402,7 +412,9 @@ def test_a_run_killed_while_its_map_renders_keeps_the_meshs_rows(tmp_path, flush
     finally:
         process.wait()
     rows = csvio.read_measurements_csv(out)
-    assert len(rows) == 1 and abs(rows[0].angle - 90.0) < 0.01
+    measured = [row for row in rows if row.angle is not None]
+    assert len(measured) == 1 and abs(measured[0].angle - 90.0) < 0.01
+    assert len(rows) == 1 + unmatched
     assert not list(maps.glob("*.png"))  # no picture of the stopped map was kept in place
 
 
