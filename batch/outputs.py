@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import contextlib
 import os
+import stat
+import sys
 from pathlib import Path
 
 import bpy
@@ -100,6 +102,21 @@ def _is_stream(out) -> bool:
     return out == files.STDOUT or (os.path.exists(out) and _kind(out) == "stream")
 
 
+def _stdout_input(inputs) -> str:
+    """The input standard output is (``"what path"``; e.g. ``>> mesh.ply``), or ""."""
+    try:
+        out = os.fstat(sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # closed, or not a file descriptor
+        return ""
+    if not stat.S_ISREG(out.st_mode):
+        return ""
+    for what, source in inputs:
+        with contextlib.suppress(OSError):
+            if os.path.samestat(out, os.stat(source)):
+                return f"the {what} {source}"
+    return ""
+
+
 def sweep_paths(out) -> tuple[Path, Path]:
     """Where ``--sweep`` writes: ``<out>_sweep.csv`` and the plot folder ``<out>_sweep/``,
     beside ``out`` as given (a link's target's folder would part them from the CSV)."""
@@ -139,7 +156,20 @@ def check_outputs(args) -> None:
         outputs.append(("--sweep's CSV", str(csv_path)))
         if plots.exists() and not plots.is_dir():
             raise UsageError(f"--sweep: {plots} (its plot folder) is a file; move it away.")
+    elif args.out and not _is_stream(args.out):
+        # Without --sweep an earlier run's sweep there is emptied (Run.empty_earlier_sweep).
+        csv_path, _ = sweep_paths(args.out)
+        if csvio.holds_sweep(csv_path):
+            outputs.append(
+                ("--out's earlier sweep CSV (emptied by a run without --sweep)", str(csv_path))
+            )
     inputs = input_files(args)
+    if args.out == files.STDOUT and (victim := _stdout_input(inputs)):
+        raise UsageError(
+            f"--out {args.out} writes to standard output, which goes to {victim}: writing there "
+            "would destroy an input. Send standard output elsewhere or give --out a file name; "
+            "nothing was read or written."
+        )
     for option, path in outputs:
         if victim := input_of(path, inputs):
             raise UsageError(

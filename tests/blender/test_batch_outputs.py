@@ -235,3 +235,41 @@ def test_sweep_outputs_are_checked_like_the_others(scan, tmp_path):
             "--sweep's CSV", "is the points CSV")  # fmt: skip
     assert victim.read_text() == "x,y,z\n0.05,0,0\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["o_sweep.csv", "scan.ply"]
+
+
+def test_an_earlier_sweep_given_as_points_is_refused_not_emptied(scan, tmp_path):
+    """A run without --sweep empties an earlier <out>_sweep.csv beside --out: where that file is
+    the points CSV (a sweep's rows have x, y and z), the run is refused and the file kept."""
+    out = tmp_path / "site.csv"
+    made = batch(scan, *AT, "--sweep", "0.2", "0.4", "3", "--out", out)
+    assert made.returncode == 0, made.stderr
+    sweep = tmp_path / "site_sweep.csv"
+    before = sweep.read_bytes()
+    assert before.count(b"\n") == 4  # the header and three radii
+    refused(batch(scan, "--points", sweep, "--radius", "0.3", "--out", out),
+            "--out's earlier sweep CSV", "is the points CSV", "would destroy an input")  # fmt: skip
+    assert sweep.read_bytes() == before
+    # Given under another --out, the sweep's points are measured and the file is left alone.
+    result = batch(scan, "--points", sweep, "--radius", "0.3", "--out", tmp_path / "other.csv")
+    assert result.returncode == 0, result.stderr
+    assert sweep.read_bytes() == before
+
+
+@pytest.mark.parametrize("what", ["mesh", "points CSV"])
+def test_out_dash_onto_standard_output_appended_to_an_input_is_refused(scan, tmp_path, what):
+    """``--out - >> INPUT`` would append the CSV to the input (``--out /dev/stdout >> INPUT``
+    was refused already): refused, the input byte for byte as it was."""
+    points = tmp_path / "points.csv"
+    points.write_text("x,y,z,site\n0.05,0,0,A\n")
+    victim = scan if what == "mesh" else points
+    before = victim.read_bytes()
+    with open(victim, "ab") as appended:
+        result = subprocess.run(
+            [sys.executable, str(BATCH_SCRIPT), str(scan), "--points", str(points),
+             "--radius", "0.3", "--out", "-"],
+            stdout=appended, stderr=subprocess.PIPE, text=True, timeout=600, check=False,
+        )  # fmt: skip
+    assert result.returncode == 2, result.stderr
+    assert "Traceback" not in result.stderr
+    assert "writes to standard output, which goes to the" in result.stderr, result.stderr
+    assert victim.read_bytes() == before

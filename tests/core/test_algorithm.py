@@ -198,9 +198,37 @@ class TestErrors:
         with pytest.raises(GoniometerError, match="integer"):
             Surface(np.zeros((3, 3)), [[0.0, 1.5, 2.0]])
 
-    def test_patch_centre_must_be_a_vertex(self):
+    @pytest.mark.parametrize("centre", [10**9, -1, 1.5, float("nan"), "a", None, True, [1, 2]])
+    def test_patch_centre_must_be_a_vertex(self, centre):
+        # A float, a bool (a mask to NumPy) or a list raised IndexError, ValueError or TypeError.
         with pytest.raises(GoniometerError, match="cannot be a patch centre"):
-            self.surface.patch(10**9, 0.5)
+            self.surface.patch(centre, 0.5)
+
+    def test_patch_centre_may_be_any_whole_number_type(self):
+        expected = self.surface.patch(5, 0.5)
+        assert expected.size > 1
+        for centre in (np.int32(5), np.int64(5), np.uint16(5)):
+            assert np.array_equal(self.surface.patch(centre, 0.5), expected)
+
+    def test_complex_coordinates_are_refused_not_cut_to_their_real_parts(self):
+        mesh = wedge(90, n=20)
+        with pytest.raises(GoniometerError, match="real numbers"):
+            Surface(mesh.points + 5j, mesh.triangles)
+
+    def test_corner_edge_ids_of_any_size_name_edges(self):
+        """Ids beyond the corners' count (loose edges, another numbering) are only names: the
+        winding read is the one of ids numbered from 0 (a 10**12 id tried to count 10**12 edges
+        and ran out of memory)."""
+        from vg_addon.fragments import flake
+
+        mesh = flake()  # closed, wound outward
+        corners = np.stack([mesh.triangles, np.roll(mesh.triangles, -1, axis=1)], axis=2)
+        edges = np.sort(corners.reshape(-1, 2), axis=1)  # corner k: from vertex k to k + 1
+        compact = np.unique(edges, axis=0, return_inverse=True)[1].reshape(-1)
+        reference = Surface(mesh.points, mesh.triangles, corner_edges=compact).winding
+        spread = compact.astype(np.int64) * 10**9 + 7
+        assert Surface(mesh.points, mesh.triangles, corner_edges=spread).winding == reference
+        assert reference == Surface(mesh.points, mesh.triangles).winding == "outward"
 
     def test_non_finite_points(self):
         mesh = wedge(90, n=20)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import numpy as np
 import pytest
 
 from vg_addon import GoniometerError
@@ -159,3 +160,21 @@ def test_the_rows_of_a_written_csv_read_back_to_the_same_rows():
     ]
     back = csvio.read_measurements_csv(csvio.format_measurements_csv(rows))
     assert [dataclasses.replace(r, date="") for r in back] == rows
+
+
+def test_an_edge_of_many_points_reads_back_and_leaves_the_csv_modules_cap_alone():
+    """An edge from a picked-points file of 20,000 points: its Points cell (about 1.2 million
+    characters) is far over the csv module's default cap of 131,072 per cell, which refused
+    the file the batch had just written. Read back exactly; the process-wide cap is restored."""
+    import csv
+
+    rng = np.random.default_rng(7)
+    points = rng.normal(size=(20_000, 3)) * 1e3
+    cell = csvio.format_points(points)
+    assert len(cell) > 8 * 131_072
+    cap = csv.field_size_limit()
+    text = csvio.format_edges_csv([edge_row(points=cell), edge_row(edge_number=2)])
+    rows = csvio.read_edges_csv(text)
+    assert [row.edge_number for row in rows] == [1, 2]
+    assert np.array_equal(np.array(csvio.parse_points(rows[0].points)), points)
+    assert csv.field_size_limit() == cap

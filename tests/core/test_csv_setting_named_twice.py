@@ -25,10 +25,31 @@ def test_a_setting_given_by_two_of_its_names_is_refused(header, row, columns):
 
 
 def test_other_columns_given_twice_are_read_as_before():
-    """A label beside a note, or an object beside the mesh name, decide nothing measured: the
-    first name the reader knows is read, as before."""
-    rows = csvio.read_replication_csv("x,y,z,Label,Note,Mesh Name,Object\n1,2,3,a,b,m,o\n")
-    assert (rows[0].label, rows[0].mesh_name) == ("a", "m")
+    """A label beside a note, or two break numbers, decide nothing measured: the first name the
+    reader knows is read, as before."""
+    rows = csvio.read_replication_csv("x,y,z,Label,Note,Break #,break\n1,2,3,a,b,4,5\n")
+    assert (rows[0].label, rows[0].break_number) == ("a", 4)
+
+
+@pytest.mark.parametrize(
+    ("header", "row", "columns"),
+    [
+        ("x,y,z,Mesh Name,Object", "1,2,3,m,o", "4 ('Mesh Name') and 5 ('Object')"),
+        ("Object,Mesh Name,x,y,z", "o,m,1,2,3", "1 ('Object') and 2 ('Mesh Name')"),
+        ("x,y,z,Edge #,edge,Arc Length", "1,2,3,1,2,0.5", "4 ('Edge #') and 5 ('edge')"),
+    ],
+)
+def test_a_mesh_name_or_edge_number_given_twice_is_refused(header, row, columns):
+    """The mesh name picks the mesh a row is measured on, and the edge number whether it is a
+    station: an object beside a mesh name was read as the mesh name alone, without a word."""
+    with pytest.raises(GoniometerError, match="nothing was read") as refusal:
+        csvio.read_replication_csv(f"{header}\n{row}\n")
+    assert f"columns {columns}" in str(refusal.value)
+
+
+def test_an_edge_number_a_spreadsheet_wrote_as_a_decimal_is_the_edge():
+    text = "x,y,z,Edge #,Arc Length,Spacing\n1,2,3,1.0,0.5,0.25\n1,2,4,2,0.75,0.25\n"
+    assert [row.edge_number for row in csvio.read_replication_csv(text)] == [1, 2]
 
 
 def test_one_name_per_setting_reads_as_before():

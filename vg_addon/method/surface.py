@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import operator
 from dataclasses import replace
 
 import numpy as np
@@ -74,7 +75,12 @@ def _as_corner_edges(corner_edges, n_triangles: int) -> np.ndarray:
         )
     if given.size and given.min() < 0:
         raise GoniometerError("The corner edges must be edge ids from 0 up; got a negative one.")
-    return given.reshape(-1)
+    given = given.reshape(-1)
+    if given.size and int(given.max()) >= given.size:
+        # Ids only name edges: numbered from 0 in order, the counts per edge need no more room
+        # than there are corners (a mesh with loose edges, or ids of another numbering).
+        given = np.unique(given, return_inverse=True)[1].reshape(-1)
+    return given
 
 
 class Surface:
@@ -195,13 +201,14 @@ class Surface:
         """
         radius = as_radius(radius)
         mode = check_patch_mode(patch)
-        if not (0 <= int(center_index) < self.n_points and self.valid[center_index]):
+        index = operator.index(center_index) if _is_vertex_number(center_index) else -1
+        if not (0 <= index < self.n_points and self.valid[index]):
             raise GoniometerError(
-                f"Vertex {center_index} cannot be a patch centre: it is not a vertex of this "
-                "surface with a normal. Use Surface.snap to find one."
+                f"Vertex {center_index!r} cannot be a patch centre: it is not a vertex of this "
+                "surface with a normal (a whole number from 0). Use Surface.snap to find one."
             )
-        indices, _ = self.index.ball(self.points[center_index], radius)
-        return self._restrict(indices, int(center_index), radius, mode)
+        indices, _ = self.index.ball(self.points[index], radius)
+        return self._restrict(indices, index, radius, mode)
 
     def _restrict(self, indices: np.ndarray, center_index: int, radius: float, mode: str):
         """The patch within the Euclidean ball ``indices``: all of it, or its geodesic part."""
@@ -343,6 +350,11 @@ def _too_far(center: np.ndarray, radius: float) -> GoniometerError:
         f"{radius:g} from every vertex of the surface: pick a point on the surface, or check "
         "that the coordinates are in the mesh's units and frame."
     )
+
+
+def _is_vertex_number(value) -> bool:
+    """Whether ``value`` is a whole number (a NumPy integer too), not a bool or a float."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
 def check_patch_mode(patch) -> str:

@@ -165,6 +165,13 @@ def _lenient_number(raw: str) -> int | float | None:
     return None
 
 
+def _whole(value: int | float | None) -> int | None:
+    """An edge number as a whole number; a spreadsheet may have re-saved ``1`` as ``1.0``."""
+    if isinstance(value, float) and value.is_integer() and abs(value) < 2**53:
+        return int(value)
+    return value if isinstance(value, int) else None
+
+
 def _parse_name(raw: str) -> str | None:
     """A mesh name or a note as written, surrounding spaces kept (a file " lead.ply" is the
     mesh " lead"; a note is re-recorded as it was); ``None`` when blank."""
@@ -186,6 +193,8 @@ def _aliases(header: list[str]) -> dict:
 #: of its aliases (``lambda`` and ``SegParam``), is refused: the first alias would be measured
 #: and the other column ignored without a word.
 _SETTINGS = {
+    "mesh_name": "mesh name",  # the mesh a row is measured on
+    "edge_number": "edge number",  # a station of an edge, or a measurement of its own
     "x": "x",
     "y": "y",
     "z": "z",
@@ -355,7 +364,7 @@ def parse_replication_csv(
                 label=_parse_name(cell("label")),
                 number=_lenient_number(cell("number")),
                 break_number=break_number,
-                edge_number=edge_number if isinstance(edge_number, int) else None,
+                edge_number=_whole(edge_number),
                 arc_length=values["arc_length"],
                 spacing=values["spacing"],
                 edge_closed=edge_closed,

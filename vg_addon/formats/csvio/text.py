@@ -255,6 +255,9 @@ def read_records(text: str, source: str) -> list[tuple[int, list[str]]]:
     records = []
     header: list[str] = []
     line = 1
+    # The csv module's default cap on a cell (131,072 characters) is below what an edge's Points
+    # cell holds for a few thousand picked points; no cell is longer than the text.
+    limit = csv.field_size_limit(max(csv.field_size_limit(), min(len(text) + 1, 2**31 - 1)))
     try:
         while True:
             line = reader.line_num + 1  # the physical line the record starts on
@@ -277,6 +280,8 @@ def read_records(text: str, source: str) -> list[tuple[int, list[str]]]:
             f"{source} is not a readable CSV near line {reader.line_num}: {error}. "
             "Check the quotes on that line."
         ) from None
+    finally:
+        csv.field_size_limit(limit)  # process-wide: other code in Blender keeps its cap
     return records
 
 
