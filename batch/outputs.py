@@ -6,7 +6,6 @@ from __future__ import annotations
 import contextlib
 import os
 import stat
-import sys
 from pathlib import Path
 
 import bpy
@@ -103,10 +102,11 @@ def _is_stream(out) -> bool:
 
 
 def _stdout_input(inputs) -> str:
-    """The input standard output is (``"what path"``; e.g. ``>> mesh.ply``), or ""."""
+    """The input standard output is (``"what path"``; e.g. ``>> mesh.ply``), or "". Descriptor
+    1, which the CSV is written to (``files``), whatever ``sys.stdout`` has been replaced by."""
     try:
-        out = os.fstat(sys.stdout.fileno())
-    except (OSError, ValueError, AttributeError):  # closed, or not a file descriptor
+        out = os.fstat(1)
+    except OSError:  # closed
         return ""
     if not stat.S_ISREG(out.st_mode):
         return ""

@@ -321,7 +321,7 @@ class Run:
         """An earlier run's ``<out>_sweep.csv`` beside this run's CSV is emptied to its header:
         left, it would pair this CSV with the sweep of other points. Said, as its plots left in
         ``<out>_sweep/`` are; a failure is a failed output (exit 2)."""
-        if self.args.out == files.STDOUT:
+        if self.stream:  # standard output, a pipe or a device: nothing is written beside it
             return
         csv_path, plots = sweep_paths(self.args.out)
         if not csvio.holds_sweep(csv_path):

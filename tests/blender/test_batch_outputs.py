@@ -273,3 +273,20 @@ def test_out_dash_onto_standard_output_appended_to_an_input_is_refused(scan, tmp
     assert "Traceback" not in result.stderr
     assert "writes to standard output, which goes to the" in result.stderr, result.stderr
     assert victim.read_bytes() == before
+
+
+def test_a_sweep_beside_a_named_pipe_out_is_not_emptied(scan, tmp_path):
+    """Nothing is written beside a stream: with --out a named pipe, a file named like its sweep
+    CSV (here the points CSV) is measured and left as it was (before: emptied to its header)."""
+    made = batch(scan, *AT, "--sweep", "0.2", "0.4", "3", "--out", tmp_path / "first.csv")
+    assert made.returncode == 0, made.stderr
+    sweep = (tmp_path / "first_sweep.csv").rename(tmp_path / "pipe_sweep.csv")
+    before = sweep.read_bytes()
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    with subprocess.Popen(["cat", str(pipe)], stdout=subprocess.PIPE) as reader:
+        result = batch(scan, "--points", sweep, "--radius", "0.3", "--out", pipe)
+        received = reader.communicate(timeout=60)[0].decode()
+    assert result.returncode == 0, result.stderr
+    assert len(csvio.parse_measurements_csv(received)) == 3
+    assert sweep.read_bytes() == before

@@ -207,13 +207,21 @@ class TestErrors:
     def test_patch_centre_may_be_any_whole_number_type(self):
         expected = self.surface.patch(5, 0.5)
         assert expected.size > 1
-        for centre in (np.int32(5), np.int64(5), np.uint16(5)):
+        for centre in (np.int32(5), np.int64(5), np.uint16(5), np.array(5)):
             assert np.array_equal(self.surface.patch(centre, 0.5), expected)
 
     def test_complex_coordinates_are_refused_not_cut_to_their_real_parts(self):
         mesh = wedge(90, n=20)
         with pytest.raises(GoniometerError, match="real numbers"):
             Surface(mesh.points + 5j, mesh.triangles)
+        surface = Surface(mesh.points, mesh.triangles)
+        for centre in (np.array([0.1 + 5j, 0, 0]), [0.1 + 5j, 0, 0]):
+            with pytest.raises(GoniometerError, match="three real numbers"):
+                surface.measure(centre, 0.3)
+
+    def test_ragged_points_are_refused_with_a_reason(self):
+        with pytest.raises(GoniometerError, match=r"numbers in an \(n, 3\) array"):
+            Surface([[0, 0, 0], [1, 0, 0], [0, 1]], [[0, 1, 2]])
 
     def test_corner_edge_ids_of_any_size_name_edges(self):
         """Ids beyond the corners' count (loose edges, another numbering) are only names: the

@@ -2,7 +2,8 @@
 
 With the centre on one face, most of the patch lies on that face, and Algorithm 1's split can
 cut that face in two: the two planes then still meet near the centre, so no earlier check saw
-it (a 90° wedge clicked 0.24 from its edge at radius 0.3 read 128.78°). The oracle is the
+it (a regular 90° wedge clicked 0.24 from its edge at radius 0.3 read 128.78°, the irregular
+one here 131.04°). The oracle is the
 wedge's construction: its crease is the x axis and its faces make the angle it was built with.
 """
 
@@ -54,7 +55,7 @@ def test_every_reading_off_the_edge_is_right_or_refused(wedge_surface):
 
 @pytest.mark.parametrize(("angle", "distance"), [(90.0, 0.24), (60.0, 0.26), (120.0, 0.18)])
 def test_the_refusal_names_what_the_faces_read_and_how_far_the_edge_is(angle, distance):
-    """The reviewer's cases (before: 128.78°, 63.16°, 145.5°): the reading the normals' sides
+    """The reviewer's cases (on regular wedges before: 128.78°, 63.16°, 145.5°): the reading the normals' sides
     give is the wedge's angle, and the edge's distance is where the centre was put."""
     shape = wedge(angle, n=60, irregular=True, seed=5)
     surface = Surface(shape.points, shape.triangles)

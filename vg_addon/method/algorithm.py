@@ -50,11 +50,12 @@ CROSSED_SHARE = 0.12
 CROSSED_MOVE_DEG = 2.0
 CROSSED_OFF_EDGE = 0.5
 """Under the refined rule a reading is refused where more than ``CROSSED_SHARE`` of a side's
-vertices have normals past the other side by ``CROSSED_NOISE`` times the normals' noise, and
-giving them to it moves the angle by more than ``CROSSED_MOVE_DEG``. On the 27 readings of
-wedges clicked off the edge that were 3° to 87° off, the share is 0.14 to 0.91 and giving the
-vertices over reads the true angle; on 700 right readings (wedges exact, noisy and jittered,
-the reference meshes, the synthetic bone) it is at most 0.09 (docs/METHOD.md)."""
+vertices have normals past the other side by ``CROSSED_NOISE`` times the normals' noise, giving
+them to it moves the angle by more than ``CROSSED_MOVE_DEG``, and the planes so fitted meet more
+than ``CROSSED_OFF_EDGE`` radii from the centre. On the 27 readings of wedges clicked off the
+edge that were 3° to 87° off, the share is 0.14 to 0.91 and giving the vertices over reads the
+true angle; on 700 right readings (wedges exact, noisy and jittered, the reference meshes, the
+synthetic bone) it is at most 0.09 (docs/METHOD.md)."""
 
 NEAR_FLAT_DEG = 170.0
 """A refused reading above this many degrees is said to be near flat: there the planes' meeting
@@ -347,11 +348,13 @@ def _check_sides_follow_normals(points, normals, fields, center, radius, noise) 
     if abs(moved_angle - fields["angle"]) <= CROSSED_MOVE_DEG:
         return
     line = crease_line(planes, center)
-    off = math.inf if line is None else norm3(line[0] - center)
+    if line is None:
+        return  # parallel: no edge to say the centre is off
+    off = norm3(line[0] - center)
     if off <= CROSSED_OFF_EDGE * radius:
         return  # the faces the normals tell meet at the centre too: not a centre off its edge
     raise GoniometerError(
-        f"The split does not follow the faces: {max(shares):.0%} of the vertices of one side "
+        f"The split does not follow the faces: {max(shares):.1%} of the vertices of one side "
         f"face the other side's plane, and given to it they read {moved_angle:.2f}° instead of "
         f"{fields['angle']:.2f}°, with the edge {off / radius:.2f} times the radius from the "
         "centre: the centre is off the break edge (the patch lies mostly on one face), or the "
@@ -526,11 +529,14 @@ def _refine(points, normals, center, radius, fields, planes) -> tuple | None:
 
 def as_points(name: str, values, *, allow_empty: bool = False) -> np.ndarray:
     """Validate an (n, 3) array of finite numbers and return it as C-contiguous float64."""
-    if np.iscomplexobj(values):  # float64 conversion would drop the imaginary parts
-        raise GoniometerError(f"The {name} must be real numbers; got complex ones.")
     try:
-        array = np.ascontiguousarray(np.asarray(values, dtype=np.float64))
+        given = np.asarray(values)
+        if given.dtype.kind == "c":  # float64 conversion would drop the imaginary parts
+            raise GoniometerError(f"The {name} must be real numbers; got complex ones.")
+        array = np.ascontiguousarray(given, dtype=np.float64)
     except (TypeError, ValueError) as error:
+        if isinstance(error, GoniometerError):
+            raise
         raise GoniometerError(f"The {name} must be numbers in an (n, 3) array: {error}") from None
     if array.ndim != 2 or array.shape[1] != 3:
         raise GoniometerError(
@@ -584,11 +590,15 @@ def as_lambda(lam) -> float:
 def as_center(center) -> np.ndarray:
     """Validate a centre: three finite numbers."""
     try:
-        value = np.asarray(center, dtype=np.float64).reshape(-1)
+        given = np.asarray(center)
+        complex_given = given.dtype.kind == "c"  # float64 would drop the imaginary parts
+        value = None if complex_given else np.asarray(given, dtype=np.float64).reshape(-1)
     except (TypeError, ValueError):
         raise GoniometerError(
             f"The centre must be three numbers x, y, z; got {center!r}."
         ) from None
+    if value is None:
+        raise GoniometerError(f"The centre must be three real numbers x, y, z; got {center!r}.")
     if value.shape != (3,) or not np.isfinite(value).all():
         raise GoniometerError(f"The centre must be three finite numbers x, y, z; got {center!r}.")
     return value

@@ -353,7 +353,10 @@ def _too_far(center: np.ndarray, radius: float) -> GoniometerError:
 
 
 def _is_vertex_number(value) -> bool:
-    """Whether ``value`` is a whole number (a NumPy integer too), not a bool or a float."""
+    """Whether ``value`` is a whole number (a NumPy integer or a 0-d integer array too), not a
+    bool or a float."""
+    if isinstance(value, np.ndarray):
+        return value.ndim == 0 and value.dtype.kind in "iu"
     return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 

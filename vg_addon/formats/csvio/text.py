@@ -28,6 +28,7 @@ import math
 import operator
 import os
 import re
+import threading
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
@@ -234,6 +235,9 @@ def _check_delimiter(header_line: str, source: str) -> None:
 _EXCEL_SEPARATOR = re.compile(r'"?sep=.?"?', re.IGNORECASE)
 
 
+_CAP_LOCK = threading.Lock()
+
+
 def read_records(text: str, source: str) -> list[tuple[int, list[str]]]:
     """Every record with its spreadsheet row number, after the BOM and delimiter checks (an
     Excel ``sep=`` first line is dropped, and not counted: Excel does not show it)."""
@@ -249,15 +253,24 @@ def read_records(text: str, source: str) -> list[tuple[int, list[str]]]:
         )
     header_line = next(line for line in text.splitlines() if line.strip())
     _check_delimiter(header_line, source)
+    # The csv module's default cap on a cell (131,072 characters) is below what an edge's Points
+    # cell holds for a few thousand picked points; no cell is longer than the text. The cap is
+    # the process's: one reader at a time lifts it and puts it back.
+    with _CAP_LOCK:
+        limit = csv.field_size_limit(max(csv.field_size_limit(), min(len(text) + 1, 2**31 - 1)))
+        try:
+            return _records(text, source)
+        finally:
+            csv.field_size_limit(limit)  # other code in Blender keeps its cap
+
+
+def _records(text: str, source: str) -> list[tuple[int, list[str]]]:
     # strict: a quote still open at the end of the file, or text after a closing quote, is an
     # error, not a cell that swallows the rest of the file.
     reader = csv.reader(io.StringIO(text, newline=""), strict=True)
     records = []
     header: list[str] = []
     line = 1
-    # The csv module's default cap on a cell (131,072 characters) is below what an edge's Points
-    # cell holds for a few thousand picked points; no cell is longer than the text.
-    limit = csv.field_size_limit(max(csv.field_size_limit(), min(len(text) + 1, 2**31 - 1)))
     try:
         while True:
             line = reader.line_num + 1  # the physical line the record starts on
@@ -280,8 +293,6 @@ def read_records(text: str, source: str) -> list[tuple[int, list[str]]]:
             f"{source} is not a readable CSV near line {reader.line_num}: {error}. "
             "Check the quotes on that line."
         ) from None
-    finally:
-        csv.field_size_limit(limit)  # process-wide: other code in Blender keeps its cap
     return records
 
 
