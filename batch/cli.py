@@ -10,8 +10,8 @@ from pathlib import Path
 from ..bridge.map_edges import EDGE_ENDS
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats import picked_points
-from ..vg_addon.method.algorithm import as_lambda
 from ..vg_addon.method.break_edges import BreakEdgeParameters
+from ..vg_addon.method.inputs import as_lambda
 from ..vg_addon.method.sweep import sweep_radii
 
 # --units: Blender's unit system, unit scale and length unit for what one coordinate unit is.

@@ -15,8 +15,9 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, picked_points, profile_plot
 from ..vg_addon.formats.record_codec import exact_numbers
-from ..vg_addon.method.algorithm import DEFAULT_RULE, as_lambda, as_radius, check_rule
+from ..vg_addon.method.algorithm import DEFAULT_RULE, check_rule
 from ..vg_addon.method.edge_profile import check_station_count
+from ..vg_addon.method.inputs import as_lambda, as_radius
 from ..vg_addon.method.surface import check_patch_mode
 from ..vg_addon.workflow import batchplan
 from . import stopping

@@ -95,9 +95,10 @@ def _kind(out: str) -> str:
         raise UsageError(f"--out {out}: {error}") from None
 
 
-def _is_stream(out) -> bool:
+def is_stream(out) -> bool:
     """Whether ``--out`` is standard output or a stream (a pipe, a terminal, a device), which
-    nothing can be written beside."""
+    nothing is written beside and which gets the CSV once, at the end. The one verdict for both
+    the output check and the run."""
     return out == files.STDOUT or (os.path.exists(out) and _kind(out) == "stream")
 
 
@@ -136,18 +137,18 @@ def check_outputs(args) -> None:
     outputs = [(option, path) for option, path in outputs if path and path != files.STDOUT]
     edge_options = (("--edge", "edge"), ("--edges", "edges_csv"), ("--find-edges", "find_edges"))
     edges = [option for option, name in edge_options if getattr(args, name, None)]
-    if args.out and edges and _is_stream(args.out):
+    if args.out and edges and is_stream(args.out):
         raise UsageError(
             f"{edges[0]} writes the edge summary <out>_edges.csv and a plot per edge beside "
             f"--out, so --out {args.out} must be a file name, not standard output or a stream."
         )
-    summary = csvio.edges_path_for(args.out) if args.out and not _is_stream(args.out) else None
+    summary = csvio.edges_path_for(args.out) if args.out and not is_stream(args.out) else None
     # Written with edges; without, an earlier run's summary there is emptied
     # (csvio.write_export): either way never an input.
     if summary is not None and (edges or csvio.holds_edge_summary(summary)):
         outputs.append(("--out's edge summary", str(summary)))
     if args.sweep:
-        if _is_stream(args.out):
+        if is_stream(args.out):
             raise UsageError(
                 f"--sweep writes <out>_sweep.csv and a plot folder beside --out, so --out "
                 f"{args.out} must be a file name, not standard output or a stream."
@@ -156,7 +157,7 @@ def check_outputs(args) -> None:
         outputs.append(("--sweep's CSV", str(csv_path)))
         if plots.exists() and not plots.is_dir():
             raise UsageError(f"--sweep: {plots} (its plot folder) is a file; move it away.")
-    elif args.out and not _is_stream(args.out):
+    elif args.out and not is_stream(args.out):
         # Without --sweep an earlier run's sweep there is emptied (Run.empty_earlier_sweep).
         csv_path, _ = sweep_paths(args.out)
         if csvio.holds_sweep(csv_path):

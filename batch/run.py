@@ -35,7 +35,7 @@ from .edges import (
 )
 from .find_edges import find_options
 from .measure import MeshResult, error_row, run_units_label, safe_measure_mesh, set_units
-from .outputs import check_outputs, input_files, make_folders, sweep_paths
+from .outputs import check_outputs, input_files, is_stream, make_folders, sweep_paths
 from .pictures import reason
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
@@ -76,7 +76,7 @@ class Run:
         self.units = run_units_label(getattr(args, "units", None))
         # A pipe or standard output gets the CSV once, at the end; a file is rewritten as the
         # meshes finish, so a run that is stopped keeps what it measured.
-        self.stream = files.output_target(args.out) == "stream"
+        self.stream = is_stream(args.out)
         self.failed_outputs: list[str] = []  # .blend or pictures that could not be written
         self.write_error = ""  # why the last write of the CSV failed ("" if it did not)
         # Each row's CSV line, formatted once: every rewrite of the growing CSV reuses them.
@@ -337,8 +337,7 @@ class Run:
         )
 
     def unmeasured(self, task, message: str):
-        """The row of a task without a measurement, saying why (a stopped run, a worker that
-        failed its mesh)."""
+        """A task's row without a measurement, saying why (a stopped run, a failed worker)."""
         name = self.sources[task.mesh].name if task.mesh >= 0 else task.mesh_name
         return error_row(task, name, message, self.units)
 
@@ -366,24 +365,26 @@ class Run:
         return unmeasured_mesh_edges(source, self.options, message, self.units, search=search)
 
     def finish(self) -> int:
-        missing = [t for t in self.tasks if t.index not in self.rows]
-        for task in missing:  # e.g. a worker that could not even start
-            self.rows[task.index] = self.unmeasured(task, STOPPED)
-        for mesh in self.meshes:  # a mesh the run never reached, or lost with its worker
-            if mesh not in self.edges_by_mesh:
-                stations, summaries = self.unmeasured_edges(mesh, STOPPED_EDGE, STOPPED_SEARCH)
-                self.edges_by_mesh[mesh] = (
-                    [csvio.writable_row(row) for row in stations],
-                    [csvio.writable_row(row) for row in summaries],
-                )
-        try:
-            self.write_csv()
-        except csvio.SummaryWriteError as error:
-            self.recover_summary(error)
-            return 2
-        except (OSError, GoniometerError) as error:
-            self.recover_csv(error)
-            return 2
+        # Locked: a slot thread that outlived a stop's wait (run_workers) may still add rows.
+        with self.lock:
+            missing = [t for t in self.tasks if t.index not in self.rows]
+            for task in missing:  # e.g. a worker that could not even start
+                self.rows[task.index] = self.unmeasured(task, STOPPED)
+            for mesh in self.meshes:  # a mesh the run never reached, or lost with its worker
+                if mesh not in self.edges_by_mesh:
+                    stations, summaries = self.unmeasured_edges(mesh, STOPPED_EDGE, STOPPED_SEARCH)
+                    self.edges_by_mesh[mesh] = (
+                        [csvio.writable_row(row) for row in stations],
+                        [csvio.writable_row(row) for row in summaries],
+                    )
+            try:
+                self.write_csv()
+            except csvio.SummaryWriteError as error:
+                self.recover_summary(error)
+                return 2
+            except (OSError, GoniometerError) as error:
+                self.recover_csv(error)
+                return 2
         if self.args.sweep:
             self.write_sweep_csv()
         else:

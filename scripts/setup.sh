@@ -36,6 +36,28 @@ find_python() {  # find_python 3.11|3.13 -> path of a working interpreter of tha
     exit 2
 }
 
+# An environment takes about 1.5 GB (bpy alone 0.9); pip needs some room besides. A disk that
+# fills half-way through an install leaves a broken environment and pip's own OSError, so the
+# space is looked at first.
+NEEDED_MB=2048
+check_space() {  # check_space DIR: refuse, saying why, when DIR's disk has too little room
+    local free_mb old_mb=0
+    # Where DIR is made: beside it (a link in its place is removed, not followed). An outdated
+    # environment there is removed first, and its room counts.
+    free_mb=$(df -Pm "$(dirname "$1")" | awk 'NR == 2 { print $4 }')
+    if [ -d "$1" ] && [ ! -L "$1" ]; then
+        old_mb=$(du -sm "$1" | cut -f1)
+    fi
+    [ -n "$free_mb" ] || return 0 # df could not tell: pip will
+    free_mb=$((free_mb + old_mb))
+    if [ "$free_mb" -lt "$NEEDED_MB" ]; then
+        echo "error: setting up $1 needs about $NEEDED_MB MB free on its disk, and $free_mb MB" \
+            "are (with the outdated environment it replaces); make room (each environment of" \
+            "a clone of this project, .venv*, takes about 1.5 GB) and run again" >&2
+        exit 2
+    fi
+}
+
 make_env() {  # make_env DIR PYTHON-VERSION REQUIREMENTS
     local dir=$1 want=$2 requirements=$3 python stamp
     python=$(find_python "$want")
@@ -46,6 +68,7 @@ make_env() {  # make_env DIR PYTHON-VERSION REQUIREMENTS
     if [ -f "$dir/.vg-stamp" ] && [ "$(cat "$dir/.vg-stamp")" = "$stamp" ]; then
         return
     fi
+    check_space "$dir"
     echo "setting up $dir from $requirements with $python" \
         "(the bpy wheels are large: a few minutes the first time)" >&2
     rm -rf "$dir" # a symlinked environment loses only its link

@@ -210,6 +210,19 @@ class TestErrors:
         for centre in (np.int32(5), np.int64(5), np.uint16(5), np.array(5)):
             assert np.array_equal(self.surface.patch(centre, 0.5), expected)
 
+    @pytest.mark.parametrize("flag", ["False", "no", 2, None, 0.0])
+    def test_stability_must_be_true_or_false(self, flag):
+        # A string "False" is true to Python: the figure was computed where it was not asked for.
+        with pytest.raises(GoniometerError, match="stability must be True or False"):
+            self.surface.measure([0, 0, 0], 0.5, stability=flag)
+        with pytest.raises(GoniometerError, match="stability must be True or False"):
+            self.surface.measure_along([[0, 0, -0.2], [0, 0, 0.2]], 0.1, 0.5, stability=flag)
+
+    @pytest.mark.parametrize("flag, computed", [(False, False), (np.True_, True), (1, True)])
+    def test_stability_takes_bools_and_zero_or_one(self, flag, computed):
+        measurement = self.surface.measure([0, 0, 0], 0.5, stability=flag)
+        assert (measurement.stability is not None) == computed
+
     def test_complex_coordinates_are_refused_not_cut_to_their_real_parts(self):
         mesh = wedge(90, n=20)
         with pytest.raises(GoniometerError, match="real numbers"):

@@ -316,6 +316,23 @@ def test_full_reader_lists_missing_columns_and_bad_cells():
         csvio.read_measurements_csv(bad)
 
 
+@pytest.mark.parametrize("written, read", [("812.0", 812), ("812.00", 812), ("8.12e2", 812)])
+def test_whole_numbers_resaved_as_floats_read_as_whole_numbers(written, read):
+    """pandas and R write a column with blanks (Edge # of single measurements) as floats."""
+    text = csvio.format_measurements_csv([good_row()]).replace(",812,", f",{written},", 1)
+    assert csvio.read_measurements_csv(text)[0].n_vertices == read
+
+
+@pytest.mark.parametrize(
+    "written", ["812.5", "1e300", "811.99999999999999999", "812.0000000000000001"]
+)
+def test_a_fraction_or_a_huge_float_in_a_whole_number_column_is_refused(written):
+    """Exactly whole, not whole once rounded to a float."""
+    text = csvio.format_measurements_csv([good_row()]).replace(",812,", f",{written},", 1)
+    with pytest.raises(GoniometerError, match=r"row 2: Number of Vertices is not a whole number"):
+        csvio.read_measurements_csv(text)
+
+
 # --------------------------------------------------------------------------- mesh names
 
 
@@ -388,3 +405,15 @@ def test_an_integer_too_long_for_python_is_a_clear_problem():
     assert rows[0].number is None  # Measurement # is informative only: not a number then
     with pytest.raises(GoniometerError, match="row 2: Break # must be a whole number"):
         csvio.read_replication_csv(f"x,y,z,Break #\n1,2,3,{digits}\n")
+
+
+@pytest.mark.parametrize(("written", "read"), [("2.0", 2), ("2", 2), ("", None)])
+def test_a_break_number_resaved_as_a_float_is_that_break_when_re_measured(written, read):
+    text = f"Mesh Name,x,y,z,Break #\nbone,1,2,3,{written}\n"
+    assert csvio.read_replication_csv(text)[0].break_number == read
+
+
+@pytest.mark.parametrize("written", ["2.5", "0.0", "1e12"])
+def test_a_break_number_that_is_not_a_whole_number_from_1_is_refused(written):
+    with pytest.raises(GoniometerError, match="Break # must be a whole number from 1"):
+        csvio.read_replication_csv(f"Mesh Name,x,y,z,Break #\nbone,1,2,3,{written}\n")

@@ -235,6 +235,18 @@ def test_failed_write_removes_the_temp(tmp_path, monkeypatch):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.csv"]
 
 
+@pytest.mark.parametrize("stem", ["m" * 251, "é" * 125 + "m"])
+def test_a_name_as_long_as_the_disk_takes_is_written_and_rewritten(tmp_path, stem):
+    """A 255-byte name (the limit of most disks): its hidden temporary name was longer, and
+    the write failed with "File name too long"."""
+    path = tmp_path / f"{stem}.csv"
+    assert len(path.name.encode()) == 255
+    for number in (1, 2):
+        csvio.write_measurements_csv(path, [good_row(number=number)])
+        assert csvio.read_measurements_csv(path)[0].number == number
+    assert [p.name for p in tmp_path.iterdir()] == [path.name]
+
+
 def test_writing_into_a_missing_folder_says_so(tmp_path):
     with pytest.raises(GoniometerError, match="does not exist"):
         csvio.write_measurements_csv(tmp_path / "nowhere" / "m.csv", [good_row()])

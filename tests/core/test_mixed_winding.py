@@ -73,7 +73,9 @@ def test_a_closed_fragment_with_a_flipped_fracture_face_is_refused_or_flagged():
         try:
             reading = surface.measure(site.point, 2.0, stability=True)
         except GoniometerError as error:
-            assert REFUSAL in str(error)
+            # The acute sites' patches hold few vertices of the flipped face: refused as a
+            # side almost all facing the other plane, whose message names the flip too.
+            assert REFUSAL in str(error) or "normals point the other way" in str(error)
             refused.append(site.label)
             continue
         error = abs(reading.angle - site.angle)

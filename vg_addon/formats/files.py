@@ -15,6 +15,8 @@ from ..errors import GoniometerError
 
 STDOUT = "-"  # the target name of standard output
 
+TEMP_STEM_BYTES = 200  # of a file's name, at most, in the temporary name it is written under
+
 
 def _replace_atomically(path: str, data: bytes) -> None:
     folder = os.path.dirname(os.path.abspath(path)) or "."
@@ -27,7 +29,10 @@ def _replace_atomically(path: str, data: bytes) -> None:
     except OSError:
         mode = None
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
-    base = os.path.basename(path)
+    # The temporary name adds 14 bytes: cut a long name's stem so that it stays a name the
+    # disk takes (255 bytes on most), where the file's own name fits.
+    base = os.path.basename(path).encode("utf-8", "surrogateescape")[:TEMP_STEM_BYTES]
+    base = base.decode("utf-8", "ignore")
     while True:
         temp = os.path.join(folder, f".{base}.{secrets.token_hex(4)}.tmp")
         try:

@@ -12,11 +12,21 @@ from .fixed_order import (
     column_moments,
     dot3,
     eigh3,
+    eigh3_batched,
     eigh3_entries,
     moments,
     norm3,
     row_dot,
     total,
+)
+from .inputs import (
+    MAX_MAGNITUDE,
+    as_center,
+    as_lambda,
+    as_normals,
+    as_points,
+    as_radius,
+    check_magnitude,
 )
 from .planes import (
     RANK_TOLERANCE,
@@ -32,9 +42,6 @@ MIN_SIDE_VERTICES = 5
 """A plane needs three vertices, but three or four always fit one (almost) exactly and would
 report a precise-looking nonsense; five is the fewest whose fit error means something."""
 
-MAX_LAMBDA = 1e6
-"""Beyond this, λ only scales positions past floating-point range; the split no longer changes."""
-
 FLAT_TOLERANCE_DEG = 0.5
 """Angles closer than this to 180° mean the patch holds no break edge."""
 
@@ -49,6 +56,7 @@ CROSSED_NOISE = 2.5
 CROSSED_SHARE = 0.12
 CROSSED_MOVE_DEG = 2.0
 CROSSED_OFF_EDGE = 0.5
+COS_CROSSED_MOVE = 0.9993908270190958  # cos(CROSSED_MOVE_DEG), written out: the same bits anywhere
 """Under the refined rule a reading is refused where more than ``CROSSED_SHARE`` of a side's
 vertices have normals past the other side by ``CROSSED_NOISE`` times the normals' noise, giving
 them to it moves the angle by more than ``CROSSED_MOVE_DEG``, and the planes so fitted meet more
@@ -56,6 +64,7 @@ than ``CROSSED_OFF_EDGE`` radii from the centre. On the 27 readings of wedges cl
 edge that were 3° to 87° off, the share is 0.14 to 0.91 and giving the vertices over reads the
 true angle; on 700 right readings (wedges exact, noisy and jittered, the reference meshes, the
 synthetic bone) it is at most 0.09 (docs/METHOD.md)."""
+
 
 NEAR_FLAT_DEG = 170.0
 """A refused reading above this many degrees is said to be near flat: there the planes' meeting
@@ -84,10 +93,6 @@ SHARED_ROW_FACTOR = 1.5
 """A side whose vertices lie on one line borrows the other side's vertices within this factor of
 the nearest one's distance to that line: the row of vertices on the edge, which belongs to both
 faces."""
-
-MAX_MAGNITUDE = 1e150
-"""Largest coordinate and radius, in any unit: squares of larger values, and sums of them over
-many points, overflow float64 (from about 1e154). A scan in any real unit is far below this."""
 
 MIN_RADIUS = 1e-152
 """Smallest radius to measure with: squared distances below about 1e-154 lose precision
@@ -164,34 +169,33 @@ def _fit_side(points, joined, mask, side: str) -> tuple[np.ndarray, float, int, 
     other side nearest it (the vertices on the edge, which lie on both faces) completes it.
     """
     rows = np.compress(mask, joined, axis=0)  # joined[mask], without fancy indexing's overhead
-    means = _column_means(rows)
-    own, centroid = rows[:, :3], means[:3]
-    normal, error, spans = _plane(own, centroid)
+    normal, error, spans, centroid, mean_normal = _side_plane(rows)
     borrowed = 0
     if not spans:
+        own = rows[:, :3]
         beside = _row_beside(own, points[~mask])
         borrowed = int(beside.sum())
         if borrowed:
             normal, error, spans = _plane(np.vstack([own, points[~mask][beside]]))
+            normal = -normal if dot3(normal, mean_normal) < 0 else normal
         if not spans:
             raise GoniometerError(
                 f"The vertices on the {side} side lie on a line, even with the row of vertices "
                 "beside it, so no plane can be fitted: use a larger radius (each side needs at "
                 "least two rows of vertices off the edge) or move the centre onto the break edge."
             )
-    if dot3(normal, means[3:]) < 0:
-        normal = -normal
     return normal, error, borrowed, centroid
 
 
-def _check_finite(name: str, array: np.ndarray) -> None:
-    bad = ~np.isfinite(array).all(axis=1)
-    if bad.any():
-        first = int(np.flatnonzero(bad)[0])
-        raise GoniometerError(
-            f"{int(bad.sum())} {name} are not finite (NaN or infinite), the first at row {first}: "
-            f"repair or remove them before measuring."
-        )
+def _side_plane(rows: np.ndarray) -> tuple[np.ndarray, float, bool, np.ndarray, np.ndarray]:
+    """The plane of a side's own vertices: its normal turned towards their mean normal, its fit
+    error, whether they span a plane, and the means of their points and normals. ``rows``: the
+    side's points and normals side by side, shape (k, 6)."""
+    means = _column_means(rows)
+    centroid, mean_normal = means[:3], means[3:]
+    normal, error, spans = _plane(rows[:, :3], centroid)
+    normal = -normal if dot3(normal, mean_normal) < 0 else normal
+    return normal, error, spans, centroid, mean_normal
 
 
 def check_rule(rule) -> str:
@@ -308,7 +312,31 @@ def _check_crease_in_patch(fields, centroids, center, radius) -> None:
     )
 
 
-def _check_sides_follow_normals(points, normals, fields, center, radius, noise) -> None:
+def _plane_rests_on_one_vertex(joined: np.ndarray, side: np.ndarray, normal) -> bool:
+    """Whether leaving out one of the ``side``'s vertices turns its plane (unit ``normal``) by
+    more than :data:`CROSSED_MOVE_DEG`: a few vertices of the other face with one past the
+    crease, which tilts their plane, or a few noisy ones, whose plane no one of them may set.
+
+    Each vertex left out in turn, at once: the scatter matrix less that vertex's share
+    (``C − k/(k−1) d dᵀ``, ``d`` its offset from the mean). A vertex without which the rest
+    lie on a line is passed over: the plane through a row and one vertex is what it is."""
+    points = np.compress(side, joined[:, :3], axis=0)
+    count = points.shape[0]
+    if count < 3:
+        return False  # no plane to turn (the split and the refinement keep 5 a side)
+    offsets = points - _column_means(points)
+    scatter = moments(offsets)
+    without = scatter[None] - (count / (count - 1)) * (offsets[:, :, None] * offsets[:, None, :])
+    values, vectors = eigh3_batched(without)
+    # Where the rest lie on a line (a row on the crease), that vertex is what makes the plane,
+    # as for a side that borrowed a row: not a turn.
+    spans = values[:, 1] > RANK_TOLERANCE * np.maximum(values[:, 2], np.finfo(float).tiny)
+    planes = vectors[spans, :, 0]
+    # A cosine, not an angle: C's acos may round differently from one machine to the next.
+    return bool((np.abs(row_dot(planes, normal)) < COS_CROSSED_MOVE).any())
+
+
+def _check_sides_follow_normals(joined, fields, center, radius, noise) -> None:
     """Refuse where many vertices of a side face the other side's plane, and giving them to it
     moves the angle: the split did not follow the faces. A centre off the edge (a patch mostly
     on one face) is split inside that face; its planes still meet near the centre.
@@ -316,7 +344,9 @@ def _check_sides_follow_normals(points, normals, fields, center, radius, noise) 
     A vertex faces the other plane when its normal, along the direction from the "−" plane's
     normal to the "+" one's, lies past the other side by more than :data:`CROSSED_NOISE` times
     the normals' ``noise`` (their RMS along the crease, which a crease does not bend).
+    ``joined``: the points and normals side by side, shape (k, 6).
     """
+    normals = joined[:, 3:]
     plus, minus = fields["normal_plus"], fields["normal_minus"]
     towards_plus = (plus - minus) / norm3(plus - minus)
     facing = row_dot(normals, towards_plus)
@@ -334,16 +364,37 @@ def _check_sides_follow_normals(points, normals, fields, center, radius, noise) 
     moved = ((labels & ~crossed_plus) | crossed_minus) & used
     sides = (moved, used & ~moved)
     if min(np.count_nonzero(side) for side in sides) < MIN_SIDE_VERTICES:
-        return
+        # Too few left to fit the faces the normals tell. The vertices on the crease lie on
+        # both faces and their normals lean either way, so that alone says nothing; a side
+        # whose plane turns when one vertex is left out is a few vertices of the other face
+        # with one past the crease, and reads what that vertex makes of it.
+        facing_one_face = min(np.count_nonzero(side) for side in sides)
+        crossed_sides = [
+            (side, normal)
+            for side, normal, share in (
+                (plus_side, plus, shares[0]),
+                (minus_side, minus, shares[1]),
+            )
+            if share > CROSSED_SHARE
+        ]
+        if not any(_plane_rests_on_one_vertex(joined, *crossed) for crossed in crossed_sides):
+            return
+        raise GoniometerError(
+            f"The patch lies almost entirely on one face: {max(shares):.1%} of the vertices of "
+            f"one side face the other side's plane, and without them that side keeps "
+            f"{facing_one_face} (at least {MIN_SIDE_VERTICES} are needed to fit a plane to "
+            "a face). The centre is off the "
+            "break edge or the radius is too small for the mesh: move the centre onto the edge, "
+            "or use a larger radius. Or one face's normals point the other way (its triangles "
+            "wound against the rest): make them consistent, e.g. in Blender's Edit Mode with "
+            "Mesh > Normals > Recalculate Outside."
+        )
     planes = []
     for side in sides:
-        side_points = np.compress(side, points, axis=0)
-        centroid = _column_means(side_points)
-        normal, _, spans = _plane(side_points, centroid)
+        normal, _, spans, centroid, _ = _side_plane(np.compress(side, joined, axis=0))
         if not spans:
             return
-        mean_normal = _column_means(np.compress(side, normals, axis=0))
-        planes.append((-normal if dot3(normal, mean_normal) < 0 else normal, centroid))
+        planes.append((normal, centroid))
     moved_angle = 180.0 - acos_degrees(dot3(planes[0][0], planes[1][0]))
     if abs(moved_angle - fields["angle"]) <= CROSSED_MOVE_DEG:
         return
@@ -458,9 +509,9 @@ def measure_patch(
         raise GoniometerError(
             contradicting_normals_message(fields["angle"], cloud=estimated_normals)
         )
-    if rule == "refined" and not estimated_normals:
+    if rule == "refined":
         noise = math.sqrt(max(along_tangent, 0.0) / n_points)  # the normals' RMS along t
-        _check_sides_follow_normals(points, normals, fields, center, radius, noise)
+        _check_sides_follow_normals(joined, fields, center, radius, noise)
     return fields
 
 
@@ -527,105 +578,6 @@ def _refine(points, normals, center, radius, fields, planes) -> tuple | None:
     return centroids
 
 
-def as_points(name: str, values, *, allow_empty: bool = False) -> np.ndarray:
-    """Validate an (n, 3) array of finite numbers and return it as C-contiguous float64."""
-    try:
-        given = np.asarray(values)
-        if given.dtype.kind == "c":  # float64 conversion would drop the imaginary parts
-            raise GoniometerError(f"The {name} must be real numbers; got complex ones.")
-        array = np.ascontiguousarray(given, dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        if isinstance(error, GoniometerError):
-            raise
-        raise GoniometerError(f"The {name} must be numbers in an (n, 3) array: {error}") from None
-    if array.ndim != 2 or array.shape[1] != 3:
-        raise GoniometerError(
-            f"The {name} must be an (n, 3) array of x, y, z values; got shape {array.shape}."
-        )
-    if not allow_empty and array.shape[0] == 0:
-        raise GoniometerError(f"There are no {name}: the mesh or patch is empty.")
-    _check_finite(name, array)
-    _check_magnitude(
-        f"The {name} reach",
-        array,
-        "scale the mesh to a real unit (e.g. millimetres) before measuring",
-    )
-    return array
-
-
-def _check_magnitude(what: str, array: np.ndarray, advice: str) -> None:
-    """Refuse values beyond ±:data:`MAX_MAGNITUDE` ("``what`` 1e+200, beyond ...: ``advice``.")."""
-    largest = float(np.abs(array).max()) if array.size else 0.0
-    if largest > MAX_MAGNITUDE:
-        raise GoniometerError(
-            f"{what} {largest:.3g}, beyond ±{MAX_MAGNITUDE:g}, where squared distances "
-            f"overflow: {advice}."
-        )
-
-
-def as_radius(radius) -> float:
-    """Validate a patch radius: a finite number greater than zero."""
-    try:
-        value = float(radius)
-    except (TypeError, ValueError):
-        raise GoniometerError(f"The radius must be a number; got {radius!r}.") from None
-    if not np.isfinite(value) or value <= 0:
-        raise GoniometerError(f"The radius must be a finite number greater than 0; got {value!r}.")
-    return value
-
-
-def as_lambda(lam) -> float:
-    """Validate the segmentation parameter λ: a number from 0 to :data:`MAX_LAMBDA`."""
-    try:
-        value = float(lam)
-    except (TypeError, ValueError):
-        raise GoniometerError(f"λ (SegParam) must be a number; got {lam!r}.") from None
-    if not np.isfinite(value) or not 0 <= value <= MAX_LAMBDA:
-        raise GoniometerError(
-            f"λ (SegParam) must be a number from 0 to {MAX_LAMBDA:g} (2 is the usual); got {value!r}."
-        )
-    return value
-
-
-def as_center(center) -> np.ndarray:
-    """Validate a centre: three finite numbers."""
-    try:
-        given = np.asarray(center)
-        complex_given = given.dtype.kind == "c"  # float64 would drop the imaginary parts
-        value = None if complex_given else np.asarray(given, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        raise GoniometerError(
-            f"The centre must be three numbers x, y, z; got {center!r}."
-        ) from None
-    if value is None:
-        raise GoniometerError(f"The centre must be three real numbers x, y, z; got {center!r}.")
-    if value.shape != (3,) or not np.isfinite(value).all():
-        raise GoniometerError(f"The centre must be three finite numbers x, y, z; got {center!r}.")
-    return value
-
-
-def unit_normals(name: str, normals: np.ndarray) -> np.ndarray:
-    """Normalise given normals; zero-length ones are an error (they carry no direction)."""
-    lengths = np.linalg.norm(normals, axis=1)
-    zero = lengths <= 1e-300
-    if zero.any():
-        raise GoniometerError(
-            f"{int(zero.sum())} {name} have zero length (the first at row "
-            f"{int(np.flatnonzero(zero)[0])}): recompute the normals or drop those vertices."
-        )
-    return normals / lengths[:, None]
-
-
-def as_normals(normals, n_points: int) -> np.ndarray:
-    """Validate given normals: one finite, non-zero 3-vector per point; returned normalised."""
-    normals = as_points("normals", normals)
-    if normals.shape[0] != n_points:
-        raise GoniometerError(
-            f"There must be one normal per point: {n_points} points, {normals.shape[0]} normals."
-        )
-    return unit_normals("normals", normals)
-
-
 def goniometer(
     points, normals, lam: float = 2.0, center=None, radius=None, rule: str = DEFAULT_RULE
 ) -> Measurement:
@@ -667,7 +619,7 @@ def goniometer(
     ordered_points, ordered_normals = points[order], normals[order]
     center = ordered_points.mean(axis=0) if center is None else as_center(center)
     # Surface.measure snaps to a vertex; a given centre is used as is.
-    _check_magnitude("The centre reaches", center, "give a centre among the points, in their units")
+    check_magnitude("The centre reaches", center, "give a centre among the points, in their units")
     if radius is None:
         radius = float(np.sqrt(((ordered_points - center) ** 2).sum(axis=1).max()))
         if radius <= 0:

@@ -33,8 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import GoniometerError, bounded_list
-from .algorithm import DEFAULT_RULE, as_center, as_radius
+from .algorithm import DEFAULT_RULE
 from .edge_summary import EdgeSummary, sd_text, summarize
+from .inputs import as_center, as_flag, as_radius
 from .mesh_edges import MeshEdges
 from .ranges import expand_ranges
 
@@ -602,6 +603,7 @@ def measure_along(
         Bad settings, a spacing finer than the mesh, or stations that cannot be measured (all
         of them listed with their arc lengths and reasons; nothing is returned then).
     """
+    stability = as_flag("stability", stability)
     if not isinstance(path, EdgePath):
         polyline = np.asarray(path, dtype=np.float64)
         if polyline.ndim != 2 or polyline.shape[0] < 2 or polyline.shape[1] != 3:

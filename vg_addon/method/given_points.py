@@ -7,8 +7,8 @@ import math
 import numpy as np
 
 from ..errors import GoniometerError
-from .algorithm import as_radius
 from .edge_profile import ridge_graph
+from .inputs import as_radius
 
 
 def check_given_points(surface, points, radius: float, where: str) -> None:

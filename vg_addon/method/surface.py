@@ -8,18 +8,9 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import GoniometerError
-from .algorithm import (
-    DEFAULT_RULE,
-    MIN_SIDE_VERTICES,
-    as_center,
-    as_lambda,
-    as_normals,
-    as_points,
-    as_radius,
-    check_rule,
-    measure_patch,
-)
+from .algorithm import DEFAULT_RULE, MIN_SIDE_VERTICES, check_rule, measure_patch
 from .geodesic import EdgeGraph
+from .inputs import as_center, as_flag, as_lambda, as_normals, as_points, as_radius
 from .normals import pca_normals, vertex_normals
 from .ordering import canonical_ranks
 from .precision import check_rounding, precision_of
@@ -270,6 +261,7 @@ class Surface:
         requested = as_center(center)
         radius = as_radius(radius)
         lam = as_lambda(lam)
+        stability = as_flag("stability", stability)
         mode = check_patch_mode(patch)
         rule = check_rule(rule)
         # The snap looks up the few cells around the click, the ball those around the snapped

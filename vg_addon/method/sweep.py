@@ -7,7 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import GoniometerError
-from .algorithm import DEFAULT_RULE, as_radius
+from .algorithm import DEFAULT_RULE
+from .inputs import as_radius
 from .result import Measurement
 
 MAX_SWEEP_RADII = 1000

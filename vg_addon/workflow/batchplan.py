@@ -18,7 +18,8 @@ from pathlib import Path
 from ..errors import GoniometerError, bounded_list
 from ..formats.csvio import ReplicationRow, mesh_name_match
 from ..formats.meshio import MESH_EXTENSIONS
-from ..method.algorithm import DEFAULT_RULE, as_center, as_lambda, as_radius
+from ..method.algorithm import DEFAULT_RULE
+from ..method.inputs import as_center, as_lambda, as_radius
 from ..method.surface import check_patch_mode
 
 STOPPED_EDGE = "the run was stopped before this edge"

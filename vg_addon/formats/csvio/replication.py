@@ -33,6 +33,7 @@ from .text import (
     read_records,
     resolve_columns,
     text_cell,
+    whole_cell,
 )
 
 #: How :attr:`ReplicationRow.source_format` names the kinds of file the reader accepts.
@@ -150,8 +151,9 @@ def break_number_cell(raw: str) -> int | str | None:
     text = raw.strip()
     if not text:
         return None
-    if INTEGER.fullmatch(text) and 1 <= int(text) <= MAX_BREAK_NUMBER:
-        return int(text)
+    number = whole_cell(text)  # "2.0" too, as a table tool re-saves a column with blanks
+    if number is not None and 1 <= number <= MAX_BREAK_NUMBER:
+        return number
     return f"must be a whole number from 1 to {MAX_BREAK_NUMBER} (got {text!r})"
 
 
@@ -163,13 +165,6 @@ def _lenient_number(raw: str) -> int | float | None:
         value = float(text)
         return value if math.isfinite(value) else None
     return None
-
-
-def _whole(value: int | float | None) -> int | None:
-    """An edge number as a whole number; a spreadsheet may have re-saved ``1`` as ``1.0``."""
-    if isinstance(value, float) and value.is_integer() and abs(value) < 2**53:
-        return int(value)
-    return value if isinstance(value, int) else None
 
 
 def _parse_name(raw: str) -> str | None:
@@ -350,7 +345,6 @@ def parse_replication_csv(
             rule = "paper"  # MeshLab, the earlier add-on, exports from before the Rule column
         if problems:
             continue  # nothing is returned anyway; keep collecting
-        edge_number = _lenient_number(cell("edge_number"))
         rows.append(
             ReplicationRow(
                 row_number=number,
@@ -364,7 +358,7 @@ def parse_replication_csv(
                 label=_parse_name(cell("label")),
                 number=_lenient_number(cell("number")),
                 break_number=break_number,
-                edge_number=_whole(edge_number),
+                edge_number=whole_cell(cell("edge_number").strip()),
                 arc_length=values["arc_length"],
                 spacing=values["spacing"],
                 edge_closed=edge_closed,

@@ -21,8 +21,10 @@ a quoted cell that spans lines stays one row.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
+import decimal
 import io
 import math
 import operator
@@ -350,6 +352,22 @@ def problems_error(source: str, problems: list[str]) -> GoniometerError:
     )
 
 
+def whole_cell(text: str) -> int | None:
+    """A stripped cell as a whole number, ``None`` if it is not one. ``1.0`` is 1: a column with
+    blanks that a table tool (pandas, R) re-saved holds its whole numbers as floats."""
+    if INTEGER.fullmatch(text):
+        return int(text)
+    if NUMBER.fullmatch(text):
+        value = float(text)
+        if value.is_integer() and abs(value) < 2**53:
+            # Exactly whole, not after rounding to a float ("0.99999999999999999" is not 1).
+            with contextlib.suppress(decimal.InvalidOperation):  # exponents beyond its range
+                exact = decimal.Decimal(text)
+                if exact == exact.to_integral_value():
+                    return int(exact)
+    return None
+
+
 def number_cell(raw: str) -> tuple[float | None, str | None]:
     """A non-blank cell as a finite number: ``(value, None)``, or ``(None, why not)`` worded as
     this package's messages are (a decimal comma named as the cause)."""
@@ -492,7 +510,7 @@ def parse_table(text, source, schema, row_type, optional, what, check=None):
                 values[field] = number_of(names[0])
             elif kind == "int":
                 raw = cell(names[0]).strip()
-                values[field] = int(raw) if INTEGER.fullmatch(raw) else None
+                values[field] = whole_cell(raw)
                 if raw and values[field] is None:
                     problems.append(f"row {number}: {names[0]} is not a whole number ({raw!r})")
             elif kind == "bool":
