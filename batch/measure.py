@@ -350,12 +350,16 @@ def draw_pictures(result: MeshResult, obj, options, stem: str, plots, name: str)
 def _measure_task(surface, geometry, task, options):
     """The measurement of one task, or the GoniometerError saying why it cannot be taken."""
     try:
-        center, radius = task.center, task.radius
+        center, radius, requested = task.center, task.radius, task.requested
         if task.coordinates == records.WORLD:  # a row of an export of earlier versions
             center, radius = measuring.from_world(
                 center, radius, geometry.matrix, scale_radius=not task.default_radius
             )
-        return surface.measure(
+            if requested is not None:
+                requested = mesh_data.mesh_points(
+                    np.asarray(requested, np.float64), geometry.matrix
+                )
+        measurement = surface.measure(
             center,
             radius,
             task.lam,
@@ -363,6 +367,9 @@ def _measure_task(surface, geometry, task, options):
             rule=task.rule,
             stability=bool(options.get("stability")),
         )
+        if requested is not None:  # measured at the stored centre, asked for where it was
+            measurement = measurement.with_requested(requested)
+        return measurement
     except GoniometerError as error:
         return error
 

@@ -78,6 +78,8 @@ def blend_objects(names: list[str], blend: str) -> list[MeshSource]:
             continue
         try:
             mesh_data.check_measurable(obj)
+            graph = bpy.context.evaluated_depsgraph_get()
+            mesh_data.check_evaluated(obj, obj.evaluated_get(graph), "to measure")
         except GoniometerError as error:
             problems.append(str(error))
             continue

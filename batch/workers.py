@@ -293,7 +293,8 @@ def _measure_from_stdin(plan: dict, parent: Parent) -> int:
     tasks = {int(k): [batchplan.Task(**t) for t in v] for k, v in plan["tasks"].items()}
     for t in tasks.values():
         for i, task in enumerate(t):
-            t[i] = dataclasses.replace(task, center=tuple(task.center))
+            requested = None if task.requested is None else tuple(task.requested)
+            t[i] = dataclasses.replace(task, center=tuple(task.center), requested=requested)
     options = plan["options"]
     for line in sys.stdin:
         line = line.strip()

@@ -46,7 +46,7 @@ from ..vg_addon.workflow.labels import SIX_VIEWS, flake_views, looks_at, place_l
 from .colors import ATTRIBUTE_NAME, has_attribute, new_sides_material
 from .label_data import labels_of
 from .map_edges import EDGE_ENDS, LINE_COLOUR, add_edge_lines, stations_without_views
-from .mesh_data import read_positions, world_points
+from .mesh_data import check_evaluated, read_positions, world_points
 
 MAP_VIEWS = ("SIX", "FLAKE")
 TEXT_FRACTION = 0.035  # label height, as a fraction of the picture's width
@@ -137,12 +137,7 @@ class MapJob:
         self.size = (width, height)
         self.samples = int(samples)
         self.depsgraph = bpy.context.evaluated_depsgraph_get()
-        if not obj.evaluated_get(self.depsgraph).is_evaluated:
-            raise GoniometerError(
-                f"'{obj.name}' is disabled in the viewports or left out of this view layer (the "
-                "monitor icon or the checkbox in the Outliner, its own or its collection's), so "
-                "Blender has no evaluated mesh to render: enable it, then make the map."
-            )
+        check_evaluated(obj, obj.evaluated_get(self.depsgraph), "to render")
         self.views = list(view_list(obj, views, self.depsgraph))
         self.labels = labels_of(obj)
         unviewed = stations_without_views(obj, edge_ends)

@@ -8,6 +8,7 @@ exporting one is ``replication``.
 
 from __future__ import annotations
 
+import bpy
 import numpy as np
 
 from ..vg_addon import GoniometerError, Measurement
@@ -373,8 +374,13 @@ def stale_numbers(obj, *, depsgraph=None) -> set[int]:
     (computed, not read from the flags; nothing is changed)."""
     if not len(obj.vg.measurements):
         return set()
+    graph = depsgraph or bpy.context.evaluated_depsgraph_get()
+    if not obj.evaluated_get(graph).is_evaluated:
+        # Disabled in the viewports: its mesh as the user sees it cannot be read, so the flags
+        # set when it was last evaluated stand (not every record stale).
+        return {item.number for item in obj.vg.measurements if item.stale}
     try:
-        current = evaluated_geometry(obj, depsgraph)
+        current = evaluated_geometry(obj, graph)
     except GoniometerError:  # e.g. every vertex deleted since
         current = None
     return {

@@ -349,6 +349,18 @@ def _sharing_objects(obj) -> list[str]:
     return sorted(other.name for other in bpy.data.objects if other.data == mesh and other != obj)
 
 
+def check_evaluated(obj, obj_eval, purpose: str) -> None:
+    """Raise a :class:`GoniometerError` where ``obj_eval`` (``obj.evaluated_get(depsgraph)``) is
+    not evaluated, saying it has no evaluated mesh for ``purpose`` ("to render")."""
+    if not obj_eval.is_evaluated:
+        raise GoniometerError(
+            f"'{obj.name}' is disabled in the viewports or left out of this view layer (the "
+            "monitor icon or the checkbox in the Outliner, its own or its collection's), so "
+            f"Blender has no evaluated mesh {purpose}: enable it first (hiding it with H is "
+            "fine)."
+        )
+
+
 def evaluated_geometry(obj, depsgraph=None) -> Geometry:
     """The evaluated mesh of ``obj`` (modifiers applied) in its own coordinates.
 
@@ -365,6 +377,9 @@ def evaluated_geometry(obj, depsgraph=None) -> Geometry:
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
     obj_eval = obj.evaluated_get(depsgraph)
+    # Not in the depsgraph, Blender hands back the original, whose mesh lacks the modifiers and
+    # shape keys the user sees, and whose matrix_world is not kept up to date.
+    check_evaluated(obj, obj_eval, "to measure (its modifiers and shape keys are not applied)")
     key = obj.session_uid
     kept = _geometries.get(key)
     if _watching and kept is not None and key in _current:

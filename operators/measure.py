@@ -10,7 +10,12 @@ from bpy.props import (
 )
 
 from ..bridge import measuring, plots, records
-from ..bridge.mesh_data import check_measurable, evaluated_geometry, uniform_scale
+from ..bridge.mesh_data import (
+    check_evaluated,
+    check_measurable,
+    evaluated_geometry,
+    uniform_scale,
+)
 from ..vg_addon import GoniometerError
 from ..vg_addon.formats.record_codec import exact_numbers
 from ..vg_addon.method.result import fit_text
@@ -132,12 +137,19 @@ def _removing(operator, context):
     """The measurable active object whose records are to be removed, and its evaluated geometry
     to repaint with: ``(None, None)`` after reporting why the object cannot be changed, or
     ``(obj, None)`` where its mesh cannot be read now (every vertex deleted): records can always
-    be removed, and then there is nothing to repaint."""
+    be removed, and then there is nothing to repaint. An object disabled in the viewports is
+    refused: its records' colours could not be taken off its mesh."""
     obj = _active_measurable(operator, context)
     if obj is None:
         return None, None
+    depsgraph = context.evaluated_depsgraph_get()
     try:
-        return obj, evaluated_geometry(obj, context.evaluated_depsgraph_get())
+        check_evaluated(obj, obj.evaluated_get(depsgraph), "to repaint")
+    except GoniometerError as error:
+        operator.report({"ERROR"}, str(error))
+        return None, None
+    try:
+        return obj, evaluated_geometry(obj, depsgraph)
     except GoniometerError:
         return obj, None
 

@@ -10,7 +10,7 @@ import weakref
 import bpy
 import numpy as np
 
-from ..bridge.mesh_data import check_measurable, evaluated_geometry
+from ..bridge.mesh_data import check_evaluated, check_measurable, evaluated_geometry
 from ..vg_addon import GoniometerError
 from .common import clear_texts
 from .drag import object_alive, pointer_in_view
@@ -106,10 +106,16 @@ class ViewSession:
 
     def absent(self, context) -> str:
         """Why the session's object cannot be clicked on now: it is not in this scene (another
-        scene is shown); ``""`` when it is."""
-        if object_alive(context, self.obj):
-            return ""
-        return f"'{self.obj.name}' is not in this scene: go back to its scene to go on, or Esc."
+        scene is shown), or it was disabled in the viewports; ``""`` when it can."""
+        if not object_alive(context, self.obj):
+            return f"'{self.obj.name}' is not in this scene: go back to its scene to go on, or Esc."
+        try:
+            check_evaluated(
+                self.obj, self.obj.evaluated_get(context.evaluated_depsgraph_get()), "to click on"
+            )
+        except GoniometerError as error:
+            return str(error)
+        return ""
 
     def closed(self) -> str:
         """Why the session must end though the user did not end it (``""`` while it can go

@@ -391,11 +391,15 @@ def _blas_core():
 def _core_at(commit: str, alias: str):
     """The core as it was at ``commit``, imported as ``alias`` from ``git archive`` (None, with
     the reason printed, where git or that commit is not available)."""
+    import atexit
+    import shutil
     import subprocess
     import tempfile
 
     root = Path(__file__).resolve().parents[1]
     folder = Path(tempfile.mkdtemp(prefix=f"{alias}-"))
+    # Removed when the script ends, not before: the old core imports its modules lazily.
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
     try:
         archive = subprocess.run(
             ["git", "-C", str(root), "archive", commit, "vg_addon"],

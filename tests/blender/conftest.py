@@ -26,6 +26,15 @@ else:
 
 bpy = pytest.importorskip("bpy", reason="the bpy module (Blender as a Python module) is needed")
 
+# The processes the tests start (batch runs, workers, map children) make their temporary files,
+# Blender's session folder among them, here: a test that kills one with SIGKILL on purpose would
+# otherwise leave its folder in the machine's temporary folder. This process's own are made
+# where they were (tempfile has already chosen its folder, bpy has made its session folder).
+_CHILDREN_TEMP = tempfile.mkdtemp(prefix="vg-blender-tests-")
+for _name in ("TMPDIR", "TEMP", "TMP"):
+    os.environ[_name] = _CHILDREN_TEMP
+atexit.register(shutil.rmtree, _CHILDREN_TEMP, ignore_errors=True)
+
 import addon_utils  # noqa: E402  (Blender's, importable once bpy is)
 
 REPO = "user_default"
@@ -98,6 +107,9 @@ def pytest_unconfigure(config):
         session = Path(bpy.app.tempdir or ".").resolve()
         if session.name.startswith("blender_"):
             shutil.rmtree(session, ignore_errors=True)
+        for folder in (_CHILDREN_TEMP, _USER_DIR):  # os._exit runs no atexit handler
+            if folder:
+                shutil.rmtree(folder, ignore_errors=True)
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(_exit_status["code"])

@@ -159,12 +159,18 @@ def test_points_csv_plain_our_export_and_meshlab_replicate_the_same_angles(meshe
     original = rows_of(first)
     assert [r.user_data for r in original] == ["site 1", "site 2", "site 3"]
 
-    # Our own export, fed back: every row re-measured at its snapped centre, same numbers.
-    again = tmp_path / "again.csv"
-    ok(batch(meshes["ply"], "--points", first, "--out", again))
-    for a, b in zip(original, rows_of(again), strict=True):
-        assert (b.angle, b.fit, b.x, b.y, b.z, b.n_vertices) == (a.angle, a.fit, a.x, a.y, a.z,
-                                                                 a.n_vertices)  # fmt: skip
+    # Our own export, fed back: every row re-measured at its snapped centre, same numbers, and
+    # where each was asked for kept (it once became the snapped centre, with a snap of 0); in
+    # worker processes too.
+    assert any(r.snap_distance > 0 for r in original)
+    for jobs in ("1", "2"):
+        again = tmp_path / f"again{jobs}.csv"
+        ok(batch(meshes["ply"], "--points", first, "--out", again, "--jobs", jobs))
+        for a, b in zip(original, rows_of(again), strict=True):
+            assert (b.angle, b.fit, b.x, b.y, b.z, b.n_vertices) == (a.angle, a.fit, a.x, a.y, a.z,
+                                                                     a.n_vertices)  # fmt: skip
+            assert b.requested == a.requested
+            assert b.snap_distance == a.snap_distance
 
     # The MeshLab plugin's CSV: its 14 columns, the file name as Mesh Name, its own radius and
     # SegParam per row (here a different radius on the second row).
@@ -420,6 +426,13 @@ def test_blend_input_errors_exit_2(tmp_path):
     assert "2 mesh objects (A, B): name the ones to measure with --object" in result.stderr
     result = ok(batch(source, "--object", "C", "--at", 0, 0, 0, "--radius", 1, "--out", out), 2)
     assert "has no object named 'C'" in result.stderr
+    # Disabled in the viewports, an object has no evaluated mesh: its rows would read its mesh
+    # without modifiers, so the run is refused naming it before anything is measured.
+    bpy.data.objects["B"].hide_viewport = True
+    bpy.ops.wm.save_as_mainfile(filepath=str(source))
+    result = ok(batch(source, "--object", "B", "--at", 0, 0, 0, "--radius", 1, "--out", out), 2)
+    assert "'B' is disabled in the viewports" in result.stderr
+    assert not out.exists()
 
 
 def test_sample_scan_in_millimetres_matches_measure_xyz(vg, shared_data, tmp_path):

@@ -98,6 +98,35 @@ def test_export_then_import_replicates_exactly(vg, tmp_path):
     assert replicas[0].note == "=SUM(A1)"
 
 
+def test_an_import_keeps_where_each_measurement_was_asked_for(vg, tmp_path):
+    """A replication measures at the stored centre (x, y, z); it once recorded that centre as
+    the requested one, with a snap distance of 0, losing where the user had clicked. Now the
+    file's Requested x/y/z come back, with their snap distance; a row whose x, y, z were edited
+    (its Snap Distance no longer theirs) asks for its new x, y, z. Oracle: the clicks made."""
+    obj = measured_wedge()
+    path = tmp_path / "out.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    originals = [exact(item) for item in obj.vg.measurements]
+    assert all(o["snap_distance"] > 0 for o in originals[1:])  # clicks off a vertex
+    bpy.ops.vg.import_csv(filepath=str(path))
+    for original, replica in zip(originals, obj.vg.measurements[3:], strict=True):
+        copy = exact(replica)
+        assert copy["requested"] == original["requested"]
+        assert copy["snap_distance"] == original["snap_distance"]
+    rows = read_rows(path)
+    header = rows[0]
+    x, snap = header.index("x"), header.index("Snap Distance")
+    rows[3][x] = repr(float(rows[3][x]) + 0.02)  # the third measurement moved by hand
+    edited = tmp_path / "edited.csv"
+    with open(edited, "w", newline="", encoding="utf-8") as handle:
+        csv.writer(handle).writerows(rows)
+    assert float(rows[3][snap]) > 0
+    bpy.ops.vg.import_csv(filepath=str(edited))
+    moved = exact(obj.vg.measurements[-1])
+    assert moved["requested"][0] == float(rows[3][x])
+    assert moved["snap_distance"] < originals[2]["snap_distance"]
+
+
 def test_export_all_objects(vg, tmp_path):
     measured_wedge("A")
     measured_wedge("B", angle=70.0)

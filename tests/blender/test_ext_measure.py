@@ -1,6 +1,8 @@
 """bpy.ops.vg.measure_xyz against the core: the same inputs in mesh coordinates give
 bit-identical numbers, wherever the object is placed."""
 
+import math
+
 import bpy
 import numpy as np
 import pytest
@@ -21,6 +23,7 @@ from bpy_helpers import (
 )
 
 from vg_addon import Surface
+from vg_addon.formats import csvio
 
 
 def triangles_of(obj) -> np.ndarray:
@@ -452,3 +455,48 @@ def test_one_face_of_a_break_keeps_one_colour_along_it(vg):
     assert seen[1.0] | seen[-1.0] == set(pair)
     for item, plus_face in zip(obj.vg.measurements, plus_faces, strict=True):
         assert item.colors == f"{min(seen[plus_face])}/{min(seen[-plus_face])}"
+
+
+def test_an_object_left_out_of_the_depsgraph_is_refused_not_measured_without_its_modifiers(
+    vg, tmp_path
+):
+    """An object with Disable in Viewports on (or in an excluded collection) is not evaluated:
+    Blender hands back the original, and its mesh was measured without its modifiers (a 100°
+    wedge stretched to 134.48° by a hook read 100°, recorded as current). Oracle: the stretch's
+    angle, 2·atan(2·tan 50°)."""
+    stretched = math.degrees(2.0 * math.atan(2.0 * math.tan(math.radians(50.0))))
+
+    def hooked(name):
+        obj = wedge_object(100.0, name, irregular=False)
+        handle = bpy.data.objects.new(name + " hook", None)
+        bpy.context.scene.collection.objects.link(handle)
+        handle.scale = (1.0, 2.0, 1.0)
+        hook = obj.modifiers.new("Hook", "HOOK")
+        hook.object = handle
+        hook.vertex_indices_set(list(range(len(obj.data.vertices))))
+        bpy.context.view_layer.objects.active = obj
+        return obj
+
+    shown = hooked("Shown")
+    bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    assert abs(shown.vg.measurements[0].angle - stretched) < 0.01
+    disabled = hooked("Disabled")
+    disabled.hide_viewport = True
+    with pytest.raises(RuntimeError, match="disabled in the viewports"):
+        bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    assert len(disabled.vg.measurements) == 0
+    # Measured while shown, then disabled: measuring again is refused too, though its geometry
+    # was read and kept while it was shown.
+    shown.hide_viewport = True
+    bpy.context.view_layer.objects.active = shown
+    with pytest.raises(RuntimeError, match="disabled in the viewports"):
+        bpy.ops.vg.measure_xyz(location=(0, 0, 0), radius=0.5)
+    assert len(shown.vg.measurements) == 1
+    # Its measurement is exported as current, not stale (its mesh cannot be read to say), and
+    # deleting it is refused: its colours could not be taken off the mesh.
+    path = tmp_path / "disabled.csv"
+    bpy.ops.vg.export_csv(filepath=str(path))
+    assert [row.stale for row in csvio.read_measurements_csv(path)] == [False]
+    with pytest.raises(RuntimeError, match="disabled in the viewports"):
+        bpy.ops.vg.delete_measurement()
+    assert len(shown.vg.measurements) == 1

@@ -223,6 +223,24 @@ class TestErrors:
         measurement = self.surface.measure([0, 0, 0], 0.5, stability=flag)
         assert (measurement.stability is not None) == computed
 
+    @pytest.mark.parametrize(
+        ("arguments", "refusal"),
+        [
+            ((True,), "radius must be a number"),
+            (("0.5",), "radius must be a number"),
+            ((0.5, "2"), "λ .SegParam. must be a number"),
+            ((0.5, np.True_), "λ .SegParam. must be a number"),
+        ],
+    )
+    def test_text_and_bools_are_not_numbers(self, arguments, refusal):
+        # float() takes True as 1 and "0.5" as 0.5: a call with its arguments mixed up measured.
+        with pytest.raises(GoniometerError, match=refusal):
+            self.surface.measure([0, 0, 0], *arguments)
+        with pytest.raises(GoniometerError, match="centre must be three numbers"):
+            self.surface.measure(["0", "0", "0"], 0.5)
+        with pytest.raises(GoniometerError, match="points must be numbers"):
+            Surface(wedge(90, n=20).points.astype(str))
+
     def test_complex_coordinates_are_refused_not_cut_to_their_real_parts(self):
         mesh = wedge(90, n=20)
         with pytest.raises(GoniometerError, match="real numbers"):

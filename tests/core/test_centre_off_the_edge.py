@@ -159,3 +159,12 @@ def test_a_point_cloud_clicked_off_the_edge_reads_right_or_is_refused(angle, n):
             assert abs(reading - angle) < 2.0, (off, face, reading)
             read += 1
     assert read >= 2  # on the edge the cloud reads
+
+
+def test_the_written_out_cosine_is_the_cosine_of_the_threshold():
+    """The leave-one-out test compares cosines against a constant written out so that no
+    machine's ``cos`` can move it; it must stay the cosine of the threshold in degrees."""
+    from vg_addon.method import algorithm
+
+    expected = math.cos(math.radians(algorithm.CROSSED_MOVE_DEG))
+    assert abs(algorithm.COS_CROSSED_MOVE - expected) <= 1e-15

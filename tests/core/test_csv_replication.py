@@ -333,6 +333,23 @@ def test_a_fraction_or_a_huge_float_in_a_whole_number_column_is_refused(written)
         csvio.read_measurements_csv(text)
 
 
+@pytest.mark.parametrize(
+    ("forms", "read"),
+    [
+        (("10000000000000000", "1e16", "1.0e16", "10000000000000000.0"), 10**16),
+        (("999999999999999999", "999999999999999999.0"), 10**18 - 1),
+        (("1000000000000000000", "1e18", "1.0e18"), None),
+    ],
+)
+def test_a_whole_number_reads_alike_however_it_is_written(forms, read):
+    """Up to 18 digits, a whole number is read whether written as digits or as a float (a table
+    tool's re-save); beyond, it is refused in every form. Once ``1e16`` was refused while its
+    digits were read."""
+    from vg_addon.formats.csvio.text import whole_cell
+
+    assert [whole_cell(form) for form in forms] == [read] * len(forms)
+
+
 # --------------------------------------------------------------------------- mesh names
 
 
@@ -417,3 +434,20 @@ def test_a_break_number_resaved_as_a_float_is_that_break_when_re_measured(writte
 def test_a_break_number_that_is_not_a_whole_number_from_1_is_refused(written):
     with pytest.raises(GoniometerError, match="Break # must be a whole number from 1"):
         csvio.read_replication_csv(f"Mesh Name,x,y,z,Break #\nbone,1,2,3,{written}\n")
+
+
+def test_requested_centres_are_read_where_their_snap_distance_is_theirs():
+    """An export's Requested x/y/z are where the user asked, kept where the row's Snap Distance
+    is their distance from x, y, z; a row whose x, y, z were edited since asks for those."""
+    header = "Mesh Name,x,y,z,Requested x,Requested y,Requested z,Snap Distance\n"
+    rows = csvio.read_replication_csv(
+        header
+        + "b,1,2,3,1.1,2,3,0.1\n"  # as exported: 0.1 from x, y, z
+        + "b,1,2,3,,,,\n"  # no requested centre
+        + "b,1,2,3.5,1.1,2,3,0.1\n"  # x, y, z edited: the snap distance is no longer theirs
+        + "b,1,2,3,1,2,3,0\n"  # asked for at the vertex itself
+    )
+    assert [r.requested for r in rows] == [(1.1, 2.0, 3.0), None, None, (1.0, 2.0, 3.0)]
+    # Where it was asked for is not what is measured: incomplete, such a row asks for x, y, z.
+    rows = csvio.read_replication_csv(header + "b,1,2,3,1.1,,3,0.1\nb,1,2,3,a,2,3,0.1\n")
+    assert [(r.requested, r.x) for r in rows] == [(None, 1.0), (None, 1.0)]

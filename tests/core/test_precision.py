@@ -112,3 +112,18 @@ def test_the_limit_is_the_documented_share_of_the_spacing(n_vertices):
         else:
             check_rounding(points, radius, "float32")
         check_rounding(points, radius, "float64")  # float64 is never refused for this
+
+
+def test_float16_coordinates_are_refused_not_checked_as_float32():
+    """float16 keeps about three digits: a 150° wedge 100 units out read 153.21° with no flag,
+    its rounding checked against float32's step, some 8,000 times finer. Oracle: the wedge's
+    true angle, read from the same coordinates as float32."""
+    shape = wedge(150.0, n=47)
+    offset = np.array([100.0, -50.0, 25.0])
+    points = shape.points + offset
+    assert (
+        abs(Surface(points.astype(np.float32), shape.triangles).measure(offset, 0.3).angle - 150.0)
+        < 0.05
+    )
+    with pytest.raises(GoniometerError, match=r"stored as float16.*float32 or float64"):
+        Surface(points.astype(np.float16), shape.triangles)

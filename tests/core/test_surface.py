@@ -318,3 +318,16 @@ def test_an_unsigned_index_past_the_vertices_is_named_as_given():
     triangles[-1, 2] = np.uint64(2**63 + 5)
     with pytest.raises(GoniometerError, match=f"refers to vertex {2**63 + 5}, but the mesh"):
         Surface(shape.points, triangles)
+
+
+def test_a_geodesic_patch_on_an_unwelded_mesh_says_why_it_is_small():
+    """An STL keeps each triangle's own corners: no edge joins one triangle to the next, so a
+    geodesic patch holds one triangle whatever the radius. It was refused as "holds only 3
+    vertices ... use a larger radius", which no radius helps; the Euclidean patch reads it."""
+    shape = wedge(100.0, n=30)
+    corners = shape.points[shape.triangles.ravel()]  # every triangle its own three vertices
+    triangles = np.arange(corners.shape[0]).reshape(-1, 3)
+    surface = Surface(corners, triangles)
+    with pytest.raises(GoniometerError, match=r"reaches only 3 of the \d+ vertices.*Merge by"):
+        surface.measure([0.0, 0.0, 0.0], 0.4, patch="geodesic")
+    assert abs(surface.measure([0.0, 0.0, 0.0], 0.4).angle - 100.0) < 0.01

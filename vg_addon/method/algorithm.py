@@ -56,7 +56,6 @@ CROSSED_NOISE = 2.5
 CROSSED_SHARE = 0.12
 CROSSED_MOVE_DEG = 2.0
 CROSSED_OFF_EDGE = 0.5
-COS_CROSSED_MOVE = 0.9993908270190958  # cos(CROSSED_MOVE_DEG), written out: the same bits anywhere
 """Under the refined rule a reading is refused where more than ``CROSSED_SHARE`` of a side's
 vertices have normals past the other side by ``CROSSED_NOISE`` times the normals' noise, giving
 them to it moves the angle by more than ``CROSSED_MOVE_DEG``, and the planes so fitted meet more
@@ -64,6 +63,30 @@ than ``CROSSED_OFF_EDGE`` radii from the centre. On the 27 readings of wedges cl
 edge that were 3° to 87° off, the share is 0.14 to 0.91 and giving the vertices over reads the
 true angle; on 700 right readings (wedges exact, noisy and jittered, the reference meshes, the
 synthetic bone) it is at most 0.09 (docs/METHOD.md)."""
+
+SPLIT_MISSED_FIT = 0.25
+"""Under the refined rule, where the faces the normals tell meet at the centre at another angle
+than the reading's, and their planes fit with less than this share of the reading's fit error,
+the split missed the faces: refused (a mesh much finer on one face than on the other, whose
+split halves the fine face)."""
+
+
+def _split_missed_message(fields, share, moved_angle, moved_error) -> str:
+    return (
+        f"The split does not follow the faces: {share:.1%} of the vertices of one side face the "
+        f"other side's plane; given to it, the two faces the normals tell read {moved_angle:.2f}° "
+        f"with fit error {moved_error:.2g}, where the split reads {fields['angle']:.2f}° with "
+        f"fit error {fields['fit_error']:.2g}. The split counts vertices, so a face meshed much "
+        "more finely than the other outweighs it, or the patch holds more than two faces (a "
+        "corner): move the centre onto the edge away from corners, use a smaller radius, or "
+        "remesh the scan to an even density. Or one face's normals point the other way (its "
+        "triangles wound against the rest): make them consistent (Blender: Mesh > Normals > "
+        "Recalculate Outside)."
+    )
+
+
+COS_CROSSED_MOVE = 0.9993908270190958
+"""cos(:data:`CROSSED_MOVE_DEG`), written out so that the comparison has the same bits anywhere."""
 
 
 NEAR_FLAT_DEG = 170.0
@@ -336,6 +359,18 @@ def _plane_rests_on_one_vertex(joined: np.ndarray, side: np.ndarray, normal) -> 
     return bool((np.abs(row_dot(planes, normal)) < COS_CROSSED_MOVE).any())
 
 
+def _sides_by_normals(joined, binormal, used) -> tuple[np.ndarray, np.ndarray] | None:
+    """The patch's used vertices split by their normals alone (Algorithm 1's split at λ = 0):
+    the two faces the normals tell, or ``None`` where no split keeps enough on each side."""
+    along = row_dot(joined[:, 3:], binormal)
+    try:
+        threshold, _ = withinss_split(along[used], min_size=MIN_SIDE_VERTICES)
+    except GoniometerError:
+        return None
+    upper = used & (along >= threshold)
+    return upper, used & ~upper
+
+
 def _check_sides_follow_normals(joined, fields, center, radius, noise) -> None:
     """Refuse where many vertices of a side face the other side's plane, and giving them to it
     moves the angle: the split did not follow the faces. A centre off the edge (a patch mostly
@@ -363,12 +398,12 @@ def _check_sides_follow_normals(joined, fields, center, radius, noise) -> None:
         return
     moved = ((labels & ~crossed_plus) | crossed_minus) & used
     sides = (moved, used & ~moved)
-    if min(np.count_nonzero(side) for side in sides) < MIN_SIDE_VERTICES:
+    facing_one_face = min(np.count_nonzero(side) for side in sides)
+    if facing_one_face < MIN_SIDE_VERTICES:
         # Too few left to fit the faces the normals tell. The vertices on the crease lie on
         # both faces and their normals lean either way, so that alone says nothing; a side
         # whose plane turns when one vertex is left out is a few vertices of the other face
         # with one past the crease, and reads what that vertex makes of it.
-        facing_one_face = min(np.count_nonzero(side) for side in sides)
         crossed_sides = [
             (side, normal)
             for side, normal, share in (
@@ -378,23 +413,27 @@ def _check_sides_follow_normals(joined, fields, center, radius, noise) -> None:
             if share > CROSSED_SHARE
         ]
         if not any(_plane_rests_on_one_vertex(joined, *crossed) for crossed in crossed_sides):
-            return
-        raise GoniometerError(
-            f"The patch lies almost entirely on one face: {max(shares):.1%} of the vertices of "
-            f"one side face the other side's plane, and without them that side keeps "
-            f"{facing_one_face} (at least {MIN_SIDE_VERTICES} are needed to fit a plane to "
-            "a face). The centre is off the "
-            "break edge or the radius is too small for the mesh: move the centre onto the edge, "
-            "or use a larger radius. Or one face's normals point the other way (its triangles "
-            "wound against the rest): make them consistent, e.g. in Blender's Edit Mode with "
-            "Mesh > Normals > Recalculate Outside."
-        )
-    planes = []
+            sides = _sides_by_normals(joined, fields["binormal"], used)
+            if sides is None:
+                return
+        else:
+            raise GoniometerError(
+                f"The patch lies almost entirely on one face: {max(shares):.1%} of the vertices of "
+                f"one side face the other side's plane, and without them that side keeps "
+                f"{facing_one_face} (at least {MIN_SIDE_VERTICES} are needed to fit a plane to "
+                "a face). The centre is off the "
+                "break edge or the radius is too small for the mesh: move the centre onto the edge, "
+                "or use a larger radius. Or one face's normals point the other way (its triangles "
+                "wound against the rest): make them consistent, e.g. in Blender's Edit Mode with "
+                "Mesh > Normals > Recalculate Outside."
+            )
+    planes, moved_error = [], 0.0
     for side in sides:
-        normal, _, spans, centroid, _ = _side_plane(np.compress(side, joined, axis=0))
+        normal, error, spans, centroid, _ = _side_plane(np.compress(side, joined, axis=0))
         if not spans:
             return
         planes.append((normal, centroid))
+        moved_error += error
     moved_angle = 180.0 - acos_degrees(dot3(planes[0][0], planes[1][0]))
     if abs(moved_angle - fields["angle"]) <= CROSSED_MOVE_DEG:
         return
@@ -403,6 +442,10 @@ def _check_sides_follow_normals(joined, fields, center, radius, noise) -> None:
         return  # parallel: no edge to say the centre is off
     off = norm3(line[0] - center)
     if off <= CROSSED_OFF_EDGE * radius:
+        if moved_error < SPLIT_MISSED_FIT * fields["fit_error"]:
+            raise GoniometerError(
+                _split_missed_message(fields, max(shares), moved_angle, moved_error)
+            )
         return  # the faces the normals tell meet at the centre too: not a centre off its edge
     raise GoniometerError(
         f"The split does not follow the faces: {max(shares):.1%} of the vertices of one side "

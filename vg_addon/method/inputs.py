@@ -55,7 +55,16 @@ def _real_float64(values) -> np.ndarray | None:
     given = np.asarray(values)
     if given.dtype.kind == "c":
         return None
+    if given.dtype.kind in "bUS":  # NumPy would read True as 1 and "0.3" as 0.3 without a word
+        raise TypeError(f"got {given.dtype.name} values, not numbers")
     return np.ascontiguousarray(given, dtype=np.float64)
+
+
+def _real_number(value) -> float:
+    """``value`` as a float; ``TypeError`` for a bool or text, which ``float`` would take."""
+    if isinstance(value, (bool, str, bytes)) or np.asarray(value).dtype.kind in "bUS":
+        raise TypeError("not a number")
+    return float(value)
 
 
 def check_magnitude(what: str, array: np.ndarray, advice: str) -> None:
@@ -71,7 +80,7 @@ def check_magnitude(what: str, array: np.ndarray, advice: str) -> None:
 def as_radius(radius) -> float:
     """Validate a patch radius: a finite number greater than zero."""
     try:
-        value = float(radius)
+        value = _real_number(radius)
     except (TypeError, ValueError):
         raise GoniometerError(f"The radius must be a number; got {radius!r}.") from None
     if not np.isfinite(value) or value <= 0:
@@ -82,7 +91,7 @@ def as_radius(radius) -> float:
 def as_lambda(lam) -> float:
     """Validate the segmentation parameter λ: a number from 0 to :data:`MAX_LAMBDA`."""
     try:
-        value = float(lam)
+        value = _real_number(lam)
     except (TypeError, ValueError):
         raise GoniometerError(f"λ (SegParam) must be a number; got {lam!r}.") from None
     if not np.isfinite(value) or not 0 <= value <= MAX_LAMBDA:

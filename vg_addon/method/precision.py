@@ -31,8 +31,9 @@ def rounding_limit(n_vertices: int) -> float:
 
 def precision_of(points, precision=None) -> str:
     """The precision the coordinates ``points`` were stored at: ``precision`` if given (one of
-    :data:`PRECISIONS`), else ``"float32"`` for a float32 (or narrower) NumPy array and
-    ``"float64"`` for anything else."""
+    :data:`PRECISIONS`), else ``"float32"`` for a float32 NumPy array and ``"float64"`` for
+    anything else. Narrower floats (float16) are refused: their rounding is not float32's, and
+    with three significant digits they cannot hold a scan."""
     if precision is not None:
         if precision not in PRECISIONS:
             raise GoniometerError(
@@ -40,7 +41,13 @@ def precision_of(points, precision=None) -> str:
             )
         return precision
     dtype = getattr(points, "dtype", None)
-    if dtype is not None and dtype.kind == "f" and dtype.itemsize <= 4:
+    if dtype is not None and dtype.kind == "f" and dtype.itemsize < 4:
+        raise GoniometerError(
+            f"The coordinates are stored as {dtype.name}, which keeps about three significant "
+            "digits: too coarse to measure on. Give them as float32 or float64 (convert them "
+            "where they were made, not here: the rounding has already happened)."
+        )
+    if dtype is not None and dtype.kind == "f" and dtype.itemsize == 4:
         return "float32"
     return "float64"
 

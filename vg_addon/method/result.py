@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -341,6 +342,18 @@ class Measurement:
     split_angle: float | None = None
     n_left_out: int = 0
     left_out: np.ndarray | None = None
+
+    def with_requested(self, requested) -> Measurement:
+        """This measurement as asked for at ``requested`` (mesh coordinates): a replication
+        measures at the stored centre and keeps where the original was asked for, its snap
+        distance from that centre."""
+        point = np.array(requested, dtype=np.float64)
+        offset = (self.center - point)[None]  # as the snap measures it (spatial.GridIndex)
+        return dataclasses.replace(
+            self,
+            requested_center=point,
+            snap_distance=math.sqrt(float(np.einsum("ij,ij->i", offset, offset)[0])),
+        )
 
     @property
     def angle_meaning(self) -> str:

@@ -277,6 +277,15 @@ class Surface:
             step = float(np.spacing(np.float32(np.abs(self.points[center_index]).max())))
             if self.precision == "float32" and step >= 0.1 * radius:
                 check_rounding(np.take(self.points, indices, axis=0), radius, self.precision)
+            if ball.size >= 2 * max(indices.size, 2 * MIN_SIDE_VERTICES):  # geodesic: far fewer
+                raise GoniometerError(
+                    f"The geodesic patch of radius {radius:g} reaches only {indices.size} of the "
+                    f"{ball.size} vertices within the radius; along the mesh's edges the others "
+                    "lie farther. Where the mesh is not connected (separate pieces, or seams "
+                    "whose vertices are not merged, as STL files keep each triangle's own "
+                    "corners), merge its vertices by distance (Blender: Mesh > Clean Up > Merge "
+                    "by Distance); else use a larger radius, or the Euclidean patch."
+                )
             raise GoniometerError(
                 f"The patch of radius {radius:g} holds only {indices.size} vertices; at least "
                 f"{2 * MIN_SIDE_VERTICES} are needed: use a larger radius."

@@ -71,6 +71,10 @@ class Task:
     units : str
         A CSV row's ``Units`` cell ("" where it has none): a run without ``--units`` takes the
         unit its rows name as the mesh's.
+    requested : tuple of 3 float, or None
+        Where an exported row's measurement was asked for (its ``Requested x/y/z``, in
+        ``coordinates``): the row is measured at ``center`` and records this as its requested
+        centre. None: ``center`` is what was asked for.
     """
 
     index: int
@@ -89,6 +93,7 @@ class Task:
     rule: str = DEFAULT_RULE
     units: str = ""
     default_radius: bool = False
+    requested: tuple[float, float, float] | None = None
 
 
 # --------------------------------------------------------------------------- command line values
@@ -328,6 +333,7 @@ def plan_rows(
                 coordinates=row.coordinates,
                 rule=row.rule or rule,
                 units=row.units or "",
+                requested=row.requested,
             )
         )
     return tasks

@@ -90,6 +90,11 @@ class ReplicationRow:
     units : str or None
         The ``Units`` cell of an export (what one coordinate unit is, e.g. ``"mm"``); ``None``
         when absent or blank.
+    requested : tuple of 3 float, or None
+        Where the original measurement was asked for (``Requested x/y/z`` of an export, in
+        ``coordinates``), kept where the row's ``Snap Distance`` is its distance from x, y, z
+        (a row whose x, y, z were edited asks for x, y, z); ``None`` when absent or blank. The
+        row is measured at x, y, z and keeps this as its requested centre.
     """
 
     row_number: int
@@ -111,6 +116,7 @@ class ReplicationRow:
     coordinates: str = MESH_COORDINATES
     rule: str | None = None
     units: str | None = None
+    requested: tuple[float, float, float] | None = None
 
 
 # Header aliases of the replication reader, normalised (case-folded, "_" as space, whitespace
@@ -132,6 +138,10 @@ _REPLICATION_ALIASES = {
     "edge_closed": ("edge closed",),
     "error": ("error",),
     "units": ("units",),
+    "requested_x": ("requested x",),
+    "requested_y": ("requested y",),
+    "requested_z": ("requested z",),
+    "snap_distance": ("snap distance",),
 }
 
 
@@ -311,6 +321,9 @@ def parse_replication_csv(
             problems.append(
                 f"row {number}: {name_of('lam')} (λ) must be 0 or more (got {cell('lam').strip()})"
             )
+        requested = _requested_cells([cell(f"requested_{axis}") for axis in "xyz"])
+        if requested is not None and not _snaps_to(requested, values, cell("snap_distance")):
+            requested = None
         edge_closed, why = flag_cell(cell("edge_closed"))
         if why:
             problems.append(f"row {number}: {name_of('edge_closed')} {why}")
@@ -366,6 +379,7 @@ def parse_replication_csv(
                 coordinates=coordinates,
                 rule=rule,
                 units=optional_text(cell("units")),
+                requested=requested,
             )
         )
     if problems:
@@ -431,3 +445,23 @@ def read_replication_csv(path_or_text, passed_over: list | None = None) -> list[
     """
     text, source = load(path_or_text)
     return parse_replication_csv(text, source, passed_over)
+
+
+def _requested_cells(cells: list[str]) -> tuple[float, float, float] | None:
+    """The ``Requested x/y/z`` cells as a point; ``None`` unless all three are finite numbers
+    (they are where the original was asked for, not what is measured: a row without them asks
+    for its x, y, z)."""
+    values = [number_cell(raw) if raw.strip() else (None, "blank") for raw in cells]
+    if any(why for _, why in values):
+        return None
+    return (values[0][0], values[1][0], values[2][0])
+
+
+def _snaps_to(requested, values: dict, snap_cell: str) -> bool:
+    """Whether the row's ``Snap Distance`` is the distance from ``requested`` to its x, y, z, as
+    the export wrote them (to a part in a million)."""
+    snap, why = number_cell(snap_cell) if snap_cell.strip() else (None, "blank")
+    if why or None in (values["x"], values["y"], values["z"]):
+        return False
+    distance = math.dist(requested, (values["x"], values["y"], values["z"]))
+    return math.isfinite(distance) and abs(distance - snap) <= 1e-6 * max(distance, snap, 1e-300)

@@ -359,11 +359,11 @@ def whole_cell(text: str) -> int | None:
         return int(text)
     if NUMBER.fullmatch(text):
         value = float(text)
-        if value.is_integer() and abs(value) < 2**53:
+        if value.is_integer() and abs(value) <= 1e18:  # INTEGER's 18 digits, written any way
             # Exactly whole, not after rounding to a float ("0.99999999999999999" is not 1).
             with contextlib.suppress(decimal.InvalidOperation):  # exponents beyond its range
                 exact = decimal.Decimal(text)
-                if exact == exact.to_integral_value():
+                if exact == exact.to_integral_value() and abs(exact) < 10**18:
                     return int(exact)
     return None
 
