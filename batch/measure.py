@@ -350,26 +350,19 @@ def draw_pictures(result: MeshResult, obj, options, stem: str, plots, name: str)
 def _measure_task(surface, geometry, task, options):
     """The measurement of one task, or the GoniometerError saying why it cannot be taken."""
     try:
-        center, radius, requested = task.center, task.radius, task.requested
-        if task.coordinates == records.WORLD:  # a row of an export of earlier versions
-            center, radius = measuring.from_world(
-                center, radius, geometry.matrix, scale_radius=not task.default_radius
-            )
-            if requested is not None:
-                requested = mesh_data.mesh_points(
-                    np.asarray(requested, np.float64), geometry.matrix
-                )
-        measurement = surface.measure(
-            center,
-            radius,
-            task.lam,
-            task.patch,
+        return measuring.replicate_measurement(
+            surface,
+            geometry.matrix,
+            task.center,
+            task.radius,
+            requested=task.requested,
+            world=task.coordinates == records.WORLD,  # a row of an export of earlier versions
+            scale_radius=not task.default_radius,
+            lam=task.lam,
+            patch=task.patch,
             rule=task.rule,
             stability=bool(options.get("stability")),
         )
-        if requested is not None:  # measured at the stored centre, asked for where it was
-            measurement = measurement.with_requested(requested)
-        return measurement
     except GoniometerError as error:
         return error
 

@@ -71,6 +71,7 @@ def blend_objects(names: list[str], blend: str) -> list[MeshSource]:
             )
         names = [meshes[0].name]
     sources, problems = [], []
+    graph = bpy.context.evaluated_depsgraph_get()
     for name in names:
         obj = bpy.data.objects.get(name)
         if obj is None:
@@ -78,8 +79,7 @@ def blend_objects(names: list[str], blend: str) -> list[MeshSource]:
             continue
         try:
             mesh_data.check_measurable(obj)
-            graph = bpy.context.evaluated_depsgraph_get()
-            mesh_data.check_evaluated(obj, obj.evaluated_get(graph), "to measure")
+            mesh_data.check_evaluated(obj, graph, "to measure")
         except GoniometerError as error:
             problems.append(str(error))
             continue

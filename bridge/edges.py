@@ -22,7 +22,7 @@ from ..vg_addon.method.edge_profile import summarize
 from ..vg_addon.method.given_points import check_given_points
 from . import measuring, records
 from .mesh_data import (
-    check_evaluated,
+    NotEvaluatedError,
     check_measurable,
     evaluated_geometry,
     mesh_points,
@@ -500,10 +500,10 @@ def delete_edge(obj, index: int, *, depsgraph=None) -> int:
     data = obj.vg
     if not 0 <= index < len(data.edges):
         raise GoniometerError(f"'{obj.name}' has no edge profile at list position {index}.")
-    graph = depsgraph or bpy.context.evaluated_depsgraph_get()
-    check_evaluated(obj, obj.evaluated_get(graph), "to repaint")  # its colours stay otherwise
     try:
-        geometry = evaluated_geometry(obj, graph)
+        geometry = evaluated_geometry(obj, depsgraph, purpose="to repaint")
+    except NotEvaluatedError:
+        raise  # its colours could not be taken off: the edge stays
     except GoniometerError:
         geometry = None  # every vertex deleted: the records still go, and nothing is painted
     edge = data.edges[index]

@@ -137,7 +137,7 @@ class MapJob:
         self.size = (width, height)
         self.samples = int(samples)
         self.depsgraph = bpy.context.evaluated_depsgraph_get()
-        check_evaluated(obj, obj.evaluated_get(self.depsgraph), "to render")
+        check_evaluated(obj, self.depsgraph, "to render")
         self.views = list(view_list(obj, views, self.depsgraph))
         self.labels = labels_of(obj)
         unviewed = stations_without_views(obj, edge_ends)

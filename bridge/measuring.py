@@ -20,6 +20,7 @@ from .mesh_data import (
     Geometry,
     check_measurable,
     evaluated_geometry,
+    is_evaluated,
     mesh_points,
     own_write,
     surface_for,
@@ -375,7 +376,7 @@ def stale_numbers(obj, *, depsgraph=None) -> set[int]:
     if not len(obj.vg.measurements):
         return set()
     graph = depsgraph or bpy.context.evaluated_depsgraph_get()
-    if not obj.evaluated_get(graph).is_evaluated:
+    if not is_evaluated(obj, graph):
         # Disabled in the viewports: its mesh as the user sees it cannot be read, so the flags
         # set when it was last evaluated stand (not every record stale).
         return {item.number for item in obj.vg.measurements if item.stale}
@@ -412,6 +413,39 @@ def from_world(location, radius, matrix, *, scale_radius=True):
         )
     location = mesh_points(np.asarray(location, dtype=np.float64), matrix)
     return location, (radius / scale if scaled else radius)
+
+
+def replicate_measurement(
+    surface,
+    matrix,
+    center,
+    radius,
+    *,
+    requested=None,
+    world=False,
+    scale_radius=True,
+    lam,
+    patch,
+    rule,
+    stability=False,
+) -> Measurement:
+    """A stored measurement taken again on ``surface``: at its stored ``center`` (world space
+    where ``world``, mapped by ``matrix`` as :func:`from_world` does), recorded as asked for at
+    ``requested`` (where the click was, or ``None`` for the centre itself) with the snap's own
+    distance. Shared by Blender's import and the batch's replication.
+
+    Raises
+    ------
+    GoniometerError
+        Why it cannot be taken (the message of :func:`from_world` or ``Surface.measure``).
+    """
+    if world:
+        center, radius = from_world(center, radius, matrix, scale_radius=scale_radius)
+        if requested is not None:
+            requested = mesh_points(np.asarray(requested, np.float64), matrix)
+    m = surface.measure(center, radius, lam, patch, rule=rule, stability=stability)
+    # measured at the stored centre, asked for where it was
+    return m if requested is None else m.with_requested(requested)
 
 
 def forget_paint() -> None:

@@ -349,11 +349,26 @@ def _sharing_objects(obj) -> list[str]:
     return sorted(other.name for other in bpy.data.objects if other.data == mesh and other != obj)
 
 
-def check_evaluated(obj, obj_eval, purpose: str) -> None:
-    """Raise a :class:`GoniometerError` where ``obj_eval`` (``obj.evaluated_get(depsgraph)``) is
-    not evaluated, saying it has no evaluated mesh for ``purpose`` ("to render")."""
-    if not obj_eval.is_evaluated:
-        raise GoniometerError(
+_TO_MEASURE = "to measure (its modifiers and shape keys are not applied)"
+
+
+class NotEvaluatedError(GoniometerError):
+    """The object has no evaluated mesh: it is disabled in the viewports or left out of the view
+    layer. Its records stand, but nothing can be measured, painted or rendered on it."""
+
+
+def is_evaluated(obj, depsgraph) -> bool:
+    """Whether ``depsgraph`` holds ``obj`` evaluated (its modifiers and shape keys applied).
+    Where it does not, Blender hands back the original, whose mesh lacks the modifiers and shape
+    keys the user sees, and whose matrix_world is not kept up to date."""
+    return obj.evaluated_get(depsgraph).is_evaluated
+
+
+def check_evaluated(obj, depsgraph, purpose: str) -> None:
+    """Raise :class:`NotEvaluatedError` where ``depsgraph`` does not hold ``obj`` evaluated, saying it
+    has no evaluated mesh for ``purpose`` ("to render")."""
+    if not is_evaluated(obj, depsgraph):
+        raise NotEvaluatedError(
             f"'{obj.name}' is disabled in the viewports or left out of this view layer (the "
             "monitor icon or the checkbox in the Outliner, its own or its collection's), so "
             f"Blender has no evaluated mesh {purpose}: enable it first (hiding it with H is "
@@ -361,7 +376,7 @@ def check_evaluated(obj, obj_eval, purpose: str) -> None:
         )
 
 
-def evaluated_geometry(obj, depsgraph=None) -> Geometry:
+def evaluated_geometry(obj, depsgraph=None, *, purpose: str = _TO_MEASURE) -> Geometry:
     """The evaluated mesh of ``obj`` (modifiers applied) in its own coordinates.
 
     Read once and kept until a depsgraph update touches the object's geometry
@@ -373,13 +388,20 @@ def evaluated_geometry(obj, depsgraph=None) -> Geometry:
         A mesh object (the original, not the evaluated copy).
     depsgraph : bpy.types.Depsgraph, optional
         Default: the context's evaluated depsgraph.
+    purpose : str, optional
+        What the mesh is read for, in the :class:`NotEvaluatedError` message ("to repaint").
+
+    Raises
+    ------
+    NotEvaluatedError
+        The object is disabled in the viewports or left out of the view layer.
+    GoniometerError
+        The mesh cannot be measured (no vertices, say).
     """
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
+    check_evaluated(obj, depsgraph, purpose)
     obj_eval = obj.evaluated_get(depsgraph)
-    # Not in the depsgraph, Blender hands back the original, whose mesh lacks the modifiers and
-    # shape keys the user sees, and whose matrix_world is not kept up to date.
-    check_evaluated(obj, obj_eval, "to measure (its modifiers and shape keys are not applied)")
     key = obj.session_uid
     kept = _geometries.get(key)
     if _watching and kept is not None and key in _current:

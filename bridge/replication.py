@@ -7,14 +7,12 @@ from __future__ import annotations
 from collections import Counter
 from pathlib import Path
 
-import numpy as np
-
 from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio
 from ..vg_addon.method.algorithm import DEFAULT_RULE
 from . import colors, edges, measuring, records
-from .mesh_data import check_measurable, evaluated_geometry, mesh_points, names_of, surface_for
+from .mesh_data import check_measurable, evaluated_geometry, names_of, surface_for
 
 
 def replicate_rows(
@@ -145,26 +143,23 @@ def replicate_steps(
                 )
             if row_radius is None:
                 raise GoniometerError("no radius (the CSV has no Radius for this row)")
-            location, requested = (row.x, row.y, row.z), row.requested
-            lengths = (row.arc_length or 0.0, row.spacing or 0.0)  # an edge station's
-            if row.coordinates == records.WORLD:
-                location, row_radius = measuring.from_world(
-                    location, row_radius, geometry.matrix, scale_radius=row.radius is not None
-                )
-                if requested is not None:
-                    requested = mesh_points(np.asarray(requested, np.float64), geometry.matrix)
-                if row.edge_number is not None:
-                    lengths = edges.mesh_lengths(obj, *lengths)
-            m = surface.measure(
-                location,
+            world = row.coordinates == records.WORLD
+            m = measuring.replicate_measurement(
+                surface,
+                geometry.matrix,
+                (row.x, row.y, row.z),
                 row_radius,
-                lam if row.lam is None else row.lam,
-                row.patch or patch,
+                requested=row.requested,
+                world=world,
+                scale_radius=row.radius is not None,
+                lam=lam if row.lam is None else row.lam,
+                patch=row.patch or patch,
                 rule=row.rule or rule,
                 stability=stability,
             )
-            if requested is not None:  # measured at the stored centre, asked for where it was
-                m = m.with_requested(requested)
+            lengths = (row.arc_length or 0.0, row.spacing or 0.0)  # an edge station's
+            if world and row.edge_number is not None:
+                lengths = edges.mesh_lengths(obj, *lengths)
         except GoniometerError as error:
             failures.append(f"row {row.row_number}: {error}")
             continue

@@ -11,7 +11,7 @@ from bpy.props import (
 
 from ..bridge import measuring, plots, records
 from ..bridge.mesh_data import (
-    check_evaluated,
+    NotEvaluatedError,
     check_measurable,
     evaluated_geometry,
     uniform_scale,
@@ -142,14 +142,11 @@ def _removing(operator, context):
     obj = _active_measurable(operator, context)
     if obj is None:
         return None, None
-    depsgraph = context.evaluated_depsgraph_get()
     try:
-        check_evaluated(obj, obj.evaluated_get(depsgraph), "to repaint")
-    except GoniometerError as error:
+        return obj, evaluated_geometry(obj, context.evaluated_depsgraph_get(), purpose="to repaint")
+    except NotEvaluatedError as error:
         operator.report({"ERROR"}, str(error))
         return None, None
-    try:
-        return obj, evaluated_geometry(obj, depsgraph)
     except GoniometerError:
         return obj, None
 

@@ -110,9 +110,7 @@ class ViewSession:
         if not object_alive(context, self.obj):
             return f"'{self.obj.name}' is not in this scene: go back to its scene to go on, or Esc."
         try:
-            check_evaluated(
-                self.obj, self.obj.evaluated_get(context.evaluated_depsgraph_get()), "to click on"
-            )
+            check_evaluated(self.obj, context.evaluated_depsgraph_get(), "to click on")
         except GoniometerError as error:
             return str(error)
         return ""

@@ -82,6 +82,28 @@ def test_another_scene_shown_keeps_the_clicks(edge, view):  # noqa: F811
     session.finish()
 
 
+def test_an_object_disabled_mid_session_says_why_and_keeps_the_clicks(edge, view):  # noqa: F811
+    """Disable in Viewports (the monitor icon) mid-session: Blender then hands back the original
+    object, without the modifiers the clicks were picked on. A click says why instead of tracing
+    on that mesh, Enter records nothing, and once enabled again the session goes on."""
+    session = two_clicks(edge, view)
+    point = view.points[ridge_vertex(view, N // 2)]
+    view.obj.hide_viewport = True
+    try:
+        assert not view.obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).is_evaluated
+        assert session.handle(bpy.context, "click", window_pixel(view, point)) == "running"
+        assert "disabled in the viewports" in session.machine.message
+        assert len(session.machine.clicks) == 2
+        assert session.handle(bpy.context, "confirm") == "running"
+        assert "disabled in the viewports" in session.machine.message
+        assert not len(view.obj.vg.edges)
+    finally:
+        view.obj.hide_viewport = False
+    assert session.handle(bpy.context, "click", window_pixel(view, point)) == "running"
+    assert len(session.machine.clicks) == 3, session.machine.message
+    session.finish()
+
+
 def test_enter_on_an_object_in_edit_mode_keeps_the_clicks(edge, view):  # noqa: F811
     """Enter with the object in Edit Mode ended the session, and then the record was refused:
     every click lost. Now Enter says why and the session goes on."""

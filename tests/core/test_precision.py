@@ -111,7 +111,37 @@ def test_the_limit_is_the_documented_share_of_the_spacing(n_vertices):
                 check_rounding(points, radius, "float32")
         else:
             check_rounding(points, radius, "float32")
-        check_rounding(points, radius, "float64")  # float64 is never refused for this
+        check_rounding(points, radius, "float64")  # float64's step here is 2.3e-10
+
+
+def test_float64_trillions_of_units_out_is_measured_relative_to_its_centre():
+    """Sums of float64 coordinates 2.3e12 units out round by up to the vertex count times
+    float64's step there (0.0005): a 90° wedge's patch of about 8,800 vertices read 94.56°, fit error
+    small, no flag. The oracle is the wedge's true angle, and the same vertices moved back to
+    the origin (an exact subtraction: both terms are within a factor two of each other)."""
+    shape = wedge(90.0, n=150, irregular=True, seed=2)
+    centre = OFFSET * 2e12
+    points = np.asarray(shape.points, dtype=np.float64) + centre
+    far = Surface(points, shape.triangles).measure(centre, 0.5)
+    near = Surface(points - centre, shape.triangles).measure(np.zeros(3), 0.5)
+    assert far.n_vertices > 8000
+    assert far.angle == pytest.approx(90.0, abs=0.01)
+    assert far.angle == pytest.approx(near.angle, abs=1e-3)
+
+
+def test_float64_rounded_past_its_vertex_spacing_is_refused_with_the_reason():
+    """1.1e14 units out float64 keeps coordinates to steps of 0.016, half the wedge's vertex
+    spacing: the rounded vertices, moved back to the origin exactly, read 0.32° off the true 90°.
+    The same limit as float32's refuses it, saying to subtract an offset."""
+    points, _, triangles, centre = far_wedge(1e14)
+    near = Surface(points - centre, triangles).measure(np.zeros(3), 0.5).angle
+    assert abs(near - 90.0) > 0.3  # what the refusal keeps from the user
+    with pytest.raises(
+        GoniometerError,
+        match=r"reach 113,000,000,000,000 units from its origin, where even float64 rounds them "
+        r"to steps of 0\.016.*Subtract an offset",
+    ):
+        Surface(points, triangles).measure(centre, 0.5)
 
 
 def test_float16_coordinates_are_refused_not_checked_as_float32():

@@ -70,21 +70,6 @@ than the reading's, and their planes fit with less than this share of the readin
 the split missed the faces: refused (a mesh much finer on one face than on the other, whose
 split halves the fine face)."""
 
-
-def _split_missed_message(fields, share, moved_angle, moved_error) -> str:
-    return (
-        f"The split does not follow the faces: {share:.1%} of the vertices of one side face the "
-        f"other side's plane; given to it, the two faces the normals tell read {moved_angle:.2f}° "
-        f"with fit error {moved_error:.2g}, where the split reads {fields['angle']:.2f}° with "
-        f"fit error {fields['fit_error']:.2g}. The split counts vertices, so a face meshed much "
-        "more finely than the other outweighs it, or the patch holds more than two faces (a "
-        "corner): move the centre onto the edge away from corners, use a smaller radius, or "
-        "remesh the scan to an even density. Or one face's normals point the other way (its "
-        "triangles wound against the rest): make them consistent (Blender: Mesh > Normals > "
-        "Recalculate Outside)."
-    )
-
-
 COS_CROSSED_MOVE = 0.9993908270190958
 """cos(:data:`CROSSED_MOVE_DEG`), written out so that the comparison has the same bits anywhere."""
 
@@ -116,6 +101,13 @@ SHARED_ROW_FACTOR = 1.5
 """A side whose vertices lie on one line borrows the other side's vertices within this factor of
 the nearest one's distance to that line: the row of vertices on the edge, which belongs to both
 faces."""
+
+FAR_RADII = 1e6
+"""A patch whose centre lies more than this many radii from the origin (in any coordinate) is
+measured relative to its centre. Its sums of coordinates would otherwise round by up to the
+vertex count times float64's step there (a 90° wedge 2e12 units out, about 8,800 patch
+vertices, read 94.56°); nearer, where that rounding is some 1e-10 radii at most, the coordinates
+are used as given, so readings keep their bits (docs/METHOD.md, "float64 far out")."""
 
 MIN_RADIUS = 1e-152
 """Smallest radius to measure with: squared distances below about 1e-154 lose precision
@@ -371,6 +363,20 @@ def _sides_by_normals(joined, binormal, used) -> tuple[np.ndarray, np.ndarray] |
     return upper, used & ~upper
 
 
+def _split_missed_message(fields, share, moved_angle, moved_error) -> str:
+    return (
+        f"The split does not follow the faces: {share:.1%} of the vertices of one side face the "
+        f"other side's plane; given to it, the two faces the normals tell read {moved_angle:.2f}° "
+        f"with fit error {moved_error:.2g}, where the split reads {fields['angle']:.2f}° with "
+        f"fit error {fields['fit_error']:.2g}. The split counts vertices, so a face meshed much "
+        "more finely than the other outweighs it, or the patch holds more than two faces (a "
+        "corner): move the centre onto the edge away from corners, use a smaller radius, or "
+        "remesh the scan to an even density. Or one face's normals point the other way (its "
+        "triangles wound against the rest): make them consistent (Blender: Mesh > Normals > "
+        "Recalculate Outside)."
+    )
+
+
 def _check_sides_follow_normals(joined, fields, center, radius, noise) -> None:
     """Refuse where many vertices of a side face the other side's plane, and giving them to it
     moves the angle: the split did not follow the faces. A centre off the edge (a patch mostly
@@ -483,6 +489,8 @@ def measure_patch(
             f"The patch holds {n_points} vertices; at least {2 * MIN_SIDE_VERTICES} are needed "
             f"({MIN_SIDE_VERTICES} per side): use a larger radius."
         )
+    if float(np.abs(center).max()) > FAR_RADII * radius:
+        points, center = points - center, np.zeros(3)
     along_tangent, tangent, normal_eigenvalues = _smallest_eigenvector(moments(normals))
     mean_normal = _column_means(normals)
     # np.cross's arithmetic on Python floats (the same IEEE operations, without its overhead).

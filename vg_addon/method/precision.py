@@ -1,5 +1,6 @@
-"""Coordinates stored as float32 (as Blender keeps a mesh): where their rounding is too coarse
-for a patch, a measurement is refused rather than read off the rounding."""
+"""Coordinates stored as float32 (as Blender keeps a mesh), or as float64 trillions of units from
+the origin: where their rounding is too coarse for a patch, a measurement is refused rather than
+read off the rounding."""
 
 from __future__ import annotations
 
@@ -53,15 +54,16 @@ def precision_of(points, precision=None) -> str:
 
 
 def check_rounding(patch_points: np.ndarray, radius: float, precision: str) -> None:
-    """Refuse a patch whose float32 coordinates are rounded by more than
-    :func:`rounding_limit` of the spacing of its vertices.
+    """Refuse a patch whose coordinates are rounded by more than :func:`rounding_limit` of the
+    spacing of its vertices.
 
     Far from the mesh's origin, float32 keeps coordinates only to a coarse step (0.25 units at
     4 million units, 6e-5 at a thousand): each vertex is moved by up to half a step, which tilts
     the normals the sides are split by and the planes fitted to them. The angle moves by about
     the step's share of the spacing over the vertex count (times up to about 900 degrees, measured;
     by degrees once the step nears the spacing), so a small patch takes a finer step than a
-    large one (see docs/METHOD.md).
+    large one (see docs/METHOD.md). float64 rounds the same way some 5e8 times finer: its step
+    reaches a scan's vertex spacing only trillions of units out (0.002 at 1e13).
 
     Parameters
     ----------
@@ -70,17 +72,15 @@ def check_rounding(patch_points: np.ndarray, radius: float, precision: str) -> N
     radius : float
         The patch radius; with ``n`` it gives the spacing, ``radius * sqrt(pi / n)``.
     precision : {"float32", "float64"}
-        How the coordinates were stored; float64 coordinates are never refused here.
+        How the coordinates were stored: the step is that type's.
 
     Raises
     ------
     GoniometerError
         The rounding step is too coarse, with the numbers and what to do.
     """
-    if precision != "float32":
-        return
     largest = float(np.abs(patch_points).max())
-    step = float(np.spacing(np.float32(largest)))
+    step = float(np.spacing(np.dtype(precision).type(largest)))
     n_vertices = patch_points.shape[0]
     spacing = radius * float(np.sqrt(np.pi / n_vertices))
     limit = rounding_limit(n_vertices)
@@ -90,13 +90,21 @@ def check_rounding(patch_points: np.ndarray, radius: float, precision: str) -> N
     if limit < MAX_ROUNDING:
         larger = ", or use a larger radius (a patch of more vertices takes a coarser step)"
     distance = f"{largest:,.0f}" if largest >= 10.0 else f"{largest:.3g}"
+    rounding = (
+        f"rounds them to steps of {step:.2g}: {step / spacing:.2g} of the spacing of the "
+        f"vertices here ({spacing:.2g}), more than the {limit:.2g} at which it can move the "
+        f"angle of a patch of {n_vertices} vertices by {MAX_MOVE:g}°."
+    )
+    if precision == "float64":
+        raise GoniometerError(
+            f"This mesh's coordinates reach {distance} units from its origin, where even float64 "
+            f"{rounding} Subtract an offset from the coordinates (move the scan near the origin) "
+            f"and measure again{larger}."
+        )
     raise GoniometerError(
         f"This mesh's coordinates are stored as float32 (as Blender keeps every mesh), which at "
-        f"coordinates up to {distance} units rounds them to steps of {step:.2g}: "
-        f"{step / spacing:.2g} of the spacing of the vertices here ({spacing:.2g}), more than "
-        f"the {limit:.2g} at which it can move the angle of a patch of {n_vertices} vertices "
-        f"by {MAX_MOVE:g}°. The rounding happened when the mesh was stored: move the scan near "
-        "the origin before it is imported (subtract an offset from its coordinates), or keep "
-        "its coordinates as float64 (vg_batch measures a float64 mesh file at the file's own "
-        f"coordinates){larger}."
+        f"coordinates up to {distance} units {rounding} The rounding happened when the mesh was "
+        "stored: move the scan near the origin before it is imported (subtract an offset from "
+        "its coordinates), or keep its coordinates as float64 (vg_batch measures a float64 mesh "
+        f"file at the file's own coordinates){larger}."
     )

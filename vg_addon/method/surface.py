@@ -94,8 +94,8 @@ class Surface:
     precision : {"float32", "float64"}, optional
         The precision the coordinates were stored at before they reached here (Blender keeps
         every mesh as float32). Default: ``"float32"`` for a float32 array, else ``"float64"``.
-        A patch whose float32 rounding is too coarse for its vertex spacing is refused (see
-        :func:`~vg_addon.method.precision.check_rounding`).
+        A patch whose rounding at that precision is too coarse for its vertex spacing is refused
+        (see :func:`~vg_addon.method.precision.check_rounding`).
 
     Notes
     -----
@@ -272,10 +272,11 @@ class Surface:
         ball, _ = self.index.ball(self.points[center_index], radius)
         indices = self._restrict(ball, center_index, radius, mode)
         if indices.size < 2 * MIN_SIDE_VERTICES:
-            # Far from the origin float32 rounding merges vertices: say so, not "too few", where
-            # its step is a tenth of the radius or more (else the radius is simply too small).
-            step = float(np.spacing(np.float32(np.abs(self.points[center_index]).max())))
-            if self.precision == "float32" and step >= 0.1 * radius:
+            # Far from the origin rounding merges vertices: say so, not "too few", where its
+            # step is a tenth of the radius or more (else the radius is simply too small).
+            largest = np.abs(self.points[center_index]).max()
+            step = float(np.spacing(np.dtype(self.precision).type(largest)))
+            if step >= 0.1 * radius:
                 check_rounding(np.take(self.points, indices, axis=0), radius, self.precision)
             if ball.size >= 2 * max(indices.size, 2 * MIN_SIDE_VERTICES):  # geodesic: far fewer
                 raise GoniometerError(
