@@ -81,6 +81,7 @@ def error_row(task, mesh_name: str, message: str, units: str):
         radius=task.radius,
         lam=task.lam,
         patch=task.patch,
+        rule=task.rule,  # a retry of the row is measured as the run was asked to
         requested=tuple(task.center),
         units=units,
         extension_version=records.extension_version(),

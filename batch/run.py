@@ -19,8 +19,8 @@ from ..vg_addon.formats import csvio, files
 from ..vg_addon.method.edge_summary import sd_text
 from ..vg_addon.method.result import stability_text, stability_warning
 from ..vg_addon.method.winding import winding_message
-from ..vg_addon.workflow import agreement, batchplan
-from . import extension, stopping
+from ..vg_addon.workflow import batchplan
+from . import extension, replay_agreement, stopping
 from .blend_file import append_objects, forget, save_blend
 from .cli import UsageError, is_picked_points
 from .edges import (
@@ -64,6 +64,7 @@ class Run:
         self.bad_files: list[str] = []
         self.passed_over: list[str] = []  # lines naming .pp files that name no mesh given
         self.replayed = 0  # how many rows of a --points file the tasks were planned from
+        self.replayed_export = False  # whether that file's header is this extension's export
         self.lock = threading.Lock()
         self.started = time.perf_counter()
         self.last_progress = 0.0
@@ -110,36 +111,21 @@ class Run:
     def say_agreement(self) -> None:
         """After re-measuring an export (this extension's or a batch run's): a line saying how
         the angles agree with the file's (``workflow.agreement``)."""
-        if not self.args.points or not self.replayed:
-            return
-        try:
-            file_rows = csvio.replayed_rows(csvio.read_measurements_csv(Path(self.args.points)))
-        except (GoniometerError, OSError, ValueError):
-            return  # MeshLab's, the earlier add-on's or a plain points file: no angles of ours
-        if len(file_rows) != self.replayed:
-            return
-        rows = [row for _, row in sorted(self.rows.items())]
-        agreed = agreement.agreement_of_rows(
-            [file_rows[index] for index in sorted(self.rows)],
-            [row.angle for row in rows],
-            [row.precision for row in rows],
-        )
-        if agreed.text:
-            self.say(f"re-measured {Path(self.args.points).name}: " + agreed.text[2:])
+        if self.args.points and self.replayed:
+            line = replay_agreement.points_line(
+                Path(self.args.points), self.replayed, self.replayed_export, self.rows
+            )
+            if line:
+                self.say(line)
 
     def say_edge_agreement(self) -> None:
         """After re-measuring an edge summary (``--edges CSV``): a line saying how the edges'
         figures agree with the file's (``workflow.agreement.edge_agreement``)."""
         path = self.args.edges_csv
-        if not path or is_picked_points(path):
-            return
-        try:
-            file_rows = csvio.read_edges_csv(Path(path))
-        except (GoniometerError, OSError, ValueError):
-            return  # read when the run was planned; gone or changed since: nothing to compare
-        agreed = agreement.edge_agreement(file_rows, self.edge_rows)
-        if agreed.text:
-            self.say(f"re-measured {Path(path).name}: " + agreed.text[2:])
+        if path and not is_picked_points(path):
+            line = replay_agreement.edges_line(Path(path), self.edge_rows)
+            if line:
+                self.say(line)
 
     def say_flagged(self, by_index: dict) -> None:
         """The summary's lines for unstable readings (points, then edge stations): how many,
@@ -548,6 +534,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             raise UsageError(f"two inputs are both named {source.name!r}: rename one.")
         seen[source.name] = source
     replayed = 0  # rows of a --points file, in order: task i is its row i
+    replayed_export = False
     passed_over = []  # the summary's lines on input rows not measured again
     try:
         if args.at:
@@ -570,6 +557,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             except OSError as error:
                 raise UsageError(f"{args.points}: {error.strerror or error}") from None
             replayed = len(rows)
+            replayed_export = bool(rows) and rows[0].source_format == "extension"
             tasks = bp.plan_rows(
                 [s.names for s in sources],
                 rows,
@@ -626,6 +614,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     run = Run(args, sources, tasks, groups, options)
     run.passed_over = passed_over
     run.replayed = replayed
+    run.replayed_export = replayed_export
     for note in renamed:
         run.say(f"note: {note}")
     if args.shard and not args.quiet:

@@ -132,8 +132,13 @@ def import_mesh(source: MeshSource):
     points = np.ascontiguousarray(data.points, dtype=np.float32)
     rounded = not np.array_equal(points.astype(np.float64), data.points)
     exact_points = data.points if rounded else None
-    mesh = mesh_data.new_mesh(source.name, points, data.triangles)
-    if data.triangles is not None and needs_validation(data.triangles):
+    polygons, repeated, duplicated = data.polygons, False, False
+    if polygons is not None:
+        repeated, duplicated = polygon_flaws(*polygons)
+        if repeated:  # Blender's importers each repair such a face their own way: the fans
+            polygons = None
+    mesh = mesh_data.new_mesh(source.name, points, data.triangles, polygons)
+    if duplicated or (data.triangles is not None and needs_validation(data.triangles)):
         # Drop degenerate and duplicate faces as Blender's own importers do, so the object is
         # the one File > Import would make from the same file. (Indices are in range: the
         # reader checked them; so a list with neither has nothing for validate() to change.)
@@ -141,6 +146,18 @@ def import_mesh(source: MeshSource):
     obj = bpy.data.objects.new(source.name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     return obj, exact_points
+
+
+def polygon_flaws(corners: np.ndarray, sizes: np.ndarray) -> tuple[bool, bool]:
+    """Whether a polygon repeats a corner, and whether two polygons have the same vertices (in
+    any order, from any corner): faces Blender's importers repair."""
+    starts = np.cumsum(sizes) - sizes
+    repeated = duplicated = False
+    for size in np.unique(sizes):
+        rows = np.sort(corners[starts[sizes == size][:, None] + np.arange(size)], axis=1)
+        repeated |= bool((rows[:, 1:] == rows[:, :-1]).any())
+        duplicated |= bool(np.unique(rows, axis=0).shape[0] < rows.shape[0])
+    return repeated, duplicated
 
 
 def needs_validation(triangles: np.ndarray) -> bool:

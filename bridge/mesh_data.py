@@ -204,21 +204,27 @@ def is_legacy(stored: str) -> bool:
     return len(stored) == 32 and not stored.startswith(FINGERPRINT_PREFIX)
 
 
-def new_mesh(name: str, points, triangles=None):
+def new_mesh(name: str, points, triangles=None, polygons=None):
     """A new Blender mesh of ``points`` (stored as float32, as Blender keeps positions) and
-    ``triangles`` (vertex indices; None for a point cloud), its edges computed: the one way
-    this extension builds a mesh from arrays. The attribute arrays take plain copies, much
-    faster than the per-vertex properties."""
+    ``triangles`` (vertex indices; None for a point cloud), or ``polygons`` where given
+    (``(corners, sizes)``, as ``MeshData.polygons``: faces of any size, which Blender fills with
+    its own triangles, as its importers' meshes), its edges computed: the one way this
+    extension builds a mesh from arrays. The attribute arrays take plain copies, much faster
+    than the per-vertex properties."""
     points = np.ascontiguousarray(points, dtype=np.float32)
     mesh = bpy.data.meshes.new(name)
     mesh.vertices.add(points.shape[0])
     mesh.attributes["position"].data.foreach_set("vector", points.ravel())
-    if triangles is not None:
-        triangles = np.ascontiguousarray(triangles, dtype=np.int32)
-        mesh.loops.add(triangles.size)
-        mesh.attributes[".corner_vert"].data.foreach_set("value", triangles.ravel())
-        mesh.polygons.add(triangles.shape[0])
-        mesh.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
+    if polygons is not None:
+        corners, sizes = (np.ascontiguousarray(a, dtype=np.int32) for a in polygons)
+    elif triangles is not None:
+        corners = np.ascontiguousarray(triangles, dtype=np.int32).ravel()
+        sizes = np.full(corners.size // 3, 3, dtype=np.int32)
+    if polygons is not None or triangles is not None:
+        mesh.loops.add(corners.size)
+        mesh.attributes[".corner_vert"].data.foreach_set("value", corners)
+        mesh.polygons.add(sizes.size)
+        mesh.polygons.foreach_set("loop_start", (np.cumsum(sizes) - sizes).astype(np.int32))
     mesh.update(calc_edges=True)
     return mesh
 

@@ -250,6 +250,7 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             return None
         self._obj, self._path_name, self._steps = obj, bpy.path.basename(path), steps
         self._full_path = path
+        self._export = bool(rows) and rows[0].source_format == "extension"
         return steps
 
     def execute(self, context):
@@ -288,7 +289,7 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
         except GoniometerError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        extra, differing = follow_export(self._obj, self._full_path, numbers)
+        extra, differing = follow_export(self._obj, self._full_path, numbers, self._export)
         if taken := getattr(self, "_notes_taken", []):
             extra += (
                 f"; {len(taken)} edge(s) take their note from {self._notes_from} (edited after "
@@ -385,15 +386,18 @@ def edge_agreement_text(obj, summaries, edge_numbers) -> str:
     return agreement.edge_agreement(summaries, replayed).text
 
 
-def follow_export(obj, path, numbers) -> tuple[str, bool]:
+def follow_export(obj, path, numbers, export: bool) -> tuple[str, bool]:
     """After re-measuring an export of this extension: take its Units as ``obj``'s Scan Units
     (unless the user chose them), paint each new measurement's sides the way round its Colors
     cell says, and compare the new angles with the file's; returns what to add to the report
-    ("" for a file of another kind) and whether an angle came back different."""
+    ("" for a file of another kind) and whether it is a warning: an angle came back different,
+    or none could be compared. ``export``: the file's header has columns of this extension's
+    export (a file that then does not read back as one is said to be so)."""
     try:
         rows = csvio.read_measurements_csv(path)
-    except (GoniometerError, OSError, ValueError):
-        return "", False  # MeshLab's, the earlier add-on's or a points file: no Units, no Colors
+    except (GoniometerError, OSError, ValueError) as error:
+        # else MeshLab's, the earlier add-on's or a points file: no Units, no Colors
+        return (agreement.not_compared(error), True) if export else ("", False)
     rows = csvio.replayed_rows(rows)
     if len(rows) != len(numbers):
         return "", False

@@ -7,6 +7,7 @@ import csv
 import subprocess
 
 import numpy as np
+import pytest
 from bpy_helpers import batch as run_batch
 
 from vg_addon import Surface
@@ -135,6 +136,33 @@ def test_an_export_without_its_rule_column_is_said_to_be_replayed_with_the_paper
     assert csvio.read_measurements_csv(tmp_path / "again.csv")[0].rule == "paper"
     assert "1 without a Rule in a file of a version that records it" in result.stderr
     assert "other than the file's" not in result.stderr, result.stderr
+
+
+def test_a_failed_row_retried_as_the_summary_says_is_measured_with_the_runs_rule(tmp_path):
+    """A failed row had an empty Rule, which a replay of the run's own CSV read as an export of
+    before the Rule column: the paper's rule. Retried as the summary says (Requested x, y, z
+    copied, here corrected, into x, y, z, the error cleared), a concave 100° edge read 125.98°
+    "equal to the file's", exit 0. Oracle: the wedge's construction angle."""
+    shape = wedge(100.0, n=20, concave=True)
+    mesh = meshio.write_ply(tmp_path / "cave.ply", shape.points, shape.triangles)
+    first = tmp_path / "first.csv"
+    run = ("--radius", "0.3", "--rule", "oriented")
+    failing = run_batch(mesh, "--at", "0", "0", "0", "--at", "0.5", "0", "5", *run, "--out", first)
+    assert failing.returncode == 1 and "Traceback" not in failing.stderr, failing.stderr
+    failed_row = csvio.read_measurements_csv(first)[1]
+    assert failed_row.error and failed_row.rule == "oriented"
+    with first.open(encoding="utf-8", newline="") as file:
+        header, _, cells = csv.reader(file)
+    for axis, value in zip("xyz", ("0.5", "0", "0"), strict=True):
+        cells[header.index(axis)] = value
+    cells[header.index("error")] = ""
+    retry = tmp_path / "retry.csv"
+    with retry.open("w", encoding="utf-8", newline="") as file:
+        csv.writer(file).writerows([header, cells])
+    batch(mesh, "--points", retry, "--out", tmp_path / "again.csv")
+    (again,) = csvio.read_measurements_csv(tmp_path / "again.csv")
+    assert again.rule == "oriented"
+    assert again.angle == pytest.approx(100.0, abs=1e-6)
 
 
 def test_inward_wound_closed_mesh_is_named_once(tmp_path):

@@ -453,10 +453,13 @@ def test_an_import_says_which_failed_rows_it_passed_over(vg, tmp_path, capfd):
     capfd.readouterr()
     assert bpy.ops.vg.import_csv(filepath=path) == {"FINISHED"}
     said = capfd.readouterr()
+    assert "Re-measured 1 row(s) of run.csv on 'scan' (measurements 1–1); " in said.out
     assert (
-        "Re-measured 1 row(s) of run.csv on 'scan' (measurements 1–1); passed over 1 row(s) a "
-        "batch run could not measure (rows 3: no x, y, z; their error column says why)"
+        "passed over 1 row(s) a batch run could not measure (rows 3: no x, y, z; their error "
+        "column says why)"
     ) in said.out + said.err
+    # Its header has columns of an export, not all: its angles were not compared, as it says.
+    assert "its angles were not compared with the file's" in said.out
 
 
 def test_an_edge_note_edited_after_measuring_comes_back_with_the_export(vg, tmp_path, capfd):
@@ -522,3 +525,37 @@ def test_an_export_of_an_edge_with_a_station_deleted_says_its_summary_keeps_it(v
         "1 edge(s) lost stations after they were measured ('scan' edge 1): their summary rows "
         "keep the figures of every station as recorded"
     ) in said.out + said.err
+
+
+def test_an_export_that_does_not_read_back_in_full_says_its_angles_were_not_compared(
+    vg, tmp_path, capfd
+):
+    """German LibreOffice re-saves ``FALSE`` as ``FALSCH``: the import re-measured the rows and
+    said nothing of the file's angles (the strict reader refused the file, and the report took
+    it for a file of another kind), nor that its Units and Colors were not taken. It now says
+    the angles were not compared, and why; the batch's replay says the same."""
+    measured_wedge()
+    path = tmp_path / "out.csv"
+    assert bpy.ops.vg.export_csv(filepath=str(path)) == {"FINISHED"}
+    header, *rows = read_rows(path)
+    stale = header.index("Stale")
+    assert {row[stale] for row in rows} == {"FALSE"}
+    edited = tmp_path / "resaved.csv"
+    with edited.open("w", newline="", encoding="utf-8") as handle:
+        csv.writer(handle).writerows(
+            [header, *([*r[:stale], "FALSCH", *r[stale + 1 :]] for r in rows)]
+        )
+    capfd.readouterr()
+    assert bpy.ops.vg.import_csv(filepath=str(edited)) == {"FINISHED"}
+    said = capfd.readouterr()
+    assert "its angles were not compared with the file's" in said.out + said.err
+    assert "(row 2: Stale is not TRUE or FALSE)" in said.out + said.err
+    from bpy_helpers import batch
+
+    from vg_addon.synthetic_meshes import wedge
+
+    shape = wedge(100.0, n=40, irregular=True)  # wedge_object's, as a file
+    mesh = meshio.write_ply(tmp_path / "Wedge.ply", shape.points, shape.triangles)
+    replay = batch(mesh, "--points", edited, "--out", tmp_path / "again.csv")
+    assert replay.returncode == 0, replay.stderr
+    assert "re-measured resaved.csv: its angles were not compared" in replay.stderr

@@ -146,3 +146,133 @@ def test_the_reader_reads_what_blenders_importer_reads(name, tmp_path):
     assert np.array_equal(_multiset(our_points), _multiset(theirs))
     our_corners = ours.points[ours.triangles].astype(np.float32)
     assert np.array_equal(_triangle_multiset(our_corners), _triangle_multiset(their_corners))
+
+
+def _hexagon_wedge():
+    """A 100° wedge tiled by hexagons (each a grid cell with a vertex in the middle of either
+    side across the crease, so its fan from the first corner differs from Blender's fill), the
+    crease between vertex rows; coordinates float32 holds exactly."""
+    n, rows, step, half = 21, 10, 0.1, np.radians(50.0)
+    xs = np.linspace(-1.0, 1.0, n)
+    ys = (np.arange(-rows, rows) + 0.5) * step
+    mids = (ys[:-1] + ys[1:]) / 2
+    grid = np.stack(np.meshgrid(xs, ys, indexing="ij"), axis=-1).reshape(-1, 2)
+    middle = np.stack(np.meshgrid(xs, mids, indexing="ij"), axis=-1).reshape(-1, 2)
+    flat = np.vstack([grid, middle])
+    points = np.column_stack([flat, -np.abs(flat[:, 1]) / np.tan(half)])
+    points = points.astype(np.float32).astype(np.float64)
+    on_grid = np.arange(grid.shape[0]).reshape(n, ys.size)
+    in_middle = grid.shape[0] + np.arange(middle.shape[0]).reshape(n, mids.size)
+    i, j = np.meshgrid(np.arange(n - 1), np.arange(mids.size), indexing="ij")
+    faces = np.stack(
+        [
+            on_grid[i, j],
+            on_grid[i + 1, j],
+            in_middle[i + 1, j],
+            on_grid[i + 1, j + 1],
+            on_grid[i, j + 1],
+            in_middle[i, j],
+        ],
+        axis=-1,
+    ).reshape(-1, 6)
+    return points, faces
+
+
+def _polygon_files(folder):
+    points, faces = _hexagon_wedge()
+    ply = folder / "hexagons.ply"
+    header = [
+        "ply",
+        "format ascii 1.0",
+        f"element vertex {len(points)}",
+        *(f"property double {axis}" for axis in "xyz"),
+        f"element face {len(faces)}",
+        "property list uchar int vertex_indices",
+        "end_header",
+    ]
+    vertices = [" ".join(repr(float(v)) for v in p) for p in points]
+    ply.write_text("\n".join([*header, *vertices, *("6 " + " ".join(map(str, f)) for f in faces)]))
+    obj = folder / "hexagons.obj"
+    lines = ["v " + line for line in vertices] + [
+        "f " + " ".join(str(i + 1) for i in f) for f in faces
+    ]
+    obj.write_text("\n".join(lines) + "\n")
+    return ply, obj
+
+
+def _loop_triangle_corners(obj) -> np.ndarray:
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", tris)
+    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3)[tris.reshape(-1, 3)]
+
+
+@pytest.mark.parametrize("suffix", [".ply", ".obj"])
+def test_the_batchs_mesh_of_polygons_is_blenders_own_import(vg, tmp_path, suffix):
+    """A file of hexagons: the batch fan-triangulated each from its first corner, where
+    Blender's importer keeps the hexagon and fills it its own way; all 1,520 triangles
+    differed, and the batch's readings with them (off the crease, a stability of ±21.2° where
+    Blender's mesh gives ±0.00°). Now the batch's object keeps the polygons: the same
+    triangles as File > Import's, and the same bits when measured. The reader's own triangles
+    stay the fans (the core's users get those)."""
+    import importlib
+
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    path = dict(zip((".ply", ".obj"), _polygon_files(tmp_path), strict=True))[suffix]
+    ours, _ = sources.import_mesh(sources.MeshSource("ours", str(path)))
+    assert all(len(face.vertices) == 6 for face in ours.data.polygons)
+    _, their_corners = _blender_import(path)
+    our_corners = _loop_triangle_corners(ours)
+    assert np.array_equal(_triangle_multiset(our_corners), _triangle_multiset(their_corners))
+    fans = meshio.read_mesh(path)
+    fan_corners = fans.points[fans.triangles].astype(np.float32)
+    assert not np.array_equal(_triangle_multiset(fan_corners), _triangle_multiset(our_corners))
+    from vg_addon import Surface
+
+    def surface(corners):  # corners welded back into vertices
+        points, corner_vertices = np.unique(corners.reshape(-1, 3), axis=0, return_inverse=True)
+        return Surface(points.astype(np.float64), corner_vertices.reshape(-1, 3))
+
+    centre = [0.1, 0.05, -0.042]
+    ours_measured, theirs_measured = (
+        surface(corners).measure(centre, 0.3, stability=True)
+        for corners in (our_corners, their_corners)
+    )
+    assert (
+        Surface(fans.points, fans.triangles).measure(centre, 0.3, stability=True).stability.spread
+        > 10
+    )
+    assert ours_measured.angle == theirs_measured.angle
+    assert ours_measured.stability.spread == theirs_measured.stability.spread
+
+
+QUADS = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n"
+
+
+@pytest.mark.parametrize(
+    ("name", "text"),
+    [
+        ("twice.obj", QUADS + "f 1 2 3 4\nf 2 3 4 1\nf 2 5 6 3\n"),
+        (
+            "twice.ply",
+            "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 3\nproperty list uchar int vertex_indices\n"
+            "end_header\n" + QUADS.replace("v ", "") + "4 0 1 2 3\n4 1 2 3 0\n4 1 4 5 2\n",
+        ),
+    ],
+)
+def test_a_polygon_written_twice_is_kept_once_as_blender_keeps_it(vg, tmp_path, name, text):
+    """A quad written twice from another corner (no two of its fans alike): Blender's importers
+    keep one, the batch kept both (found by a review of the change that keeps polygons)."""
+    import importlib
+
+    sources = importlib.import_module(f"{vg.__name__}.batch.sources")
+    path = tmp_path / name
+    path.write_text(text)
+    ours, _ = sources.import_mesh(sources.MeshSource("ours", str(path)))
+    _, their_corners = _blender_import(path)
+    our_corners = _loop_triangle_corners(ours)
+    assert np.array_equal(_triangle_multiset(our_corners), _triangle_multiset(their_corners))

@@ -241,6 +241,20 @@ class TestErrors:
         with pytest.raises(GoniometerError, match="points must be numbers"):
             Surface(wedge(90, n=20).points.astype(str))
 
+    def test_python_ints_past_float64s_range_are_refused_not_raised(self):
+        """``float(10**400)`` raises OverflowError, which came out of measure as a traceback."""
+        huge = 10**400
+        with pytest.raises(GoniometerError, match=r"radius must be a finite number.*got inf"):
+            self.surface.measure([0, 0, 0], huge)
+        with pytest.raises(GoniometerError, match=r"λ .SegParam. must be a number from 0"):
+            self.surface.measure([0, 0, 0], 0.5, -huge)
+        with pytest.raises(GoniometerError, match="centre must be three numbers"):
+            self.surface.measure([huge, 0, 0], 0.5)
+        points = wedge(90, n=20).points.astype(object)
+        points[0, 0] = huge
+        with pytest.raises(GoniometerError, match=r"points must be numbers.*too large"):
+            Surface(points)
+
     def test_complex_coordinates_are_refused_not_cut_to_their_real_parts(self):
         mesh = wedge(90, n=20)
         with pytest.raises(GoniometerError, match="real numbers"):

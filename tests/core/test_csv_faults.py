@@ -153,6 +153,20 @@ def test_mesh_names_with_surrounding_spaces_read_back_as_written(name):
     assert csvio.read_edges_csv(edges)[0].mesh_name == name
 
 
+def test_a_mesh_name_written_in_another_unicode_normalisation_finds_its_mesh():
+    """macOS keeps file names decomposed (``e`` and a combining accent); a CSV typed elsewhere
+    holds the composed ``é``. The two look alike, and the batch refused the row, naming the
+    mesh 'café' as not among ('café'). Now it finds the mesh, after an exact name."""
+    from vg_addon.workflow.batchplan import closest_mesh
+
+    composed, decomposed = "caf\u00e9", "cafe\u0301"
+    assert csvio.mesh_name_matches(composed, (decomposed,))
+    assert csvio.mesh_name_matches(f"scans/{decomposed}.ply", (composed,))
+    assert not csvio.mesh_name_matches("cafe", (composed,))
+    assert closest_mesh(composed, [(decomposed,), ("other",)], "row 2") == (0, "")
+    assert closest_mesh(composed, [(decomposed,), (composed,)], "row 2") == (1, "")
+
+
 def test_the_rows_of_a_written_csv_read_back_to_the_same_rows():
     rows = [
         MeasurementRow(mesh_name=name, user_data=note, x=0.5, y=0.0, z=0.0, radius=0.3)

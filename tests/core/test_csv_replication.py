@@ -389,6 +389,25 @@ def test_files_from_before_the_rule_replicate_with_the_papers_rule():
     assert csvio.parse_measurements_csv(old_export)[0].rule == ""
 
 
+def test_a_row_never_measured_without_a_rule_takes_the_default_rule_not_the_papers():
+    """A batch run's failed row was written with an empty Rule; the reader took that for an
+    export of before the Rule column and retried the row with the paper's rule (a concave 100°
+    edge read 125.98°). A measured row whose Rule was emptied (its Convexity filled) still
+    takes the paper's, as the replay's report says."""
+    never = good_row(rule="", convexity="", angle=None)
+    emptied = good_row(rule="")
+    rows = csvio.read_replication_csv(
+        csvio.format_measurements_csv([never, emptied, good_row(rule="oriented")])
+    )
+    assert rows[0].source_format == "extension"
+    assert [row.rule for row in rows] == [None, "paper", "oriented"]
+    # A MeshLab file with a Rule column added (no Convexity: nothing says a row was not measured)
+    meshlab = csvio.format_measurements_csv([good_row(user_data="note")]).splitlines()
+    header, row = (line.split(",")[:14] for line in meshlab[:2])
+    (added,) = csvio.read_replication_csv(",".join([*header, "Rule"]) + "\n" + ",".join([*row, ""]))
+    assert added.rule == "paper"
+
+
 def test_points_files_take_the_default_rule_or_their_own():
     assert csvio.read_replication_csv("x,y,z\n1,2,3\n")[0].rule is None
     rows = csvio.read_replication_csv("x,y,z,rule\n1,2,3,Paper\n1,2,3,\n")

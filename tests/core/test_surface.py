@@ -328,6 +328,77 @@ def test_a_geodesic_patch_on_an_unwelded_mesh_says_why_it_is_small():
     corners = shape.points[shape.triangles.ravel()]  # every triangle its own three vertices
     triangles = np.arange(corners.shape[0]).reshape(-1, 3)
     surface = Surface(corners, triangles)
-    with pytest.raises(GoniometerError, match=r"reaches only 3 of the \d+ vertices.*Merge by"):
+    with pytest.raises(GoniometerError, match=r"stops at a seam: 3 of the vertices.*Merge by"):
         surface.measure([0.0, 0.0, 0.0], 0.4, patch="geodesic")
     assert abs(surface.measure([0.0, 0.0, 0.0], 0.4).angle - 100.0) < 0.01
+
+
+def seamed_wedge(angle, bend):
+    """A wedge whose faces bend away from the crease (``bend · t²``, level at the crease, so
+    the angle there stays ``angle``), its crease vertices copied for the minus face's
+    triangles: a seam along the break edge, as an export with split sharp edges writes it."""
+    shape = wedge(angle, n=60, irregular=True, seed=4)
+    side = shape.side
+    across = np.hypot(shape.points[:, 1], shape.points[:, 2])
+    normal = np.where(side[:, None] == 1, shape.normal_plus, shape.normal_minus)
+    points = shape.points + np.where(side[:, None] == 0, 0.0, normal) * (bend * across**2)[:, None]
+    crease = np.flatnonzero(side == 0)
+    copy = np.arange(len(points))
+    copy[crease] = len(points) + np.arange(crease.size)
+    triangles = shape.triangles.copy()
+    on_minus = (side[shape.triangles] == -1).any(axis=1)
+    triangles[on_minus] = copy[shape.triangles[on_minus]]
+    return shape, np.vstack([points, points[crease]]), triangles
+
+
+@pytest.mark.parametrize("bend", [0.05, 0.3])
+def test_a_geodesic_patch_stopped_by_a_seam_along_the_edge_is_refused(bend):
+    """A mesh unmerged along its break edge: the geodesic patch never crosses it and holds one
+    face, which Algorithm 1 split in two. A 60° edge read 179.44° (bend 0.05) and 176.64° (0.3),
+    fit errors smaller than the merged mesh's, no flag. Oracle: the wedge's construction, and
+    the same patch on the merged mesh (the seam's copies joined), which reads 61.0° and 65.9°
+    (its walls curve away from the edge: the planes are secants), nowhere near flat."""
+    shape, points, triangles = seamed_wedge(60.0, bend)
+    merged = Surface(points[: len(shape.points)], shape.triangles)
+    assert 60.0 < merged.measure([0.005, 0, 0], 0.2, patch="geodesic").angle < 67.0
+    seamed = Surface(points, triangles)
+    with pytest.raises(GoniometerError, match=r"stops at a seam: \d+ of the vertices.*Merge by"):
+        seamed.measure([0.005, 0, 0], 0.2, patch="geodesic")
+    assert (
+        abs(seamed.measure([0.005, 0, 0], 0.2).angle - merged.measure([0.005, 0, 0], 0.2).angle)
+        < 0.5
+    )
+
+
+def test_a_seam_the_measured_patch_does_not_reach_refuses_nothing():
+    """A seam along a row 0.24 from the crease, beyond a geodesic patch of radius 0.24 (it
+    reaches the row's vertices, not their copies' faces): the reading and its stability figure
+    are those of the merged mesh; the figure's moved and widened patches, which reach the seam,
+    stop there as before instead of refusing the click (a review found them refusing it). Two
+    parts touching at one vertex (a refitted fragment) refuse nothing either."""
+    shape = wedge(100.0, n=60)
+    across = np.hypot(shape.points[:, 1], shape.points[:, 2])
+    rows = np.unique(np.round(across[shape.side == 1], 9))
+    row = rows[np.argmin(np.abs(rows - 0.25))]
+    on_row = np.flatnonzero((shape.side == 1) & (np.abs(across - row) < 1e-9))
+    copy = np.arange(len(shape.points))
+    copy[on_row] = len(shape.points) + np.arange(on_row.size)
+    beyond = (shape.side[shape.triangles] == 1).all(axis=1) & (
+        across[shape.triangles] > row - 1e-9
+    ).all(axis=1)
+    triangles = shape.triangles.copy()
+    triangles[beyond] = copy[shape.triangles[beyond]]
+    seamed = Surface(np.vstack([shape.points, shape.points[on_row]]), triangles)
+    merged = Surface(shape.points, shape.triangles)
+    readings = [
+        surface.measure([0, 0, 0], 0.24, patch="geodesic", stability=True)
+        for surface in (seamed, merged)
+    ]
+    assert abs(readings[0].angle - 100.0) < 1e-6
+    assert readings[0].stability.spread < 1e-6 and readings[1].stability.spread < 1e-6
+    vertex = shape.points[np.argmin(np.linalg.norm(shape.points - [0.1, 0.1, -0.1], axis=1))]
+    corners = vertex + np.array([[0, 0, 0], [0.05, 0, 0.3], [-0.05, 0, 0.3]])
+    touching = np.vstack([shape.points, corners])
+    extra = len(shape.points) + np.arange(3)
+    part = Surface(touching, np.vstack([shape.triangles, extra]))
+    assert abs(part.measure([0, 0, 0], 0.3, patch="geodesic").angle - 100.0) < 1e-6

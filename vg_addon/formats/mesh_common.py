@@ -34,6 +34,12 @@ class MeshData:
         Precision of the coordinates in the file: the declared PLY type of ``x`` (``"float32"``,
         ``"float64"``, ...), ``"float32"`` for binary STL, ``"float64"`` for text formats
         without a declared type (OBJ, ASCII STL).
+    polygons : tuple of numpy.ndarray or None
+        ``(corners, sizes)``: the faces as the file gives them, each face's vertex indices in
+        turn (int64) and each face's corner count (int64, faces of three corners or more), where
+        a face is not a triangle; ``None`` where every face is one. Blender fills a polygon
+        with other triangles than ``triangles``' fans: a Blender mesh made from a file is made
+        from these (see ``batch.sources``).
     """
 
     points: np.ndarray
@@ -41,6 +47,7 @@ class MeshData:
     normals: np.ndarray | None
     name: str
     source_dtype: str
+    polygons: tuple[np.ndarray, np.ndarray] | None = None
 
     @property
     def n_vertices(self) -> int:
@@ -83,8 +90,9 @@ def _read_bytes(path: Path) -> bytes:
     return data
 
 
-def _finish(path: Path, points, triangles, normals, source_dtype: str) -> MeshData:
-    """Validate what a reader found and pack it into fresh, writable, contiguous arrays."""
+def _finish(path: Path, points, triangles, normals, source_dtype: str, polygons=None) -> MeshData:
+    """Validate what a reader found and pack it into fresh, writable, contiguous arrays.
+    ``polygons``: the faces as :func:`_polygons` keeps them."""
     points = np.array(points, dtype=np.float64, order="C").reshape(-1, 3)
     n = points.shape[0]
     if n == 0:
@@ -115,7 +123,21 @@ def _finish(path: Path, points, triangles, normals, source_dtype: str) -> MeshDa
         normals = np.array(normals, dtype=np.float64, order="C").reshape(-1, 3)
         if normals.shape[0] != n or not np.isfinite(normals).all():
             normals = None
-    return MeshData(points, triangles, normals, path.stem, source_dtype)
+    if triangles is None:
+        polygons = None
+    return MeshData(points, triangles, normals, path.stem, source_dtype, polygons)
+
+
+def _polygons(flat: np.ndarray, counts: np.ndarray):
+    """The faces of three corners or more as ``(corners, sizes)`` (int64), where one is not a
+    triangle; ``None`` where every face is one (or none is a face)."""
+    counts = np.asarray(counts, dtype=np.int64)
+    if counts.size == 0 or (counts == 3).all():
+        return None
+    kept = counts >= 3
+    owner = np.repeat(kept, counts)
+    polygons = (np.ascontiguousarray(flat[owner], dtype=np.int64), counts[kept].copy())
+    return None if (polygons[1] == 3).all() else polygons
 
 
 def _fan(flat: np.ndarray, counts: np.ndarray) -> np.ndarray:

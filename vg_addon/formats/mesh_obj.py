@@ -12,6 +12,7 @@ from .mesh_common import (
     _as_path,
     _fan,
     _finish,
+    _polygons,
     _read_bytes,
     _Text,
 )
@@ -62,7 +63,7 @@ def read_obj(path: str | os.PathLike) -> MeshData:
     points = values[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
 
     f_lines = text.keyword(b"f")
-    triangles = corners = normal_refs = None
+    triangles = corners = normal_refs = polygons = None
     if f_lines.size:
         vertex_refs, normal_refs, counts = text.faces(f_lines)
         corners = _obj_indices(
@@ -79,6 +80,7 @@ def read_obj(path: str | os.PathLike) -> MeshData:
                 "corrupt or was written incorrectly; re-export it."
             )
         triangles = _fan(corners, counts)
+        polygons = _polygons(corners, counts)
 
     normals = None
     vn_lines = text.keyword(b"vn")
@@ -99,7 +101,7 @@ def read_obj(path: str | os.PathLike) -> MeshData:
                 refs = np.where(normal_refs < 0, normal_refs + defined, normal_refs - 1)
                 if not np.array_equal(refs, corners):
                     normals = None
-    return _finish(path, points, triangles, normals, "float64")
+    return _finish(path, points, triangles, normals, "float64", polygons)
 
 
 def _obj_indices(refs, counts, before, lines, path, what) -> np.ndarray:

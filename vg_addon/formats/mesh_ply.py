@@ -19,6 +19,7 @@ from .mesh_common import (
     _finish,
     _gather,
     _parse_numbers,
+    _polygons,
     _read_bytes,
     _where_not_a_number,
 )
@@ -193,14 +194,15 @@ def read_ply(path: str | os.PathLike) -> MeshData:
     normals = None
     if all(c in values for c in ("nx", "ny", "nz")):
         normals = np.column_stack([values["nx"], values["ny"], values["nz"]])
-    triangles = None
+    triangles = polygons = None
     if face is not None and face.count > 0:
         flat, counts = found["face"][face_list]
         flat = flat.astype(np.int64)
         _check_face_indices(flat, counts, len(points), path, lines.get("face"))
         triangles = _fan(flat, counts)
+        polygons = _polygons(flat, counts)
     source_dtype = vertex.properties[names.index("x")].dtype.name
-    return _finish(path, points, triangles, normals, source_dtype)
+    return _finish(path, points, triangles, normals, source_dtype, polygons)
 
 
 def _face_list_name(face: _PlyElement, path: Path) -> str:

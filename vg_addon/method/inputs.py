@@ -3,6 +3,8 @@ refused with a reason (a :class:`~vg_addon.errors.GoniometerError`) rather than 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import GoniometerError
@@ -57,14 +59,21 @@ def _real_float64(values) -> np.ndarray | None:
         return None
     if given.dtype.kind in "bUS":  # NumPy would read True as 1 and "0.3" as 0.3 without a word
         raise TypeError(f"got {given.dtype.name} values, not numbers")
-    return np.ascontiguousarray(given, dtype=np.float64)
+    try:
+        return np.ascontiguousarray(given, dtype=np.float64)
+    except OverflowError as error:  # a Python int past float64's range
+        raise ValueError(str(error)) from None
 
 
 def _real_number(value) -> float:
-    """``value`` as a float; ``TypeError`` for a bool or text, which ``float`` would take."""
+    """``value`` as a float; ``TypeError`` for a bool or text, which ``float`` would take. A
+    Python int past float64's range is infinite, as a float that large would be."""
     if isinstance(value, (bool, str, bytes)) or np.asarray(value).dtype.kind in "bUS":
         raise TypeError("not a number")
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
 
 
 def check_magnitude(what: str, array: np.ndarray, advice: str) -> None:

@@ -74,6 +74,30 @@ def _as_corner_edges(corner_edges, n_triangles: int) -> np.ndarray:
     return given
 
 
+SEAM_COPIES = 3
+"""A geodesic patch is refused for a seam where at least this many of its vertices have copies
+it does not reach: a seam through a patch has many, two parts touching at a vertex or two (a
+refitted fragment) few; an STL's triangle, its three corners."""
+
+
+def _unmerged_copies(points: np.ndarray, reached: np.ndarray, beyond: np.ndarray) -> int:
+    """How many of the vertices ``reached`` share their exact coordinates with a vertex
+    ``beyond`` (a copy the mesh's edges do not join them to)."""
+    if not reached.size or not beyond.size:
+        return 0
+    # x alone first: on a merged mesh few vertices share it, and the whole rows are compared
+    # for those few (as bytes, -0.0 made 0.0).
+    candidates = reached[np.isin(np.take(points[:, 0], reached), np.take(points[:, 0], beyond))]
+    if not candidates.size:
+        return 0
+    row = np.dtype((np.void, 3 * points.itemsize))
+
+    def keys(indices):
+        return (np.take(points, indices, axis=0) + 0.0).view(row).reshape(-1)
+
+    return int(np.isin(keys(candidates), keys(beyond)).sum())
+
+
 class Surface:
     """A mesh or point cloud, prepared once (normals, spatial index) and measured many times.
 
@@ -215,6 +239,25 @@ class Surface:
             indices = indices[distance <= radius]
         return indices
 
+    def _check_no_seam(self, ball: np.ndarray, patch: np.ndarray) -> None:
+        """Refuse a geodesic ``patch`` stopped by a seam: :data:`SEAM_COPIES` or more of its
+        vertices have copies at the same coordinates in the ``ball`` that it does not reach (the
+        mesh not merged there). Only the measured patch is checked: the stability figure's
+        moved patches stop at a seam as before."""
+        if ball.size == patch.size:
+            return
+        beyond = np.setdiff1d(ball, patch, assume_unique=True)
+        copies = _unmerged_copies(self.points, patch, beyond)
+        if copies >= SEAM_COPIES:
+            raise GoniometerError(
+                f"The geodesic patch stops at a seam: {copies} of the vertices it reaches have "
+                "copies at the same places, within the radius, that it does not reach (the mesh "
+                "is not merged there, as exports with split edges or joined parts keep it), so "
+                "it would hold only what lies on its side of the seam. Merge the mesh's vertices "
+                "by distance (Blender: Mesh > Clean Up > Merge by Distance), or use the "
+                "Euclidean patch."
+            )
+
     def measure(
         self,
         center,
@@ -272,12 +315,15 @@ class Surface:
         ball, _ = self.index.ball(self.points[center_index], radius)
         indices = self._restrict(ball, center_index, radius, mode)
         if indices.size < 2 * MIN_SIDE_VERTICES:
-            # Far from the origin rounding merges vertices: say so, not "too few", where its
-            # step is a tenth of the radius or more (else the radius is simply too small).
+            # Far from the origin rounding merges vertices: say so, not "too few" (nor "a
+            # seam"), where its step is a tenth of the radius or more (else the radius is simply
+            # too small).
             largest = np.abs(self.points[center_index]).max()
             step = float(np.spacing(np.dtype(self.precision).type(largest)))
             if step >= 0.1 * radius:
                 check_rounding(np.take(self.points, indices, axis=0), radius, self.precision)
+            if mode == "geodesic":
+                self._check_no_seam(ball, indices)
             if ball.size >= 2 * max(indices.size, 2 * MIN_SIDE_VERTICES):  # geodesic: far fewer
                 raise GoniometerError(
                     f"The geodesic patch of radius {radius:g} reaches only {indices.size} of the "
@@ -295,6 +341,8 @@ class Surface:
         indices = self._by_rank[np.sort(self.ranks[indices])].astype(np.int64)
         patch_points = np.take(self.points, indices, axis=0)
         check_rounding(patch_points, radius, self.precision)
+        if mode == "geodesic":
+            self._check_no_seam(ball, indices)
         fields = measure_patch(
             patch_points,
             np.take(self.normals, indices, axis=0),

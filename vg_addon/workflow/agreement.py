@@ -85,6 +85,19 @@ class Agreement:
         return "".join(f"; {part}" for part in parts)
 
 
+def not_compared(error: Exception) -> str:
+    """What a report adds ("; ...") where a file whose header has columns of this extension's
+    export could not be read back as one (``error``, from ``csvio.read_measurements_csv``: a cell a
+    spreadsheet re-saved, ``FALSCH`` for ``FALSE``, or a column deleted), so its angles were
+    not compared: said, with the first problem, instead of passed over."""
+    lines = [line.strip() for line in str(error).splitlines() if line.strip()]
+    problem = lines[1] if len(lines) > 1 else (lines[0] if lines else type(error).__name__)
+    return (
+        "; its angles were not compared with the file's: its header has columns of this "
+        f"extension's export, but the file does not read back as one ({problem})"
+    )
+
+
 def agreement(
     recorded: Sequence[float | None],
     remeasured: Sequence[float | None],

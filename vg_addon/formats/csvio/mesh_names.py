@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import unicodedata
 from collections.abc import Iterable, Sequence
 
 from ...errors import GoniometerError, bounded_list
@@ -55,8 +56,9 @@ def mesh_name_match(csv_name: str | None, names) -> int | None:
     """How closely a CSV's mesh name refers to a mesh known by ``names``: 0 exactly (surrounding
     spaces included: a mesh file " lead.ply" is the mesh " lead"), 1 without its surrounding
     spaces (a hand-typed cell), 2 after dropping a folder and a mesh file extension
-    (``"scans/bone_12.ply"`` matches ``"bone_12"``); None when it does not. A blank name is 2
-    for any mesh."""
+    (``"scans/bone_12.ply"`` matches ``"bone_12"``), 3 where only the Unicode normalisation
+    differs (``café`` typed as one character or as ``e`` and a combining accent, as macOS keeps
+    file names: the two look alike); None when it does not. A blank name is 2 for any mesh."""
     given = csv_name or ""
     if not given.strip():
         return 2
@@ -67,6 +69,12 @@ def mesh_name_match(csv_name: str | None, names) -> int | None:
         return 1
     if any(_mesh_stem(name) in candidates for name in (given, given.strip())):
         return 2
+    composed = {unicodedata.normalize("NFC", name) for name in candidates}
+    if any(
+        unicodedata.normalize("NFC", name) in composed
+        for name in (given, given.strip(), _mesh_stem(given), _mesh_stem(given.strip()))
+    ):
+        return 3
     return None
 
 

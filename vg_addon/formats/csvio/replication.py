@@ -9,6 +9,7 @@ patch mode, label and mesh columns). It checks every row first and raises one
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 from ...errors import GoniometerError
@@ -85,8 +86,9 @@ class ReplicationRow:
     rule : str or None
         The rule to replicate with: the ``Rule`` cell of an export; ``"paper"`` for MeshLab and
         earlier add-on files and for exports written before the ``Rule`` column existed (they
-        were all measured with the paper's rule); a points file's ``rule`` column, else ``None``
-        (the current default).
+        were all measured with the paper's rule), and for a measured row (its ``Convexity``
+        filled) whose ``Rule`` was emptied; a points file's ``rule`` column, else ``None`` (the
+        current default), as for a row never measured (a batch run's failed row).
     units : str or None
         The ``Units`` cell of an export (what one coordinate unit is, e.g. ``"mm"``); ``None``
         when absent or blank.
@@ -132,6 +134,7 @@ _REPLICATION_ALIASES = {
     "break_number": ("break #", "break number", "break"),
     "coordinates": ("coordinates", "coordinate space"),
     "rule": ("rule",),
+    "convexity": ("convexity",),  # filled where the row was measured
     "edge_number": ("edge #", "edge number", "edge"),
     "arc_length": ("arc length", "arc"),
     "spacing": ("spacing",),
@@ -228,6 +231,52 @@ def _settings_named_twice(header: list[str], aliases: dict) -> list[str]:
     return problems
 
 
+#: Columns whose names start like a setting's but are this extension's or MeshLab's own.
+_KNOWN_COLUMNS = frozenset(normalise(name) for name in (*EXPORT_COLUMNS, *MESHLAB_COLUMNS))
+
+
+#: What may follow a setting's name in a column that holds that setting: a unit, a symbol or
+#: an annotation in brackets ("Radius (mm)", "Lambda λ", "radius_mm"), or only punctuation.
+_ANNOTATION = re.compile(r"[(\[{<].*|mm|cm|m|µm|μm|um|nm|in|inch|inches|ft|deg|degrees|°|λ|units?|")
+
+
+def _settings_not_read(header: list[str], columns: dict, aliases: dict) -> list[str]:
+    """A problem for each column the reader does not take whose name is a setting's name with
+    a unit or an annotation ("Radius (mm)", "Lambda λ"): its values would be passed over
+    without a word, and every row measured with the default instead. Other names that merely
+    start like a setting's ("Break Type", "Radius 2") are passed over, as any column is."""
+    taken = set(columns.values()) | {
+        index  # a second name of a setting: _settings_named_twice says so
+        for index, name in enumerate(header)
+        if any(normalise(name) in names for names in aliases.values())
+    }
+    fields = (*_SETTINGS, "break_number")
+    starts = sorted(
+        ((alias, field) for field in fields for alias in aliases[field] if len(alias) >= 3),
+        key=lambda pair: -len(pair[0]),
+    )
+    problems = []
+    for index, raw in enumerate(header):
+        name = normalise(raw)
+        if index in taken or name in _KNOWN_COLUMNS:
+            continue
+        for alias, field in starts:
+            rest = name[len(alias) :].strip(" -:.,;=*")
+            if (
+                name.startswith(alias)
+                and not name[len(alias)].isalnum()
+                and _ANNOTATION.fullmatch(rest)
+            ):
+                words = _SETTINGS.get(field, "break number")
+                problems.append(
+                    f"header: column {index + 1} ({raw.strip()!r}) would not be read: names are "
+                    f"matched whole, so its values are not taken as the {words} of each row "
+                    f"(rename it {aliases[field][0]!r}, as in the CSV docs, or remove it)"
+                )
+                break
+    return problems
+
+
 def default_coordinates(header: list[str]) -> str:
     """The coordinate space of a row whose ``Coordinates`` cell is blank or absent, in a file
     with this header: ``"world"`` in this extension's exports (it wrote world coordinates until
@@ -256,6 +305,7 @@ def parse_replication_csv(
     aliases = _aliases(header)
     columns = resolve_columns(header, aliases, problems)
     problems += _settings_named_twice(header, aliases)
+    problems += _settings_not_read(header, columns, aliases)
     missing = [field for field in _REQUIRED if field not in columns]
     if missing:
         found = ", ".join(repr(name.strip()) for name in header if name.strip()) or "none"
@@ -354,8 +404,13 @@ def parse_replication_csv(
                 problems.append(
                     f"row {number}: unknown rule {cell('rule').strip()!r} (use {' or '.join(RULES)})"
                 )
-        elif fmt != "points":
-            rule = "paper"  # MeshLab, the earlier add-on, exports from before the Rule column
+        elif fmt != "points" and not (
+            "rule" in columns and "convexity" in columns and not cell("convexity").strip()
+        ):
+            # MeshLab, the earlier add-on, exports from before the Rule column, and a measured
+            # row whose Rule was emptied; a row never measured (a batch run's failed row, from
+            # before it kept its Rule) takes the default, as the run that wrote it did.
+            rule = "paper"
         if problems:
             continue  # nothing is returned anyway; keep collecting
         rows.append(
