@@ -23,6 +23,7 @@ from ..vg_addon.workflow import batchplan
 from . import stopping
 from .cli import UsageError, is_picked_points
 from .find_edges import found_edge_specs
+from .sources import readable_name
 
 
 def edge_specs(args, sources, passed_over: list | None = None) -> list[dict]:
@@ -189,30 +190,31 @@ def picked_point_specs(args, sources, passed_over: list | None = None) -> list[d
     names = [source.name for source in sources]
     specs, problems, unmatched = [], [], []
     for path in paths:
+        shown = readable_name(path.name)  # as mesh names are: every output can hold it
         # --ignore-mesh-names comes with a single mesh (edge_specs)
         name = (
-            sources[0].name if args.ignore_mesh_names else picked_points.mesh_for_file(path, names)
+            sources[0].name if args.ignore_mesh_names else picked_points.mesh_for_file(shown, names)
         )
         if name is None:
             if folder:
-                unmatched.append(path.name)
+                unmatched.append(shown)
             else:
                 problems.append(
-                    f"{path.name}: no mesh given is named by it (NAME.pp or NAME_*.pp belongs "
+                    f"{shown}: no mesh given is named by it (NAME.pp or NAME_*.pp belongs "
                     "to the mesh NAME)"
                 )
             continue
         try:
             points = picked_points.edge_points(picked_points.read_picked_points(path))
         except GoniometerError as error:
-            problems.append(str(error))
+            problems.append(readable_name(str(error)))
             continue
-        mesh, why = closest_source(name, sources, path.name)
+        mesh, why = closest_source(name, sources, shown)
         if why:
             problems.append(why)
             continue
-        spec = args_spec(args, points.tolist(), mesh_name=name, note=path.name, given=path.name)
-        add_checked(specs, problems, {**spec, "mesh": mesh}, path.name)
+        spec = args_spec(args, points.tolist(), mesh_name=name, note=shown, given=shown)
+        add_checked(specs, problems, {**spec, "mesh": mesh}, shown)
     if problems:
         raise UsageError(
             f"--edges {given}: {len(problems)} picked-points file(s) cannot be measured:\n"

@@ -557,7 +557,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
             except OSError as error:
                 raise UsageError(f"{args.points}: {error.strerror or error}") from None
             replayed = len(rows)
-            replayed_export = bool(rows) and rows[0].source_format == "extension"
+            replayed_export = csvio.read_from_export(rows)
             tasks = bp.plan_rows(
                 [s.names for s in sources],
                 rows,

@@ -132,13 +132,14 @@ def import_mesh(source: MeshSource):
     points = np.ascontiguousarray(data.points, dtype=np.float32)
     rounded = not np.array_equal(points.astype(np.float64), data.points)
     exact_points = data.points if rounded else None
-    polygons, repeated, duplicated = data.polygons, False, False
-    if polygons is not None:
-        repeated, duplicated = polygon_flaws(*polygons)
-        if repeated:  # Blender's importers each repair such a face their own way: the fans
-            polygons = None
+    polygons = data.polygons
+    flaws = (False, False) if polygons is None else face_flaws(*polygons)
+    if flaws[0]:
+        polygons = None  # a face repeats a corner: Blender's importers each repair it their way
+    if polygons is None and data.triangles is not None:
+        flaws = face_flaws(data.triangles.reshape(-1), np.full(data.triangles.shape[0], 3))
     mesh = mesh_data.new_mesh(source.name, points, data.triangles, polygons)
-    if duplicated or (data.triangles is not None and needs_validation(data.triangles)):
+    if any(flaws):
         # Drop degenerate and duplicate faces as Blender's own importers do, so the object is
         # the one File > Import would make from the same file. (Indices are in range: the
         # reader checked them; so a list with neither has nothing for validate() to change.)
@@ -148,31 +149,48 @@ def import_mesh(source: MeshSource):
     return obj, exact_points
 
 
-def polygon_flaws(corners: np.ndarray, sizes: np.ndarray) -> tuple[bool, bool]:
-    """Whether a polygon repeats a corner, and whether two polygons have the same vertices (in
-    any order, from any corner): faces Blender's importers repair."""
-    starts = np.cumsum(sizes) - sizes
+def face_flaws(corners: np.ndarray, sizes: np.ndarray) -> tuple[bool, bool]:
+    """Whether a face repeats a corner, and whether two faces have the same vertices (in any
+    order, from any corner): the faces Blender's importers repair.
+
+    Parameters
+    ----------
+    corners : ndarray of int, shape (sum(sizes),)
+        Each face's vertex indices, one face after the other.
+    sizes : ndarray of int, shape (f,)
+        Each face's number of corners.
+    """
+    if sizes.size == 0:
+        return False, False
+    if (sizes == sizes[0]).all():  # one size (all triangles, say): no gathering needed
+        groups = [corners.reshape(-1, int(sizes[0]))]
+    else:
+        starts = np.cumsum(sizes) - sizes
+        groups = [corners[starts[sizes == k][:, None] + np.arange(k)] for k in np.unique(sizes)]
     repeated = duplicated = False
-    for size in np.unique(sizes):
-        rows = np.sort(corners[starts[sizes == size][:, None] + np.arange(size)], axis=1)
-        repeated |= bool((rows[:, 1:] == rows[:, :-1]).any())
-        duplicated |= bool(np.unique(rows, axis=0).shape[0] < rows.shape[0])
+    for rows in groups:
+        flaws = _triangle_flaws(rows) if rows.shape[1] == 3 else _polygon_flaws(rows)
+        repeated, duplicated = repeated or flaws[0], duplicated or flaws[1]
     return repeated, duplicated
 
 
-def needs_validation(triangles: np.ndarray) -> bool:
-    """Whether a triangle list has a degenerate face (a vertex twice) or the same face twice
-    (the same three vertices, in any order)."""
+def _polygon_flaws(rows: np.ndarray) -> tuple[bool, bool]:
+    rows = np.sort(rows, axis=1)
+    repeated = bool((rows[:, 1:] == rows[:, :-1]).any())
+    return repeated, bool(np.unique(rows, axis=0).shape[0] < rows.shape[0])
+
+
+def _triangle_flaws(triangles: np.ndarray) -> tuple[bool, bool]:
+    """:func:`_polygon_flaws` of triangles, on one int64 key each where their indices fit."""
     a, b, c = (np.ascontiguousarray(triangles[:, k], dtype=np.int64) for k in range(3))
-    if ((a == b) | (b == c) | (a == c)).any():
-        return True
+    repeated = bool(((a == b) | (b == c) | (a == c)).any())
     low = np.minimum(np.minimum(a, b), c)
     high = np.maximum(np.maximum(a, b), c)
     middle = a + b + c - low - high
     n = int(high.max()) + 1
     if n < 1 << 21:  # the three indices packed into one int64 key
         keys = np.sort((low << 42) | (middle << 21) | high)
-        return bool((keys[1:] == keys[:-1]).any())
+        return repeated, bool((keys[1:] == keys[:-1]).any())
     order = np.lexsort((high, low * n + middle))
     first, second = (low * n + middle)[order], high[order]
-    return bool(((first[1:] == first[:-1]) & (second[1:] == second[:-1])).any())
+    return repeated, bool(((first[1:] == first[:-1]) & (second[1:] == second[:-1])).any())

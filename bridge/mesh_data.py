@@ -371,8 +371,8 @@ def is_evaluated(obj, depsgraph) -> bool:
 
 
 def check_evaluated(obj, depsgraph, purpose: str) -> None:
-    """Raise :class:`NotEvaluatedError` where ``depsgraph`` does not hold ``obj`` evaluated, saying it
-    has no evaluated mesh for ``purpose`` ("to render")."""
+    """Raise :class:`NotEvaluatedError` where ``depsgraph`` does not hold ``obj`` evaluated,
+    saying it has no evaluated mesh for ``purpose`` ("to render")."""
     if not is_evaluated(obj, depsgraph):
         raise NotEvaluatedError(
             f"'{obj.name}' is disabled in the viewports or left out of this view layer (the "

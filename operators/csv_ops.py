@@ -250,7 +250,7 @@ class VG_OT_import_csv(bpy.types.Operator, ImportHelper):
             return None
         self._obj, self._path_name, self._steps = obj, bpy.path.basename(path), steps
         self._full_path = path
-        self._export = bool(rows) and rows[0].source_format == "extension"
+        self._export = csvio.read_from_export(rows)
         return steps
 
     def execute(self, context):

@@ -556,18 +556,24 @@ def test_imported_mesh_is_blenders_own_ply_import(vg, tmp_path, flaw):
     assert len(ours.data.polygons) == len(shape.triangles)  # the flaw is gone
 
 
-def test_needs_validation_agrees_with_brute_force(vg):
+def test_face_flaws_agree_with_brute_force(vg):
     sources = importlib.import_module(f"{vg.__name__}.batch.sources")
     rng = np.random.default_rng(0)
     for n in (6, 40, 3_000_000):  # the last packs no key into 63 bits
-        for _ in range(30):
-            triangles = rng.integers(0, min(n, 40), size=(int(rng.integers(1, 12)), 3))
-            triangles[0, 0] = n - 1  # fixes the largest index
-            seen, flawed = set(), False
-            for row in triangles.tolist():
-                flawed |= len(set(row)) < 3 or frozenset(row) in seen
-                seen.add(frozenset(row))
-            assert sources.needs_validation(triangles) == flawed, triangles
+        for mixed in (False, True):
+            for _ in range(30):
+                count = int(rng.integers(1, 12))
+                sizes = rng.integers(3, 6, size=count) if mixed else np.full(count, 3)
+                corners = rng.integers(0, min(n, 40), size=int(sizes.sum()))
+                corners[0] = n - 1  # fixes the largest index
+                faces = np.split(corners, np.cumsum(sizes)[:-1])
+                seen, repeated, duplicated = set(), False, False
+                for face in (f.tolist() for f in faces):
+                    repeated |= len(set(face)) < len(face)
+                    duplicated |= tuple(sorted(face)) in seen
+                    seen.add(tuple(sorted(face)))
+                got = sources.face_flaws(corners, sizes)
+                assert got == (repeated, duplicated), faces
 
 
 # --------------------------------------------------------------------------- whole edges

@@ -7,6 +7,8 @@ The .pp files are written here as MeshLab writes them (text), the oracle is the 
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 from bpy_helpers import batch
 
@@ -78,6 +80,32 @@ def test_a_folder_of_pp_files_measures_each_on_the_mesh_its_name_names(tmp_path)
     again = csvio.read_measurements_csv(single)
     first = [r.angle for r in rows if r.edge_number == edges[0].edge_number]
     assert [r.angle for r in again] == first
+
+
+def test_a_pp_file_whose_name_is_not_utf8_is_measured_with_the_others(tmp_path):
+    """A file name with a Latin-1 byte (``caf\\xe9``, as older archives keep them) was written
+    into the edge's note as Python holds it (a surrogate), which Blender refused with a
+    TypeError: an internal error, that edge and every edge after it on the mesh not measured,
+    exit 2. Now its name is written as the mesh names are (``\\xe9``), and all three edges are
+    measured as the core measures them."""
+    shape = varying_wedge(80.0, 120.0, half_width=2.0, depth=1.0, n=20)
+    scans = tmp_path / "scans"
+    scans.mkdir()
+    mesh = scans / "ramp.ply"
+    meshio.write_ply(mesh, shape.points, shape.triangles)
+    points = [[-1.5, 0.0, 0.0], [1.5, 0.0, 0.0]]
+    for name in (b"ramp_a.pp", b"ramp_caf\xe9.pp", b"ramp_z.pp"):
+        os.rename(write_pp(scans / "picked.pp", points), bytes(scans) + b"/" + name)
+    out = tmp_path / "out.csv"
+    ok(batch(mesh, "--edges", scans, "--spacing", 0.5, "--radius", 0.3, "--out", out))
+    edges = csvio.read_edges_csv(out.with_name("out_edges.csv"))
+    assert [e.user_data for e in edges] == ["ramp_a.pp", "ramp_caf\\xe9.pp", "ramp_z.pp"]
+    profile = Surface(meshio.read_mesh(mesh).points, shape.triangles).measure_along(
+        points, 0.5, 0.3
+    )
+    assert [(e.mean, e.n_stations, e.error) for e in edges] == [
+        (profile.mean, len(profile.stations), "")
+    ] * 3
 
 
 def test_bad_pp_files_stop_the_run_before_anything_is_measured(tmp_path):

@@ -285,3 +285,31 @@ def test_a_mesh_stored_far_from_its_origin_is_refused_with_the_reason(vg):
     placed = mesh_object("Placed", shape.points, shape.triangles, location=centre)
     bpy.ops.vg.measure_xyz(location=(0.0, 0.0, 0.0), radius=0.5, space="MESH")
     assert placed.vg.measurements[-1].angle == pytest.approx(90.0, abs=0.01)
+
+
+def test_a_patch_on_a_fin_is_refused_and_the_edge_beyond_it_is_measured(vg):
+    """A third face standing on the break edge (a fin ten vertex spacings high, each crease
+    edge under it bordering three faces, as Blender keeps it): the click on it is refused with
+    how to select such edges, nothing changed (before: 69.65° recorded for a 90° edge); the
+    same edge beyond the fin reads its angle, the oracle."""
+    from defect_meshes import wedge_with_fin
+
+    points, triangles = wedge_with_fin(90.0, rows=10)
+    obj = mesh_object("Fin", points, triangles)
+    multi_face = [len(edge_faces) for edge_faces in _faces_of_edges(obj).values()]
+    assert max(multi_face) == 3  # Blender kept the fin on the crease
+    bpy.ops.vg.measure_xyz(location=(0.5, 0.0, 0.0), radius=0.3)
+    before = snapshot(obj)
+    assert_refused(
+        r"shared by three or more faces.*Non Manifold", location=(-0.6, 0, 0), radius=0.3
+    )
+    assert snapshot(obj) == before
+    assert obj.vg.measurements[-1].angle == pytest.approx(90.0, abs=1e-4)
+
+
+def _faces_of_edges(obj) -> dict:
+    faces = {}
+    for polygon in obj.data.polygons:
+        for key in polygon.edge_keys:
+            faces.setdefault(key, []).append(polygon.index)
+    return faces

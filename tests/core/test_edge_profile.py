@@ -390,8 +390,39 @@ def test_a_path_that_turns_back_is_not_measured_twice_at_one_vertex(ramp):
     _, surface = ramp
     there_and_back = surface.trace_edge([-3, 0, 0], [-2, 0, 0], via=[[3, 0, 0]])
     assert np.unique(there_and_back.vertices).size < there_and_back.vertices.size
-    with pytest.raises(GoniometerError, match="same vertex twice"):
+    with pytest.raises(GoniometerError, match=r"same stretch twice, at arc lengths 1 to 5\.967"):
         surface.measure_along(there_and_back, spacing=0.5, radius=0.3)
+
+
+@pytest.mark.parametrize("spacing", [0.35, 0.37, 0.41, 0.43])
+def test_points_out_of_order_are_refused_whatever_the_spacing(spacing):
+    """Picked points out of their order along the edge (-3.9, -1, 3, then 0.5): the path runs
+    from x = 0.5 to 3 and back. At spacings 0.35, 0.41 and 0.43 no two stations met on a vertex,
+    and the edge was measured with that stretch counted twice (a review: mean 90.96° where the
+    points in order read 86.49°, the 60° to 120° ramp's mean over x from -3.9 to 3 being
+    86.625°); at 0.37 it was refused, saying the spacing was finer than the mesh (its segments
+    0.05 long). Now each is refused for what it is, and the points in order are measured."""
+    shape = varying_wedge(60.0, 120.0, n=20)
+    surface = Surface(shape.points, shape.triangles)
+    with pytest.raises(GoniometerError, match="same stretch twice") as refused:
+        surface.measure_along([[-3.9, 0, 0], [-1.0, 0, 0], [3.0, 0, 0], [0.5, 0, 0]], spacing, 0.4)
+    assert "finer than the mesh" not in str(refused.value)
+    in_order = surface.measure_along([[-3.9, 0, 0], [3.0, 0, 0]], spacing, 0.4)
+    along = np.column_stack([np.linspace(-3.9, 3.0, 1001), np.zeros((1001, 2))])
+    assert in_order.mean == pytest.approx(shape.angle_at(along).mean(), abs=0.3)
+
+
+def test_a_spur_shorter_than_half_a_spacing_is_measured(ramp):
+    """A path out to a vertex and back (a spur, as a noisy ridge can leave): at most one station
+    stands on it, so the edge is measured, its warning naming the spur."""
+    shape, surface = ramp
+    crease = np.sort(shape.points[shape.edge, 0])
+    step = float(np.diff(crease).min())  # one edge along the crease
+    path = surface.trace_edge([-3, 0, 0], [0, 0, 0], via=[[-1.0, 0, 0], [-1.0 - step, 0, 0]])
+    assert path.revisited_spans and "passes the same vertices twice" in path.warning
+    assert max(b - a for a, b in path.revisited_spans) < 0.25
+    profile = surface.measure_along(path, spacing=0.5, radius=0.3)
+    assert profile.path is path and len(profile.stations) == int(path.length // 0.5) + 1
 
 
 def test_a_point_on_a_large_face_is_on_the_mesh_however_far_its_vertices():

@@ -562,8 +562,10 @@ def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
     if np.unique(vertices).size == count:
         return positions
     neighbours = vertices[1:] == vertices[:-1]
-    if (loop and count > 1 and vertices[0] == vertices[-1]) or neighbours.any():
-        longest = float(np.diff(arc).max())
+    longest = float(np.diff(arc).max())
+    if spacing < longest and (
+        (loop and count > 1 and vertices[0] == vertices[-1]) or neighbours.any()
+    ):
         raise GoniometerError(
             f"The spacing {spacing:g} is finer than the mesh along this edge (its segments are up "
             f"to {longest:.4g} long), so two stations would share a vertex: use a spacing of at "
@@ -574,6 +576,23 @@ def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
         "itself), and two stations fall on it: one place would be measured twice. Trace the edge "
         "again with points that do not turn back along it."
     )
+
+
+def _check_single_pass(path: EdgePath, spacing: float) -> None:
+    """Refuse a path that passes a stretch of half a spacing or more twice (it doubles back,
+    or its points are out of order): stations there would measure that stretch twice over, and
+    the edge's figures would weigh it twice. A shorter revisit (a spur of a vertex or two, as
+    a noisy ridge can leave) holds one station at most, and is measured."""
+    twice = [(a, b) for a, b in path.revisited_spans if b - a >= spacing / 2]
+    if twice:
+        spans = bounded_list(f"{a:.4g} to {b:.4g}" for a, b in twice)
+        raise GoniometerError(
+            f"The traced path passes the same stretch twice, at arc lengths {spans} of "
+            f"{path.length:.4g} (it doubles back or crosses itself): its stations there would "
+            "measure one place twice, and count it twice in the edge's mean. Give the points in "
+            "their order along the edge (start, the via points as they come, end), or undo the "
+            "click that turned back."
+        )
 
 
 def measure_along(
@@ -611,6 +630,7 @@ def measure_along(
                 "The path must be a traced EdgePath or at least two x, y, z points."
             )
         path = trace_edge(surface, polyline[0], polyline[-1], via=polyline[1:-1])
+    _check_single_pass(path, spacing)
     positions = station_positions(path, spacing)
     stations, failures = [], []
     for position in positions:

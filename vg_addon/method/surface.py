@@ -17,7 +17,7 @@ from .precision import check_rounding, precision_of
 from .result import Measurement
 from .spatial import GridIndex, estimate_spacing
 from .stability import SMALL_PATCH_VERTICES, estimate_stability
-from .winding import mesh_winding
+from .winding import edge_census, mesh_winding
 
 PATCH_MODES = ("euclidean", "geodesic")
 
@@ -136,6 +136,8 @@ class Surface:
             self.triangles = None
         self._graph = None
         self._winding = None
+        self._census = None
+        self._fins = None
         self._corner_edges = None
         if self.triangles is not None and corner_edges is not None:
             self._corner_edges = _as_corner_edges(corner_edges, self.triangles.shape[0])
@@ -196,8 +198,36 @@ class Surface:
         """``"outward"``, ``"inward"``, ``"mixed"`` or ``"open"`` (see ``winding.WINDINGS``);
         computed on first use. On an ``"inward"`` surface convex edges are labelled concave."""
         if self._winding is None:
-            self._winding = mesh_winding(self.points, self.triangles, self._corner_edges)
+            census = None if self.triangles is None else self._edge_census()
+            self._winding = mesh_winding(self.points, self.triangles, census=census)
         return self._winding
+
+    def _edge_census(self):
+        """How the faces use the edges (one sort, taken once); marks the vertices of fins."""
+        if self._census is None:
+            self._census = edge_census(self.points, self.triangles, self._corner_edges)
+            if self._census.fin_vertices.size:
+                self._fins = np.zeros(self.n_points, dtype=bool)
+                self._fins[self._census.fin_vertices] = True
+        return self._census
+
+    def _check_no_fin(self, patch: np.ndarray) -> None:
+        """Refuse a patch holding a vertex of an edge of three or more faces (see :mod:`.fins`)."""
+        if self.triangles is None:
+            return
+        self._edge_census()
+        if self._fins is None:
+            return
+        count = int(np.count_nonzero(np.take(self._fins, patch)))
+        if count:
+            raise GoniometerError(
+                f"The patch holds {count} vertices of edges shared by three or more faces (a fin "
+                "or an inner wall standing on the surface, or a face given twice): their normals "
+                "belong to neither face of the break, and such a reading can be degrees off (a "
+                "90° edge with a fin on it read 69.65°). Remove the extra faces (Blender: Select > "
+                "Select All by Trait > Non Manifold, with only Multiple Faces on) and measure "
+                "again, or measure away from them."
+            )
 
     def snap(self, center, radius: float) -> tuple[int, float]:
         """Index of the vertex nearest ``center`` and its distance; an error if farther than ``radius``."""
@@ -296,8 +326,8 @@ class Surface:
         ------
         GoniometerError
             Centre farther than ``radius`` from the surface, bad radius or λ, unknown patch mode,
-            too few vertices, float32 coordinates rounded too coarsely for the patch, a flat
-            patch, a side that is a line, or (refined rule) two fitted planes that meet farther
+            too few vertices, float32 coordinates rounded too coarsely for the patch, a patch
+            holding an edge of three or more faces (see :mod:`.fins`), a flat patch, a side that is a line, or (refined rule) two fitted planes that meet farther
             than the radius from the centre or sides whose normals face opposite ways (a face
             wound against the other; for point clouds under every rule).
         """
@@ -343,6 +373,7 @@ class Surface:
         check_rounding(patch_points, radius, self.precision)
         if mode == "geodesic":
             self._check_no_seam(ball, indices)
+        self._check_no_fin(indices)
         fields = measure_patch(
             patch_points,
             np.take(self.normals, indices, axis=0),

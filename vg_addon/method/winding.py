@@ -11,7 +11,11 @@ reads as the supplement of its angle: the refined rule refuses it where the side
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+
+from . import fins
 
 WINDINGS = ("outward", "inward", "mixed", "open")
 """``"outward"``/``"inward"``: closed and consistently wound, with positive/negative volume.
@@ -24,7 +28,10 @@ _CHUNK = 1 << 18  # triangles per block: the temporaries stay small
 
 
 def mesh_winding(
-    points: np.ndarray, triangles: np.ndarray | None, corner_edges: np.ndarray | None = None
+    points: np.ndarray,
+    triangles: np.ndarray | None,
+    corner_edges: np.ndarray | None = None,
+    census: EdgeCensus | None = None,
 ) -> str:
     """Classify the winding of a triangle mesh (see :data:`WINDINGS`).
 
@@ -37,6 +44,8 @@ def mesh_winding(
         For each corner, the id of the undirected edge from it to the next corner of its
         triangle, aligned with ``triangles.ravel()`` (Blender's ``.corner_edge`` of an
         all-triangle mesh), one id per pair of vertices. Spares sorting the edges.
+    census : EdgeCensus, optional
+        :func:`edge_census` of the same triangles, if already taken.
 
     Returns
     -------
@@ -45,18 +54,48 @@ def mesh_winding(
     """
     if triangles is None or len(triangles) == 0:
         return "open"
-    if corner_edges is None:
-        closed, consistent = _edge_uses(triangles, points.shape[0])
-    else:
-        closed, consistent = _edge_uses_by_id(triangles, corner_edges)
-    if not closed:
+    if census is None:
+        census = edge_census(points, triangles, corner_edges)
+    if not census.closed:
         return "open"  # a boundary, or an edge of more than two faces
-    if not consistent:
+    if not census.consistent:
         return "mixed"  # each edge is used twice, but twice in the same direction somewhere
     volume = _signed_volume(points, triangles)
     if volume == 0.0:
         return "open"
     return "outward" if volume > 0 else "inward"
+
+
+@dataclass(frozen=True)
+class EdgeCensus:
+    """How a triangle mesh's edges are used, from one pass over its corners.
+
+    Attributes
+    ----------
+    closed : bool
+        Every edge is used by exactly two faces.
+    consistent : bool
+        Closed, and each edge is used once each way.
+    fin_vertices : ndarray of int64
+        The vertices of edges used by three or more faces with area (see :mod:`.fins`).
+    """
+
+    closed: bool
+    consistent: bool
+    fin_vertices: np.ndarray
+
+
+def edge_census(points: np.ndarray, triangles: np.ndarray, corner_edges=None) -> EdgeCensus:
+    """Take the :class:`EdgeCensus` of a triangle mesh, from a sort of the corners' edges or,
+    given each corner's edge id (see :func:`mesh_winding`), from counts."""
+    if corner_edges is not None:
+        return _census_by_id(points, triangles, corner_edges)
+    keys = _sorted_corner_keys(triangles, points.shape[0])
+    closed, consistent = _pairs(keys)
+    if closed:
+        return EdgeCensus(True, consistent, np.empty(0, dtype=np.int64))
+    keys >>= 1  # the undirected edges, still sorted
+    return EdgeCensus(False, False, fins.from_sorted_edges(keys, points, triangles))
 
 
 def _corner_edges(block: np.ndarray):
@@ -65,12 +104,9 @@ def _corner_edges(block: np.ndarray):
     return block.ravel(), block[:, [1, 2, 0]].ravel()
 
 
-def _edge_uses(triangles: np.ndarray, n: int) -> tuple[bool, bool]:
-    """Whether every edge is used by exactly two faces (closed), and once each way (consistent).
-
-    One sort of a key per corner: the undirected edge (low, high) times two, plus one when the
-    corner runs from high to low. Collapsed corners (both ends one vertex) add no edge.
-    """
+def _sorted_corner_keys(triangles: np.ndarray, n: int) -> np.ndarray:
+    """A key per corner, sorted: the undirected edge (low, high) times two, plus one when the
+    corner runs from high to low. Collapsed corners (both ends one vertex) add no key."""
     m = triangles.shape[0]
     keys = np.empty(3 * m, dtype=np.int64)
     for first in range(0, m, _CHUNK):
@@ -83,7 +119,12 @@ def _edge_uses(triangles: np.ndarray, n: int) -> tuple[bool, bool]:
         key[start == end] = -1
         keys[3 * first : 3 * first + key.size] = key
     keys.sort()
-    keys = keys[np.searchsorted(keys, 0) :]
+    return keys[np.searchsorted(keys, 0) :]
+
+
+def _pairs(keys: np.ndarray) -> tuple[bool, bool]:
+    """Whether every edge of the sorted corner ``keys`` is used by exactly two faces (closed),
+    and once each way (consistent)."""
     if keys.size % 2:
         return False, False
     # Closed: sorted, the keys come in pairs of one edge, each edge in one pair only.
@@ -100,8 +141,8 @@ def _edge_uses(triangles: np.ndarray, n: int) -> tuple[bool, bool]:
     return True, consistent
 
 
-def _edge_uses_by_id(triangles: np.ndarray, corner_edges: np.ndarray) -> tuple[bool, bool]:
-    """:func:`_edge_uses` from each corner's edge id: counts instead of a sort."""
+def _census_by_id(points, triangles: np.ndarray, corner_edges: np.ndarray) -> EdgeCensus:
+    """:func:`edge_census` from each corner's edge id: counts instead of a sort."""
     ids = np.asarray(corner_edges).ravel()
     m = triangles.shape[0]
     if ids.size != 3 * m:
@@ -115,9 +156,9 @@ def _edge_uses_by_id(triangles: np.ndarray, corner_edges: np.ndarray) -> tuple[b
         block = ids[3 * first : 3 * first + start.size]
         uses += np.bincount(block[start != end], minlength=size)
         forward += np.bincount(block[start < end], minlength=size)
-    if not ((uses == 0) | (uses == 2)).all():
-        return False, False
-    return True, bool((2 * forward == uses).all())
+    if ((uses == 0) | (uses == 2)).all():
+        return EdgeCensus(True, bool((2 * forward == uses).all()), np.empty(0, dtype=np.int64))
+    return EdgeCensus(False, False, fins.from_edge_uses(uses, ids, points, triangles))
 
 
 def _signed_volume(points: np.ndarray, triangles: np.ndarray) -> float:

@@ -63,6 +63,7 @@ from .replication import (
     ReplicationRow,
     break_number_cell,
     parse_replication_csv,
+    read_from_export,
     read_replication_csv,
 )
 from .sweep import SWEEP_COLUMNS, format_sweep_rows, holds_sweep, sweep_cells, write_sweep_csv
@@ -121,6 +122,7 @@ __all__ = [
     "parse_points",
     "parse_replication_csv",
     "read_edges_csv",
+    "read_from_export",
     "read_measurements_csv",
     "read_replication_csv",
     "read_table",

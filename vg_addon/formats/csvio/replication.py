@@ -231,10 +231,6 @@ def _settings_named_twice(header: list[str], aliases: dict) -> list[str]:
     return problems
 
 
-#: Columns whose names start like a setting's but are this extension's or MeshLab's own.
-_KNOWN_COLUMNS = frozenset(normalise(name) for name in (*EXPORT_COLUMNS, *MESHLAB_COLUMNS))
-
-
 #: What may follow a setting's name in a column that holds that setting: a unit, a symbol or
 #: an annotation in brackets ("Radius (mm)", "Lambda λ", "radius_mm"), or only punctuation.
 _ANNOTATION = re.compile(r"[(\[{<].*|mm|cm|m|µm|μm|um|nm|in|inch|inches|ft|deg|degrees|°|λ|units?|")
@@ -258,7 +254,7 @@ def _settings_not_read(header: list[str], columns: dict, aliases: dict) -> list[
     problems = []
     for index, raw in enumerate(header):
         name = normalise(raw)
-        if index in taken or name in _KNOWN_COLUMNS:
+        if index in taken:
             continue
         for alias, field in starts:
             rest = name[len(alias) :].strip(" -:.,;=*")
@@ -445,6 +441,12 @@ def parse_replication_csv(
             "(their error column is filled and they have no coordinates)."
         )
     return rows
+
+
+def read_from_export(rows: list[ReplicationRow]) -> bool:
+    """Whether ``rows`` (as :func:`read_replication_csv` returns them) come from a file whose
+    header is this extension's export, so that its angles can be compared with the new ones."""
+    return bool(rows) and rows[0].source_format == "extension"
 
 
 def read_replication_csv(path_or_text, passed_over: list | None = None) -> list[ReplicationRow]:
