@@ -412,6 +412,17 @@ def test_points_out_of_order_are_refused_whatever_the_spacing(spacing):
     assert in_order.mean == pytest.approx(shape.angle_at(along).mean(), abs=0.3)
 
 
+@pytest.mark.parametrize("spacing", ["0.2", None, 10**400, -1.0, 0.0, float("nan")])
+def test_a_bad_spacing_is_refused_as_such_on_a_path_passed_twice(spacing):
+    """The check of a stretch passed twice divided the spacing before it was checked: a text
+    or None raised a TypeError, 10**400 an OverflowError, and -1 or 0 were refused as a path
+    passed twice (a review of the change)."""
+    shape = varying_wedge(60.0, 120.0, n=20)
+    surface = Surface(shape.points, shape.triangles)
+    with pytest.raises(GoniometerError, match="spacing must be a finite number greater than 0"):
+        surface.measure_along([[-3.9, 0, 0], [3.0, 0, 0], [0.5, 0, 0]], spacing, 0.4)
+
+
 def test_a_spur_shorter_than_half_a_spacing_is_measured(ramp):
     """A path out to a vertex and back (a spur, as a noisy ridge can leave): at most one station
     stands on it, so the edge is measured, its warning naming the spur."""

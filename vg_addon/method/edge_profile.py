@@ -524,6 +524,15 @@ def is_loop(path: EdgePath) -> bool:
     return path.vertices.size > 1 and bool(path.vertices[0] == path.vertices[-1])
 
 
+def _as_spacing(spacing) -> float:
+    try:
+        return as_radius(spacing)
+    except GoniometerError:
+        raise GoniometerError(
+            f"The spacing must be a finite number greater than 0; got {spacing!r}."
+        ) from None
+
+
 def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
     """Positions in ``path.vertices`` of the stations ``spacing`` apart.
 
@@ -540,12 +549,7 @@ def station_positions(path: EdgePath, spacing: float) -> np.ndarray:
         one so fine that two stations snap to one vertex, or a path that passes a station's
         vertex twice.
     """
-    try:
-        spacing = as_radius(spacing)
-    except GoniometerError:
-        raise GoniometerError(
-            f"The spacing must be a finite number greater than 0; got {spacing!r}."
-        ) from None
+    spacing = _as_spacing(spacing)
     check_station_count(path.length, spacing)
     arc = path.arc_lengths
     loop = is_loop(path)
@@ -582,7 +586,8 @@ def _check_single_pass(path: EdgePath, spacing: float) -> None:
     """Refuse a path that passes a stretch of half a spacing or more twice (it doubles back,
     or its points are out of order): stations there would measure that stretch twice over, and
     the edge's figures would weigh it twice. A shorter revisit (a spur of a vertex or two, as
-    a noisy ridge can leave) holds one station at most, and is measured."""
+    a noisy ridge can leave) is measured, unless two stations fall on its vertex
+    (:func:`station_positions` refuses that)."""
     twice = [(a, b) for a, b in path.revisited_spans if b - a >= spacing / 2]
     if twice:
         spans = bounded_list(f"{a:.4g} to {b:.4g}" for a, b in twice)
@@ -630,6 +635,7 @@ def measure_along(
                 "The path must be a traced EdgePath or at least two x, y, z points."
             )
         path = trace_edge(surface, polyline[0], polyline[-1], via=polyline[1:-1])
+    spacing = _as_spacing(spacing)
     _check_single_pass(path, spacing)
     positions = station_positions(path, spacing)
     stations, failures = [], []

@@ -15,8 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-#: A face whose height is below this share of its longest side counts as without area.
+#: A face whose height is at most this share of its longest side counts as without area.
 FLAT = 1e-6
+
+_CHUNK = 1 << 18  # faces per block
 
 
 def from_sorted_edges(edges: np.ndarray, points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
@@ -41,11 +43,13 @@ def from_sorted_edges(edges: np.ndarray, points: np.ndarray, triangles: np.ndarr
         return np.empty(0, dtype=np.int64)
     n = np.int64(points.shape[0])
     candidates = np.unique(third)
-    start, end = _corner_ends(triangles)
-    keys = np.minimum(start, end) * n + np.maximum(start, end)
-    slot = np.minimum(np.searchsorted(candidates, keys), candidates.size - 1)
-    on_candidates = (candidates[slot] == keys).reshape(-1, 3).any(axis=1)
-    start, end = _flat_corner_edges(points, triangles[on_candidates])
+    involved = []  # the faces on a candidate edge, block by block: the temporaries stay small
+    for first in range(0, triangles.shape[0], _CHUNK):
+        start, end = _corner_ends(triangles[first : first + _CHUNK])
+        keys = np.minimum(start, end) * n + np.maximum(start, end)
+        slot = np.minimum(np.searchsorted(candidates, keys), candidates.size - 1)
+        involved.append(first + np.flatnonzero((candidates[slot] == keys).reshape(-1, 3).any(1)))
+    start, end = _flat_corner_edges(points, triangles[np.concatenate(involved)])
     flat = np.sort(np.minimum(start, end) * n + np.maximum(start, end))
     uses = _count(edges, candidates) - _count(flat, candidates)
     kept = candidates[uses >= 3]
@@ -79,13 +83,13 @@ def _count(sorted_keys: np.ndarray, values: np.ndarray) -> np.ndarray:
 
 
 def _flat(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Which triangles have no area: twice their area at most ``2 FLAT`` times the square of
-    their longest side (a repeated vertex among them)."""
+    """Which triangles have no area: height at most :data:`FLAT` times their longest side, so
+    twice their area at most ``FLAT`` times its square (a repeated vertex among them)."""
     a, b, c = (np.take(points, triangles[:, k], axis=0) for k in range(3))
     ab, bc, ca = b - a, c - b, a - c
     twice_area = np.linalg.norm(np.cross(ab, -ca), axis=1)
     longest = np.max([np.einsum("ij,ij->i", v, v) for v in (ab, bc, ca)], axis=0)
-    return twice_area <= 2 * FLAT * longest
+    return twice_area <= FLAT * longest
 
 
 def _corner_ends(triangles: np.ndarray):
