@@ -23,11 +23,12 @@ INNER_RADIUS, OUTER_RADIUS, HALF_HEIGHT, CUT_X = 1.5, 2.5, 0.5, 0.5
 HALF_ANNULUS_EDGES = {
     (CUT, OUTER): math.degrees(math.acos(CUT_X / OUTER_RADIUS)),  # 78.46°
     (CUT_2, OUTER): math.degrees(math.acos(CUT_X / OUTER_RADIUS)),
-    (CUT, INNER): 180.0 - math.degrees(math.acos(CUT_X / INNER_RADIUS)),  # 109.47°, concave
+    # 109.47°, where the cut meets the concave inner wall (a convex edge of the solid)
+    (CUT, INNER): 180.0 - math.degrees(math.acos(CUT_X / INNER_RADIUS)),
     (CUT_2, INNER): 180.0 - math.degrees(math.acos(CUT_X / INNER_RADIUS)),
     (TOP, OUTER): 90.0,
     (BOTTOM, OUTER): 90.0,
-    (TOP, INNER): 90.0,  # concave
+    (TOP, INNER): 90.0,  # at the concave inner wall
     (BOTTOM, INNER): 90.0,
     (TOP, CUT): 90.0,
     (BOTTOM, CUT_2): 90.0,
@@ -75,7 +76,8 @@ def _half_annulus_terms(p: np.ndarray) -> np.ndarray:
 
 def half_annulus(spacing: float = 0.05) -> LabelledMesh:
     """The half annulus: a ring of radii 1.5 and 2.5 and height 1 (``|z| ≤ 0.5``), the part
-    with ``x ≥ 0.5``; edges of 78.46°, 109.47° (concave) and 90° (:data:`HALF_ANNULUS_EDGES`).
+    with ``x ≥ 0.5``; edges of 78.46°, 109.47° (where the cut meets the concave inner wall) and
+    90° (:data:`HALF_ANNULUS_EDGES`).
 
     ``spacing`` is the marching grid's step (0.05 gives about 11,000 vertices, like the
     reference file).

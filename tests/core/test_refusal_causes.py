@@ -61,3 +61,18 @@ def test_a_cloud_of_repeated_points_is_refused_for_the_repeats():
     # One point given twice is no cause to name.
     once = np.vstack([shape.points, shape.points[:1]])
     assert Surface(once).measure(shape.points[0], 0.4).angle > 0
+
+
+def test_a_cloud_sampled_in_rows_far_apart_is_refused_for_its_rows():
+    """A cloud sampled in rows ten times farther apart than its points along them (a laser
+    scanner's lines), folded into a 90° wedge: each point's neighbourhood is its own row, a
+    line, and the refusal spoke of "no faces with area, or an empty point cloud" (a review)."""
+    along, across = 0.002, 0.02
+    u = np.arange(-250, 251) * along
+    v = (np.arange(-25, 26) + 0.37) * across
+    uu, vv = (grid.ravel() for grid in np.meshgrid(u, v, indexing="ij"))
+    half = np.radians(45.0)
+    points = np.column_stack([uu, vv * np.sin(half), -np.abs(vv) * np.cos(half)])
+    with pytest.raises(GoniometerError, match=r"lie on a line: a cloud sampled in rows") as refused:
+        Surface(points)
+    assert str(refused.value).startswith("No point of this cloud has a normal")

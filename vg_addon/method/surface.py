@@ -166,6 +166,14 @@ class Surface:
             step = float(np.spacing(np.float32(largest)))
             extent = float(np.ptp(self.points, axis=0).max()) if n else 0.0
             # The rounding can have collapsed the faces only where the mesh spans few steps.
+            if full_index is not None and n >= 3 and not rounded:
+                rounded = (
+                    f" Each point's neighbours within {full_index.cell_size:.3g} (about twice the "
+                    "points' typical spacing) are fewer than three or lie on a line: a cloud "
+                    "sampled in rows farther apart than its points along them (a laser "
+                    "scanner's lines) gives no plane to take a normal from. Resample the cloud "
+                    "to an even spacing, or measure a mesh made from it."
+                )
             if self.precision == "float32" and n and not rounded and extent <= 100 * step:
                 rounded = (
                     f" Its coordinates are float32 and reach {largest:.3g}, where float32 keeps "
@@ -173,10 +181,13 @@ class Surface:
                     "has collapsed its faces; move the mesh near the origin (subtract an offset "
                     "from its coordinates)."
                 )
-            raise GoniometerError(
-                "No vertex of this mesh has a normal (no faces with area, or an empty point cloud): "
-                f"nothing can be measured.{rounded}"
+            what = (
+                "No point of this cloud has a normal"
+                if full_index is not None and n
+                else "No vertex of this mesh has a normal (no faces with area, or an empty point "
+                "cloud)"
             )
+            raise GoniometerError(f"{what}: nothing can be measured.{rounded}")
         if full_index is not None and self.valid_ids.size == n:
             self.index = full_index  # the same points: the normals' index serves the queries
         elif self.valid_ids.size == n:
