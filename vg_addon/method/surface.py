@@ -154,11 +154,11 @@ class Surface:
             self.normals, self.valid = pca_normals(self.points, full_index)
         self.valid_ids = np.flatnonzero(self.valid)
         if self.valid_ids.size == 0:
-            rounded = ""
+            cause = ""
             if full_index is not None and n:
                 distinct = np.unique(self.points, axis=0).shape[0]
                 if 2 * distinct <= n:  # most points repeated: their neighbourhoods are copies
-                    rounded = (
+                    cause = (
                         f" The cloud repeats its points ({distinct:,} distinct of {n:,}): merge "
                         "the duplicates and measure again."
                     )
@@ -166,20 +166,20 @@ class Surface:
             step = float(np.spacing(np.float32(largest)))
             extent = float(np.ptp(self.points, axis=0).max()) if n else 0.0
             # The rounding can have collapsed the faces only where the mesh spans few steps.
-            if full_index is not None and n >= 3 and not rounded:
-                rounded = (
+            if self.precision == "float32" and n and not cause and extent <= 100 * step:
+                cause = (
+                    f" Its coordinates are float32 and reach {largest:.3g}, where float32 keeps "
+                    f"steps of {step:.2g}, and the whole mesh spans {extent:.2g}: the rounding "
+                    "has collapsed its faces; move the mesh near the origin (subtract an offset "
+                    "from its coordinates)."
+                )
+            if full_index is not None and n >= 3 and not cause:
+                cause = (
                     f" Each point's neighbours within {full_index.cell_size:.3g} (about twice the "
                     "points' typical spacing) are fewer than three or lie on a line: a cloud "
                     "sampled in rows farther apart than its points along them (a laser "
                     "scanner's lines) gives no plane to take a normal from. Resample the cloud "
                     "to an even spacing, or measure a mesh made from it."
-                )
-            if self.precision == "float32" and n and not rounded and extent <= 100 * step:
-                rounded = (
-                    f" Its coordinates are float32 and reach {largest:.3g}, where float32 keeps "
-                    f"steps of {step:.2g}, and the whole mesh spans {extent:.2g}: the rounding "
-                    "has collapsed its faces; move the mesh near the origin (subtract an offset "
-                    "from its coordinates)."
                 )
             what = (
                 "No point of this cloud has a normal"
@@ -187,7 +187,7 @@ class Surface:
                 else "No vertex of this mesh has a normal (no faces with area, or an empty point "
                 "cloud)"
             )
-            raise GoniometerError(f"{what}: nothing can be measured.{rounded}")
+            raise GoniometerError(f"{what}: nothing can be measured.{cause}")
         if full_index is not None and self.valid_ids.size == n:
             self.index = full_index  # the same points: the normals' index serves the queries
         elif self.valid_ids.size == n:
@@ -338,9 +338,10 @@ class Surface:
         GoniometerError
             Centre farther than ``radius`` from the surface, bad radius or λ, unknown patch mode,
             too few vertices, float32 coordinates rounded too coarsely for the patch, a patch
-            holding an edge of three or more faces (see :mod:`.fins`), a flat patch, a side that is a line, or (refined rule) two fitted planes that meet farther
-            than the radius from the centre or sides whose normals face opposite ways (a face
-            wound against the other; for point clouds under every rule).
+            holding an edge of three or more faces (see :mod:`.fins`), a flat patch, a side
+            that is a line, or (refined rule) two fitted planes that meet farther than the
+            radius from the centre or sides whose normals face opposite ways (a face wound
+            against the other; for point clouds under every rule).
         """
         requested = as_center(center)
         radius = as_radius(radius)
