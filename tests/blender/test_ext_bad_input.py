@@ -307,6 +307,28 @@ def test_a_patch_on_a_fin_is_refused_and_the_edge_beyond_it_is_measured(vg):
     assert obj.vg.measurements[-1].angle == pytest.approx(90.0, abs=1e-4)
 
 
+def test_a_separate_part_in_the_ball_is_left_out_and_the_paper_rule_refused(vg):
+    """Another fragment kept in the same mesh, its sheet 0.005 from the +1 face of a 120° edge
+    and joined to it by no face: the click there measures the wedge's part alone (before: 30.00°
+    recorded), as the geodesic patch does; the paper rule, which takes the whole ball, is
+    refused with how to separate the parts, nothing changed. Oracle: the edge's angle."""
+    from defect_meshes import wedge_with_fragment
+
+    points, triangles = wedge_with_fragment(120.0, 0.005)
+    obj = mesh_object("Refitted", points, triangles)
+    bpy.ops.vg.measure_xyz(location=(-0.3, 0.0, 0.0), radius=0.3)
+    bpy.ops.vg.measure_xyz(location=(-0.3, 0.0, 0.0), radius=0.3, patch="geodesic")
+    before = snapshot(obj)
+    assert_refused(
+        r"separate part of the mesh.*paper rule.*By Loose Parts",
+        location=(-0.3, 0, 0),
+        radius=0.3,
+        rule="paper",
+    )
+    assert snapshot(obj) == before
+    assert [item.angle for item in obj.vg.measurements] == pytest.approx([120.0, 120.0], abs=1e-4)
+
+
 def _faces_of_edges(obj) -> dict:
     faces = {}
     for polygon in obj.data.polygons:

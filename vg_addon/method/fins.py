@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .normals import face_normals
+
 #: A face whose height is at most this share of its longest side counts as without area.
 FLAT = 1e-6
 
@@ -45,7 +47,7 @@ def from_sorted_edges(edges: np.ndarray, points: np.ndarray, triangles: np.ndarr
     candidates = np.unique(third)
     involved = []  # the faces on a candidate edge, block by block: the temporaries stay small
     for first in range(0, triangles.shape[0], _CHUNK):
-        start, end = _corner_ends(triangles[first : first + _CHUNK])
+        start, end = corner_ends(triangles[first : first + _CHUNK])
         keys = np.minimum(start, end) * n + np.maximum(start, end)
         slot = np.minimum(np.searchsorted(candidates, keys), candidates.size - 1)
         involved.append(first + np.flatnonzero((candidates[slot] == keys).reshape(-1, 3).any(1)))
@@ -66,13 +68,13 @@ def from_edge_uses(
         return np.empty(0, dtype=np.int64)
     ids = ids.reshape(-1, 3)
     involved = candidates[ids].any(axis=1)
-    faces, face_ids = triangles[involved], ids[involved]
-    start, end = _corner_ends(faces)
+    faces, face_ids = triangles[involved], ids[involved].reshape(-1)
+    start, end = corner_ends(faces)
     corners = np.repeat(_flat(points, faces), 3) & (start != end)
-    fin = uses - np.bincount(face_ids.reshape(-1)[corners], minlength=uses.size) >= 3
+    fin = uses - np.bincount(face_ids[corners], minlength=uses.size) >= 3
     if not fin.any():
         return np.empty(0, dtype=np.int64)
-    corners = fin[face_ids.reshape(-1)]
+    corners = fin[face_ids]
     return np.unique(np.concatenate([start[corners], end[corners]]))
 
 
@@ -85,15 +87,16 @@ def _count(sorted_keys: np.ndarray, values: np.ndarray) -> np.ndarray:
 def _flat(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """Which triangles have no area: height at most :data:`FLAT` times their longest side, so
     twice their area at most ``FLAT`` times its square (a repeated vertex among them)."""
+    x, y, z = face_normals(points, triangles)
+    twice_area = np.sqrt(x * x + y * y + z * z)
     a, b, c = (np.take(points, triangles[:, k], axis=0) for k in range(3))
-    ab, bc, ca = b - a, c - b, a - c
-    twice_area = np.linalg.norm(np.cross(ab, -ca), axis=1)
-    longest = np.max([np.einsum("ij,ij->i", v, v) for v in (ab, bc, ca)], axis=0)
+    longest = np.max([np.einsum("ij,ij->i", v, v) for v in (b - a, c - b, a - c)], axis=0)
     return twice_area <= FLAT * longest
 
 
-def _corner_ends(triangles: np.ndarray):
-    """Start and end vertex (int64) of each corner's edge, corner k to corner k + 1."""
+def corner_ends(triangles: np.ndarray):
+    """Start and end vertex (int64) of each corner's edge (corner k to corner k + 1) of some
+    triangles, aligned with ``triangles.ravel()``."""
     triangles = triangles.astype(np.int64, copy=False)
     return triangles.reshape(-1), triangles[:, [1, 2, 0]].reshape(-1)
 
@@ -101,5 +104,5 @@ def _corner_ends(triangles: np.ndarray):
 def _flat_corner_edges(points: np.ndarray, triangles: np.ndarray):
     """Start and end vertex of each corner edge of the faces without area, collapsed corners
     left out."""
-    start, end = _corner_ends(triangles[_flat(points, triangles)])
+    start, end = corner_ends(triangles[_flat(points, triangles)])
     return start[start != end], end[start != end]

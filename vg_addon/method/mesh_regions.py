@@ -90,18 +90,22 @@ def edge_component_steps(n: int, sources: np.ndarray, targets: np.ndarray):
         np.minimum.at(label, targets, offered)
         del offered
         yield
-        # Jump: follow labels to their root. A vertex whose label names a root keeps it (roots
-        # do not move while jumping), so only the others are looked at again.
-        active = touched
-        while active.size:
-            current = label[active]
-            jumped = label[current]
-            moved = jumped != current
-            active = active[moved]
-            label[active] = jumped[moved]
+        jump_to_roots(label, touched)
         yield
         if np.array_equal(before, label[touched]):
             return label
+
+
+def jump_to_roots(label: np.ndarray, active: np.ndarray) -> None:
+    """Follow the labels of the vertices ``active`` to their roots (a root is its own label), in
+    place, by pointer jumping. A vertex whose label names a root keeps it (roots do not move
+    while jumping), so only the others are looked at again."""
+    while active.size:
+        current = label[active]
+        jumped = label[current]
+        moved = jumped != current
+        active = active[moved]
+        label[active] = jumped[moved]
 
 
 def flood_labels(

@@ -13,6 +13,7 @@ from .geodesic import EdgeGraph
 from .inputs import as_center, as_flag, as_lambda, as_normals, as_points, as_radius
 from .normals import pca_normals, vertex_normals
 from .ordering import canonical_ranks
+from .parts import measured_part, mesh_parts
 from .precision import check_rounding, precision_of
 from .result import Measurement
 from .spatial import GridIndex, estimate_spacing
@@ -138,6 +139,8 @@ class Surface:
         self._winding = None
         self._census = None
         self._fins = None
+        self._parts = None
+        self._part_sizes = None
         self._corner_edges = None
         if self.triangles is not None and corner_edges is not None:
             self._corner_edges = _as_corner_edges(corner_edges, self.triangles.shape[0])
@@ -240,6 +243,59 @@ class Surface:
                 "again, or measure away from them."
             )
 
+    def _measured_part(self, ball: np.ndarray, center_index: int, radius: float) -> np.ndarray:
+        """The vertices of a Euclidean ``ball`` on the part measured (see :mod:`.parts`)."""
+        if self.triangles is None:
+            return ball
+        self._label_parts()
+        patch = measured_part(self._parts, self._part_sizes, ball, center_index)
+        if patch is None:
+            raise GoniometerError(
+                "The vertex measured is on a crumb of the mesh that no face joins to the rest "
+                f"(it has fewer vertices than the rest of the {ball.size} within radius "
+                f"{radius:g}), and the radius reaches several larger parts (fragments kept in one "
+                "mesh, or scan debris): which surface to measure cannot be told. Measure nearer "
+                "the surface meant, or separate the parts (Blender: Edit Mode > Mesh > Separate > "
+                "By Loose Parts) and delete the debris; where the parts are one surface whose "
+                "vertices were not merged, merge them by distance (Mesh > Clean Up > Merge by "
+                "Distance)."
+            )
+        return patch
+
+    def _label_parts(self) -> None:
+        """Label the mesh's parts (see :mod:`.parts`), once."""
+        if self._parts is None:
+            self._parts, self._part_sizes = mesh_parts(self.points, self.triangles)
+
+    def on_measured_parts(self, ids: np.ndarray, m) -> np.ndarray | None:
+        """Which of ``ids`` are not on a part that the Euclidean measurement ``m`` left out of
+        its ball (for the stability figure's pool and moved centres); ``None`` where none is.
+        """
+        if self.triangles is None:  # a point cloud: no parts to tell apart
+            return None
+        self._label_parts()
+        labels = np.take(self._parts, ids)
+        if not labels.size or (labels == labels[0]).all():
+            return None
+        ball, _ = self.index.ball(self.points[m.center_index], m.radius)
+        if ball.size == m.indices.size:
+            return None
+        left_out = np.setdiff1d(np.take(self._parts, ball), np.take(self._parts, m.indices))
+        return ~np.isin(labels, left_out)
+
+    def _whole_ball(self, ball: np.ndarray, patch: np.ndarray) -> None:
+        """Refuse the paper rule where the Euclidean patch is not the whole ball."""
+        if patch.size != ball.size:
+            raise GoniometerError(
+                f"{ball.size - patch.size} of the {ball.size} vertices within the radius lie on "
+                "a separate part of the mesh, which no face joins to the one measured (another "
+                "fragment kept in the same mesh, or scan debris). Algorithm 1 as printed (the "
+                "paper rule) takes every vertex within the radius, and such a reading can be "
+                "degrees off. Measure with the refined or oriented rule, which take the measured "
+                "part alone, or separate the parts (Blender: Edit Mode > Mesh > Separate > By "
+                "Loose Parts)."
+            )
+
     def snap(self, center, radius: float) -> tuple[int, float]:
         """Index of the vertex nearest ``center`` and its distance; an error if farther than ``radius``."""
         center = as_center(center)
@@ -252,8 +308,9 @@ class Surface:
     def patch(self, center_index: int, radius: float, patch: str = "euclidean") -> np.ndarray:
         """Indices of the vertices in the patch of ``radius`` around vertex ``center_index``.
 
-        ``"euclidean"``: within straight-line distance ``radius``. ``"geodesic"``: reachable along
-        mesh edges by a path no longer than ``radius`` (needs triangles).
+        ``"euclidean"``: within straight-line distance ``radius``, on the part of the mesh measured
+        (see :mod:`.parts`). ``"geodesic"``: reachable along mesh edges by a path no longer than
+        ``radius`` (needs triangles).
         """
         radius = as_radius(radius)
         mode = check_patch_mode(patch)
@@ -267,7 +324,10 @@ class Surface:
         return self._restrict(indices, index, radius, mode)
 
     def _restrict(self, indices: np.ndarray, center_index: int, radius: float, mode: str):
-        """The patch within the Euclidean ball ``indices``: all of it, or its geodesic part."""
+        """The patch within the Euclidean ball ``indices``: the part of the mesh measured (see
+        :mod:`.parts`), or the geodesic patch."""
+        if mode == "euclidean":
+            return self._measured_part(indices, center_index, radius)
         if mode == "geodesic":
             if self.triangles is None:
                 raise GoniometerError(
@@ -338,7 +398,9 @@ class Surface:
         GoniometerError
             Centre farther than ``radius`` from the surface, bad radius or λ, unknown patch mode,
             too few vertices, float32 coordinates rounded too coarsely for the patch, a patch
-            holding an edge of three or more faces (see :mod:`.fins`), a flat patch, a side
+            holding an edge of three or more faces (see :mod:`.fins`), a centre on a crumb of
+            the mesh with several larger parts in reach, or (paper rule) a Euclidean ball
+            reaching a large separate part (see :mod:`.parts`), a flat patch, a side
             that is a line, or (refined rule) two fitted planes that meet farther than the
             radius from the centre or sides whose normals face opposite ways (a face wound
             against the other; for point clouds under every rule).
@@ -366,6 +428,11 @@ class Surface:
                 check_rounding(np.take(self.points, indices, axis=0), radius, self.precision)
             if mode == "geodesic":
                 self._check_no_seam(ball, indices)
+            if mode == "euclidean" and indices.size < ball.size:
+                raise GoniometerError(
+                    f"The patch of radius {radius:g} holds only {indices.size} vertices; at "
+                    f"least {2 * MIN_SIDE_VERTICES} are needed.{_left_out(ball, indices)}"
+                )
             if ball.size >= 2 * max(indices.size, 2 * MIN_SIDE_VERTICES):  # geodesic: far fewer
                 raise GoniometerError(
                     f"The geodesic patch of radius {radius:g} reaches only {indices.size} of the "
@@ -385,16 +452,23 @@ class Surface:
         check_rounding(patch_points, radius, self.precision)
         if mode == "geodesic":
             self._check_no_seam(ball, indices)
+        elif rule == "paper":
+            self._whole_ball(ball, indices)
         self._check_no_fin(indices)
-        fields = measure_patch(
-            patch_points,
-            np.take(self.normals, indices, axis=0),
-            self.points[center_index],
-            radius,
-            lam,
-            rule,
-            estimated_normals=self.estimated_orientation,
-        )
+        try:
+            fields = measure_patch(
+                patch_points,
+                np.take(self.normals, indices, axis=0),
+                self.points[center_index],
+                radius,
+                lam,
+                rule,
+                estimated_normals=self.estimated_orientation,
+            )
+        except GoniometerError as error:
+            if mode == "euclidean" and indices.size < ball.size:
+                raise GoniometerError(f"{error}{_left_out(ball, indices)}") from None
+            raise
         measurement = Measurement(
             **fields,
             indices=indices,
@@ -435,6 +509,17 @@ class Surface:
         from .break_edges import find_break_edges
 
         return find_break_edges(self, **parameters)
+
+
+def _left_out(ball: np.ndarray, patch: np.ndarray) -> str:
+    """What a refusal adds where the Euclidean patch left another part of the mesh out."""
+    return (
+        f" {ball.size - patch.size} of the {ball.size} vertices within the radius were left out: "
+        "they are on another part of the mesh, which no face joins to the one measured (see "
+        "the Euclidean patch in METHOD.md). Where that part is the same surface (two scans' "
+        "shells, a seam whose vertices are a little apart), merge the vertices by distance "
+        "(Blender: Mesh > Clean Up > Merge by Distance)."
+    )
 
 
 def _too_far(center: np.ndarray, radius: float) -> GoniometerError:

@@ -98,19 +98,13 @@ def edge_census(points: np.ndarray, triangles: np.ndarray, corner_edges=None) ->
     return EdgeCensus(False, False, fins.from_sorted_edges(keys, points, triangles))
 
 
-def _corner_edges(block: np.ndarray):
-    """Start and end vertex of each corner's edge (corner k to corner k + 1) of some triangles."""
-    block = block.astype(np.int64, copy=False)
-    return block.ravel(), block[:, [1, 2, 0]].ravel()
-
-
 def _sorted_corner_keys(triangles: np.ndarray, n: int) -> np.ndarray:
     """A key per corner, sorted: the undirected edge (low, high) times two, plus one when the
     corner runs from high to low. Collapsed corners (both ends one vertex) add no key."""
     m = triangles.shape[0]
     keys = np.empty(3 * m, dtype=np.int64)
     for first in range(0, m, _CHUNK):
-        start, end = _corner_edges(triangles[first : first + _CHUNK])
+        start, end = fins.corner_ends(triangles[first : first + _CHUNK])
         low = np.minimum(start, end)
         key = low * np.int64(n)
         key += np.maximum(start, end)
@@ -152,7 +146,7 @@ def _census_by_id(points, triangles: np.ndarray, corner_edges: np.ndarray) -> Ed
     forward = np.zeros(size, dtype=np.int64)
     step = 8 * _CHUNK  # large blocks: each bincount walks all the edge counts
     for first in range(0, m, step):
-        start, end = _corner_edges(triangles[first : first + step])
+        start, end = fins.corner_ends(triangles[first : first + step])
         block = ids[3 * first : 3 * first + start.size]
         uses += np.bincount(block[start != end], minlength=size)
         forward += np.bincount(block[start < end], minlength=size)
