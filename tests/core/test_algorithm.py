@@ -343,3 +343,18 @@ def test_the_extreme_scales_still_allowed_measure_right(scale):
     for triangles in (shape.triangles, None):
         m = Surface(shape.points * scale, triangles).measure([0, 0, 0], 0.5 * scale)
         assert abs(m.angle - shape.angle) < 1e-9
+
+
+@pytest.mark.parametrize("scale", [1e-160, 1e-170, 1e-300])
+def test_given_normals_too_short_to_square_keep_their_direction(scale):
+    """A normal of length 1e-170 was called "zero length": its squares underflow. It carries a
+    direction, and reads as the unit normals do; a normal of length 0 is still refused."""
+    shape = wedge(90.0, n=30)
+    normals = Surface(shape.points, shape.triangles).normals
+    given = Surface(shape.points, normals=normals * scale)
+    assert np.abs(given.normals - normals).max() < 1e-12
+    assert abs(given.measure([0, 0, 0], 0.5).angle - shape.angle) < 1e-9
+    assert abs(goniometer(shape.points, normals * scale).angle - shape.angle) < 1e-9
+    normals[7] = 0.0
+    with pytest.raises(GoniometerError, match=r"1 normals have zero length \(the first at row 7\)"):
+        Surface(shape.points, normals=normals * scale)

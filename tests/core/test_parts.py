@@ -60,8 +60,8 @@ def _joined_by_faces_without_area(points, triangles):
     """The same mesh made one part by a face without area from each part's least vertex to
     vertex 0 (a repeated corner): its normals are the same bits, and no vertex is left out."""
     labels, _ = mesh_parts(points, triangles)
-    firsts = np.unique(labels[np.unique(triangles)], return_index=True)[1]
-    firsts = np.unique(triangles)[firsts]
+    used = np.unique(triangles)
+    firsts = used[np.unique(labels[used], return_index=True)[1]]
     extra = np.column_stack([np.zeros_like(firsts), firsts, firsts])
     return Surface(points, np.vstack([triangles, extra]))
 

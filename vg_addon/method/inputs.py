@@ -126,10 +126,23 @@ def as_center(center) -> np.ndarray:
     return value
 
 
+TINY_LENGTH = 1e-150
+"""Below this length a normal's squared components can underflow; it is rescaled first."""
+
+
 def unit_normals(name: str, normals: np.ndarray) -> np.ndarray:
     """Normalise given normals; zero-length ones are an error (they carry no direction)."""
     lengths = np.linalg.norm(normals, axis=1)
-    zero = lengths <= 1e-300
+    short = np.flatnonzero(lengths < TINY_LENGTH)
+    if short.size:
+        # Their squares underflow (a length of 1e-170 came out as 0): scaled by their largest
+        # component first, they keep their direction. Other rows keep their bits.
+        normals = normals.copy()
+        largest = np.abs(normals[short]).max(axis=1)
+        nonzero = largest > 0
+        normals[short[nonzero]] /= largest[nonzero, None]
+        lengths[short] = np.linalg.norm(normals[short], axis=1)
+    zero = lengths == 0
     if zero.any():
         raise GoniometerError(
             f"{int(zero.sum())} {name} have zero length (the first at row "

@@ -65,7 +65,7 @@ def _moved_centers(surface, m: Measurement) -> np.ndarray:
     reach = CENTER_EDGE_LENGTHS * mean_edge_length(m.radius, m.n_vertices)
     ids, distance = surface.index.ball(m.center, reach)
     keep = ids != m.center_index
-    if m.patch == "euclidean" and (taken := surface.on_measured_parts(ids, m)) is not None:
+    if (taken := surface.on_measured_parts(ids, m)) is not None:
         keep &= taken
     ids, distance = ids[keep], distance[keep]
     coords = surface.points[ids]
@@ -453,7 +453,7 @@ def _pool(surface, m: Measurement, center_ids, radii):
     their features for exact sums of up to all of them."""
     reach = float(np.linalg.norm(surface.points[center_ids] - m.center, axis=1).max())
     ids, _ = surface.index.ball(m.center, float(radii.max()) + reach)
-    if m.patch == "euclidean" and (taken := surface.on_measured_parts(ids, m)) is not None:
+    if (taken := surface.on_measured_parts(ids, m)) is not None:
         ids = ids[taken]
     _check_size(center_ids.size + N_BOOTSTRAP, ids.size)
     ids = np.sort(ids)

@@ -141,6 +141,7 @@ class Surface:
         self._fins = None
         self._parts = None
         self._part_sizes = None
+        self._left_out = None  # (measurement, labels): see _left_out_parts
         self._corner_edges = None
         if self.triangles is not None and corner_edges is not None:
             self._corner_edges = _as_corner_edges(corner_edges, self.triangles.shape[0])
@@ -269,19 +270,29 @@ class Surface:
 
     def on_measured_parts(self, ids: np.ndarray, m) -> np.ndarray | None:
         """Which of ``ids`` are not on a part that the Euclidean measurement ``m`` left out of
-        its ball (for the stability figure's pool and moved centres); ``None`` where none is.
+        its ball (for the stability figure's pool and moved centres); ``None`` where none is (a
+        geodesic patch, which follows the faces, leaves no part out of its reach).
         """
-        if self.triangles is None:  # a point cloud: no parts to tell apart
+        if m.patch != "euclidean" or self.triangles is None:  # a point cloud has no parts
             return None
         self._label_parts()
         labels = np.take(self._parts, ids)
         if not labels.size or (labels == labels[0]).all():
             return None
+        left_out = self._left_out_parts(m)
+        return None if left_out is None else ~np.isin(labels, left_out)
+
+    def _left_out_parts(self, m) -> np.ndarray | None:
+        """The labels of the parts that ``m``'s ball reached and its patch left out; ``None``
+        where it left out nothing. The last answer is kept: the stability figure asks twice."""
+        if self._left_out is not None and self._left_out[0] is m:
+            return self._left_out[1]
         ball, _ = self.index.ball(self.points[m.center_index], m.radius)
-        if ball.size == m.indices.size:
-            return None
-        left_out = np.setdiff1d(np.take(self._parts, ball), np.take(self._parts, m.indices))
-        return ~np.isin(labels, left_out)
+        left_out = None
+        if ball.size != m.indices.size:
+            left_out = np.setdiff1d(np.take(self._parts, ball), np.take(self._parts, m.indices))
+        self._left_out = (m, left_out)
+        return left_out
 
     def _whole_ball(self, ball: np.ndarray, patch: np.ndarray) -> None:
         """Refuse the paper rule where the Euclidean patch is not the whole ball."""
