@@ -51,7 +51,10 @@ def main(argv: list[str]) -> int:
         print(f"vg_batch: error: {error.strerror or error}{where}", file=sys.stderr, flush=True)
         return 2
     except KeyboardInterrupt:
-        print("vg_batch: interrupted; the CSV holds what was measured so far", file=sys.stderr)
+        print(
+            "vg_batch: interrupted; what was measured so far is kept (see the lines above)",
+            file=sys.stderr,
+        )
         return 130
     finally:
         map_process.close()

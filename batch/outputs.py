@@ -125,6 +125,80 @@ def sweep_paths(out) -> tuple[Path, Path]:
     return out.with_name(out.stem + "_sweep.csv"), out.with_name(out.stem + "_sweep")
 
 
+def keeps_earlier(out) -> bool:
+    """Whether ``--out`` is a regular file already, which the run keeps whole until it
+    completes (:func:`partial_paths`); a stream or a new file is written as the run goes."""
+    return bool(out) and not is_stream(out) and os.path.isfile(out)
+
+
+def partial_paths(out) -> tuple[Path, Path, Path]:
+    """Where a run to an earlier ``--out`` writes its CSV until it completes: the side file
+    ``<stem>.partial<suffix>``, its edge summary ``<stem>.partial_edges<suffix>`` and its sweep
+    ``<stem>.partial_sweep.csv``, beside ``out`` as given (as :func:`sweep_paths`)."""
+    out = Path(out)
+    partial = out.with_name(f"{out.stem}.partial{out.suffix or '.csv'}")
+    return partial, csvio.edges_path_for(partial), sweep_paths(partial)[0]
+
+
+def holds_export(path) -> bool:
+    """Whether ``path`` is a measurement CSV (its header begins with MeshLab's columns), as a
+    run's side file is; any other file of that name is not the run's to remove."""
+    if not os.path.isfile(path):
+        return False
+    try:
+        _, header, _ = csvio.read_table(Path(path))
+    except (OSError, GoniometerError):
+        return False
+    return tuple(header[: len(csvio.MESHLAB_COLUMNS)]) == csvio.MESHLAB_COLUMNS
+
+
+def partial_outputs(args, edges: bool) -> list[tuple[str, str]]:
+    """``(what, path)`` of the side files this run writes (its ``--out`` is an earlier file) or
+    removes once it completes (an earlier stopped run's): outputs like any other."""
+    if not args.out or is_stream(args.out):
+        return []
+    partial, partial_edges, partial_sweep = partial_paths(args.out)
+    earlier = keeps_earlier(args.out)
+    found = []
+    if earlier or holds_export(partial):
+        found.append(("--out's partial results", str(partial)))
+    if (earlier and edges) or csvio.holds_edge_summary(partial_edges):
+        found.append(("--out's partial edge summary", str(partial_edges)))
+    if (earlier and args.sweep) or csvio.holds_sweep(partial_sweep):
+        found.append(("--out's partial sweep CSV", str(partial_sweep)))
+    return found
+
+
+def remove_partial(out) -> list[str]:
+    """Remove the side files of :func:`partial_paths` that a run wrote (once the run to ``out``
+    has completed, they are stale); returns why any could not be removed."""
+    partial, partial_edges, partial_sweep = partial_paths(out)
+    problems = []
+    for path, ours in (
+        (partial, holds_export),
+        (partial_edges, csvio.holds_edge_summary),
+        (partial_sweep, csvio.holds_sweep),
+    ):
+        if ours(path):
+            try:
+                path.unlink()
+            except OSError as error:
+                problems.append(f"{path}: {error.strerror or error}")
+    return problems
+
+
+def _holds_something(path: Path) -> bool:
+    """Whether ``path`` is a file with more than blanks and a byte-order mark in it (or one that
+    cannot be read, which is not ours to replace either)."""
+    if not path.is_file():
+        return False
+    try:
+        with open(path, "rb") as handle:
+            return bool(handle.read(4096).removeprefix(b"\xef\xbb\xbf").strip())
+    except OSError:
+        return True
+
+
 def check_outputs(args) -> None:
     """Refuse outputs that are inputs or each other, and outputs that cannot be written.
 
@@ -164,6 +238,7 @@ def check_outputs(args) -> None:
             outputs.append(
                 ("--out's earlier sweep CSV (emptied by a run without --sweep)", str(csv_path))
             )
+    outputs += partial_outputs(args, bool(edges))
     inputs = input_files(args)
     if args.out == files.STDOUT and (victim := _stdout_input(inputs)):
         raise UsageError(
@@ -177,6 +252,12 @@ def check_outputs(args) -> None:
                 f"{option} {path} is {victim}: writing there would destroy an input. Choose "
                 "another file name; nothing was read or written."
             )
+    if args.sweep and _holds_something(csv_path) and not csvio.holds_sweep(csv_path):
+        raise UsageError(
+            f"--sweep writes {csv_path}, which holds a file that is not a radius-sweep CSV (the "
+            "user's notes, or another list): move it away or give --out another name; nothing "
+            "was read or written."
+        )
     for at, (option, path) in enumerate(outputs):
         for other, other_path in outputs[at + 1 :]:
             if _same_file(path, other_path):

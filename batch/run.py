@@ -17,7 +17,6 @@ from ..vg_addon import GoniometerError
 from ..vg_addon.errors import bounded_list
 from ..vg_addon.formats import csvio, files
 from ..vg_addon.method.edge_summary import sd_text
-from ..vg_addon.method.result import stability_text, stability_warning
 from ..vg_addon.method.winding import winding_message
 from ..vg_addon.workflow import batchplan
 from . import extension, replay_agreement, stopping
@@ -34,8 +33,18 @@ from .edges import (
     unmeasured_mesh_edges,
 )
 from .find_edges import find_options
+from .flagged import flagged_lines
 from .measure import MeshResult, error_row, run_units_label, safe_measure_mesh, set_units
-from .outputs import check_outputs, input_files, is_stream, make_folders, sweep_paths
+from .outputs import (
+    check_outputs,
+    input_files,
+    is_stream,
+    keeps_earlier,
+    make_folders,
+    partial_paths,
+    remove_partial,
+    sweep_paths,
+)
 from .pictures import reason
 from .sources import blend_objects, file_sources, start_file
 from .stdio import say
@@ -78,6 +87,10 @@ class Run:
         # A pipe or standard output gets the CSV once, at the end; a file is rewritten as the
         # meshes finish, so a run that is stopped keeps what it measured.
         self.stream = is_stream(args.out)
+        # An earlier --out is the user's results: a run stopped part-way must not replace them
+        # with fewer, so the rewrites go to a side file until the run completes.
+        earlier = keeps_earlier(args.out)
+        self.target = str(partial_paths(args.out)[0]) if earlier else args.out  # where it goes now
         self.failed_outputs: list[str] = []  # .blend or pictures that could not be written
         self.write_error = ""  # why the last write of the CSV failed ("" if it did not)
         # Each row's CSV line, formatted once: every rewrite of the growing CSV reuses them.
@@ -128,27 +141,9 @@ class Run:
                 self.say(line)
 
     def say_flagged(self, by_index: dict) -> None:
-        """The summary's lines for unstable readings (points, then edge stations): how many,
-        and the first ten with why."""
-        flagged = []
-        for index, row, warning in flagged_rows(self.rows):
-            task = by_index[index]
-            where = f"row {task.source_row}" if task.source_row else f"point {task.number}"
-            flagged.append((where, row, warning))
-        for _, row, warning in flagged_rows(dict(enumerate(self.station_rows))):
-            where = f"edge {row.edge_number} station at arc length {row.arc_length:.4g}"
-            flagged.append((where, row, warning))
-        if not flagged:
-            return
-        self.say(f"{len(flagged):,} flagged reading(s): unstable, or the ± figure undetermined")
-        for where, row, warning in flagged[:10]:
-            self.say(
-                f"  flagged: {where} on {row.mesh_name!r}: {row.angle:.2f}° "
-                f"{stability_text(row.stability, *_counts(row))}"
-                f": {warning}"
-            )
-        if len(flagged) > 10:
-            self.say(f"  ... and {len(flagged) - 10} more flagged rows (see the Stability columns)")
+        """The summary's lines for unstable readings (see :func:`.flagged.flagged_lines`)."""
+        for line in flagged_lines(self.rows, self.station_rows, by_index):
+            self.say(line)
 
     def progress(self, mesh: int, done: int, force: bool = False) -> None:
         with self.lock:
@@ -232,7 +227,7 @@ class Run:
         except (OSError, GoniometerError) as error:
             if not self.write_error:
                 self.say(
-                    f"could not write {what_failed(error, self.args.out)}; measuring goes on, "
+                    f"could not write {what_failed(error, self.target)}; measuring goes on, "
                     "and the CSV is written again at the end"
                 )
             self.write_error = reason(error)
@@ -243,10 +238,10 @@ class Run:
     def recover_csv(self, error) -> None:
         """The CSV could not be written at the end: write the rows into the temporary folder
         instead and say where, so nothing measured is lost."""
-        stem = Path(self.args.out).stem if self.args.out != files.STDOUT else "out"
+        stem = Path(self.target).stem if self.target != files.STDOUT else "out"
         handle, path = tempfile.mkstemp(prefix=f"vg_batch_{stem}_", suffix=".csv")
         os.close(handle)
-        where = "standard output" if self.args.out == files.STDOUT else self.args.out
+        where = "standard output" if self.target == files.STDOUT else self.target
         try:
             self.write_csv(path)
         except csvio.SummaryWriteError as second:
@@ -276,14 +271,15 @@ class Run:
         with os.fdopen(handle, "wb") as stream:
             stream.write(error.summary_text)
         self.say(
-            f"could not write {what_failed(error, self.args.out)}; the edge summary is in {path} "
+            f"could not write {what_failed(error, self.target)}; the edge summary is in {path} "
             "(move it where it belongs)"
         )
 
     def write_csv(self, out=None) -> None:
-        """Write the rows to ``out`` (default ``--out``), and the edge summaries beside it (emptied
-        where an earlier run left one and this one measures no edge)."""
-        out = self.args.out if out is None else out
+        """Write the rows to ``out`` (default ``--out``, or its side file while a run to an earlier
+        ``--out`` has not completed), and the edge summaries beside it (emptied where an earlier
+        run left one and this one measures no edge)."""
+        out = self.target if out is None else out
         start = time.perf_counter()
         rows = [self.rows[i] for i in sorted(self.rows)] + self.station_rows
         edges = any(getattr(self.args, name, None) for name in ("edge", "edges_csv", "find_edges"))
@@ -293,7 +289,7 @@ class Run:
 
     def write_sweep_csv(self) -> None:
         """Write ``<out>_sweep.csv``; a failure is a failed output (exit 2), the rows kept."""
-        csv_path, plots = sweep_paths(self.args.out)
+        csv_path, plots = sweep_paths(self.target)[0], sweep_paths(self.args.out)[1]
         rows = [cells for _, cells in sorted(self.sweep_rows, key=lambda pair: pair[0])]
         try:
             files.replace_atomically(str(csv_path), csvio.format_sweep_rows(rows).encode("utf-8"))
@@ -309,7 +305,7 @@ class Run:
         ``<out>_sweep/`` are; a failure is a failed output (exit 2)."""
         if self.stream:  # standard output, a pipe or a device: nothing is written beside it
             return
-        csv_path, plots = sweep_paths(self.args.out)
+        csv_path, plots = sweep_paths(self.target)[0], sweep_paths(self.args.out)[1]
         if not csvio.holds_sweep(csv_path):
             return
         try:
@@ -350,7 +346,13 @@ class Run:
         source = self.sources[mesh]
         return unmeasured_mesh_edges(source, self.options, message, self.units, search=search)
 
-    def finish(self) -> int:
+    def finish(self, completed: bool = True) -> int:
+        """Write the CSV (and the files beside it) with every row, those not measured saying
+        why, and say what the run did; returns the exit status. ``completed``: the run was
+        neither stopped nor failed, so its CSV replaces an earlier ``--out`` (else it stays in
+        the side file, and the earlier one as it was)."""
+        if completed:
+            self.target = self.args.out
         # Locked: a slot thread that outlived a stop's wait (run_workers) may still add rows.
         with self.lock:
             missing = [t for t in self.tasks if t.index not in self.rows]
@@ -375,6 +377,9 @@ class Run:
             self.write_sweep_csv()
         else:
             self.empty_earlier_sweep()
+        if completed and not self.stream:
+            for problem in remove_partial(self.args.out):
+                self.say(f"could not remove a stopped run's partial results {problem}")
         failed = [(i, row) for i, row in sorted(self.rows.items()) if row.error]
         failed_edges = [row for row in self.station_rows if row.error]
         measured = len(self.rows) - len(failed)
@@ -434,7 +439,7 @@ class Run:
         if len(failed_edges) > 10:
             self.say(f"  ... and {len(failed_edges) - 10} more failed edges (see the error column)")
         if self.edge_rows or failed_edges:
-            self.say(f"wrote {csvio.edges_path_for(self.args.out)}")
+            self.say(f"wrote {csvio.edges_path_for(self.target)}")
         for message in self.bad_files:
             self.say(f"  unreadable mesh: {message}")
         for line in self.passed_over:
@@ -453,8 +458,14 @@ class Run:
                 f"--sweep measured no radius at {unswept} site(s) (see the sweep CSV's error "
                 "column)"
             )
-        where = "standard output" if self.args.out == files.STDOUT else self.args.out
-        self.say(f"wrote the CSV to {where}")
+        if self.target != self.args.out:
+            self.say(
+                f"the run did not complete: {self.args.out} is kept as it was, with the earlier "
+                f"results; this run's results so far are in {self.target}"
+            )
+        else:
+            where = "standard output" if self.args.out == files.STDOUT else self.args.out
+            self.say(f"wrote the CSV to {where}")
         return batchplan.exit_code(len(failed) + len(failed_edges) + unswept, len(self.bad_files))
 
     def unswept_sites(self) -> int:
@@ -484,31 +495,6 @@ def what_failed(error, out) -> str:
             "written)"
         )
     return f"the CSV to {out}: {reason(error)}"
-
-
-def _counts(row) -> tuple:
-    """A row's stability runs, refused runs and refused crease bands (0 where empty), and
-    whether the normals' noise hides the crease (``None`` where empty)."""
-    noise = row.stability_noise_hides_crease
-    return (
-        row.stability_runs or 0,
-        row.stability_refused or 0,
-        row.stability_crease_refused or 0,
-        None if noise is None else bool(noise),
-    )
-
-
-def flagged_rows(rows: dict) -> list:
-    """``(index, row, warning)`` of the measured rows whose stability figure flags them (see
-    ``vg_addon.method.result.stability_warning``), in row order."""
-    flagged = []
-    for index, row in sorted(rows.items()):
-        if row.error or row.stability is None:
-            continue
-        warning = stability_warning(row.stability, *_counts(row))
-        if warning:
-            flagged.append((index, row, warning))
-    return flagged
 
 
 def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
@@ -631,6 +617,7 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
     folder = tempfile.mkdtemp(prefix="vg-batch-") if parallel else ""
     kept = []  # objects measured in this process, kept for --save-blend
     pictures = bool(args.render or args.sweep or edges or args.find_edges)  # after the rows
+    completed = False  # neither stopped nor failed: the CSV may replace an earlier --out
     try:
         try:
             if parallel:
@@ -660,8 +647,9 @@ def run_batch(args, file_ready: bool = False) -> tuple[int, Run | None]:
                         kept.append(result.object_name)
                     elif result.object_name:
                         forget(result.object_name)
+            completed = not stopping.requested()  # a stop a Blender handler swallowed too
         finally:
-            code = run.finish()  # also after an error or Ctrl-C: write what was measured
+            code = run.finish(completed)  # also after an error or Ctrl-C: write what was measured
         stopping.check()  # a stop a Blender handler swallowed: the run ends as stopped
         if args.save_blend:
             if parallel:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -290,3 +291,99 @@ def test_a_sweep_beside_a_named_pipe_out_is_not_emptied(scan, tmp_path):
     assert result.returncode == 0, result.stderr
     assert len(csvio.parse_measurements_csv(received)) == 3
     assert sweep.read_bytes() == before
+
+
+SLOW_ROWS = 3_000  # ~1 ms each: a re-run is stopped while the slow mesh is measured
+
+
+def _rerun_stopped(command, stop) -> tuple[int, str]:
+    """Run the batch ``command`` and send it ``stop`` once it said the fast mesh is measured
+    (its rows are then in the CSV: they are written before the mesh's pictures)."""
+    process = subprocess.Popen(
+        [sys.executable, str(BATCH_SCRIPT), *(str(a) for a in command)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    said = []
+    for line in process.stderr:
+        said.append(line)
+        if "fast: 3 measured" in line:
+            break
+    assert process.poll() is None, "the run ended before it was stopped:\n" + "".join(said)
+    process.send_signal(stop)
+    _, rest = process.communicate(timeout=600)
+    return process.returncode, "".join(said) + rest
+
+
+def test_a_rerun_stopped_part_way_keeps_the_earlier_out_and_its_summary(tmp_path):
+    """A re-run to an existing --out replaced the earlier, complete CSV (and its edge summary)
+    at its first rewrite: stopped part-way, the earlier rows were lost. Now the earlier files
+    stay byte for byte until the run completes; a stopped re-run's rows go to
+    ``out.partial.csv`` (and ``out.partial_edges.csv``), said in one line, and a completed
+    re-run replaces the earlier files and leaves no side file, also one a killed run left."""
+    fast, slow = (
+        wedge(90.0, n=24, irregular=True, seed=3),
+        wedge(60.0, n=60, irregular=True, seed=4),
+    )
+    meshio.write_ply(tmp_path / "fast.ply", fast.points, fast.triangles)
+    meshio.write_ply(tmp_path / "slow.ply", slow.points, slow.triangles)
+    points = tmp_path / "points.csv"
+    xs = [f"{-0.4 + 0.8 * (i % 997) / 997:.6f}" for i in range(SLOW_ROWS)]
+    points.write_text(
+        "mesh,x,y,z\n" + "".join(f"fast,{x},0,0\n" for x in ("-0.3", "0", "0.3"))
+        + "".join(f"slow,{x},0,0\n" for x in xs)
+    )  # fmt: skip
+    out, summary = tmp_path / "out.csv", tmp_path / "out_edges.csv"
+    partial, partial_summary = tmp_path / "out.partial.csv", tmp_path / "out.partial_edges.csv"
+    command = [tmp_path / "fast.ply", tmp_path / "slow.ply", "--points", points, "--radius",
+               "0.3", "--edge", "-0.4", "0", "0", "0.4", "0", "0", "--spacing", "0.2",
+               "--out", out]  # fmt: skip
+    first = batch(*command, "--quiet")
+    assert first.returncode == 0, first.stderr
+    earlier, earlier_summary = out.read_bytes(), summary.read_bytes()
+    assert not partial.exists()
+
+    code, stderr = _rerun_stopped(command, signal.SIGINT)
+    assert code == 130 and "Traceback" not in stderr, stderr
+    assert out.read_bytes() == earlier and summary.read_bytes() == earlier_summary
+    assert (
+        f"the run did not complete: {out} is kept as it was, with the earlier results; this "
+        f"run's results so far are in {partial}"
+    ) in stderr, stderr
+    rows = csvio.read_measurements_csv(partial)
+    assert len(rows) == 3 + SLOW_ROWS + 5 + 1  # the points, the fast edge's stations, the slow's
+    assert all(row.angle is not None for row in rows[:3])
+    stopped = [row for row in rows[3 : 3 + SLOW_ROWS] if row.error]
+    assert stopped and all("the run was stopped before this point" in r.error for r in stopped)
+    edges = csvio.read_edges_csv(partial_summary)
+    assert [bool(edge.error) for edge in edges] == [False, True], edges
+
+    code, stderr = _rerun_stopped(command, signal.SIGKILL)  # after its first rewrite
+    assert code == -signal.SIGKILL, stderr
+    assert out.read_bytes() == earlier and summary.read_bytes() == earlier_summary
+    assert [row.mesh_name for row in csvio.read_measurements_csv(partial)][:3] == ["fast"] * 3
+
+    again = batch(*command, "--quiet")
+    assert again.returncode == 0, again.stderr
+    rows = csvio.read_measurements_csv(out)
+    assert len(rows) == 3 + SLOW_ROWS + 5 + 4 and not any(row.error for row in rows)
+    assert len(csvio.read_edges_csv(summary)) == 2
+    left = [p.name for p in tmp_path.iterdir() if ".partial" in p.name or p.suffix == ".tmp"]
+    assert left == []
+
+
+def test_a_file_named_like_the_sweep_csv_that_is_not_one_is_refused_not_replaced(scan, tmp_path):
+    """``--sweep`` writes ``<out>_sweep.csv``: where the user keeps another file of that name
+    (notes), the run is refused, the file kept byte for byte (before: silently replaced; found
+    by a review), as a file named like the edge summary is. An earlier sweep there is replaced."""
+    notes = tmp_path / "res_sweep.csv"
+    notes.write_bytes(b"my notes,important\n1,2\n")
+    sweep = ("--sweep", "0.2", "0.3", "2")
+    refused(batch(scan, *AT, *sweep, "--out", tmp_path / "res.csv"),
+            "--sweep writes", "not a radius-sweep CSV")  # fmt: skip
+    assert notes.read_bytes() == b"my notes,important\n1,2\n"
+    assert not (tmp_path / "res.csv").exists()
+    notes.unlink()
+    for _ in range(2):  # the second run replaces the first one's sweep
+        result = batch(scan, *AT, *sweep, "--out", tmp_path / "res.csv")
+        assert result.returncode == 0, result.stderr
+    assert notes.read_bytes().count(b"\n") == 3  # the header and two radii

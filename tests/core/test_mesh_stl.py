@@ -164,3 +164,14 @@ def test_a_truncated_ascii_stl_is_refused(tmp_path, cut):
     expect_error(tmp_path / "cut.stl", "truncated ASCII STL", expected)
     (tmp_path / "whole.stl").write_bytes(data)
     assert read_mesh(tmp_path / "whole.stl").triangles.shape == (12, 3)
+
+
+def test_an_ascii_stl_in_capitals_reads_as_in_lower_case(tmp_path):
+    """Some writers put the keywords in capitals (SOLID, FACET NORMAL, VERTEX, ENDSOLID): such a
+    file was called "truncated ASCII STL: no 'endsolid' line" (found by a review)."""
+    lower = stl_ascii(CUBE_CORNERS[CUBE_TRIANGLES])
+    (tmp_path / "lower.stl").write_bytes(lower)
+    (tmp_path / "upper.stl").write_bytes(lower.upper())
+    expected, mesh = read_mesh(tmp_path / "lower.stl"), read_mesh(tmp_path / "upper.stl")
+    assert np.array_equal(mesh.points, expected.points) and mesh.n_triangles == 12
+    assert np.array_equal(mesh.triangles, expected.triangles)

@@ -229,12 +229,16 @@ class _Text:
             todo = todo[self.blank[first[todo]] & (first[todo] < self.ends[todo])]
         self.first = first  # first non-blank byte of each line (its newline if the line is blank)
 
-    def keyword(self, word: bytes) -> np.ndarray:
-        """Indices of the lines whose first word is ``word``."""
+    def keyword(self, word: bytes, ignore_case: bool = False) -> np.ndarray:
+        """Indices of the lines whose first word is ``word`` (a lower-case word; with
+        ``ignore_case``, in capitals too)."""
         after = self.first + len(word)
         match = after <= self.ends
         for k, byte in enumerate(word):
-            match &= self.buffer[np.minimum(self.first + k, self.ends)] == byte
+            found = self.buffer[np.minimum(self.first + k, self.ends)]
+            if ignore_case and chr(byte).isalpha():
+                found = found | 0x20  # ASCII capitals to lower case
+            match &= found == byte
         return np.flatnonzero(match & self.blank[np.minimum(after, self.ends)])
 
     def body(self, lines: np.ndarray, skip: int) -> tuple[np.ndarray, np.ndarray]:

@@ -98,8 +98,8 @@ def read_stl(path: str | os.PathLike) -> MeshData:
 def _stl_ascii_corners(data: bytes, path: Path) -> np.ndarray:
     """The ``(3 m, 3)`` corners of an ASCII STL, each facet line checked with its vertices."""
     text = _Text(data, path)
-    facet_lines = text.keyword(b"facet")
-    vertex_lines = text.keyword(b"vertex")
+    facet_lines = text.keyword(b"facet", ignore_case=True)
+    vertex_lines = text.keyword(b"vertex", ignore_case=True)
     # Facet normals are not used, so only their count is checked ("facet normal nx ny nz").
     numbers = text.word_counts(facet_lines) - 2
     if (numbers != 3).any():
@@ -129,7 +129,7 @@ def _stl_ascii_corners(data: bytes, path: Path) -> np.ndarray:
             f"'{path}', line {facet_lines[k] + 1}: this facet has {per_facet[k]} vertex lines, "
             "not 3 (an STL facet is one triangle). The file is corrupt; re-export it."
         )
-    closing = text.keyword(b"endfacet")
+    closing = text.keyword(b"endfacet", ignore_case=True)
     closed = np.zeros(facet_lines.size, dtype=bool)  # each facet's own endfacet, after its vertices
     if closing.size:
         owner = np.searchsorted(facet_lines, closing) - 1
@@ -138,7 +138,7 @@ def _stl_ascii_corners(data: bytes, path: Path) -> np.ndarray:
             last_vertex[facet - 1] = vertex_lines  # in order: the last one written stays
         ok = owner >= 0
         closed[owner[ok][closing[ok] > last_vertex[owner[ok]]]] = True
-    ends = text.keyword(b"endsolid")
+    ends = text.keyword(b"endsolid", ignore_case=True)
     if not closed.all() or not ends.size or (facet_lines.size and ends[-1] < facet_lines[-1]):
         k = int(np.argmin(closed)) if not closed.all() else facet_lines.size - 1
         where = (

@@ -6,7 +6,7 @@ import numpy as np
 
 from .fixed_order import dot3, eigh3_batched
 from .ranges import expand_ranges
-from .spatial import GridIndex, bounds
+from .spatial import GridIndex, bounds, neighbour_pairs
 
 _CHUNK = 1 << 18  # triangles per block: the temporaries stay small and in cache
 
@@ -90,39 +90,6 @@ def vertex_normals(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarra
     return normals, valid
 
 
-def _neighbour_pairs(index: GridIndex, radius: float, chunk: int = 20_000):
-    """Yield chunks of (i, j) id pairs with ``|p_i - p_j| <= radius <= index.cell_size``.
-
-    For each point and each of the 27 cells around its own, the points of that cell are one
-    contiguous run of the index's sorted arrays, found with ``searchsorted``; runs are expanded
-    with ``repeat`` and filtered by distance, so no Python loop runs per point.
-    """
-    dims = index.dims
-    total = index.points.shape[0]
-    offsets = np.array([(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)])
-    for start in range(0, total, chunk):
-        stop = min(start + chunk, total)
-        own = np.arange(start, stop, dtype=np.int64)
-        ijk = index._cells(index.points[start:stop])
-        rows_out, cols_out = [], []
-        for offset in offsets:
-            neighbour = ijk + offset
-            inside = ((neighbour >= 0) & (neighbour < dims)).all(axis=1)
-            key = (neighbour[:, 0] * dims[1] + neighbour[:, 1]) * dims[2] + neighbour[:, 2]
-            lo = np.searchsorted(index.keys, key, side="left")
-            hi = np.searchsorted(index.keys, key, side="right")
-            lengths = np.where(inside, hi - lo, 0)
-            if not lengths.any():
-                continue
-            cols = expand_ranges(lo, lengths)
-            rows = np.repeat(own, lengths)
-            gap = index.points[rows] - index.points[cols]
-            close = np.einsum("ij,ij->i", gap, gap) <= radius * radius
-            rows_out.append(index.ids[rows[close]])
-            cols_out.append(index.ids[cols[close]])
-        yield np.concatenate(rows_out), np.concatenate(cols_out)
-
-
 def pca_normals(points: np.ndarray, index: GridIndex, radius: float | None = None):
     """Normals of a point cloud from the PCA of each point's neighbourhood, oriented outward.
 
@@ -152,7 +119,7 @@ def pca_normals(points: np.ndarray, index: GridIndex, radius: float | None = Non
     moments = np.zeros((n, 3, 3))
     counts = np.zeros(n)
     pair_rows, pair_cols = [], []
-    for rows, cols in _neighbour_pairs(index, radius):
+    for rows, cols in neighbour_pairs(index, radius):
         neighbours = points[cols] - points[rows]  # relative: no cancellation far from the origin
         counts += np.bincount(rows, minlength=n)
         for a in range(3):

@@ -6,20 +6,35 @@ debris, the ball can reach a part that is not the break's: a 120° edge with the
 fragment 0.005 from one face read 30.00° under the refined rule, a 90° edge under a sheet of
 debris 66.56° under every rule, each with a small fit error and nothing else to show it. So the
 Euclidean patch leaves out the vertices of such a part (:func:`measured_part`) where it is
-large; a crumb, a speck of debris or a bead a thin edge broke into (marching-cubes wedges of 5°
-and 20°, thinner than a voxel at the crease, break into beads along it), is kept as before.
-Algorithm 1 as printed (the paper rule) takes the whole ball, and is refused where the two differ.
+large. A smaller part, a crumb (a speck of debris, or a bead a thin edge broke into:
+marching-cubes wedges of 5° and 20°, thinner than a voxel at the crease, break into beads along
+it), stays, and ``Surface.measure`` refuses a reading that its crumbs move
+(:func:`crumb_vertices`). Algorithm 1 as printed (the paper rule) takes the whole ball, and is
+refused where the ball reaches a large part left out.
 
-A part is what faces join, with the vertices at exactly the same coordinates taken as one
+A part is what faces join, with the vertices at the same coordinates taken as one
 (:func:`mesh_parts`): a seam whose vertices were not merged (a mesh split in two, an STL's
-loose triangles) is one surface.
+loose triangles) is one surface, also where rounding moved its copies apart
+(:data:`SEAM_ROUNDING`).
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
+from .fins import corner_ends
 from .mesh_regions import edge_components, jump_to_roots
+from .spatial import GridIndex, neighbour_pairs
+
+SEAM_ROUNDING = 1e-6
+"""Boundary vertices of two parts (on an edge of one face, once copies at the same coordinates
+are one vertex) at most this times the mesh's largest coordinate apart are one place: a seam
+whose copies rounding moved apart (about eight float32 steps; the parts transformed or exported
+apart). Split along a scan's crease with copies 1e-9 apart, the faces were two parts, and a 90°
+edge read 175.92° on the one the centre was on. A tenth of an edge (the first version) joined a
+refitted fragment whose rim ran 0.002 beside the scan's (a review): 120° read 30.00° again."""
 
 
 def part_labels(n: int, triangles: np.ndarray) -> np.ndarray:
@@ -64,7 +79,33 @@ def part_labels(n: int, triangles: np.ndarray) -> np.ndarray:
         jump_to_roots(label, np.flatnonzero(label != np.arange(n, dtype=kind)))
 
 
-def mesh_parts(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+class MeshParts(NamedTuple):
+    """A mesh's parts (:func:`mesh_parts`).
+
+    Attributes
+    ----------
+    labels : ndarray of int, shape (n,)
+        The same number for the vertices of one part: what faces join, vertices at the same
+        coordinates (-0.0 as 0.0) joined too where the faces make more than one part, and seams'
+        copies that rounding moved apart (:data:`SEAM_ROUNDING`). A vertex on no face is a part
+        of its own, or of the vertices at its coordinates.
+    sizes : ndarray of int64
+        ``sizes[label]``: how many vertices have that label.
+    near : ndarray of int64, shape (2, k)
+        The pairs of copies that rounding moved apart which joined two parts; empty where none
+        did.
+    boundary : ndarray of bool, shape (n,) or None
+        Where the faces make more than one part: the vertices on an edge of one face (copies at
+        the same coordinates taken as one vertex). ``None`` on a mesh of one part.
+    """
+
+    labels: np.ndarray
+    sizes: np.ndarray
+    near: np.ndarray
+    boundary: np.ndarray | None
+
+
+def mesh_parts(points: np.ndarray, triangles: np.ndarray) -> MeshParts:
     """Label each vertex with its part, and count each part's vertices.
 
     Parameters
@@ -74,26 +115,34 @@ def mesh_parts(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, n
 
     Returns
     -------
-    labels : ndarray of int, shape (n,)
-        The same number for the vertices of one part: what faces join, vertices at the same
-        coordinates (-0.0 as 0.0) joined too where the faces make more than one part. A vertex
-        on no face is a part of its own, or of the vertices at its coordinates.
-    sizes : ndarray of int64
-        ``sizes[label]``: how many vertices have that label.
+    MeshParts
 
     Notes
     -----
     The faces are labelled first (:func:`part_labels`); only where they make more than one part
-    are the vertices sorted by their coordinates, and parts holding the same coordinates joined.
+    are the vertices sorted by their coordinates, and parts holding the same coordinates joined,
+    and the boundary vertices found and those of different parts near each other looked for.
     """
-    labels = part_labels(points.shape[0], triangles)
-    if triangles.shape[0] and (labels[triangles[:, 0]] != labels[triangles[0, 0]]).any():
-        first, second = _same_coordinates(points)
+    n = points.shape[0]
+    labels = part_labels(n, triangles)
+    near = np.empty((2, 0), dtype=np.int64)
+    if not triangles.shape[0] or (labels[triangles[:, 0]] == labels[triangles[0, 0]]).all():
+        return MeshParts(labels, np.bincount(labels, minlength=n), near, None)
+    first, second = _same_coordinates(points)
+    apart = labels[first] != labels[second]
+    if apart.any():
+        labels = edge_components(n, labels[first[apart]], labels[second[apart]])[labels]
+    welded = edge_components(n, first, second)  # each vertex as the first of its coordinates
+    ends = _boundary_vertices(welded[triangles], n)
+    if (labels[triangles[:, 0]] != labels[triangles[0, 0]]).any():
+        first, second = _near_copies(points, ends)
         apart = labels[first] != labels[second]
         if apart.any():
-            joined = edge_components(points.shape[0], labels[first[apart]], labels[second[apart]])
-            labels = joined[labels]
-    return labels, np.bincount(labels, minlength=points.shape[0])
+            labels = edge_components(n, labels[first[apart]], labels[second[apart]])[labels]
+            near = np.stack([first[apart], second[apart]]).astype(np.int64)
+    boundary = np.zeros(n, dtype=bool)
+    boundary[ends] = True
+    return MeshParts(labels, np.bincount(labels, minlength=n), near, boundary[welded])
 
 
 def _same_coordinates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -106,6 +155,39 @@ def _same_coordinates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ordered = column[order]
         same &= ordered[1:] == ordered[:-1]
     return order[:-1][same], order[1:][same]
+
+
+def _boundary_vertices(welded: np.ndarray, n: int) -> np.ndarray:
+    """The vertices (sorted) on an edge that one of the ``welded`` faces alone uses."""
+    start, end = corner_ends(welded)
+    keys = np.minimum(start, end) * np.int64(n) + np.maximum(start, end)
+    keys = keys[start != end]
+    keys.sort()
+    once = np.ones(keys.size, dtype=bool)
+    same = keys[1:] == keys[:-1]
+    once[1:] &= ~same
+    once[:-1] &= ~same
+    return np.unique(np.concatenate([keys[once] // n, keys[once] % n]))
+
+
+def _near_copies(points: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs of the boundary vertices ``ends`` at most :data:`SEAM_ROUNDING` times the largest
+    coordinate apart. Only boundaries: a closed fragment touching another, or a sheet lying on
+    a face, is not a seam, in an indexed mesh or an STL's soup."""
+    gap = SEAM_ROUNDING * float(np.abs(points).max())
+    if ends.size < 2 or not gap > 0:
+        return ends[:0], ends[:0]
+    return _pairs_within(points, ends, gap)
+
+
+def _pairs_within(points: np.ndarray, ids: np.ndarray, gap: float):
+    """Pairs of ``ids`` (two different ones) whose points lie at most ``gap`` apart."""
+    index = GridIndex(points[ids], cell_size=gap, ids=ids)
+    found = list(neighbour_pairs(index, gap))
+    first = np.concatenate([pair[0] for pair in found])
+    second = np.concatenate([pair[1] for pair in found])
+    keep = first != second
+    return first[keep], second[keep]
 
 
 def measured_part(
@@ -152,3 +234,52 @@ def measured_part(
     if dropped.size == 0:
         return ball
     return ball[~np.isin(part, dropped)]
+
+
+def touching(
+    points: np.ndarray, boundary: np.ndarray, patch: np.ndarray, left_out: np.ndarray, gap: float
+) -> int:
+    """How many of the boundary vertices ``left_out`` lie within ``gap`` of a boundary vertex of
+    ``patch``: a large part left out whose rim runs along the measured part's (a seam whose
+    copies are farther apart than rounding), where leaving it out cuts a face of the edge away.
+    A fragment or a sheet of debris lying over a face has its rim elsewhere."""
+    patch, left_out = patch[boundary[patch]], left_out[boundary[left_out]]
+    if not left_out.size or not patch.size or not gap > 0:
+        return 0
+    first, second = _pairs_within(points, np.concatenate([patch, left_out]), gap)
+    side = np.zeros(points.shape[0], dtype=np.int8)
+    side[patch], side[left_out] = 1, 2
+    cross = side[first] != side[second]
+    return int(np.unique(np.where(side[first[cross]] == 2, first[cross], second[cross])).size)
+
+
+def crumb_vertices(
+    labels: np.ndarray, sizes: np.ndarray, ball_size: int, patch: np.ndarray
+) -> np.ndarray | None:
+    """Which vertices of a Euclidean ``patch`` (from :func:`measured_part`) lie on crumbs.
+
+    Parameters
+    ----------
+    labels, sizes : ndarray of int
+        :func:`mesh_parts` of the mesh.
+    ball_size : int
+        How many vertices the ball held, before large parts were left out.
+    patch : ndarray of int
+        The patch's vertices.
+
+    Returns
+    -------
+    ndarray of bool or None
+        ``True`` for the vertices of parts smaller than the rest of the ball (see
+        :func:`measured_part`), in the order of ``patch``; ``None`` where the patch lies on one
+        part (one gather), or where every part in it is a crumb (there is no surface to measure
+        without them).
+    """
+    patch_labels = np.take(labels, patch)
+    if (patch_labels == patch_labels[0]).all():
+        return None
+    parts, part = np.unique(patch_labels, return_inverse=True)
+    part = part.reshape(-1)
+    inside = np.bincount(part, minlength=parts.size)
+    crumb = sizes[parts] + inside < ball_size
+    return crumb[part] if crumb.any() and not crumb.all() else None

@@ -210,3 +210,36 @@ class GridIndex:
             coords = self.points[positions[tied]]
             best = tied[np.lexsort((coords[:, 2], coords[:, 1], coords[:, 0]))[0]]
         return int(positions[best]), math.sqrt(float(smallest))
+
+
+def neighbour_pairs(index: GridIndex, radius: float, chunk: int = 20_000):
+    """Yield chunks of (i, j) id pairs with ``|p_i - p_j| <= radius <= index.cell_size``.
+
+    For each point and each of the 27 cells around its own, the points of that cell are one
+    contiguous run of the index's sorted arrays, found with ``searchsorted``; runs are expanded
+    with ``repeat`` and filtered by distance, so no Python loop runs per point.
+    """
+    dims = index.dims
+    total = index.points.shape[0]
+    offsets = np.array([(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)])
+    for start in range(0, total, chunk):
+        stop = min(start + chunk, total)
+        own = np.arange(start, stop, dtype=np.int64)
+        ijk = index._cells(index.points[start:stop])
+        rows_out, cols_out = [], []
+        for offset in offsets:
+            neighbour = ijk + offset
+            inside = ((neighbour >= 0) & (neighbour < dims)).all(axis=1)
+            key = (neighbour[:, 0] * dims[1] + neighbour[:, 1]) * dims[2] + neighbour[:, 2]
+            lo = np.searchsorted(index.keys, key, side="left")
+            hi = np.searchsorted(index.keys, key, side="right")
+            lengths = np.where(inside, hi - lo, 0)
+            if not lengths.any():
+                continue
+            cols = expand_ranges(lo, lengths)
+            rows = np.repeat(own, lengths)
+            gap = index.points[rows] - index.points[cols]
+            close = np.einsum("ij,ij->i", gap, gap) <= radius * radius
+            rows_out.append(index.ids[rows[close]])
+            cols_out.append(index.ids[cols[close]])
+        yield np.concatenate(rows_out), np.concatenate(cols_out)

@@ -13,8 +13,9 @@ from .geodesic import EdgeGraph
 from .inputs import as_center, as_flag, as_lambda, as_normals, as_points, as_radius
 from .normals import pca_normals, vertex_normals
 from .ordering import canonical_ranks
-from .parts import measured_part, mesh_parts
+from .parts import crumb_vertices, measured_part, mesh_parts, touching
 from .precision import check_rounding, precision_of
+from .refinement import mean_edge_length
 from .result import Measurement
 from .spatial import GridIndex, estimate_spacing
 from .stability import SMALL_PATCH_VERTICES, estimate_stability
@@ -75,6 +76,20 @@ def _as_corner_edges(corner_edges, n_triangles: int) -> np.ndarray:
     return given
 
 
+CRUMB_CHANGE = 0.1
+"""Degrees: a Euclidean patch holding crumbs of the mesh (see :mod:`.parts`) is refused where
+leaving them out moves the reading by more than this. A crumb can be a bead of the edge itself
+(a thin edge meshed by marching cubes breaks into beads along the crease) or scan debris off it,
+and nothing in its shape or size tells which: a loose triangle 0.05 above a 90° edge read 85.94°,
+a 9-vertex speck 81.02°, under every rule."""
+
+TOUCHING = 2.0
+"""A large part left out of a Euclidean patch runs along the part measured where a vertex of its
+rim lies within this many mean edge lengths of one of the patch's rim; the patch is then
+refused. Split along its crease with the seam's copies 1e-5 to 0.01 apart (beyond rounding, at
+spacing 0.02), a marched 60° wedge read 175.36° under the oriented rule, on the face the centre
+was on."""
+
 SEAM_COPIES = 3
 """A geodesic patch is refused for a seam where at least this many of its vertices have copies
 it does not reach: a seam through a patch has many, two parts touching at a vertex or two (a
@@ -97,6 +112,15 @@ def _unmerged_copies(points: np.ndarray, reached: np.ndarray, beyond: np.ndarray
         return (np.take(points, indices, axis=0) + 0.0).view(row).reshape(-1)
 
     return int(np.isin(keys(candidates), keys(beyond)).sum())
+
+
+def _near_copies_beyond(near: np.ndarray, reached: np.ndarray, beyond: np.ndarray) -> int:
+    """How many of the vertices ``reached`` have a copy ``beyond`` among the ``near`` pairs."""
+    if not near.shape[1] or not beyond.size:
+        return 0
+    first, second = near
+    ahead = np.concatenate([first[np.isin(second, beyond)], second[np.isin(first, beyond)]])
+    return int(np.isin(reached, ahead).sum())
 
 
 class Surface:
@@ -141,6 +165,8 @@ class Surface:
         self._fins = None
         self._parts = None
         self._part_sizes = None
+        self._near_copies = None  # pairs of a seam's copies apart by rounding (see .parts)
+        self._boundary = None  # on a mesh of several parts, its boundary vertices
         self._left_out = None  # (measurement, labels): see _left_out_parts
         self._corner_edges = None
         if self.triangles is not None and corner_edges is not None:
@@ -261,12 +287,30 @@ class Surface:
                 "vertices were not merged, merge them by distance (Mesh > Clean Up > Merge by "
                 "Distance)."
             )
+        if patch.size < ball.size:
+            left_out = np.setdiff1d(ball, patch)
+            gap = TOUCHING * mean_edge_length(radius, patch.size)
+            if count := touching(self.points, self._boundary, patch, left_out, gap):
+                raise GoniometerError(
+                    f"The radius reaches another part of the mesh, which no face joins to the "
+                    f"one measured but whose rim runs along its rim: {count} of its rim's "
+                    f"vertices lie within {gap:.3g} (two edges) of the measured part's. That "
+                    "is a seam whose vertices were not merged, or a crack, and leaving the part "
+                    "out would cut a face of the edge away. Where it is one surface, "
+                    "merge the vertices by distance (Blender: Mesh > Clean Up > Merge by "
+                    "Distance); where it is another fragment, separate the parts (Edit Mode > "
+                    "Mesh > Separate > By Loose Parts) and measure each alone."
+                )
         return patch
 
     def _label_parts(self) -> None:
         """Label the mesh's parts (see :mod:`.parts`), once."""
         if self._parts is None:
-            self._parts, self._part_sizes = mesh_parts(self.points, self.triangles)
+            parts = mesh_parts(self.points, self.triangles)
+            # The labels last: another thread takes them as the sign the rest is there.
+            self._part_sizes, self._near_copies = parts.sizes, parts.near
+            self._boundary = parts.boundary
+            self._parts = parts.labels
 
     def on_measured_parts(self, ids: np.ndarray, m) -> np.ndarray | None:
         """Which of ``ids`` are not on a part that the Euclidean measurement ``m`` left out of
@@ -285,14 +329,46 @@ class Surface:
     def _left_out_parts(self, m) -> np.ndarray | None:
         """The labels of the parts that ``m``'s ball reached and its patch left out; ``None``
         where it left out nothing. The last answer is kept: the stability figure asks twice."""
-        if self._left_out is not None and self._left_out[0] is m:
-            return self._left_out[1]
+        kept = self._left_out  # read once: another thread may measure on this surface
+        if kept is not None and kept[0] is m:
+            return kept[1]
         ball, _ = self.index.ball(self.points[m.center_index], m.radius)
         left_out = None
         if ball.size != m.indices.size:
             left_out = np.setdiff1d(np.take(self._parts, ball), np.take(self._parts, m.indices))
         self._left_out = (m, left_out)
         return left_out
+
+    def _check_crumbs(self, fields, indices, ball_size, center_index, radius, lam, rule):
+        """Refuse a reading that crumbs in the patch move by more than :data:`CRUMB_CHANGE`."""
+        crumbs = crumb_vertices(self._parts, self._part_sizes, ball_size, indices)
+        if crumbs is None:
+            return
+        kept = np.compress(~crumbs, indices)  # still in the canonical order
+        try:
+            without = measure_patch(
+                np.take(self.points, kept, axis=0),
+                np.take(self.normals, kept, axis=0),
+                self.points[center_index],
+                radius,
+                lam,
+                rule,
+            )["angle"]
+        except GoniometerError as error:
+            change = f"without them it is refused ({str(error).rstrip('.')})"
+        else:
+            if abs(without - fields["angle"]) <= CRUMB_CHANGE:
+                return
+            change = f"without them it is {without:.2f}°"
+        count = int(crumbs.sum())
+        raise GoniometerError(
+            f"{count} of the patch's {indices.size} vertices lie on loose crumbs of the mesh that "
+            "no face joins to the surface measured (scan debris, or beads that a thin edge broke "
+            f"into when it was meshed), and they move the reading: with them it is "
+            f"{fields['angle']:.2f}°, {change}. Which is right cannot be told. Delete the debris "
+            "(Blender: Edit Mode, point at it and press L, then X), mesh the edge again finer, "
+            "or measure where no crumb lies within the radius."
+        )
 
     def _whole_ball(self, ball: np.ndarray, patch: np.ndarray) -> None:
         """Refuse the paper rule where the Euclidean patch is not the whole ball."""
@@ -353,13 +429,17 @@ class Surface:
 
     def _check_no_seam(self, ball: np.ndarray, patch: np.ndarray) -> None:
         """Refuse a geodesic ``patch`` stopped by a seam: :data:`SEAM_COPIES` or more of its
-        vertices have copies at the same coordinates in the ``ball`` that it does not reach (the
-        mesh not merged there). Only the measured patch is checked: the stability figure's
-        moved patches stop at a seam as before."""
+        vertices have copies in the ``ball`` that it does not reach (the mesh not merged there):
+        at the same coordinates, or moved apart by rounding (see :data:`.parts.SEAM_ROUNDING`). Only
+        the measured patch is checked: the stability figure's moved patches stop at a seam as
+        before."""
         if ball.size == patch.size:
             return
         beyond = np.setdiff1d(ball, patch, assume_unique=True)
         copies = _unmerged_copies(self.points, patch, beyond)
+        if copies < SEAM_COPIES:  # copies that rounding moved apart (see .parts)
+            self._label_parts()
+            copies += _near_copies_beyond(self._near_copies, patch, beyond)
         if copies >= SEAM_COPIES:
             raise GoniometerError(
                 f"The geodesic patch stops at a seam: {copies} of the vertices it reaches have "
@@ -410,7 +490,9 @@ class Surface:
             Centre farther than ``radius`` from the surface, bad radius or λ, unknown patch mode,
             too few vertices, float32 coordinates rounded too coarsely for the patch, a patch
             holding an edge of three or more faces (see :mod:`.fins`), a centre on a crumb of
-            the mesh with several larger parts in reach, or (paper rule) a Euclidean ball
+            the mesh with several larger parts in reach, crumbs that move the reading by more
+            than :data:`CRUMB_CHANGE`, a geodesic patch stopped by a seam, or (paper rule) a
+            Euclidean ball
             reaching a large separate part (see :mod:`.parts`), a flat patch, a side
             that is a line, or (refined rule) two fitted planes that meet farther than the
             radius from the centre or sides whose normals face opposite ways (a face wound
@@ -480,6 +562,8 @@ class Surface:
             if mode == "euclidean" and indices.size < ball.size:
                 raise GoniometerError(f"{error}{_left_out(ball, indices)}") from None
             raise
+        if mode == "euclidean" and self.triangles is not None:
+            self._check_crumbs(fields, indices, ball.size, center_index, radius, lam, rule)
         measurement = Measurement(
             **fields,
             indices=indices,
