@@ -153,18 +153,16 @@ def holds_export(path) -> bool:
 
 
 def partial_outputs(args, edges: bool) -> list[tuple[str, str]]:
-    """``(what, path)`` of the side files this run writes (its ``--out`` is an earlier file) or
-    removes once it completes (an earlier stopped run's): outputs like any other."""
-    if not args.out or is_stream(args.out):
+    """``(what, path)`` of the side files this run writes (its ``--out`` is an earlier file):
+    outputs like any other. (Where one is there already, the run is refused: it holds a stopped
+    run's results, see :func:`check_outputs`.)"""
+    if not args.out or is_stream(args.out) or not keeps_earlier(args.out):
         return []
     partial, partial_edges, partial_sweep = partial_paths(args.out)
-    earlier = keeps_earlier(args.out)
-    found = []
-    if earlier or holds_export(partial):
-        found.append(("--out's partial results", str(partial)))
-    if (earlier and edges) or csvio.holds_edge_summary(partial_edges):
+    found = [("--out's partial results", str(partial))]
+    if edges:
         found.append(("--out's partial edge summary", str(partial_edges)))
-    if (earlier and args.sweep) or csvio.holds_sweep(partial_sweep):
+    if args.sweep:
         found.append(("--out's partial sweep CSV", str(partial_sweep)))
     return found
 
@@ -252,6 +250,14 @@ def check_outputs(args) -> None:
                 f"{option} {path} is {victim}: writing there would destroy an input. Choose "
                 "another file name; nothing was read or written."
             )
+    if args.out and not is_stream(args.out):
+        for path in partial_paths(args.out):
+            if _holds_something(path):
+                raise UsageError(
+                    f"{path} is there: the results so far of a run to {args.out} that was "
+                    "stopped (or a file of yours of that name). A run would replace it: move it "
+                    "away, or delete it, and run again; nothing was read or written."
+                )
     if args.sweep and _holds_something(csv_path) and not csvio.holds_sweep(csv_path):
         raise UsageError(
             f"--sweep writes {csv_path}, which holds a file that is not a radius-sweep CSV (the "

@@ -318,8 +318,9 @@ def test_a_rerun_stopped_part_way_keeps_the_earlier_out_and_its_summary(tmp_path
     """A re-run to an existing --out replaced the earlier, complete CSV (and its edge summary)
     at its first rewrite: stopped part-way, the earlier rows were lost. Now the earlier files
     stay byte for byte until the run completes; a stopped re-run's rows go to
-    ``out.partial.csv`` (and ``out.partial_edges.csv``), said in one line, and a completed
-    re-run replaces the earlier files and leaves no side file, also one a killed run left."""
+    ``out.partial.csv`` (and ``out.partial_edges.csv``), said in one line; a run while they
+    are there is refused; and a completed re-run replaces the earlier files and leaves no side
+    file."""
     fast, slow = (
         wedge(90.0, n=24, irregular=True, seed=3),
         wedge(60.0, n=60, irregular=True, seed=4),
@@ -357,10 +358,22 @@ def test_a_rerun_stopped_part_way_keeps_the_earlier_out_and_its_summary(tmp_path
     edges = csvio.read_edges_csv(partial_summary)
     assert [bool(edge.error) for edge in edges] == [False, True], edges
 
+    # The stopped run's results are the user's now: a run that would replace them is refused,
+    # nothing touched (a review: the next run's header replaced them at once).
+    stopped_rows = partial.read_bytes()
+    refused(batch(*command), f"{partial} is there", "move it away")
+    assert partial.read_bytes() == stopped_rows and out.read_bytes() == earlier
+    kept = tmp_path / "kept"
+    kept.mkdir()
+    for side in (partial, partial_summary):
+        side.rename(kept / side.name)
+
     code, stderr = _rerun_stopped(command, signal.SIGKILL)  # after its first rewrite
     assert code == -signal.SIGKILL, stderr
     assert out.read_bytes() == earlier and summary.read_bytes() == earlier_summary
     assert [row.mesh_name for row in csvio.read_measurements_csv(partial)][:3] == ["fast"] * 3
+    for side in tmp_path.glob("out.partial*"):
+        side.unlink()
 
     again = batch(*command, "--quiet")
     assert again.returncode == 0, again.stderr
@@ -387,3 +400,17 @@ def test_a_file_named_like_the_sweep_csv_that_is_not_one_is_refused_not_replaced
         result = batch(scan, *AT, *sweep, "--out", tmp_path / "res.csv")
         assert result.returncode == 0, result.stderr
     assert notes.read_bytes().count(b"\n") == 3  # the header and two radii
+
+
+def test_a_file_of_the_users_named_like_the_side_file_is_refused_not_replaced(scan, tmp_path):
+    """``results.partial.csv`` beside an earlier ``results.csv`` is where a re-run writes until
+    it completes: where the user keeps a file of that name, the run is refused and the file
+    kept byte for byte (before: replaced by the run's header, then deleted when it completed;
+    found by a review)."""
+    out = tmp_path / "results.csv"
+    assert batch(scan, *AT, "--out", out).returncode == 0
+    notes = tmp_path / "results.partial.csv"
+    notes.write_bytes(b"my notes,important\n1,2\n")
+    before = out.read_bytes()
+    refused(batch(scan, *AT, "--out", out), f"{notes} is there", "move it away")
+    assert notes.read_bytes() == b"my notes,important\n1,2\n" and out.read_bytes() == before

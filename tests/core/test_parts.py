@@ -346,3 +346,50 @@ def test_part_labels_match_scipys_connected_components(seed):
     least = np.full(expected.max() + 1, n)
     np.minimum.at(least, expected, np.arange(n))
     assert labels.tolist() == least[expected].tolist()
+
+
+@pytest.mark.parametrize("offset", [1e4, 1e5, 5e6])
+def test_a_fragment_far_from_the_origin_is_left_out_as_near_it(offset):
+    """Rounding's distance, a millionth of the largest coordinate, is 0.01 at 1e4 from the
+    origin: alone it joined the fragment's rim, 0.005 beside the scan's, and 120° read 30.00°
+    (a review). The seam's copies are also held to a hundredth of a boundary edge."""
+    points, triangles = wedge_with_fragment(120.0, 0.005)
+    surface = Surface(points + offset, triangles)
+    for rule in ("refined", "oriented"):
+        m = surface.measure(np.array([-0.3, 0.0, 0.0]) + offset, 0.3, rule=rule)
+        assert m.angle == pytest.approx(120.0, abs=1e-6)
+
+
+@pytest.mark.parametrize("seed", [None, 2])
+@pytest.mark.parametrize("width", [0.03, 0.05, 0.08])
+def test_a_crack_along_the_crease_is_refused_in_either_patch(seed, width):
+    """The two faces of a marched 60° wedge apart by a crack along the crease (``width``, at
+    spacing 0.02): the Euclidean patch kept the centre's face and the triangles across the
+    crease, and read 149.03° (turned with seed 2) or 175.36° (oriented rule); the geodesic
+    patch, which cannot cross the crack, 149.64° to 156.84° (a review). Both are refused,
+    under every rule."""
+    points, triangles, _, direction = marched_wedge(60, 0.02, turn_seed=seed)
+    across = np.cross(direction, np.cross(direction, [1.0, 0.0, 0.0]))
+    split_points, split = _split_along_the_crease(points, triangles, direction, 0.0)
+    split_points[len(points) :] += width * across / np.linalg.norm(across)
+    surface = Surface(split_points, split)
+    for patch in ("euclidean", "geodesic"):
+        for rule in RULES:
+            with pytest.raises(GoniometerError, match=r"whose rim runs along its rim"):
+                surface.measure([0, 0, 0], 0.2, rule=rule, patch=patch)
+
+
+def test_a_loose_vertex_with_a_given_normal_is_refused_not_a_traceback():
+    """A vertex on no face, given a normal, is a part of its own: in a ball of two vertices it
+    was a large part left out, and the check of its rim raised TypeError (a review)."""
+    mesh = wedge(90.0, n=60)
+    points, triangles = np.asarray(mesh.points), np.asarray(mesh.triangles)
+    normals = Surface(points, triangles).normals
+    vertex = points[np.argmin(np.linalg.norm(points, axis=1))]
+    surface = Surface(
+        np.vstack([points, [vertex + np.array([0.0, 0.0, 0.001])]]),
+        triangles,
+        normals=np.vstack([normals, [[0.0, 0.0, 1.0]]]),
+    )
+    with pytest.raises(GoniometerError, match="holds only"):
+        surface.measure(vertex, 0.002)

@@ -28,6 +28,11 @@ from .fins import corner_ends
 from .mesh_regions import edge_components, jump_to_roots
 from .spatial import GridIndex, neighbour_pairs
 
+SEAM_EDGES = 0.01
+"""However far from the origin, copies joined as a seam's lie at most this many median boundary
+edges apart: 1e-6 of the coordinates alone joined, 1e4 from the origin, a fragment's rim
+running 0.005 beside the scan's, and 120° read 30.00° (a review)."""
+
 SEAM_ROUNDING = 1e-6
 """Boundary vertices of two parts (on an edge of one face, once copies at the same coordinates
 are one vertex) at most this times the mesh's largest coordinate apart are one place: a seam
@@ -97,12 +102,15 @@ class MeshParts(NamedTuple):
     boundary : ndarray of bool, shape (n,) or None
         Where the faces make more than one part: the vertices on an edge of one face (copies at
         the same coordinates taken as one vertex). ``None`` on a mesh of one part.
+    boundary_edge : float
+        The median length of those boundary edges (0 where there is none, or one part).
     """
 
     labels: np.ndarray
     sizes: np.ndarray
     near: np.ndarray
     boundary: np.ndarray | None
+    boundary_edge: float = 0.0
 
 
 def mesh_parts(points: np.ndarray, triangles: np.ndarray) -> MeshParts:
@@ -133,16 +141,18 @@ def mesh_parts(points: np.ndarray, triangles: np.ndarray) -> MeshParts:
     if apart.any():
         labels = edge_components(n, labels[first[apart]], labels[second[apart]])[labels]
     welded = edge_components(n, first, second)  # each vertex as the first of its coordinates
-    ends = _boundary_vertices(welded[triangles], n)
+    low, high = _boundary_edges(welded[triangles], n)
+    ends = np.unique(np.concatenate([low, high]))
+    edge = float(np.median(np.linalg.norm(points[low] - points[high], axis=1))) if low.size else 0.0
     if (labels[triangles[:, 0]] != labels[triangles[0, 0]]).any():
-        first, second = _near_copies(points, ends)
+        first, second = _near_copies(points, ends, edge)
         apart = labels[first] != labels[second]
         if apart.any():
             labels = edge_components(n, labels[first[apart]], labels[second[apart]])[labels]
             near = np.stack([first[apart], second[apart]]).astype(np.int64)
     boundary = np.zeros(n, dtype=bool)
     boundary[ends] = True
-    return MeshParts(labels, np.bincount(labels, minlength=n), near, boundary[welded])
+    return MeshParts(labels, np.bincount(labels, minlength=n), near, boundary[welded], edge)
 
 
 def _same_coordinates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -157,8 +167,8 @@ def _same_coordinates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return order[:-1][same], order[1:][same]
 
 
-def _boundary_vertices(welded: np.ndarray, n: int) -> np.ndarray:
-    """The vertices (sorted) on an edge that one of the ``welded`` faces alone uses."""
+def _boundary_edges(welded: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The ends of the edges that one of the ``welded`` faces alone uses."""
     start, end = corner_ends(welded)
     keys = np.minimum(start, end) * np.int64(n) + np.maximum(start, end)
     keys = keys[start != end]
@@ -167,14 +177,15 @@ def _boundary_vertices(welded: np.ndarray, n: int) -> np.ndarray:
     same = keys[1:] == keys[:-1]
     once[1:] &= ~same
     once[:-1] &= ~same
-    return np.unique(np.concatenate([keys[once] // n, keys[once] % n]))
+    return keys[once] // n, keys[once] % n
 
 
-def _near_copies(points: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _near_copies(points: np.ndarray, ends: np.ndarray, edge: float) -> tuple[np.ndarray, ...]:
     """Pairs of the boundary vertices ``ends`` at most :data:`SEAM_ROUNDING` times the largest
-    coordinate apart. Only boundaries: a closed fragment touching another, or a sheet lying on
-    a face, is not a seam, in an indexed mesh or an STL's soup."""
-    gap = SEAM_ROUNDING * float(np.abs(points).max())
+    coordinate apart, and never more than :data:`SEAM_EDGES` times the median boundary
+    ``edge``. Only boundaries: a closed fragment touching another, or a sheet lying on a face,
+    is not a seam, in an indexed mesh or an STL's soup."""
+    gap = min(SEAM_ROUNDING * float(np.abs(points).max()), SEAM_EDGES * edge)
     if ends.size < 2 or not gap > 0:
         return ends[:0], ends[:0]
     return _pairs_within(points, ends, gap)

@@ -90,6 +90,12 @@ refused. Split along its crease with the seam's copies 1e-5 to 0.01 apart (beyon
 spacing 0.02), a marched 60° wedge read 175.36° under the oriented rule, on the face the centre
 was on."""
 
+TOUCHING_RADIUS = 0.5
+"""And at least this fraction of the radius: a crack along the crease as wide as 2.5 edges
+(0.05 at spacing 0.02, r 0.2) left one face and the triangles across the crease, which read a
+60° wedge as 149.03° and a 120° one as 179.27° (a review). A part left out for lying over the
+face measured (a fragment, debris) has its rim beyond the ball, or none in it."""
+
 SEAM_COPIES = 3
 """A geodesic patch is refused for a seam where at least this many of its vertices have copies
 it does not reach: a seam through a patch has many, two parts touching at a vertex or two (a
@@ -167,6 +173,7 @@ class Surface:
         self._part_sizes = None
         self._near_copies = None  # pairs of a seam's copies apart by rounding (see .parts)
         self._boundary = None  # on a mesh of several parts, its boundary vertices
+        self._boundary_edge = 0.0  # and the median length of the boundary's edges
         self._left_out = None  # (measurement, labels): see _left_out_parts
         self._corner_edges = None
         if self.triangles is not None and corner_edges is not None:
@@ -287,21 +294,30 @@ class Surface:
                 "vertices were not merged, merge them by distance (Mesh > Clean Up > Merge by "
                 "Distance)."
             )
-        if patch.size < ball.size:
-            left_out = np.setdiff1d(ball, patch)
-            gap = TOUCHING * mean_edge_length(radius, patch.size)
-            if count := touching(self.points, self._boundary, patch, left_out, gap):
-                raise GoniometerError(
-                    f"The radius reaches another part of the mesh, which no face joins to the "
-                    f"one measured but whose rim runs along its rim: {count} of its rim's "
-                    f"vertices lie within {gap:.3g} (two edges) of the measured part's. That "
-                    "is a seam whose vertices were not merged, or a crack, and leaving the part "
-                    "out would cut a face of the edge away. Where it is one surface, "
-                    "merge the vertices by distance (Blender: Mesh > Clean Up > Merge by "
-                    "Distance); where it is another fragment, separate the parts (Edit Mode > "
-                    "Mesh > Separate > By Loose Parts) and measure each alone."
-                )
+        self._check_rims(patch, np.setdiff1d(ball, patch), radius)
         return patch
+
+    def _check_rims(self, patch: np.ndarray, left_out: np.ndarray, radius: float) -> None:
+        """Refuse a patch that leaves out a large part whose rim runs along its own (see
+        :data:`TOUCHING`): a seam not merged, or a crack, where a face of the edge is cut away."""
+        if not left_out.size or self._boundary is None:
+            return
+        # The larger of two estimates of an edge: the patch's disk, which a marched mesh's
+        # diagonals make short, and the boundary's own edges.
+        edge = max(mean_edge_length(radius, patch.size), self._boundary_edge)
+        gap = max(TOUCHING * edge, TOUCHING_RADIUS * radius)
+        if count := touching(self.points, self._boundary, patch, left_out, gap):
+            raise GoniometerError(
+                f"The radius reaches another part of the mesh, which no face joins to the "
+                f"one measured but whose rim runs along its rim: {count} of its rim's "
+                f"vertices lie within {gap:.3g} of the measured part's. That "
+                "is a seam whose vertices were not merged, a crack, or another part lying "
+                "along its rim, and leaving it out could cut a face of the edge away. Where "
+                "it is one surface, "
+                "merge the vertices by distance (Blender: Mesh > Clean Up > Merge by "
+                "Distance); where it is another fragment, separate the parts (Edit Mode > "
+                "Mesh > Separate > By Loose Parts) and measure each alone."
+            )
 
     def _label_parts(self) -> None:
         """Label the mesh's parts (see :mod:`.parts`), once."""
@@ -309,7 +325,7 @@ class Surface:
             parts = mesh_parts(self.points, self.triangles)
             # The labels last: another thread takes them as the sign the rest is there.
             self._part_sizes, self._near_copies = parts.sizes, parts.near
-            self._boundary = parts.boundary
+            self._boundary, self._boundary_edge = parts.boundary, parts.boundary_edge
             self._parts = parts.labels
 
     def on_measured_parts(self, ids: np.ndarray, m) -> np.ndarray | None:
@@ -427,12 +443,13 @@ class Surface:
             indices = indices[distance <= radius]
         return indices
 
-    def _check_no_seam(self, ball: np.ndarray, patch: np.ndarray) -> None:
+    def _check_no_seam(self, ball: np.ndarray, patch: np.ndarray, radius: float) -> None:
         """Refuse a geodesic ``patch`` stopped by a seam: :data:`SEAM_COPIES` or more of its
         vertices have copies in the ``ball`` that it does not reach (the mesh not merged there):
-        at the same coordinates, or moved apart by rounding (see :data:`.parts.SEAM_ROUNDING`). Only
-        the measured patch is checked: the stability figure's moved patches stop at a seam as
-        before."""
+        at the same coordinates, or moved apart by rounding (see :data:`.parts.SEAM_ROUNDING`);
+        or the ball holds another part whose rim runs along the patch's (a crack; see
+        :meth:`_check_rims`). Only the measured patch is checked: the stability figure's moved
+        patches stop at a seam as before."""
         if ball.size == patch.size:
             return
         beyond = np.setdiff1d(ball, patch, assume_unique=True)
@@ -449,6 +466,9 @@ class Surface:
                 "by distance (Blender: Mesh > Clean Up > Merge by Distance), or use the "
                 "Euclidean patch."
             )
+        self._label_parts()
+        others = beyond[self._parts[beyond] != self._parts[patch[0]]]
+        self._check_rims(patch, others, radius)
 
     def measure(
         self,
@@ -520,7 +540,7 @@ class Surface:
             if step >= 0.1 * radius:
                 check_rounding(np.take(self.points, indices, axis=0), radius, self.precision)
             if mode == "geodesic":
-                self._check_no_seam(ball, indices)
+                self._check_no_seam(ball, indices, radius)
             if mode == "euclidean" and indices.size < ball.size:
                 raise GoniometerError(
                     f"The patch of radius {radius:g} holds only {indices.size} vertices; at "
@@ -544,7 +564,7 @@ class Surface:
         patch_points = np.take(self.points, indices, axis=0)
         check_rounding(patch_points, radius, self.precision)
         if mode == "geodesic":
-            self._check_no_seam(ball, indices)
+            self._check_no_seam(ball, indices, radius)
         elif rule == "paper":
             self._whole_ball(ball, indices)
         self._check_no_fin(indices)
