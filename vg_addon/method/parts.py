@@ -14,8 +14,8 @@ refused where the ball reaches a large part left out.
 
 A part is what faces join, with the vertices at the same coordinates taken as one
 (:func:`mesh_parts`): a seam whose vertices were not merged (a mesh split in two, an STL's
-loose triangles) is one surface, also where rounding moved its copies apart
-(:data:`SEAM_ROUNDING`).
+loose triangles) is one surface. Copies a little apart are not joined: a large part whose rim
+runs along the measured part's refuses the patch instead (:func:`touching`).
 """
 
 from __future__ import annotations
@@ -27,19 +27,6 @@ import numpy as np
 from .fins import corner_ends
 from .mesh_regions import edge_components, jump_to_roots
 from .spatial import GridIndex, neighbour_pairs
-
-SEAM_EDGES = 0.01
-"""However far from the origin, copies joined as a seam's lie at most this many median boundary
-edges apart: 1e-6 of the coordinates alone joined, 1e4 from the origin, a fragment's rim
-running 0.005 beside the scan's, and 120° read 30.00° (a review)."""
-
-SEAM_ROUNDING = 1e-6
-"""Boundary vertices of two parts (on an edge of one face, once copies at the same coordinates
-are one vertex) at most this times the mesh's largest coordinate apart are one place: a seam
-whose copies rounding moved apart (about eight float32 steps; the parts transformed or exported
-apart). Split along a scan's crease with copies 1e-9 apart, the faces were two parts, and a 90°
-edge read 175.92° on the one the centre was on. A tenth of an edge (the first version) joined a
-refitted fragment whose rim ran 0.002 beside the scan's (a review): 120° read 30.00° again."""
 
 
 def part_labels(n: int, triangles: np.ndarray) -> np.ndarray:
@@ -91,26 +78,14 @@ class MeshParts(NamedTuple):
     ----------
     labels : ndarray of int, shape (n,)
         The same number for the vertices of one part: what faces join, vertices at the same
-        coordinates (-0.0 as 0.0) joined too where the faces make more than one part, and seams'
-        copies that rounding moved apart (:data:`SEAM_ROUNDING`). A vertex on no face is a part
-        of its own, or of the vertices at its coordinates.
+        coordinates (-0.0 as 0.0) joined too where the faces make more than one part. A vertex
+        on no face is a part of its own, or of the vertices at its coordinates.
     sizes : ndarray of int64
         ``sizes[label]``: how many vertices have that label.
-    near : ndarray of int64, shape (2, k)
-        The pairs of copies that rounding moved apart which joined two parts; empty where none
-        did.
-    boundary : ndarray of bool, shape (n,) or None
-        Where the faces make more than one part: the vertices on an edge of one face (copies at
-        the same coordinates taken as one vertex). ``None`` on a mesh of one part.
-    boundary_edge : float
-        The median length of those boundary edges (0 where there is none, or one part).
     """
 
     labels: np.ndarray
     sizes: np.ndarray
-    near: np.ndarray
-    boundary: np.ndarray | None
-    boundary_edge: float = 0.0
 
 
 def mesh_parts(points: np.ndarray, triangles: np.ndarray) -> MeshParts:
@@ -128,31 +103,32 @@ def mesh_parts(points: np.ndarray, triangles: np.ndarray) -> MeshParts:
     Notes
     -----
     The faces are labelled first (:func:`part_labels`); only where they make more than one part
-    are the vertices sorted by their coordinates, and parts holding the same coordinates joined,
-    and the boundary vertices found and those of different parts near each other looked for.
+    are the vertices sorted by their coordinates, and parts holding the same coordinates joined.
     """
     n = points.shape[0]
     labels = part_labels(n, triangles)
-    near = np.empty((2, 0), dtype=np.int64)
-    if not triangles.shape[0] or (labels[triangles[:, 0]] == labels[triangles[0, 0]]).all():
-        return MeshParts(labels, np.bincount(labels, minlength=n), near, None)
-    first, second = _same_coordinates(points)
-    apart = labels[first] != labels[second]
-    if apart.any():
-        labels = edge_components(n, labels[first[apart]], labels[second[apart]])[labels]
-    welded = edge_components(n, first, second)  # each vertex as the first of its coordinates
-    low, high = _boundary_edges(welded[triangles], n)
-    ends = np.unique(np.concatenate([low, high]))
-    edge = float(np.median(np.linalg.norm(points[low] - points[high], axis=1))) if low.size else 0.0
-    if (labels[triangles[:, 0]] != labels[triangles[0, 0]]).any():
-        first, second = _near_copies(points, ends, edge)
+    if triangles.shape[0] and (labels[triangles[:, 0]] != labels[triangles[0, 0]]).any():
+        first, second = _same_coordinates(points)
         apart = labels[first] != labels[second]
         if apart.any():
             labels = edge_components(n, labels[first[apart]], labels[second[apart]])[labels]
-            near = np.stack([first[apart], second[apart]]).astype(np.int64)
-    boundary = np.zeros(n, dtype=bool)
-    boundary[ends] = True
-    return MeshParts(labels, np.bincount(labels, minlength=n), near, boundary[welded], edge)
+    return MeshParts(labels, np.bincount(labels, minlength=n))
+
+
+def mesh_rims(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, float]:
+    """The vertices on the mesh's rims, and the median length of the rims' edges.
+
+    A rim edge is used by one face alone, copies at the same coordinates taken as one vertex
+    (so an STL's soup has the rims of the merged mesh). Returns a mask of shape (n,) and the
+    median (0 where there is no rim); for :func:`touching`.
+    """
+    n = points.shape[0]
+    welded = edge_components(n, *_same_coordinates(points))  # each vertex as its first copy
+    low, high = _boundary_edges(welded[triangles], n)
+    edge = float(np.median(np.linalg.norm(points[low] - points[high], axis=1))) if low.size else 0.0
+    rim = np.zeros(n, dtype=bool)
+    rim[low], rim[high] = True, True
+    return rim[welded], edge
 
 
 def _same_coordinates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -178,17 +154,6 @@ def _boundary_edges(welded: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]
     once[1:] &= ~same
     once[:-1] &= ~same
     return keys[once] // n, keys[once] % n
-
-
-def _near_copies(points: np.ndarray, ends: np.ndarray, edge: float) -> tuple[np.ndarray, ...]:
-    """Pairs of the boundary vertices ``ends`` at most :data:`SEAM_ROUNDING` times the largest
-    coordinate apart, and never more than :data:`SEAM_EDGES` times the median boundary
-    ``edge``. Only boundaries: a closed fragment touching another, or a sheet lying on a face,
-    is not a seam, in an indexed mesh or an STL's soup."""
-    gap = min(SEAM_ROUNDING * float(np.abs(points).max()), SEAM_EDGES * edge)
-    if ends.size < 2 or not gap > 0:
-        return ends[:0], ends[:0]
-    return _pairs_within(points, ends, gap)
 
 
 def _pairs_within(points: np.ndarray, ids: np.ndarray, gap: float):
@@ -252,8 +217,8 @@ def touching(
 ) -> int:
     """How many of the boundary vertices ``left_out`` lie within ``gap`` of a boundary vertex of
     ``patch``: a large part left out whose rim runs along the measured part's (a seam whose
-    copies are farther apart than rounding), where leaving it out cuts a face of the edge away.
-    A fragment or a sheet of debris lying over a face has its rim elsewhere."""
+    copies were not merged, or a crack), where leaving it out cuts a face of the edge away. A
+    fragment or a sheet of debris lying over a face has its rim elsewhere."""
     patch, left_out = patch[boundary[patch]], left_out[boundary[left_out]]
     if not left_out.size or not patch.size or not gap > 0:
         return 0
