@@ -137,12 +137,15 @@ def test_flake_map_has_two_faces(vg, tmp_path):
     grid = np.stack(np.meshgrid(np.linspace(-1, 1, 20), np.linspace(-0.6, 0.6, 12)), -1)
     top = np.column_stack([grid.reshape(-1, 2), 0.05 + 0.01 * rng.random(240)])
     points = np.vstack([top, top * [1, 1, -1]])
-    quads = [(j * 20 + i, j * 20 + i + 1, (j + 1) * 20 + i) for j in range(11) for i in range(19)]
+    cells = [(j * 20 + i, j * 20 + i + 1, (j + 1) * 20 + i) for j in range(11) for i in range(19)]
+    quads = cells + [(b, c + 1, c) for a, b, c in cells]  # each cell's two triangles
     triangles = np.array(quads + [(a + 240, c + 240, b + 240) for a, b, c in quads])
     obj = mesh_object("Flake", points, triangles, rotation=(0.0, 0.5, 0.0))
     # Two near-parallel sheets hold no edge: the default rule refuses the patch (its planes meet
-    # far outside it), and the map needs only a measurement, which the oriented rule gives.
-    vg.bridge.measuring.measure_on_object(obj, points[30], 0.3, rule="oriented")
+    # far outside it), and the map needs only a measurement, which the oriented rule gives in
+    # the middle of a sheet (by the margin, where the two sheets' rims run side by side and are
+    # not joined, the patch is refused: the margin's edge would be cut away).
+    vg.bridge.measuring.measure_on_object(obj, points[130], 0.3, rule="oriented")
     views, sheet = vg.bridge.measurement_map.render_map(
         obj, tmp_path, views="FLAKE", size=SIZE, samples=1
     )
